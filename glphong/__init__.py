@@ -1,0 +1,30 @@
+"""glphong: the local-illumination lecture's shading equations in GLSL, rendered offscreen
+(EGL or OSMesa) and cross-checked pixel by pixel against a numpy float64 twin.
+
+Typical use::
+
+    import glphong, trimesh
+    scene = glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0)),
+                          lights=[glphong.PointLight((2, 2, 2), power=100.0)])
+    scene.add(trimesh.creation.icosphere(4), glphong.Phong(kd=0.2, ks=0.5, q=50))
+    with glphong.Renderer(256, 256) as r:
+        frame = r.render(scene)          # frame.radiance: (256, 256, 3) float32, W/(m^2 sr)
+        report = glphong.verify(scene, r)
+"""
+from . import radiometry, reference
+from .camera import PerspectiveCamera
+from .contexts import BackendUnavailableError, available_backends, create_context
+from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
+from .materials import BlinnPhong, Lambert, Material, Phong
+from .renderer import Frame, GBuffer, Renderer
+from .scene import Scene, SceneObject
+from .verify import VerifyReport, verify
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "PerspectiveCamera", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
+    "Material", "Lambert", "Phong", "BlinnPhong", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
+    "verify", "VerifyReport", "create_context", "available_backends", "BackendUnavailableError",
+    "radiometry", "reference",
+]

@@ -1,0 +1,356 @@
+"""Headless OpenGL contexts on Mesa's EGL or OSMesa drivers.
+
+`create_context` opens an offscreen OpenGL core-profile context through EGL
+(``moderngl``'s standalone EGL backend) or through OSMesa (``libOSMesa``
+loaded with :mod:`ctypes`) and wraps it in a `GLContext`.  Rendering goes
+into framebuffer objects created on ``GLContext.mgl``; neither backend has a
+usable default framebuffer.
+
+Several contexts, of either backend, may live in one process.  Make a context
+current with ``with ctx:`` before issuing GL calls on it; ``with`` blocks nest,
+and leaving an inner block makes the enclosing block's context current again.
+"""
+
+import ctypes
+import ctypes.util
+import functools
+import os
+import threading
+
+import moderngl
+
+__all__ = [
+    "BACKENDS",
+    "SYSTEM_PACKAGES",
+    "BackendUnavailableError",
+    "GLContext",
+    "available_backends",
+    "create_context",
+]
+
+BACKENDS = ("egl", "osmesa")
+"""Backends in the order ``backend="auto"`` tries them."""
+
+SYSTEM_PACKAGES = {
+    "egl": "libegl1 libegl-mesa0 libgl1-mesa-dri",
+    "osmesa": "libosmesa6",
+}
+"""Debian/Ubuntu packages providing each backend."""
+
+_ENV_BACKEND = "GLPHONG_BACKEND"
+
+# OSMesa constants, from GL/osmesa.h and GL/gl.h.
+_OSMESA_FORMAT = 0x22
+_OSMESA_RGBA = 0x1908
+_OSMESA_DEPTH_BITS = 0x30
+_OSMESA_PROFILE = 0x33
+_OSMESA_CORE_PROFILE = 0x34
+_OSMESA_CONTEXT_MAJOR_VERSION = 0x36
+_OSMESA_CONTEXT_MINOR_VERSION = 0x37
+_GL_UNSIGNED_BYTE = 0x1401
+_OSMESA_VERSIONS = ((4, 5), (3, 3))
+
+_entered = threading.local()
+
+
+class BackendUnavailableError(RuntimeError):
+    """No OpenGL context could be created on the requested backend(s)."""
+
+
+def _entered_stack():
+    """Return this thread's stack of entered `GLContext` objects."""
+    if not hasattr(_entered, "stack"):
+        _entered.stack = []
+    return _entered.stack
+
+
+class GLContext:
+    """An offscreen OpenGL context.
+
+    Normally obtained from `create_context`.
+
+    Parameters
+    ----------
+    backend : str
+        Name of the backend that created the context, one of `BACKENDS`.
+    mgl : moderngl.Context
+        The wrapped context.  It must be current when the `GLContext` is
+        constructed.
+    on_release : callable, optional
+        Called without arguments once, after ``mgl`` is released, to free
+        native resources that moderngl does not own.
+
+    Attributes
+    ----------
+    backend : str
+        Name of the backend that created the context.
+    mgl : moderngl.Context
+        The wrapped moderngl context; create GL objects on it.
+    renderer_name : str
+        The ``GL_RENDERER`` string, e.g. ``"llvmpipe (LLVM 15.0.6, 256 bits)"``.
+    version_code : int
+        OpenGL version as reported by moderngl, e.g. ``450`` for 4.5.
+    """
+
+    def __init__(self, backend, mgl, on_release=None):
+        self.backend = backend
+        self.mgl = mgl
+        self.renderer_name = mgl.info["GL_RENDERER"]
+        self.version_code = mgl.version_code
+        self._on_release = on_release
+        self._released = False
+
+    def __enter__(self):
+        """Make this context current on the calling thread."""
+        self._make_current()
+        _entered_stack().append(self)
+        return self
+
+    def __exit__(self, *exc_info):
+        """Leave the context, restoring the enclosing ``with`` block's one."""
+        stack = _entered_stack()
+        stack.pop()
+        self.mgl.__exit__(*exc_info)
+        if stack:
+            stack[-1]._make_current()
+
+    def _make_current(self):
+        # EGL skips eglMakeCurrent for a context it already considers current,
+        # although an OSMesa context may have taken over the GL dispatch that
+        # both drivers share through libglapi since; leaving first forces a
+        # real switch.  Leaving an OSMesa context does nothing.
+        self.mgl.__exit__(None, None, None)
+        self.mgl.__enter__()
+
+    def release(self):
+        """Destroy the context.  Calling it again does nothing."""
+        if self._released:
+            return
+        self._released = True
+        self.mgl.release()
+        if self._on_release is not None:
+            self._on_release()
+
+    def check_error(self, where):
+        """Raise if the GL error flag of the current context is set.
+
+        Parameters
+        ----------
+        where : str
+            Description of the preceding operation, used in the message.
+
+        Raises
+        ------
+        RuntimeError
+            If ``glGetError`` reports an error (which it also clears).
+        """
+        err = self.mgl.error
+        if err != "GL_NO_ERROR":
+            raise RuntimeError(f"GL error {err} after {where}")
+
+    def __repr__(self):
+        state = ", released" if self._released else ""
+        return (
+            f"GLContext(backend={self.backend!r}, renderer={self.renderer_name!r}, "
+            f"version_code={self.version_code}{state})"
+        )
+
+
+class _OSMesaLoader:
+    """moderngl loader and make-current hooks for one OSMesa context."""
+
+    def __init__(self, lib, handle):
+        self._lib = lib
+        self._handle = handle
+        # OSMesa needs a colour buffer to make a context current; all
+        # rendering goes to framebuffer objects, so one pixel suffices.
+        self._buffer = (ctypes.c_ubyte * 4)()
+
+    def make_current(self):
+        """Make the context current; return whether OSMesa accepted it."""
+        return bool(
+            self._lib.OSMesaMakeCurrent(self._handle, self._buffer, _GL_UNSIGNED_BYTE, 1, 1)
+        )
+
+    def load_opengl_function(self, name):
+        """Return the address of GL function ``name``, 0 if it is missing."""
+        return self._lib.OSMesaGetProcAddress(name.encode()) or 0
+
+    def destroy(self):
+        """Destroy the OSMesa context."""
+        self._lib.OSMesaDestroyContext(self._handle)
+
+    def __enter__(self):
+        self.make_current()
+
+    def __exit__(self, *exc_info):
+        pass
+
+    def release(self):
+        pass
+
+
+@functools.cache
+def _osmesa_library():
+    """Load libOSMesa and declare the signatures used here."""
+    errors = []
+    for name in (ctypes.util.find_library("OSMesa"), "libOSMesa.so.8", "libOSMesa.so"):
+        if name is None:
+            continue
+        try:
+            lib = ctypes.CDLL(name)
+            break
+        except OSError as exc:
+            errors.append(str(exc))
+    else:
+        raise OSError("libOSMesa not found: " + "; ".join(errors))
+    lib.OSMesaCreateContextAttribs.restype = ctypes.c_void_p
+    lib.OSMesaCreateContextAttribs.argtypes = [ctypes.POINTER(ctypes.c_int), ctypes.c_void_p]
+    lib.OSMesaMakeCurrent.restype = ctypes.c_ubyte
+    lib.OSMesaMakeCurrent.argtypes = [
+        ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint, ctypes.c_int, ctypes.c_int
+    ]
+    lib.OSMesaGetProcAddress.restype = ctypes.c_void_p
+    lib.OSMesaGetProcAddress.argtypes = [ctypes.c_char_p]
+    lib.OSMesaDestroyContext.restype = None
+    lib.OSMesaDestroyContext.argtypes = [ctypes.c_void_p]
+    return lib
+
+
+def _create_egl(require):
+    # moderngl itself rejects a context older than ``require``.
+    mgl = moderngl.create_context(standalone=True, backend="egl", require=require)
+    return GLContext("egl", mgl)
+
+
+def _create_osmesa(require):
+    lib = _osmesa_library()
+    for major, minor in _OSMESA_VERSIONS:
+        attribs = (ctypes.c_int * 11)(
+            _OSMESA_FORMAT, _OSMESA_RGBA,
+            _OSMESA_DEPTH_BITS, 24,
+            _OSMESA_PROFILE, _OSMESA_CORE_PROFILE,
+            _OSMESA_CONTEXT_MAJOR_VERSION, major,
+            _OSMESA_CONTEXT_MINOR_VERSION, minor,
+            0,
+        )
+        handle = lib.OSMesaCreateContextAttribs(attribs, None)
+        if handle:
+            break
+    else:
+        raise RuntimeError("OSMesaCreateContextAttribs failed for OpenGL 4.5 and 3.3 core")
+    loader = _OSMesaLoader(lib, handle)
+    try:
+        if not loader.make_current():
+            raise RuntimeError("OSMesaMakeCurrent failed")
+        moderngl.init_context(loader)
+        mgl = moderngl.get_context()
+    except BaseException:
+        loader.destroy()
+        raise
+    ctx = GLContext("osmesa", mgl, on_release=loader.destroy)
+    if ctx.version_code < require:
+        ctx.release()
+        raise RuntimeError(f"got OpenGL {ctx.version_code}, need {require}")
+    return ctx
+
+
+_CREATORS = {"egl": _create_egl, "osmesa": _create_osmesa}
+
+
+def _try_create(backend, require):
+    """Return ``(context, None)``, or ``(None, reason)`` if creation failed.
+
+    The context current before the call stays current if it was entered.
+    """
+    try:
+        return _CREATORS[backend](require), None
+    except Exception as exc:
+        return None, str(exc) or type(exc).__name__
+    finally:
+        stack = _entered_stack()
+        if stack:
+            stack[-1]._make_current()
+
+
+def _install_hint(backend):
+    return f"Debian/Ubuntu: apt-get install {SYSTEM_PACKAGES[backend]}"
+
+
+def create_context(backend="auto", require=330):
+    """Create an offscreen OpenGL core-profile context.
+
+    The new context is current unless called inside another context's
+    ``with`` block, which then stays current.
+
+    Parameters
+    ----------
+    backend : {"auto", "egl", "osmesa"}, optional
+        Driver interface to use.  ``"auto"`` uses the backend named by the
+        ``GLPHONG_BACKEND`` environment variable if that is set and not
+        empty, otherwise the first of `BACKENDS` that works.
+    require : int, optional
+        Minimum OpenGL version, as ``major * 100 + minor * 10``.
+
+    Returns
+    -------
+    GLContext
+        The new context.  Call its `GLContext.release` when done.
+
+    Raises
+    ------
+    ValueError
+        If ``backend`` or ``GLPHONG_BACKEND`` names no known backend.
+    BackendUnavailableError
+        If no context could be created; the message gives the reason for
+        each backend tried and the system packages that provide it.
+    """
+    if backend not in ("auto", *BACKENDS):
+        raise ValueError(
+            f"backend must be one of 'auto', {', '.join(map(repr, BACKENDS))}; got {backend!r}"
+        )
+    origin = ""
+    if backend == "auto" and os.environ.get(_ENV_BACKEND):
+        backend = os.environ[_ENV_BACKEND].strip().lower()
+        if backend not in BACKENDS:
+            raise ValueError(
+                f"environment variable {_ENV_BACKEND} must be one of "
+                f"{', '.join(map(repr, BACKENDS))}; got {os.environ[_ENV_BACKEND]!r}"
+            )
+        origin = f" (chosen by {_ENV_BACKEND})"
+    if backend != "auto":
+        ctx, reason = _try_create(backend, require)
+        if ctx is None:
+            raise BackendUnavailableError(
+                f"OpenGL backend {backend!r}{origin} is unavailable: {reason}. "
+                f"{_install_hint(backend)}"
+            )
+        return ctx
+    failures = []
+    for name in BACKENDS:
+        ctx, reason = _try_create(name, require)
+        if ctx is not None:
+            return ctx
+        failures.append(f"  {name}: {reason} ({_install_hint(name)})")
+    raise BackendUnavailableError(
+        f"no OpenGL {require} backend is available; tried:\n" + "\n".join(failures)
+    )
+
+
+def available_backends():
+    """Report which backends can create an OpenGL 3.3 context.
+
+    Each backend is probed by creating and releasing a context.
+
+    Returns
+    -------
+    dict of str to str or None
+        For each name in `BACKENDS`, None if it works, else the reason it
+        does not.
+    """
+    report = {}
+    for name in BACKENDS:
+        ctx, report[name] = _try_create(name, 330)
+        if ctx is not None:
+            ctx.release()
+    return report

@@ -1,0 +1,153 @@
+"""Program keys: the one source of truth for what a GLSL program contains (DESIGN section 5).
+
+A `ProgramKey` is frozen and hashable.  It is the program-cache key, and it alone
+generates the ``#define`` lines and the list of chunks a program is assembled from:
+terms a material does not have, light kinds a scene lacks and vertex attributes
+nobody reads are left out of the source.  The numpy twin reads the same key.
+"""
+from dataclasses import dataclass, fields
+
+__all__ = ["ProgramKey", "program_key", "gbuffer_key"]
+
+OUTPUTS = ("radiance", "gbuffer")
+LOBES = (None, "phong", "blinn")
+
+
+@dataclass(frozen=True)
+class ProgramKey:
+    """What one program contains.
+
+    Attributes
+    ----------
+    output : {'radiance', 'gbuffer'}
+        Shaded radiance, or the G-buffer of shading inputs.
+    lobe : {None, 'phong', 'blinn'}
+        Specular lobe, None when the program has no specular term.
+    has_ka, has_kd_la, has_diffuse : bool
+        Presence of the terms k_a, k_d L_a and k_d (n.l) E of DESIGN E6.
+    num_point_lights, num_unattenuated_lights, num_directional_lights : int
+        Compile-time light counts per kind.
+    has_normal : bool
+        Whether the program reads the normal attribute (not needed without lights).
+    two_sided : bool
+        Flip the normal on back faces.
+    """
+
+    output: str = "radiance"
+    lobe: str = None
+    has_ka: bool = False
+    has_kd_la: bool = False
+    has_diffuse: bool = False
+    num_point_lights: int = 0
+    num_unattenuated_lights: int = 0
+    num_directional_lights: int = 0
+    has_normal: bool = True
+    two_sided: bool = True
+
+    def __post_init__(self):
+        if self.output not in OUTPUTS or self.lobe not in LOBES:
+            raise ValueError(f"invalid ProgramKey {self}")
+
+    @property
+    def has_specular(self):
+        """True when the program evaluates a specular lobe."""
+        return self.lobe is not None
+
+    @property
+    def num_lights(self):
+        """Total number of lights the program loops over."""
+        return self.num_point_lights + self.num_unattenuated_lights + self.num_directional_lights
+
+    def attributes(self):
+        """Vertex attributes the program reads, in binding order."""
+        return ("in_position", "in_normal") if self.has_normal else ("in_position",)
+
+    def defines(self):
+        """The generated ``#define`` lines as (name, value) pairs."""
+        b = lambda flag: "1" if flag else "0"  # noqa: E731
+        out = [
+            ("OUTPUT_GBUFFER", b(self.output == "gbuffer")),
+            ("HAS_NORMAL", b(self.has_normal)),
+            ("TWO_SIDED", b(self.two_sided)),
+        ]
+        if self.output == "radiance":
+            out += [
+                ("HAS_KA", b(self.has_ka)),
+                ("HAS_KD_LA", b(self.has_kd_la)),
+                ("HAS_DIFFUSE", b(self.has_diffuse)),
+                ("HAS_SPECULAR", b(self.has_specular)),
+                ("NUM_POINT_LIGHTS", str(self.num_point_lights)),
+                ("NUM_UNATTENUATED_LIGHTS", str(self.num_unattenuated_lights)),
+                ("NUM_DIRECTIONAL_LIGHTS", str(self.num_directional_lights)),
+            ]
+            if self.has_specular:
+                out.append(("SPECULAR_LOBE", f"{self.lobe}_lobe"))
+        return out
+
+    def vertex_chunks(self):
+        """Chunk files of the vertex stage, in order."""
+        return ("mesh_vertex",)
+
+    def fragment_chunks(self):
+        """Chunk files of the fragment stage, in order: only those the key needs."""
+        chunks = ["common"]
+        if self.output == "radiance":
+            if self.num_point_lights:
+                chunks.append("lights")
+            if self.has_diffuse:
+                chunks.append("lambert")
+            if self.has_specular:
+                chunks += ["lobe", self.lobe]
+            chunks.append("shade")
+        chunks.append("mesh_fragment")
+        return tuple(chunks)
+
+    def describe(self):
+        """One line naming every field that is set, e.g. ``radiance phong diffuse 2 point``."""
+        parts = [self.output]
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name != "output" and v not in (False, 0, None):
+                parts.append(f.name if v is True else f"{f.name}={v}")
+        return " ".join(parts)
+
+
+def program_key(material, light_counts, ambient_radiance, output="radiance"):
+    """The radiance-program key of one material in a scene.
+
+    Parameters
+    ----------
+    material : glphong.materials.Material
+    light_counts : dict of str to int
+        Number of lights per kind ('point', 'unattenuated', 'directional').
+    ambient_radiance : tuple of 3 float or None
+        The scene's ``L_a``.
+    output : {'radiance', 'gbuffer'}
+
+    Returns
+    -------
+    ProgramKey
+    """
+    if output == "gbuffer":
+        return gbuffer_key(material)
+    has_kd = any(c > 0.0 for c in material.kd)
+    # lights matter only to a material that reflects them
+    lit = sum(light_counts.values()) > 0 and (has_kd or material.has_specular)
+    count = lambda kind: light_counts.get(kind, 0) if lit else 0  # noqa: E731
+    return ProgramKey(
+        output="radiance",
+        lobe=material.family if (lit and material.has_specular) else None,
+        has_ka=any(c > 0.0 for c in material.ka),
+        has_kd_la=has_kd and ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance),
+        has_diffuse=lit and has_kd,
+        num_point_lights=count("point"),
+        num_unattenuated_lights=count("unattenuated"),
+        num_directional_lights=count("directional"),
+        has_normal=lit,
+        two_sided=material.two_sided and lit,
+    )
+
+
+def gbuffer_key(material):
+    """The G-buffer-program key of one material (only the two-sided flag matters)."""
+    return ProgramKey(output="gbuffer", has_normal=True, two_sided=material.two_sided)

@@ -1,0 +1,177 @@
+"""GLSL program assembly, compilation, strict uniform binding and caching.
+
+A program's source is generated from its `ProgramKey` alone: a ``#version`` line,
+the key's ``#define`` lines, then the key's chunk files, each preceded by a
+``#line 1 N`` marker so that a compile error names the chunk file and line.
+"""
+import functools
+import importlib.resources
+import re
+import time
+from pathlib import Path
+
+import moderngl
+import numpy as np
+
+__all__ = ["ProgramCache", "Program", "ShaderCompileError", "UniformError", "assemble", "chunk_source"]
+
+GLSL_VERSION = "#version 330 core"
+
+
+class ShaderCompileError(RuntimeError):
+    """A generated program failed to compile or link; the message names chunk files and lines."""
+
+
+class UniformError(ValueError):
+    """Uniform values do not match what a program declares (missing, unknown or wrong size)."""
+
+
+def _glsl_root():
+    try:
+        return importlib.resources.files("glphong.glsl")
+    except ModuleNotFoundError:  # running from a source checkout: glsl/ beside the package
+        return Path(__file__).resolve().parent.parent / "glsl"
+
+
+@functools.lru_cache(maxsize=None)
+def chunk_source(name):
+    """Text of the chunk file ``glsl/<name>.glsl``."""
+    return (_glsl_root() / f"{name}.glsl").read_text(encoding="utf-8")
+
+
+def assemble(chunks, defines):
+    """Assemble one stage's source.
+
+    Parameters
+    ----------
+    chunks : sequence of str
+        Chunk names, in order.
+    defines : sequence of (str, str)
+        ``#define`` name and value pairs.
+
+    Returns
+    -------
+    str
+        The source; source-string number ``i + 1`` is chunk ``chunks[i]``.
+    """
+    lines = [GLSL_VERSION]
+    lines += [f"#define {name} {value}" for name, value in defines]
+    for number, name in enumerate(chunks, start=1):
+        lines.append(f"#line 1 {number}")
+        lines.append(chunk_source(name).rstrip("\n"))
+    return "\n".join(lines) + "\n"
+
+
+_LOCATION = re.compile(r"\b(\d+)([:(])(\d+)")
+
+
+def _name_chunks(log, chunks):
+    """Rewrite ``N:L`` / ``N(L)`` source locations in a compiler log as ``chunk.glsl:L``."""
+    def repl(m):
+        n = int(m.group(1))
+        if 1 <= n <= len(chunks):
+            return f"{chunks[n - 1]}.glsl:{m.group(3)}"
+        return f"<generated header>:{m.group(3)}" if n == 0 else m.group(0)
+    return _LOCATION.sub(repl, log)
+
+
+_UNIFORM_DECL = re.compile(r"^\s*uniform\s+\w+\s+(\w+)", re.MULTILINE)
+
+
+class Program:
+    """One compiled program and its strict uniform binding.
+
+    Parameters
+    ----------
+    mgl : moderngl.Context
+    key : glphong.key.ProgramKey
+    """
+
+    def __init__(self, mgl, key):
+        self.key = key
+        defines = key.defines()
+        self.vertex_source = assemble(key.vertex_chunks(), defines)
+        self.fragment_source = assemble(key.fragment_chunks(), defines)
+        try:
+            self.gl_program = mgl.program(vertex_shader=self.vertex_source, fragment_shader=self.fragment_source)
+        except moderngl.Error as exc:
+            log = _name_chunks(str(exc), key.fragment_chunks() if "fragment" in str(exc).lower() else key.vertex_chunks())
+            raise ShaderCompileError(f"program {key.describe()!r} failed to build:\n{log}") from None
+        self.declared = frozenset(_UNIFORM_DECL.findall(self.vertex_source + self.fragment_source))
+        self.active = {name: self.gl_program[name] for name in self.gl_program if isinstance(self.gl_program[name], moderngl.Uniform)}
+
+    def bind(self, values):
+        """Set every active uniform from ``values``; anything else is an error.
+
+        Parameters
+        ----------
+        values : dict of str to array_like
+            float32 data per uniform name: shape ``()``, ``(k,)``, ``(k, k)`` (row-major
+            matrices, transposed here to GL's column-major) or ``(N, 3)`` for arrays.
+
+        Raises
+        ------
+        UniformError
+            A declared-and-active uniform is missing, a name is not declared by the program,
+            or the data size does not match.  Uniforms the compiler removed are skipped.
+        """
+        missing = sorted(set(self.active) - set(values))
+        unknown = sorted(set(values) - self.declared)
+        if missing or unknown:
+            raise UniformError(f"program {self.key.describe()!r}: missing uniforms {missing}, unknown uniforms {unknown}")
+        for name, uniform in self.active.items():
+            data = np.asarray(values[name], dtype=np.float32)
+            if data.ndim == 2 and data.shape[0] == data.shape[1] and uniform.dimension == data.size:
+                data = data.T
+            expected = uniform.array_length * uniform.dimension
+            if data.size != expected:
+                raise UniformError(f"uniform {name} of program {self.key.describe()!r} takes {expected} floats (got shape {data.shape})")
+            uniform.write(np.ascontiguousarray(data).tobytes())
+
+    def release(self):
+        """Release the GL program."""
+        self.gl_program.release()
+
+
+class ProgramCache:
+    """Programs of one GL context, compiled once per `ProgramKey`.
+
+    Attributes
+    ----------
+    hits, misses : int
+        Cache statistics since creation.
+    compile_seconds : float
+        Total wall time spent compiling and linking.
+    """
+
+    def __init__(self, mgl):
+        self._mgl = mgl
+        self._programs = {}
+        self.hits = 0
+        self.misses = 0
+        self.compile_seconds = 0.0
+
+    def get(self, key):
+        """The program for ``key``, compiled on first use."""
+        program = self._programs.get(key)
+        if program is not None:
+            self.hits += 1
+            return program
+        self.misses += 1
+        start = time.perf_counter()
+        program = self._programs[key] = Program(self._mgl, key)
+        self.compile_seconds += time.perf_counter() - start
+        return program
+
+    def keys(self):
+        """Keys of the compiled programs."""
+        return tuple(self._programs)
+
+    def __len__(self):
+        return len(self._programs)
+
+    def release(self):
+        """Release every program."""
+        for program in self._programs.values():
+            program.release()
+        self._programs.clear()

@@ -1,0 +1,171 @@
+"""Scenes: a camera, lights, and meshes with materials.
+
+A scene knows the program key of each of its objects and packs its lights into
+the float32 uniform arrays that both the GPU and the numpy twin read.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _validate
+from .camera import PerspectiveCamera
+from .geometry import MeshData
+from .key import program_key
+from .lights import LIGHT_KINDS, AmbientLight
+from .materials import Material
+
+__all__ = ["Scene", "SceneObject"]
+
+
+@dataclass(frozen=True, eq=False)
+class SceneObject:
+    """One mesh drawn with one material.
+
+    Attributes
+    ----------
+    mesh : MeshData
+    material : glphong.materials.Material
+    pose : (4, 4) ndarray
+        Object-to-world affine transform, float64.
+    name : str
+    """
+
+    mesh: MeshData
+    material: Material
+    pose: np.ndarray
+    name: str
+
+    @property
+    def normal_matrix(self):
+        """Inverse-transpose of the pose's 3x3 block, (3, 3) float64."""
+        return np.linalg.inv(self.pose[:3, :3]).T
+
+
+class Scene:
+    """A camera, any number of lights, and objects.
+
+    Parameters
+    ----------
+    camera : PerspectiveCamera
+    lights : sequence of PointLight, UnattenuatedPointLight or DirectionalLight
+    ambient : AmbientLight, optional
+        The ambient ``L_a`` of the term ``k_d L_a``.
+    """
+
+    def __init__(self, camera, lights=(), ambient=None):
+        if not isinstance(camera, PerspectiveCamera):
+            raise TypeError(f"camera must be a glphong.PerspectiveCamera (got {type(camera).__name__})")
+        if ambient is not None and not isinstance(ambient, AmbientLight):
+            raise TypeError(f"ambient must be a glphong.AmbientLight or None (got {type(ambient).__name__})")
+        self.camera = camera
+        self.ambient = ambient
+        self._lights = []
+        self._objects = []
+        for light in lights:
+            self.add_light(light)
+
+    @property
+    def lights(self):
+        """The lights, in the order they were added (tuple)."""
+        return tuple(self._lights)
+
+    @property
+    def objects(self):
+        """The objects, in the order they were added (tuple of SceneObject)."""
+        return tuple(self._objects)
+
+    def add_light(self, light):
+        """Add a `PointLight`, `UnattenuatedPointLight` or `DirectionalLight`."""
+        if getattr(light, "kind", None) not in LIGHT_KINDS:
+            raise TypeError(f"light must be a PointLight, UnattenuatedPointLight or DirectionalLight (got {type(light).__name__})")
+        self._lights.append(light)
+        return light
+
+    def add(self, mesh, material, pose=None, smooth=True, name=None):
+        """Add a mesh drawn with a material.
+
+        Parameters
+        ----------
+        mesh : trimesh.Trimesh or MeshData
+        material : glphong.materials.Material
+        pose : (4, 4) array_like, optional
+            Object-to-world affine transform (default identity).
+        smooth : bool
+            Interpolated vertex normals (default) or flat face normals; ignored for MeshData.
+        name : str, optional
+
+        Returns
+        -------
+        SceneObject
+        """
+        if not isinstance(material, Material):
+            raise TypeError(f"material must be a glphong material such as Lambert or Phong (got {type(material).__name__})")
+        data = mesh if isinstance(mesh, MeshData) else MeshData.from_trimesh(mesh, smooth=smooth)
+        pose = _validate.affine_transform("pose", np.eye(4) if pose is None else pose)
+        obj = SceneObject(data, material, pose, name or f"object{len(self._objects)}")
+        self._objects.append(obj)
+        return obj
+
+    def light_counts(self):
+        """Number of lights per kind, dict of str to int."""
+        return {kind: sum(1 for light in self._lights if light.kind == kind) for kind in LIGHT_KINDS}
+
+    @property
+    def ambient_radiance(self):
+        """``L_a`` as a tuple of 3 float, or None."""
+        return None if self.ambient is None else self.ambient.radiance
+
+    def program_key(self, obj, output="radiance"):
+        """The `ProgramKey` of one of this scene's objects."""
+        return program_key(obj.material, self.light_counts(), self.ambient_radiance, output)
+
+    def light_uniform_values(self, key):
+        """The light and ambient uniforms a radiance program with ``key`` declares.
+
+        Returns
+        -------
+        dict of str to ndarray
+            float32 ``(N, 3)`` arrays per present light kind and ``u_ambient`` ``(3,)``.
+        """
+        counts = {"point": key.num_point_lights, "unattenuated": key.num_unattenuated_lights,
+                  "directional": key.num_directional_lights}
+        values = {}
+        for kind, (_, where_name, value_name) in LIGHT_KINDS.items():
+            if counts[kind]:
+                rows = [light.uniform_row() for light in self._lights if light.kind == kind]
+                values[where_name] = np.array([r[0] for r in rows], dtype=np.float32)
+                values[value_name] = np.array([r[1] for r in rows], dtype=np.float32)
+        if key.has_kd_la:
+            values["u_ambient"] = np.asarray(self.ambient_radiance, dtype=np.float32)
+        return values
+
+    def uniform_values(self, index, key, aspect):
+        """Every uniform the program ``key`` declares for object ``index``, as float32.
+
+        This is the single place where scene values become shader inputs; the numpy
+        twin reads the same dictionary, so both shade identical float32 inputs.
+
+        Parameters
+        ----------
+        index : int
+            Object index in `objects`.
+        key : glphong.key.ProgramKey
+        aspect : float
+            Image width / height.
+
+        Returns
+        -------
+        dict of str to ndarray
+        """
+        obj = self._objects[index]
+        view_projection = self.camera.projection_matrix(aspect) @ self.camera.view_matrix()
+        values = {"u_model": obj.pose, "u_view_projection": view_projection}
+        if key.has_normal:
+            values["u_normal_matrix"] = obj.normal_matrix
+        if key.output == "gbuffer":
+            values["u_object_id"] = float(index)
+        else:
+            values["u_eye"] = self.camera.position
+            values.update(obj.material.uniform_values(key))
+            values.update(self.light_uniform_values(key))
+        return {name: np.asarray(v, dtype=np.float32) for name, v in values.items()}

@@ -1,0 +1,154 @@
+"""The tolerance band GPU float32 results are held to against the float64 twin (DESIGN section 4).
+
+With ``eps = 2^-24`` (float32 unit roundoff) and the constants below, the band
+around the twin's value of each term is:
+
+- Lambert: ``k_d E [max(n.l - D eps, 0), n.l + D eps] (1 +- A eps)``.
+- Lobe: the chord ``c = sqrt(2 delta)`` widened by ``+-C eps`` (for Blinn scaled by
+  ``max(1, 2/|l + v|)``, the conditioning of the half vector), mapped through
+  ``(1 - c^2/2)^q``, then widened by ``(1 +- eps (A + B lambda))``, ``lambda = -ln(lobe)``.
+- Gates: where ``|n.l| <= D eps`` (Blinn: also ``|n.v| <= D eps``, or ``|l + v|`` within
+  a factor 4 of its floor) either outcome of the gate is accepted.
+- Ambient terms: ``(1 +- A eps)``.  The sum over terms widens by ``(1 +- m eps)`` for m terms.
+- Results below FLT_MIN may be flushed: the lower bound is 0 there; above FLT_MAX the
+  upper bound is +inf.
+
+The constants held with zero failures on a 101k-pixel stress set (q up to 1e7,
+grazing lights, d in [1e-3, 1e3]) on llvmpipe.  They live here and nowhere else.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import reference as ref
+
+__all__ = ["EPS", "FLT_MIN", "FLT_MAX", "BandConstants", "BAND", "lobe_band", "radiance_band"]
+
+EPS = 2.0 ** -24
+FLT_MIN = float(np.finfo(np.float32).tiny)
+FLT_MAX = float(np.finfo(np.float32).max)
+
+
+@dataclass(frozen=True)
+class BandConstants:
+    """Multipliers of eps in the band (DESIGN section 4).
+
+    Attributes
+    ----------
+    A : float
+        Relative error of products, quotients and sums of a term.
+    B : float
+        Relative error of the lobe per unit of ``lambda = -ln(lobe)`` (exp's ``2|x|`` ulp).
+    C : float
+        Absolute error of the unit vectors' chord ``|r - v|`` (or ``|h - n|``).
+    D : float
+        Absolute error of ``n.l`` and ``n.v``.
+    """
+
+    A: float = 16.0
+    B: float = 4.0
+    C: float = 6.0
+    D: float = 8.0
+
+
+BAND = BandConstants()
+
+
+def lobe_band(delta, q, chord_scale=1.0, band=BAND):
+    """Interval of float32 lobe values consistent with a float64 ``delta``.
+
+    Parameters
+    ----------
+    delta : (...) float64 ndarray
+        Distance from the lobe peak, ``1 - cos``.
+    q : float
+        Exponent.
+    chord_scale : float or (...) ndarray
+        Factor on the chord widening ``C eps`` (the Blinn half-vector conditioning).
+    band : BandConstants
+
+    Returns
+    -------
+    low, high : (...) float64 ndarray
+    """
+    delta = np.asarray(delta, dtype=np.float64)
+    chord = np.sqrt(2.0 * np.maximum(delta, 0.0))
+    width = band.C * EPS * chord_scale
+    high = ref.lobe_from_delta(0.5 * np.maximum(chord - width, 0.0) ** 2, q)
+    low = ref.lobe_from_delta(0.5 * (chord + width) ** 2, q)
+
+    def widen(value, sign):
+        with np.errstate(divide="ignore"):
+            lam = -np.log(np.maximum(value, np.finfo(np.float64).tiny))
+        return value * (1.0 + sign * EPS * (band.A + band.B * lam))
+
+    return np.maximum(widen(low, -1.0), 0.0), widen(high, +1.0)
+
+
+def _scaled(value, factor):
+    return value * factor
+
+
+def radiance_band(scene, gbuffer, band=BAND):
+    """Per-pixel interval the GPU's radiance must lie in.
+
+    Parameters
+    ----------
+    scene : glphong.Scene
+    gbuffer : glphong.GBuffer
+    band : BandConstants
+
+    Returns
+    -------
+    low, high : (H, W, 3) float64 ndarray
+        0 where not covered.
+    """
+    low = np.zeros(gbuffer.position.shape)
+    high = np.zeros(gbuffer.position.shape)
+    for selection, key, u, position, n, n_valid in ref.shade_inputs(scene, gbuffer):
+        ambient = ref.ambient_terms(key, u, position.shape, np.float64)
+        lo, hi = ambient * (1 - band.A * EPS), ambient * (1 + band.A * EPS)
+        terms = int(key.has_ka) + int(key.has_kd_la)
+        if key.num_lights:
+            ok_v, wo, _ = ref.safe_normalize(u["u_eye"] - position)
+            lit = (n_valid & ok_v)[..., None]
+            tol = band.D * EPS
+            for valid, wi, irradiance in ref.incident_light(position, key, u):
+                terms += 1
+                n_dot_l = ref._dot(n, wi)
+                f_lo = np.zeros_like(position)
+                f_hi = np.zeros_like(position)
+                if key.has_diffuse:
+                    f_lo = f_lo + ref.lambert(u["u_kd"], np.maximum(n_dot_l - tol, 0.0))
+                    f_hi = f_hi + ref.lambert(u["u_kd"], np.maximum(n_dot_l + tol, 0.0))
+                if key.has_specular:
+                    l_lo, l_hi = _specular_band(key.lobe, n, wi, wo, u["u_q"], tol, band)
+                    f_lo = f_lo + u["u_ks"] * l_lo[..., None]
+                    f_hi = f_hi + u["u_ks"] * l_hi[..., None]
+                with np.errstate(over="ignore", invalid="ignore"):
+                    t_lo = np.nan_to_num(f_lo * irradiance * (1 - band.A * EPS), nan=0.0)
+                    t_hi = np.nan_to_num(f_hi * irradiance * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
+                certain = (lit & valid[..., None] & (n_dot_l > tol)[..., None])
+                possible = (lit & valid[..., None] & (n_dot_l > -tol)[..., None])
+                lo = lo + np.where(certain, t_lo, 0.0)
+                hi = hi + np.where(possible, t_hi, 0.0)
+        low[selection] = lo * (1 - terms * EPS)
+        high[selection] = hi * (1 + terms * EPS)
+    low = np.where(low < FLT_MIN, 0.0, low)
+    high = np.where(high > FLT_MAX, np.inf, high)
+    return low, high
+
+
+def _specular_band(lobe, n, wi, wo, q, tol, band):
+    """Interval of the lobe of one light, gates included (see the module docstring)."""
+    if lobe == "phong":
+        return lobe_band(ref.phong_delta(n, wi, wo), q, 1.0, band)
+    ok_h, _, h_len = ref.safe_normalize(wi + wo)
+    _, h_dir, _ = ref.safe_normalize(wi + wo)
+    delta = 0.5 * ref._dot(h_dir - n, h_dir - n)
+    scale = np.maximum(1.0, 2.0 / np.maximum(h_len, ref.BLINN_HALF_FLOOR))
+    low, high = lobe_band(delta, q, scale, band)
+    n_dot_v = ref._dot(n, wo)
+    certain = ok_h & (n_dot_v > tol) & (h_len > 4 * ref.BLINN_HALF_FLOOR)
+    possible = ok_h & (n_dot_v > -tol) & (h_len > ref.BLINN_HALF_FLOOR / 4)
+    return np.where(certain, low, 0.0), np.where(possible, np.where(certain, high, 1.0), 0.0)

@@ -1,0 +1,1 @@
+"""GLSL sources of glphong, shipped inside the wheel as ``glphong.glsl``."""

@@ -1,0 +1,25 @@
+// common.glsl -- numeric helpers shared by every chunk (DESIGN section 3).
+//
+// safe_normalize(x, out x_hat, out len) -> valid
+//   s = max_i |x_i|;  valid  <=>  0 < s <= FLT_MAX   (false for a zero, NaN or Inf vector)
+//   y = x / s;  len = s * sqrt(y.y);  x_hat = y * inversesqrt(y.y)
+//   |x|^2 is never formed from raw coordinates, so lengths from FLT_MIN to FLT_MAX
+//   neither underflow nor overflow.  On failure x_hat = 0 and len = 0.
+//   Units: len has the units of x; x_hat is dimensionless.
+
+const float FLT_MAX = 3.402823466e38;
+
+bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
+{
+    float s = max(max(abs(x.x), abs(x.y)), abs(x.z));
+    if (!(s > 0.0 && s <= FLT_MAX)) {
+        x_hat = vec3(0.0);
+        len = 0.0;
+        return false;
+    }
+    vec3 y = x / s;
+    float yy = dot(y, y);
+    len = s * sqrt(yy);
+    x_hat = y * inversesqrt(yy);
+    return true;
+}

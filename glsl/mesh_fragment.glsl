@@ -1,0 +1,42 @@
+// mesh_fragment.glsl -- fragment stage: per-pixel shading, or the G-buffer of its inputs.
+//
+//   n = safe_normalize(+-v_normal)  (flipped on back faces when TWO_SIDED: two-sided shading);
+//   radiance output: vec4(shade(v_position, n, n_valid, u_eye), 1)  [W/(m^2 sr)], linear float;
+//   G-buffer outputs (OUTPUT_GBUFFER): position (world, [m]) with w = object id + 1, and the
+//   normal exactly as shade() would use it (0 where it is invalid), w = 1.
+// Key defines read here: HAS_NORMAL, TWO_SIDED, OUTPUT_GBUFFER.
+
+invariant in vec3 v_position;
+#if HAS_NORMAL
+invariant in vec3 v_normal;
+#endif
+#if OUTPUT_GBUFFER
+uniform float u_object_id;
+layout(location = 0) out vec4 out_position;
+layout(location = 1) out vec4 out_normal;
+#else
+uniform vec3 u_eye;
+layout(location = 0) out vec4 out_radiance;
+#endif
+
+void main()
+{
+    vec3 n = vec3(0.0);
+    bool n_valid = false;
+#if HAS_NORMAL
+    vec3 n_raw = v_normal;
+#if TWO_SIDED
+    if (!gl_FrontFacing) {
+        n_raw = -n_raw;
+    }
+#endif
+    float n_len;
+    n_valid = safe_normalize(n_raw, n, n_len);
+#endif
+#if OUTPUT_GBUFFER
+    out_position = vec4(v_position, u_object_id + 1.0);
+    out_normal = vec4(n, 1.0);
+#else
+    out_radiance = vec4(shade(v_position, n, n_valid, u_eye), 1.0);
+#endif
+}
