@@ -99,6 +99,7 @@ class GLContext:
         self.version_code = mgl.version_code
         self._on_release = on_release
         self._released = False
+        self._idle_framebuffer = None
 
     def __enter__(self):
         """Make this context current on the calling thread."""
@@ -121,6 +122,18 @@ class GLContext:
         # real switch.  Leaving an OSMesa context does nothing.
         self.mgl.__exit__(None, None, None)
         self.mgl.__enter__()
+
+    def bind_idle_framebuffer(self):
+        """Bind a 1x1 framebuffer owned by this context; call with the context entered.
+
+        A complete framebuffer must be bound for any draw call, transform feedback
+        included (standalone EGL contexts have none), and a framebuffer about to be
+        released must not stay bound: moderngl rebinds the previously bound one when
+        it creates the next, and binding a deleted name is GL_INVALID_OPERATION.
+        """
+        if self._idle_framebuffer is None:
+            self._idle_framebuffer = self.mgl.framebuffer([self.mgl.renderbuffer((1, 1))])
+        self._idle_framebuffer.use()
 
     def release(self):
         """Destroy the context.  Calling it again does nothing."""

@@ -107,13 +107,13 @@ def log_one_minus(delta):
     delta = delta.astype(dtype)
     small = delta < 0.5
     with np.errstate(divide="ignore", invalid="ignore"):
-        sigma = np.where(small, delta / (2 - delta), 0).astype(dtype)
-        t = sigma * sigma
-        series = np.zeros_like(sigma)
+        two_sigma = np.where(small, (2 * delta) / (2 - delta), 0).astype(dtype)
+        t = (0.25 * (two_sigma * two_sigma)).astype(dtype)
+        series = np.zeros_like(two_sigma)
         for k in reversed(range(_series_terms(dtype))):
             series = (series * t + dtype.type(1.0) / dtype.type(2 * k + 1)).astype(dtype)
         direct = np.log(np.where(small, 0.5, 1 - delta)).astype(dtype)
-    return np.where(small, -2 * sigma * series, direct).astype(dtype)
+    return np.where(small, -two_sigma * series, direct).astype(dtype)
 
 
 def lobe_from_delta(delta, q):

@@ -211,6 +211,7 @@ class Renderer:
             self._meshes.pop(mesh_id).release()
 
     def _release_targets(self):
+        self.context.bind_idle_framebuffer()
         for fbo in self._targets.values():
             for attachment in (*fbo.color_attachments, fbo.depth_attachment):
                 attachment.release()

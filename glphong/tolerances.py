@@ -82,7 +82,8 @@ def lobe_band(delta, q, chord_scale=1.0, band=BAND):
             lam = -np.log(np.maximum(value, np.finfo(np.float64).tiny))
         return value * (1.0 + sign * EPS * (band.A + band.B * lam))
 
-    return np.maximum(widen(low, -1.0), 0.0), widen(high, +1.0)
+    low = widen(low, -1.0)
+    return np.where(low < FLT_MIN, 0.0, low), widen(high, +1.0)
 
 
 def _scaled(value, factor):

@@ -1,18 +1,19 @@
 // common.glsl -- numeric helpers shared by every chunk (DESIGN section 3).
 //
 // safe_normalize(x, out x_hat, out len) -> valid
-//   s = max_i |x_i|;  valid  <=>  0 < s <= FLT_MAX   (false for a zero, NaN or Inf vector)
+//   s = max_i |x_i|;  valid  <=>  no x_i is NaN or Inf, and s > 0   (false for zero, NaN, Inf)
+//   Finiteness is tested with isnan/isinf per component: on llvmpipe max() drops a NaN operand
+//   and ordered comparisons with NaN (NaN <= FLT_MAX, NaN == 0) evaluate to true.
 //   y = x / s;  len = s * sqrt(y.y);  x_hat = y * inversesqrt(y.y)
-//   |x|^2 is never formed from raw coordinates, so lengths from FLT_MIN to FLT_MAX
+//   |x|^2 is never formed from raw coordinates, so lengths from FLT_MIN to FLT_MAX (float32)
 //   neither underflow nor overflow.  On failure x_hat = 0 and len = 0.
 //   Units: len has the units of x; x_hat is dimensionless.
 
-const float FLT_MAX = 3.402823466e38;
 
 bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
 {
     float s = max(max(abs(x.x), abs(x.y)), abs(x.z));
-    if (!(s > 0.0 && s <= FLT_MAX)) {
+    if (any(isnan(x)) || any(isinf(x)) || !(s > 0.0)) {
         x_hat = vec3(0.0);
         len = 0.0;
         return false;

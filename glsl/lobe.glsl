@@ -1,7 +1,8 @@
 // lobe.glsl -- stable evaluation of a cosine-power lobe (DESIGN section 3).
 //
 // log_one_minus(delta) -> ln(1 - delta),  0 <= delta < 1
-//   delta < 1/2:  -2 artanh(sigma),  sigma = delta / (2 - delta),
+//   delta < 1/2:  -2 artanh(sigma),  sigma = delta / (2 - delta)  (2 sigma formed directly, so that
+//                 delta just above FLT_MIN does not pass through a subnormal sigma),
 //                 artanh(sigma) = sum_{k=0..7} sigma^(2k+1) / (2k+1)   (sigma <= 1/3: truncation < 2^-27)
 //   delta >= 1/2: log(1 - delta)   (1 - delta is exact there, Sterbenz)
 //   Accurate to a few ulp relative even for delta ~ 1e-30, where log(1.0 - delta) would return 0.
@@ -14,11 +15,11 @@
 float log_one_minus(float delta)
 {
     if (delta < 0.5) {
-        float sigma = delta / (2.0 - delta);
-        float t = sigma * sigma;
+        float two_sigma = (2.0 * delta) / (2.0 - delta);
+        float t = 0.25 * (two_sigma * two_sigma);
         float series = 1.0 + t * (1.0 / 3.0 + t * (1.0 / 5.0 + t * (1.0 / 7.0 + t * (1.0 / 9.0
                      + t * (1.0 / 11.0 + t * (1.0 / 13.0 + t * (1.0 / 15.0)))))));
-        return -2.0 * sigma * series;
+        return -two_sigma * series;
     }
     return log(1.0 - delta);
 }

@@ -55,3 +55,36 @@ def make_context():
     yield make
     for ctx in made:
         ctx.release()
+
+
+@pytest.fixture
+def make_renderer():
+    """Factory ``make_renderer(width, height, backend)``: a `glphong.Renderer`, released at teardown.
+
+    A backend that is unavailable skips the test, or fails it when
+    ``GLPHONG_REQUIRE_BACKENDS`` names it (the semantics of `require_backend`).
+    """
+    from glphong import Renderer
+
+    made = []
+
+    def make(width, height, backend):
+        try:
+            renderer = Renderer(width, height, backend=backend)
+        except BackendUnavailableError:
+            require_backend(backend).release()  # skips or fails; if it now works, report the original error
+            raise
+        made.append(renderer)
+        return renderer
+
+    yield make
+    for renderer in made:
+        renderer.release()
+
+
+@pytest.fixture(scope="session", params=BACKENDS)
+def session_gl(request):
+    """One `GLContext` per backend for the whole session (not entered), released at the end."""
+    ctx = require_backend(request.param)
+    yield ctx
+    ctx.release()
