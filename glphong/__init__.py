@@ -11,7 +11,7 @@ Typical use::
         frame = r.render(scene)          # frame.radiance: (256, 256, 3) float32, W/(m^2 sr)
         report = glphong.verify(scene, r)
 """
-from . import radiometry, reference
+from . import imaging, radiometry, reference
 from .camera import PerspectiveCamera
 from .contexts import BackendUnavailableError, available_backends, create_context
 from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
@@ -26,5 +26,5 @@ __all__ = [
     "PerspectiveCamera", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
     "Material", "Lambert", "Phong", "BlinnPhong", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "create_context", "available_backends", "BackendUnavailableError",
-    "radiometry", "reference",
+    "imaging", "radiometry", "reference",
 ]

@@ -75,9 +75,6 @@ def _name_chunks(log, chunks):
     return _LOCATION.sub(repl, log)
 
 
-_UNIFORM_DECL = re.compile(r"^\s*uniform\s+\w+\s+(\w+)", re.MULTILINE)
-
-
 class Program:
     """One compiled program and its strict uniform binding.
 
@@ -97,7 +94,6 @@ class Program:
         except moderngl.Error as exc:
             log = _name_chunks(str(exc), key.fragment_chunks() if "fragment" in str(exc).lower() else key.vertex_chunks())
             raise ShaderCompileError(f"program {key.describe()!r} failed to build:\n{log}") from None
-        self.declared = frozenset(_UNIFORM_DECL.findall(self.vertex_source + self.fragment_source))
         self.active = {name: self.gl_program[name] for name in self.gl_program if isinstance(self.gl_program[name], moderngl.Uniform)}
 
     def bind(self, values):
@@ -112,11 +108,12 @@ class Program:
         Raises
         ------
         UniformError
-            A declared-and-active uniform is missing, a name is not declared by the program,
-            or the data size does not match.  Uniforms the compiler removed are skipped.
+            An active uniform is missing, a given name is not an active uniform of the
+            program (the key leaves out every uniform it does not use), or the data size
+            does not match.
         """
         missing = sorted(set(self.active) - set(values))
-        unknown = sorted(set(values) - self.declared)
+        unknown = sorted(set(values) - set(self.active))
         if missing or unknown:
             raise UniformError(f"program {self.key.describe()!r}: missing uniforms {missing}, unknown uniforms {unknown}")
         for name, uniform in self.active.items():

