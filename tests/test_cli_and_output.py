@@ -1,0 +1,82 @@
+"""The main job (CLI), the output encoders and the installed package's GLSL sources."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+from PIL import Image
+
+import glphong
+from glphong.imaging import encode_srgb8, save_npy, save_png, srgb_encode
+
+
+def test_srgb_curve_exact_values():
+    # independent values of IEC 61966-2-1: the linear segment, the joint, the power segment
+    x = np.array([0.0, 0.001, 0.0031308, 0.18, 0.5, 1.0, 2.0, -1.0, np.nan])
+    want = np.array([0.0, 0.01292, 0.04044994, 1.055 * 0.18 ** (1 / 2.4) - 0.055,
+                     0.7353569830524495, 1.0, 1.0, 0.0, 0.0])
+    np.testing.assert_allclose(srgb_encode(x), want, rtol=1e-6, atol=1e-9)
+
+
+def test_encode_srgb8_applies_exposure_then_curve():
+    radiance = np.array([[[0.25, 0.5, 4.0]]])
+    out = encode_srgb8(radiance, exposure=2.0)
+    assert out.dtype == np.uint8
+    np.testing.assert_array_equal(out, [[[188, 255, 255]]])  # sRGB(0.5) * 255 = 187.52 -> 188
+
+
+def test_png_and_npy_round_trip(tmp_path):
+    radiance = np.random.default_rng(1).uniform(0, 2, size=(5, 7, 3)).astype(np.float32)
+    save_png(tmp_path / "a.png", radiance, exposure=0.5)
+    save_npy(tmp_path / "a.npy", radiance)
+    png = np.asarray(Image.open(tmp_path / "a.png"))
+    np.testing.assert_array_equal(png, encode_srgb8(radiance, 0.5))
+    np.testing.assert_array_equal(np.load(tmp_path / "a.npy"), radiance)
+
+
+def test_glsl_sources_ship_with_the_package():
+    from glphong.programs import _glsl_root, chunk_source
+
+    for name in ("common", "lights", "lambert", "lobe", "phong", "blinn", "shade", "mesh_vertex", "mesh_fragment"):
+        text = chunk_source(name)
+        assert text.startswith(f"// {name}.glsl --"), name  # every chunk opens with its formula header
+    assert (_glsl_root() / "shade.glsl").is_file()
+
+
+def test_main_job_from_outside_the_checkout(tmp_path):
+    """`python -m glphong` with no arguments writes the default figure in the working directory."""
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONPATH"}
+    result = subprocess.run([sys.executable, "-m", "glphong", "--tile", "32"], cwd=tmp_path, env=env,
+                            capture_output=True, text=True, timeout=300)
+    assert result.returncode == 0, result.stderr
+    assert "wrote phong_examples.png" in result.stdout
+    image = Image.open(tmp_path / "phong_examples.png")
+    assert image.size == (10 * 32 + 22, 4 * 32 + 44)
+    pixels = np.asarray(image)
+    assert pixels[22:-22, 22:].max() == 255 and pixels[22:-22, 22:].std() > 10  # highlights and shading
+
+
+def test_cli_verify_reports_cross_check(tmp_path):
+    from glphong.cli import main
+
+    code = main(["render", "--tile", "24", "--verify", "--out", str(tmp_path / "f.png"), "--npy", str(tmp_path / "f.npy")])
+    assert code == 0
+    radiance = np.load(tmp_path / "f.npy")
+    assert radiance.shape == (4 * 24, 10 * 24, 3) and radiance.dtype == np.float32
+    assert np.isfinite(radiance).all() and radiance.max() > 1.0  # linear, unclamped highlights
+
+
+def test_cli_rejects_unknown_backend(capsys):
+    from glphong.cli import main
+
+    with pytest.raises(SystemExit):
+        main(["render", "--backend", "vulkan"])
+    assert "invalid choice" in capsys.readouterr().err
+
+
+def test_import_does_not_pull_optional_packages():
+    code = "import sys, glphong; print(sorted(m for m in ('pyrender', 'matplotlib', 'hypothesis', 'OpenGL') if m in sys.modules))"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "[]"
