@@ -24,10 +24,13 @@ class PerspectiveCamera:
     """
 
     def __init__(self, yfov, pose=None, znear=0.05, zfar=100.0):
-        self.yfov = _validate.scalar("yfov", yfov, low=0.0, high=np.pi - 1e-6, low_inclusive=False)
+        self.yfov = _validate.scalar("yfov", yfov, low=0.0, high=np.pi, low_inclusive=False, high_inclusive=False)
         self.pose = _validate.rigid_pose("pose", np.eye(4) if pose is None else pose)
         self.znear = _validate.scalar("znear", znear, low=0.0, low_inclusive=False)
-        self.zfar = _validate.scalar("zfar", zfar, low=self.znear, low_inclusive=False)
+        self.zfar = _validate.scalar("zfar", zfar, low=0.0, low_inclusive=False)
+        if not self.zfar > self.znear:
+            raise ValueError(f"zfar must be greater than znear, in ({self.znear!r}, {_validate.FLT_MAX:g}] "
+                             f"(got zfar={self.zfar!r})")
 
     @classmethod
     def look_at(cls, eye, target, up=(0.0, 1.0, 0.0), yfov=np.pi / 4, znear=0.05, zfar=100.0):
@@ -48,11 +51,13 @@ class PerspectiveCamera:
         target = np.asarray(_validate.vec3("target", target))
         up = np.asarray(_validate.vec3("up", up, nonzero=True))
         back = eye - target
-        if not np.linalg.norm(back) > 0:
+        if not np.any(back):
             raise ValueError("target must differ from eye")
-        z = back / np.linalg.norm(back)
-        x = np.cross(up, z)
-        if not np.linalg.norm(x) > 1e-12 * np.linalg.norm(up):
+        # scaled normalisation (DESIGN section 3): no underflow for tiny vectors
+        z = back / np.max(np.abs(back))
+        z /= np.linalg.norm(z)
+        x = np.cross(up / np.max(np.abs(up)), z)
+        if not np.linalg.norm(x) > 1e-12:
             raise ValueError("up must not be parallel to the viewing direction target - eye")
         x /= np.linalg.norm(x)
         pose = np.eye(4)

@@ -6,6 +6,8 @@ its own three vertices) and triangle indices.
 """
 import numpy as np
 
+from . import _validate
+
 __all__ = ["MeshData"]
 
 
@@ -24,19 +26,25 @@ class MeshData:
     """
 
     def __init__(self, positions, normals, indices):
-        positions = np.ascontiguousarray(positions, dtype=np.float32)
-        normals = np.ascontiguousarray(normals, dtype=np.float32)
+        positions = _validate.real_array("positions", positions, "a (V, 3) array of real numbers")
+        normals = _validate.real_array("normals", normals, "a (V, 3) array of real numbers")
         indices = np.asarray(indices)
         if positions.ndim != 2 or positions.shape[1] != 3 or len(positions) == 0:
             raise ValueError(f"positions must have shape (V, 3) with V >= 1 (got shape {positions.shape})")
-        if not np.all(np.isfinite(positions)):
-            raise ValueError("positions must be finite and representable in float32")
+        if not (np.all(np.isfinite(positions)) and np.all(np.abs(positions) <= _validate.FLT_MAX)):
+            raise ValueError(f"positions must be finite with |components| <= {_validate.FLT_MAX:g} (float32)")
         if normals.shape != positions.shape:
             raise ValueError(f"normals must have the shape of positions {positions.shape} (got {normals.shape})")
         if indices.ndim != 2 or indices.shape[1] != 3 or len(indices) == 0:
             raise ValueError(f"indices must have shape (F, 3) with F >= 1 (got shape {indices.shape})")
-        if not np.issubdtype(indices.dtype, np.integer) or indices.min() < 0 or indices.max() >= len(positions):
-            raise ValueError(f"indices must be integers in [0, {len(positions) - 1}]")
+        if not np.issubdtype(indices.dtype, np.integer):
+            raise TypeError(f"indices must be integers in [0, {len(positions) - 1}] (got dtype {indices.dtype})")
+        if indices.min() < 0 or indices.max() >= len(positions):
+            raise ValueError(f"indices must be in [0, {len(positions) - 1}] (got values from {indices.min()} "
+                             f"to {indices.max()})")
+        positions = np.ascontiguousarray(positions, dtype=np.float32)
+        with np.errstate(over="ignore"):  # normals above FLT_MAX become inf: ambient-only, as documented
+            normals = np.ascontiguousarray(normals, dtype=np.float32)
         self.positions = positions
         self.normals = normals
         self.indices = np.ascontiguousarray(indices, dtype=np.uint32)

@@ -41,7 +41,10 @@ def encode_srgb8(radiance, exposure=1.0):
     (H, W, 3) uint8 ndarray
     """
     exposure = _validate.scalar("exposure", exposure, low=0.0, low_inclusive=False)
-    return np.rint(srgb_encode(exposure * np.asarray(radiance, dtype=np.float64)) * 255.0).astype(np.uint8)
+    radiance = np.asarray(radiance, dtype=np.float64)
+    if radiance.ndim != 3 or radiance.shape[2] != 3:
+        raise ValueError(f"radiance must have shape (H, W, 3) (got shape {radiance.shape})")
+    return np.rint(srgb_encode(exposure * radiance) * 255.0).astype(np.uint8)
 
 
 def save_png(path, radiance, exposure=1.0):

@@ -38,8 +38,9 @@ class Material:
     def __post_init__(self):
         object.__setattr__(self, "kd", _validate.rgb("kd", self.kd))
         object.__setattr__(self, "ka", _validate.rgb("ka", self.ka))
-        if not isinstance(self.two_sided, bool):
-            raise TypeError(f"two_sided must be a bool (got {self.two_sided!r})")
+        if not isinstance(self.two_sided, (bool, np.bool_)):
+            raise TypeError(f"two_sided must be a bool, True or False (got {self.two_sided!r})")
+        object.__setattr__(self, "two_sided", bool(self.two_sided))
 
     @property
     def has_specular(self):

@@ -172,6 +172,12 @@ class Renderer:
                        object_index=object_index, mask=mask)
 
     def _draw(self, scene, output):
+        from .scene import Scene
+
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be a glphong.Scene (got {type(scene).__name__})")
+        if self.context is None:
+            raise RuntimeError("this Renderer has been released")
         aspect = self.width / self.height
         with self.context:
             self._purge_dead_meshes()

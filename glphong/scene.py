@@ -16,6 +16,8 @@ from .materials import Material
 
 __all__ = ["Scene", "SceneObject"]
 
+_LIGHT_CLASSES = tuple(cls for cls, _, _ in LIGHT_KINDS.values())
+
 
 @dataclass(frozen=True, eq=False)
 class SceneObject:
@@ -57,11 +59,22 @@ class Scene:
             raise TypeError(f"camera must be a glphong.PerspectiveCamera (got {type(camera).__name__})")
         if ambient is not None and not isinstance(ambient, AmbientLight):
             raise TypeError(f"ambient must be a glphong.AmbientLight or None (got {type(ambient).__name__})")
+        try:
+            light_list = list(lights) if not isinstance(lights, (*_LIGHT_CLASSES, str, bytes)) else None
+        except TypeError:
+            light_list = None
+        if light_list is None:
+            raise TypeError("lights must be a sequence of PointLight, UnattenuatedPointLight or DirectionalLight "
+                            f"(got {type(lights).__name__}; wrap a single light in a list)")
+        for i, light in enumerate(light_list):
+            if not isinstance(light, _LIGHT_CLASSES):
+                raise TypeError(f"lights[{i}] must be a PointLight, UnattenuatedPointLight or DirectionalLight "
+                                f"(got {type(light).__name__})")
         self.camera = camera
         self.ambient = ambient
         self._lights = []
         self._objects = []
-        for light in lights:
+        for light in light_list:
             self.add_light(light)
 
     @property
@@ -76,7 +89,7 @@ class Scene:
 
     def add_light(self, light):
         """Add a `PointLight`, `UnattenuatedPointLight` or `DirectionalLight`."""
-        if getattr(light, "kind", None) not in LIGHT_KINDS:
+        if not isinstance(light, _LIGHT_CLASSES):
             raise TypeError(f"light must be a PointLight, UnattenuatedPointLight or DirectionalLight (got {type(light).__name__})")
         self._lights.append(light)
         return light
@@ -100,8 +113,17 @@ class Scene:
         """
         if not isinstance(material, Material):
             raise TypeError(f"material must be a glphong material such as Lambert or Phong (got {type(material).__name__})")
-        data = mesh if isinstance(mesh, MeshData) else MeshData.from_trimesh(mesh, smooth=smooth)
+        if not isinstance(smooth, (bool, np.bool_)):
+            raise TypeError(f"smooth must be a bool, True or False (got {smooth!r})")
+        if name is not None and not isinstance(name, str):
+            raise TypeError(f"name must be a str or None (got {type(name).__name__})")
+        if not isinstance(mesh, MeshData):
+            import trimesh
+
+            if not isinstance(mesh, trimesh.Trimesh):
+                raise TypeError(f"mesh must be a trimesh.Trimesh or a glphong.geometry.MeshData (got {type(mesh).__name__})")
         pose = _validate.affine_transform("pose", np.eye(4) if pose is None else pose)
+        data = mesh if isinstance(mesh, MeshData) else MeshData.from_trimesh(mesh, smooth=bool(smooth))
         obj = SceneObject(data, material, pose, name or f"object{len(self._objects)}")
         self._objects.append(obj)
         return obj
@@ -165,7 +187,8 @@ class Scene:
         if key.output == "gbuffer":
             values["u_object_id"] = float(index)
         else:
-            values["u_eye"] = self.camera.position
+            if key.num_lights:
+                values["u_eye"] = self.camera.position
             values.update(obj.material.uniform_values(key))
             values.update(self.light_uniform_values(key))
         return {name: np.asarray(v, dtype=np.float32) for name, v in values.items()}
