@@ -4,11 +4,13 @@
 with the light direction varying down the rows and the shininess q along the
 columns, Phong on the left next to Blinn-Torrance on the right.
 """
+import functools
 from dataclasses import dataclass
 
 import numpy as np
 
 from .camera import PerspectiveCamera
+from .geometry import MeshData
 from .lights import AmbientLight, PointLight
 from .materials import BlinnPhong, Phong
 from .scene import Scene
@@ -22,6 +24,14 @@ LIGHT_ANGLES = (10.0, 35.0, 60.0, 85.0)
 #: distance of the light from the sphere centre [m] and the irradiance it delivers there [W/m^2]
 LIGHT_DISTANCE = 20.0
 IRRADIANCE = 3.0
+
+
+@functools.lru_cache(maxsize=4)
+def unit_sphere(subdivisions=5):
+    """A unit icosphere as `MeshData` (cached: every tile shares one mesh and its GPU buffers)."""
+    import trimesh
+
+    return MeshData.from_trimesh(trimesh.creation.icosphere(subdivisions=subdivisions))
 
 
 def phong_examples_scene(material_class, q, light_angle_deg, sphere_subdivisions=5):
@@ -42,15 +52,13 @@ def phong_examples_scene(material_class, q, light_angle_deg, sphere_subdivisions
     -------
     Scene
     """
-    import trimesh
-
     a = np.radians(light_angle_deg)
     direction = np.array([np.sin(a) * np.sqrt(0.5), np.sin(a) * np.sqrt(0.5), np.cos(a)])
     power = IRRADIANCE * 4.0 * np.pi * LIGHT_DISTANCE ** 2  # E = Phi / (4 pi d^2) at the centre
     camera = PerspectiveCamera.look_at((0.0, 0.0, 4.0), (0.0, 0.0, 0.0), yfov=np.radians(32.0))
     scene = Scene(camera, lights=[PointLight(LIGHT_DISTANCE * direction, power)], ambient=AmbientLight(0.15))
     material = material_class(kd=(0.20, 0.05, 0.035), ks=0.5, q=q)
-    scene.add(trimesh.creation.icosphere(subdivisions=sphere_subdivisions), material)
+    scene.add(unit_sphere(sphere_subdivisions), material)
     return scene
 
 
