@@ -61,7 +61,7 @@ def safe_normalize(x):
 
 # --------------------------------------------------------------------------- lights.glsl
 def point_irradiance(intensity, d):
-    """E1 as ``(I / d) / d`` (lights.glsl).
+    """E1 as ``min((I / d) / d, FLT_MAX)`` (lights.glsl).
 
     Parameters
     ----------
@@ -77,7 +77,7 @@ def point_irradiance(intensity, d):
     """
     d = np.asarray(d)[..., None]
     with np.errstate(over="ignore", under="ignore"):
-        return (intensity / d) / d
+        return np.minimum((intensity / d) / d, FLT_MAX)
 
 
 # --------------------------------------------------------------------------- lambert.glsl
