@@ -34,8 +34,29 @@ def _render(args):
     return 0
 
 
+def _stability(args):
+    from .stability import run_stability
+
+    reports = [run_stability(args.backend, "stable")]
+    if args.naive:
+        reports.append(run_stability(args.backend, "naive"))
+    if args.json:
+        text = "[" + ",\n".join(r.to_json() for r in reports) + "]"
+        if args.json == "-":
+            print(text)
+        else:
+            with open(args.json, "w") as f:
+                f.write(text)
+    if args.json != "-":
+        for report in reports:
+            print(report.format_table())
+            print()
+    stable = reports[0]
+    return 0 if stable.passed_count == len(stable.rows) and stable.nan_count == 0 else 1
+
+
 def build_parser():
-    """The argument parser (subcommands: render)."""
+    """The argument parser (subcommands: render, stability)."""
     parser = argparse.ArgumentParser(prog="glphong", description=__doc__.strip().splitlines()[0])
     sub = parser.add_subparsers(dest="command")
     render = sub.add_parser("render", help="render the 'Phong Examples' figure (the default command)")
@@ -46,6 +67,12 @@ def build_parser():
     render.add_argument("--exposure", type=float, default=0.6, help="linear exposure before sRGB encoding")
     render.add_argument("--verify", action="store_true", help="cross-check every tile against the float64 twin")
     render.set_defaults(func=_render)
+    stability = sub.add_parser("stability", help="run the extreme-case suite: GPU vs float64 vs tolerance band")
+    stability.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
+    stability.add_argument("--naive", action="store_true",
+                           help="also run the cases through the textbook pow(dot(v, r), q) shader")
+    stability.add_argument("--json", default=None, help="write the table(s) as JSON to this path ('-': stdout only)")
+    stability.set_defaults(func=_stability)
     return parser
 
 

@@ -9,8 +9,9 @@ from dataclasses import dataclass, fields
 
 __all__ = ["ProgramKey", "program_key", "gbuffer_key"]
 
-OUTPUTS = ("radiance", "gbuffer")
+OUTPUTS = ("radiance", "gbuffer", "points")
 LOBES = (None, "phong", "blinn")
+FORMULATIONS = ("stable", "naive")
 
 
 @dataclass(frozen=True)
@@ -19,8 +20,9 @@ class ProgramKey:
 
     Attributes
     ----------
-    output : {'radiance', 'gbuffer'}
-        Shaded radiance, or the G-buffer of shading inputs.
+    output : {'radiance', 'gbuffer', 'points'}
+        Shaded radiance, the G-buffer of shading inputs, or radiance at arbitrary points
+        (a vertex-only program whose ``shade()`` result is captured by transform feedback).
     lobe : {None, 'phong', 'blinn'}
         Specular lobe, None when the program has no specular term.
     has_ka, has_kd_la, has_diffuse : bool
@@ -31,6 +33,9 @@ class ProgramKey:
         Whether the program reads the normal attribute (not needed without lights).
     two_sided : bool
         Flip the normal on back faces.
+    formulation : {'stable', 'naive'}
+        The stable float32 formulation of DESIGN section 3, or the textbook one (``normalize``,
+        ``d*d``, ``pow(dot(v, r), q)``) kept only to show why the stable one exists.
     """
 
     output: str = "radiance"
@@ -43,9 +48,10 @@ class ProgramKey:
     num_directional_lights: int = 0
     has_normal: bool = True
     two_sided: bool = True
+    formulation: str = "stable"
 
     def __post_init__(self):
-        if self.output not in OUTPUTS or self.lobe not in LOBES:
+        if self.output not in OUTPUTS or self.lobe not in LOBES or self.formulation not in FORMULATIONS:
             raise ValueError(f"invalid ProgramKey {self}")
 
     @property
@@ -70,7 +76,7 @@ class ProgramKey:
             ("HAS_NORMAL", b(self.has_normal)),
             ("TWO_SIDED", b(self.two_sided)),
         ]
-        if self.output == "radiance":
+        if self.output != "gbuffer":
             out += [
                 ("HAS_KA", b(self.has_ka)),
                 ("HAS_KD_LA", b(self.has_kd_la)),
@@ -84,23 +90,37 @@ class ProgramKey:
                 out.append(("SPECULAR_LOBE", f"{self.lobe}_lobe"))
         return out
 
+    def shading_chunks(self):
+        """Chunk files that define ``shade()`` and what it calls: only those the key needs."""
+        if self.formulation == "naive":
+            return ("naive",) + (("lambert",) if self.has_diffuse else ()) + ("shade",)
+        chunks = ["common"]
+        if self.num_point_lights:
+            chunks.append("lights")
+        if self.has_diffuse:
+            chunks.append("lambert")
+        if self.has_specular:
+            chunks += ["lobe", self.lobe]
+        chunks.append("shade")
+        return tuple(chunks)
+
     def vertex_chunks(self):
         """Chunk files of the vertex stage, in order."""
+        if self.output == "points":
+            return self.shading_chunks() + ("shade_points",)
         return ("mesh_vertex",)
 
     def fragment_chunks(self):
-        """Chunk files of the fragment stage, in order: only those the key needs."""
-        chunks = ["common"]
-        if self.output == "radiance":
-            if self.num_point_lights:
-                chunks.append("lights")
-            if self.has_diffuse:
-                chunks.append("lambert")
-            if self.has_specular:
-                chunks += ["lobe", self.lobe]
-            chunks.append("shade")
-        chunks.append("mesh_fragment")
-        return tuple(chunks)
+        """Chunk files of the fragment stage, in order (none for 'points')."""
+        if self.output == "points":
+            return ()
+        if self.output == "gbuffer":
+            return ("common", "mesh_fragment")
+        return self.shading_chunks() + ("mesh_fragment",)
+
+    def varyings(self):
+        """Transform-feedback outputs of a 'points' program."""
+        return ("out_radiance",) if self.output == "points" else ()
 
     def describe(self):
         """One line naming every field that is set, e.g. ``radiance phong diffuse 2 point``."""

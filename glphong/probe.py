@@ -17,7 +17,7 @@ import numpy as np
 
 from .programs import GLSL_VERSION, chunk_source
 
-__all__ = ["Signature", "SIGNATURES", "evaluate"]
+__all__ = ["Signature", "SIGNATURES", "evaluate", "shade_points"]
 
 _WIDTH = {"float": 1, "vec3": 3, "bool": 1}
 
@@ -126,3 +126,54 @@ def evaluate(gl, name, **inputs):
         out[p] = column > 0.5 if t == "bool" else column.copy()
         at += w
     return out
+
+
+def shade_points(gl, programs, key, uniforms, positions, normals, drop_unused=False):
+    """Evaluate the GLSL ``shade()`` of a 'points' program at arbitrary points.
+
+    Parameters
+    ----------
+    gl : glphong.contexts.GLContext
+    programs : glphong.programs.ProgramCache
+        Cache of ``gl``'s programs.
+    key : glphong.key.ProgramKey
+        With ``output='points'``.
+    uniforms : dict of str to array_like
+        Exactly the program's active uniforms (strict binding).
+    positions, normals : (N, 3) array_like
+        World-space points [m] and raw (unnormalised) normals; cast to float32.
+    drop_unused : bool
+        Drop given uniforms the compiler removed instead of raising (for the naive
+        formulation, whose ``safe_normalize`` never fails, so that e.g. a Lambert program
+        never reads ``u_eye``); missing uniforms are still an error.
+
+    Returns
+    -------
+    (N, 3) float32 ndarray
+        Radiance [W/(m^2 sr)].
+    """
+    if key.output != "points":
+        raise ValueError(f"key.output must be 'points' (got {key.output!r})")
+    positions = np.ascontiguousarray(positions, dtype=np.float32).reshape(-1, 3)
+    normals = np.ascontiguousarray(normals, dtype=np.float32).reshape(-1, 3)
+    if positions.shape != normals.shape:
+        raise ValueError(f"positions and normals must have the same shape (got {positions.shape} and {normals.shape})")
+    count = len(positions)
+    mgl = gl.mgl
+    with gl:
+        program = programs.get(key)
+        program.bind({k: v for k, v in uniforms.items() if k in program.active} if drop_unused else uniforms)
+        position_buffer, normal_buffer = mgl.buffer(positions.tobytes()), mgl.buffer(normals.tobytes())
+        result = mgl.buffer(reserve=max(count, 1) * 12)
+        content = [(b, "3f", name) for b, name in ((position_buffer, "in_position"), (normal_buffer, "in_normal"))
+                   if name in program.gl_program]  # the normal is compiled out of unlit programs
+        vao = mgl.vertex_array(program.gl_program, content)
+        try:
+            gl.bind_idle_framebuffer()
+            vao.transform(result, mode=moderngl.POINTS, vertices=count)
+            data = np.frombuffer(result.read(), dtype=np.float32)[:count * 3].reshape(count, 3).copy()
+            gl.check_error(f"shade_points of {key.describe()}")
+        finally:
+            for obj in (vao, result, position_buffer, normal_buffer):
+                obj.release()
+    return data

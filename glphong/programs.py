@@ -88,11 +88,13 @@ class Program:
         self.key = key
         defines = key.defines()
         self.vertex_source = assemble(key.vertex_chunks(), defines)
-        self.fragment_source = assemble(key.fragment_chunks(), defines)
+        self.fragment_source = assemble(key.fragment_chunks(), defines) if key.fragment_chunks() else None
         try:
-            self.gl_program = mgl.program(vertex_shader=self.vertex_source, fragment_shader=self.fragment_source)
+            self.gl_program = mgl.program(vertex_shader=self.vertex_source, fragment_shader=self.fragment_source,
+                                          varyings=key.varyings())
         except moderngl.Error as exc:
-            log = _name_chunks(str(exc), key.fragment_chunks() if "fragment" in str(exc).lower() else key.vertex_chunks())
+            stage = key.fragment_chunks() if "fragment" in str(exc).lower() else key.vertex_chunks()
+            log = _name_chunks(str(exc), stage)
             raise ShaderCompileError(f"program {key.describe()!r} failed to build:\n{log}") from None
         self.active = {name: self.gl_program[name] for name in self.gl_program if isinstance(self.gl_program[name], moderngl.Uniform)}
 

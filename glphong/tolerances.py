@@ -22,7 +22,7 @@ import numpy as np
 
 from . import reference as ref
 
-__all__ = ["EPS", "FLT_MIN", "FLT_MAX", "BandConstants", "BAND", "lobe_band", "radiance_band"]
+__all__ = ["EPS", "FLT_MIN", "FLT_MAX", "BandConstants", "BAND", "lobe_band", "point_band", "radiance_band"]
 
 EPS = 2.0 ** -24
 FLT_MIN = float(np.finfo(np.float32).tiny)
@@ -86,12 +86,57 @@ def lobe_band(delta, q, chord_scale=1.0, band=BAND):
     return np.where(low < FLT_MIN, 0.0, low), widen(high, +1.0)
 
 
-def _scaled(value, factor):
-    return value * factor
+def point_band(key, u, position, n, n_valid, band=BAND):
+    """Interval the GPU's ``shade()`` must return at given points.
+
+    Parameters
+    ----------
+    key : glphong.key.ProgramKey
+    u : dict of str to ndarray
+        The program's uniforms as float64.
+    position : (N, 3) float64 ndarray
+    n : (N, 3) float64 ndarray
+        Unit normals (as `glphong.reference.safe_normalize` returns them).
+    n_valid : (N,) bool ndarray
+    band : BandConstants
+
+    Returns
+    -------
+    low, high : (N, 3) float64 ndarray
+    """
+    ambient = ref.ambient_terms(key, u, position.shape, np.float64)
+    lo, hi = ambient * (1 - band.A * EPS), ambient * (1 + band.A * EPS)
+    terms = int(key.has_ka) + int(key.has_kd_la)
+    if key.num_lights:
+        ok_v, wo, _ = ref.safe_normalize(u["u_eye"] - position)
+        lit = (n_valid & ok_v)[..., None]
+        tol = band.D * EPS
+        for valid, wi, irradiance in ref.incident_light(position, key, u):
+            terms += 1
+            n_dot_l = ref._dot(n, wi)
+            f_lo = np.zeros_like(position)
+            f_hi = np.zeros_like(position)
+            if key.has_diffuse:
+                f_lo = f_lo + ref.lambert(u["u_kd"], np.maximum(n_dot_l - tol, 0.0))
+                f_hi = f_hi + ref.lambert(u["u_kd"], np.maximum(n_dot_l + tol, 0.0))
+            if key.has_specular:
+                l_lo, l_hi = _specular_band(key.lobe, n, wi, wo, u["u_q"], tol, band)
+                f_lo = f_lo + u["u_ks"] * l_lo[..., None]
+                f_hi = f_hi + u["u_ks"] * l_hi[..., None]
+            with np.errstate(over="ignore", invalid="ignore"):
+                t_lo = np.nan_to_num(f_lo * irradiance * (1 - band.A * EPS), nan=0.0)
+                t_hi = np.nan_to_num(f_hi * irradiance * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
+            certain = lit & valid[..., None] & (n_dot_l > tol)[..., None]
+            possible = lit & valid[..., None] & (n_dot_l > -tol)[..., None]
+            lo = lo + np.where(certain, t_lo, 0.0)
+            hi = hi + np.where(possible, t_hi, 0.0)
+    low = lo * (1 - terms * EPS)
+    high = hi * (1 + terms * EPS)
+    return np.where(low < FLT_MIN, 0.0, low), np.where(high > FLT_MAX, np.inf, high)
 
 
 def radiance_band(scene, gbuffer, band=BAND):
-    """Per-pixel interval the GPU's radiance must lie in.
+    """Per-pixel interval the GPU's radiance must lie in (`point_band` on every covered pixel).
 
     Parameters
     ----------
@@ -107,36 +152,7 @@ def radiance_band(scene, gbuffer, band=BAND):
     low = np.zeros(gbuffer.position.shape)
     high = np.zeros(gbuffer.position.shape)
     for selection, key, u, position, n, n_valid in ref.shade_inputs(scene, gbuffer):
-        ambient = ref.ambient_terms(key, u, position.shape, np.float64)
-        lo, hi = ambient * (1 - band.A * EPS), ambient * (1 + band.A * EPS)
-        terms = int(key.has_ka) + int(key.has_kd_la)
-        if key.num_lights:
-            ok_v, wo, _ = ref.safe_normalize(u["u_eye"] - position)
-            lit = (n_valid & ok_v)[..., None]
-            tol = band.D * EPS
-            for valid, wi, irradiance in ref.incident_light(position, key, u):
-                terms += 1
-                n_dot_l = ref._dot(n, wi)
-                f_lo = np.zeros_like(position)
-                f_hi = np.zeros_like(position)
-                if key.has_diffuse:
-                    f_lo = f_lo + ref.lambert(u["u_kd"], np.maximum(n_dot_l - tol, 0.0))
-                    f_hi = f_hi + ref.lambert(u["u_kd"], np.maximum(n_dot_l + tol, 0.0))
-                if key.has_specular:
-                    l_lo, l_hi = _specular_band(key.lobe, n, wi, wo, u["u_q"], tol, band)
-                    f_lo = f_lo + u["u_ks"] * l_lo[..., None]
-                    f_hi = f_hi + u["u_ks"] * l_hi[..., None]
-                with np.errstate(over="ignore", invalid="ignore"):
-                    t_lo = np.nan_to_num(f_lo * irradiance * (1 - band.A * EPS), nan=0.0)
-                    t_hi = np.nan_to_num(f_hi * irradiance * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
-                certain = (lit & valid[..., None] & (n_dot_l > tol)[..., None])
-                possible = (lit & valid[..., None] & (n_dot_l > -tol)[..., None])
-                lo = lo + np.where(certain, t_lo, 0.0)
-                hi = hi + np.where(possible, t_hi, 0.0)
-        low[selection] = lo * (1 - terms * EPS)
-        high[selection] = hi * (1 + terms * EPS)
-    low = np.where(low < FLT_MIN, 0.0, low)
-    high = np.where(high > FLT_MAX, np.inf, high)
+        low[selection], high[selection] = point_band(key, u, position, n, n_valid, band)
     return low, high
 
 

@@ -1,0 +1,379 @@
+"""The extreme-case stability suite and report (``glphong stability``).
+
+Each `Case` is data: one shading point (surface point at the origin, a raw normal, an eye
+position), a material and lights.  Its expected value comes from `oracle`, an independent
+60-digit mpmath evaluation of the textbook model E6 on the very float32 inputs the GPU gets
+(so float64 rounding cannot hide in the expectation).  The GPU evaluates the real GLSL
+``shade()`` at that point through a 'points' program; the float64 twin evaluates its mirror;
+the GPU passes when it lies in the tolerance band around the twin and is neither NaN nor Inf
+where the band is finite.
+
+Valid ranges (`VALID_RANGES`): inside them the GPU result equals the textbook value within
+the band.  Outside them it is still never NaN from finite input: results below FLT_MIN flush
+to 0, irradiance beyond FLT_MAX saturates at FLT_MAX, and sums beyond FLT_MAX become +Inf.
+"""
+import json
+from dataclasses import asdict, dataclass, field, replace
+
+import numpy as np
+
+from .key import ProgramKey
+from .tolerances import FLT_MAX, FLT_MIN, point_band
+
+__all__ = ["Case", "CASES", "VALID_RANGES", "oracle", "StabilityRow", "StabilityReport", "run_stability"]
+
+#: documented ranges inside which the GPU equals the textbook model within the tolerance band
+VALID_RANGES = {
+    "q": "0 <= q <= 1e7 tested at and around the peak (any finite q <= FLT_MAX is accepted and never NaN)",
+    "distance": "every coordinate difference (light - point, eye - point) in [FLT_MIN, FLT_MAX] per largest component, "
+                "e.g. light distances 1e-30 m to 1e30 m",
+    "power": "Phi / (4 pi) and the irradiance E = Phi / (4 pi d^2) in [FLT_MIN, FLT_MAX] (about 1.2e-38 to 3.4e38); "
+             "Phi itself is accepted from 0 to 4 pi FLT_MAX",
+    "result": "each light's term and the sum in [FLT_MIN, FLT_MAX]; below: flushed to 0, above: FLT_MAX or +Inf",
+    "normals": "any finite non-zero normal (1e-37 to 1e38 in length); zero or non-finite normals give the ambient terms",
+}
+
+
+@dataclass(frozen=True)
+class Case:
+    """One extreme shading configuration.
+
+    Attributes
+    ----------
+    name, group : str
+    family : {'lambert', 'phong', 'blinn'}
+    kd, ks, ka : tuple of 3 float
+        Coefficients (ks unused for 'lambert').
+    q : float
+    normal : tuple of 3 float
+        Raw normal at the origin (renormalised by the shader; may be zero or non-finite).
+    eye : tuple of 3 float
+        Camera centre [m].
+    lights : tuple of (kind, where, value)
+        ``('point', position, power)``, ``('unattenuated', position, radiance)`` or
+        ``('directional', direction of travel, irradiance)``.
+    ambient : float or None
+        ``L_a``.
+    in_range : bool
+        Whether the case lies inside `VALID_RANGES` (expected value representable).
+    note : str
+    """
+
+    name: str
+    group: str
+    family: str = "phong"
+    kd: tuple = (0.2, 0.2, 0.2)
+    ks: tuple = (0.5, 0.5, 0.5)
+    ka: tuple = (0.0, 0.0, 0.0)
+    q: float = 50.0
+    normal: tuple = (0.0, 0.0, 1.0)
+    eye: tuple = (0.0, 0.0, 1.0)
+    lights: tuple = (("point", (0.0, 0.0, 1.0), 4 * np.pi),)
+    ambient: float = None
+    in_range: bool = True
+    note: str = ""
+
+    def scene(self):
+        """The case as a one-object `Scene` (a dummy triangle carries the material)."""
+        from . import lights as L
+        from .camera import PerspectiveCamera
+        from .geometry import MeshData
+        from .materials import BlinnPhong, Lambert, Phong
+        from .scene import Scene
+
+        eye = np.asarray(self.eye)
+        up = (0.0, 1.0, 0.0) if abs(eye[1]) < 0.9 * np.max(np.abs(eye)) else (1.0, 0.0, 0.0)
+        camera = PerspectiveCamera.look_at(eye, (0.0, 0.0, 0.0), up=up, znear=1e-30 * np.max(np.abs(eye)) + 1e-37)
+        kinds = {"point": L.PointLight, "unattenuated": L.UnattenuatedPointLight, "directional": L.DirectionalLight}
+        scene = Scene(camera, lights=[kinds[k](w, v) for k, w, v in self.lights],
+                      ambient=None if self.ambient is None else L.AmbientLight(self.ambient))
+        material = (Lambert(self.kd, ka=self.ka) if self.family == "lambert" else
+                    {"phong": Phong, "blinn": BlinnPhong}[self.family](self.kd, self.ks, self.q, ka=self.ka))
+        scene.add(MeshData([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 1]] * 3, [[0, 1, 2]]), material)
+        return scene
+
+    def inputs(self):
+        """``(key, uniforms)`` of the case's 'points' program: exactly what the GPU is given (float32)."""
+        scene = self.scene()
+        key = replace(scene.program_key(scene.objects[0]), output="points", two_sided=False)
+        uniforms = scene.uniform_values(0, key, 1.0)
+        for name in ("u_model", "u_view_projection", "u_normal_matrix"):
+            uniforms.pop(name, None)
+        return key, uniforms
+
+
+def _unit(angle_deg, azimuth_deg=0.0):
+    """Unit vector at polar angle ``angle_deg`` from +z, azimuth ``azimuth_deg`` from +x."""
+    t, p = np.radians(angle_deg), np.radians(azimuth_deg)
+    return (float(np.sin(t) * np.cos(p)), float(np.sin(t) * np.sin(p)), float(np.cos(t)))
+
+
+def _mirror_eye(light_angle, offset_rad):
+    """Eye direction at the lobe peak of a light ``light_angle`` deg off the normal +z, turned by ``offset_rad``.
+
+    The mirror direction of ``l`` is the peak of both lobes (Phong: ``v = r``; Blinn: ``h = n``);
+    the offset rotates it about +y, away from the peak.
+    """
+    v = np.array(_unit(light_angle, 180.0))
+    c, s = np.cos(offset_rad), np.sin(offset_rad)
+    return (float(c * v[0] + s * v[2]), float(v[1]), float(-s * v[0] + c * v[2]))
+
+
+def _grazing(n_dot_l):
+    """Unit light direction with exactly the given cosine to +z (in float64)."""
+    return (float(np.sqrt(1.0 - n_dot_l * n_dot_l)), 0.0, float(n_dot_l))
+
+
+def _build_cases():
+    cases = []
+    light = _unit(30.0)
+    grey = lambda x: (x, x, x)  # noqa: E731
+    e_one = 4 * np.pi  # a point light at 1 m with E = 1 W/m^2
+    for family in ("phong", "blinn"):
+        for q in (0.0, 0.5, 1.0, 1e3, 1e4, 1e5, 1e6, 1e7):
+            width = 1.0 / np.sqrt(max(q, 1.0))
+            for label, offset in (("peak", 0.0), ("near", 0.7 * width), ("tail", 3.0 * width)):
+                cases.append(Case(f"{family} q={q:g} {label}", "lobe", family=family, q=q, kd=grey(0.1), ks=grey(1.0),
+                                  eye=_mirror_eye(30.0, offset), lights=(("point", light, e_one),)))
+    for family in ("lambert", "phong", "blinn"):
+        for cosine in (1e-2, 1e-4, 1e-6, 0.0, -1e-6):
+            cases.append(Case(f"{family} grazing light n.l={cosine:g}", "grazing", family=family, q=100.0,
+                              eye=_unit(20.0, 90.0), lights=(("point", _grazing(cosine), e_one),)))
+        cases.append(Case(f"{family} grazing view n.v=1e-5", "grazing", family=family, q=100.0,
+                          eye=_unit(90 - np.degrees(1e-5), 180.0), lights=(("point", _unit(60.0), e_one),)))
+        cases.append(Case(f"{family} light behind the surface", "behind", family=family, q=10.0, ka=grey(0.01),
+                          eye=_unit(30.0, 180.0), lights=(("point", _unit(120.0), e_one),),
+                          note="ambient only: the n.l gate removes the specular highlight too"))
+    for family in ("phong", "blinn"):
+        cases.append(Case(f"{family} l = -v", "opposite", family=family, q=1.0, eye=tuple(-c for c in light),
+                          lights=(("point", light, e_one),), note="n.v < 0: the Blinn half vector is undefined"))
+        cases.append(Case(f"{family} q=0 with v.r < 0", "lobe", family=family, q=0.0, eye=_unit(60.0, 90.0),
+                          lights=(("point", light, e_one),), note="0^0 := 1 convention, no pow(0, 0)"))
+    for label, normal in (("zero", (0.0, 0.0, 0.0)), ("tiny 1e-25", (0.0, 3e-26, 1e-25)), ("huge 1e25", (0.0, 3e24, 1e25)),
+                          ("subnormal-free 1e-37", (0.0, 0.0, 1e-37)), ("NaN", (np.nan, 0.0, 1.0)), ("Inf", (0.0, np.inf, 1.0))):
+        cases.append(Case(f"normal {label}", "normals", ka=grey(0.01), ambient=0.1, eye=_unit(10.0, 90.0),
+                          normal=normal, lights=(("point", light, e_one),),
+                          note="zero/non-finite normal: ambient terms only" if label in ("zero", "NaN", "Inf") else ""))
+    for d in (1e-30, 1e-19, 1e-3, 1e3, 2e19, 1e30):
+        cases.append(Case(f"distance {d:g}, Phi=1 W", "distance", eye=_unit(20.0, 90.0), q=10.0,
+                          lights=(("point", tuple(d * c for c in light), 1.0),),
+                          in_range=FLT_MIN <= 1.0 / (4 * np.pi * d * d) <= FLT_MAX,
+                          note="" if FLT_MIN <= 1.0 / (4 * np.pi * d * d) <= FLT_MAX else
+                          "E outside float32: saturates at FLT_MAX or flushes to 0"))
+        power = 4 * np.pi * d * d
+        if 4 * np.pi * FLT_MIN <= power <= 4 * np.pi * FLT_MAX:
+            cases.append(Case(f"distance {d:g}, E=1 W/m^2", "distance", eye=_unit(20.0, 90.0), q=10.0,
+                              lights=(("point", tuple(d * c for c in light), power),)))
+    for phi in (1e-40, 1e-30, 1.0, 1e30, 3e38):
+        i = phi / (4 * np.pi)
+        cases.append(Case(f"power {phi:g} W at 1 m", "power", eye=_unit(20.0, 90.0), q=10.0,
+                          lights=(("point", light, phi),), in_range=i >= FLT_MIN,
+                          note="" if i >= FLT_MIN else "intensity below FLT_MIN: flushed to 0"))
+    cases.append(Case("all coefficients zero", "coefficients", kd=grey(0.0), ks=grey(0.0), ka=grey(0.0), eye=_unit(10.0, 90.0),
+                      lights=(("point", light, e_one),)))
+    cases.append(Case("kd=(1,0,0) under saturating light", "coefficients", kd=(1.0, 0.0, 0.0), ks=grey(0.0),
+                      eye=_unit(10.0, 90.0), lights=(("point", tuple(1e-30 * c for c in light), 1.0),), in_range=False,
+                      note="E saturates at FLT_MAX; zero channels stay 0, never 0 * Inf = NaN"))
+    cases.append(Case("ks only, q=1e6 peak", "coefficients", kd=grey(0.0), ks=(0.0, 0.5, 1.0), q=1e6,
+                      eye=_mirror_eye(30.0, 0.0), lights=(("point", light, e_one),)))
+    # light k at 10^(k-4) m delivering E_k = 10^(6k-20) W/m^2
+    many = tuple(("point", tuple(10.0 ** (k - 4) * c for c in _unit(10.0 + 8 * k, 45.0 * k)),
+                  4 * np.pi * 10.0 ** (2 * (k - 4)) * 10.0 ** (6 * k - 20)) for k in range(8))
+    cases.append(Case("8 lights, E from 1e-20 to 1e22 W/m^2", "dynamic range", family="blinn", q=200.0,
+                      eye=_unit(25.0, 200.0), lights=many))
+    cases.append(Case("3 light kinds + ambient", "dynamic range", family="phong", q=500.0, ka=grey(1e-3), ambient=1e-2,
+                      eye=_mirror_eye(30.0, 0.0), lights=(("point", light, e_one), ("unattenuated", (0.0, 5.0, 5.0), 1e-6),
+                                                                 ("directional", (0.0, 0.0, -1.0), 1e6))))
+    return tuple(cases)
+
+
+#: the suite, in report order
+CASES = _build_cases()
+
+
+def oracle(case, key, uniforms, digits=60):
+    """Independent high-precision value of E6 at the case's point.
+
+    Evaluates ``L = k_a + k_d L_a + sum_j [n.l_j > 0] (k_d n.l_j + k_s lobe_j) E_j`` in mpmath with
+    ``digits`` significant digits on the float32 inputs in ``uniforms`` and the float32 normal,
+    with the conventions of DESIGN section 1 (q = 0 gives lobe 1; Blinn's lobe is 0 where n.v <= 0
+    or l + v = 0).  It shares no code with the shaders or the twin.
+
+    Returns
+    -------
+    (3,) float64 ndarray
+    """
+    import mpmath
+
+    mp = mpmath.mp
+    mp.dps = digits
+    f = lambda x: mpmath.mpf(float(np.float32(x)))  # noqa: E731
+    vec = lambda a: [f(x) for x in np.asarray(a, dtype=np.float64).ravel()[:3]]  # noqa: E731
+    dot = lambda a, b: sum(x * y for x, y in zip(a, b))  # noqa: E731
+    norm = lambda a: mpmath.sqrt(dot(a, a))  # noqa: E731
+    u = {k: np.asarray(v, dtype=np.float32) for k, v in uniforms.items()}
+    zero = [mpmath.mpf(0)] * 3
+    out = [mpmath.mpf(0)] * 3
+    if key.has_ka:
+        out = [o + f(k) for o, k in zip(out, u["u_ka"])]
+    if key.has_kd_la:
+        out = [o + f(kd) * f(la) for o, kd, la in zip(out, u["u_kd"], u["u_ambient"])]
+    raw_n = np.asarray(case.normal, dtype=np.float32)
+    if key.num_lights == 0 or not np.all(np.isfinite(raw_n)) or not np.any(raw_n):
+        return np.array([float(o) for o in out])
+    n = vec(raw_n)
+    n = [x / norm(n) for x in n]
+    eye = vec(u["u_eye"])
+    v = [x / norm(eye) for x in eye]
+    lights = []
+    for j in range(key.num_point_lights):
+        p = vec(u["u_point_position"][j])
+        d = norm(p)
+        lights.append(([x / d for x in p], [f(i) / (d * d) for i in u["u_point_intensity"][j]]))
+    for j in range(key.num_unattenuated_lights):
+        p = vec(u["u_unattenuated_position"][j])
+        lights.append(([x / norm(p) for x in p], vec(u["u_unattenuated_radiance"][j])))
+    for j in range(key.num_directional_lights):
+        lights.append((vec(u["u_directional_direction"][j]), vec(u["u_directional_irradiance"][j])))
+    for l, e in lights:
+        ndl = dot(n, l)
+        if ndl <= 0:
+            continue
+        lobe = mpmath.mpf(0)
+        if key.has_specular:
+            q = f(u["u_q"])
+            if key.lobe == "phong":
+                c = dot(v, [2 * ndl * a - b for a, b in zip(n, l)])
+                valid = True
+            else:
+                s = [a + b for a, b in zip(l, v)]
+                valid = dot(n, v) > 0 and norm(s) > 0
+                c = dot(n, [x / norm(s) for x in s]) if valid else mpmath.mpf(0)
+            lobe = mpmath.mpf(1) if (q == 0 and valid) else (max(c, 0) ** q if valid else mpmath.mpf(0))
+        kd = vec(u["u_kd"]) if key.has_diffuse else zero
+        ks = vec(u["u_ks"]) if key.has_specular else zero
+        out = [o + (a * ndl + b * lobe) * ee for o, a, b, ee in zip(out, kd, ks, e)]
+    return np.array([float(o) for o in out])
+
+
+@dataclass(frozen=True)
+class StabilityRow:
+    """One case's result (channel-wise arrays are lists of 3 floats)."""
+
+    case: str
+    group: str
+    gpu: list
+    expected: list
+    twin: list
+    low: list
+    high: list
+    relative_error: float
+    band_width: float
+    passed: bool
+    nan: int
+    inf: int
+    in_range: bool
+    note: str = ""
+
+
+@dataclass
+class StabilityReport:
+    """The table of a stability run."""
+
+    backend: str
+    renderer: str
+    formulation: str
+    rows: list = field(default_factory=list)
+
+    @property
+    def passed_count(self):
+        return sum(r.passed for r in self.rows)
+
+    @property
+    def nan_count(self):
+        return sum(r.nan for r in self.rows)
+
+    @property
+    def inf_count(self):
+        return sum(r.inf for r in self.rows)
+
+    def to_json(self):
+        """The whole report as a JSON string."""
+        return json.dumps(asdict(self) | {"passed": self.passed_count, "cases": len(self.rows)}, indent=1,
+                          default=float, allow_nan=True)
+
+    def format_table(self):
+        """A fixed-width text table, one case per line (the channel with the largest expected value)."""
+        head = (f"{'case':44s} {'GPU':>12s} {'float64':>12s} {'rel err':>9s} {'band':>9s} {'':4s} NaN Inf  note")
+        lines = [f"glphong stability: {self.formulation} formulation on {self.backend} ({self.renderer})", head,
+                 "-" * len(head)]
+        for r in self.rows:
+            c = int(np.argmax(np.abs(r.expected))) if np.any(np.isfinite(r.expected)) else 0
+            lines.append(f"{r.case[:44]:44s} {r.gpu[c]:12.5g} {r.expected[c]:12.5g} {r.relative_error:9.2g} "
+                         f"{r.band_width:9.2g} {'pass' if r.passed else 'FAIL'} {r.nan:3d} {r.inf:3d}  "
+                         f"{'' if r.in_range else '[outside valid range] '}{r.note}")
+        lines.append(f"{self.passed_count}/{len(self.rows)} cases inside the tolerance band; "
+                     f"{self.nan_count} NaN and {self.inf_count} Inf channels")
+        return "\n".join(lines)
+
+
+def _relative(a, b):
+    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.where(a == b, 0.0, np.abs(a - b) / np.abs(b))
+    return float(np.nanmax(np.where(np.isnan(rel), np.inf, rel)))
+
+
+def run_stability(backend="auto", formulation="stable", cases=CASES, context=None):
+    """Run the suite on a backend.
+
+    Parameters
+    ----------
+    backend : {'auto', 'egl', 'osmesa'}
+    formulation : {'stable', 'naive'}
+        The shader formulation to evaluate ('naive': the textbook ``pow(dot(v, r), q)`` one).
+    cases : sequence of Case
+    context : glphong.contexts.GLContext, optional
+        Use this context instead of creating one.
+
+    Returns
+    -------
+    StabilityReport
+    """
+    from . import reference as ref
+    from .contexts import create_context
+    from .probe import shade_points
+    from .programs import ProgramCache
+
+    gl = context or create_context(backend)
+    programs = ProgramCache(gl.mgl)
+    report = StabilityReport(gl.backend, gl.renderer_name, formulation)
+    try:
+        for case in cases:
+            key, uniforms = case.inputs()
+            key = replace(key, formulation=formulation)
+            position = np.zeros((1, 3))
+            normal = np.asarray([case.normal], dtype=np.float32)
+            gpu = shade_points(gl, programs, key, uniforms, position, normal,
+                               drop_unused=formulation == "naive")[0].astype(np.float64)
+            u64 = {k: v.astype(np.float64) for k, v in uniforms.items()}
+            n_valid, n, _ = ref.safe_normalize(normal.astype(np.float64))
+            twin = ref.shade_point(position, n, n_valid, u64.get("u_eye"), key, u64)[0]
+            low, high = point_band(key, u64, position, n, n_valid)
+            low, high = low[0], high[0]
+            expected = oracle(case, key, uniforms)
+            finite_band = np.isfinite(high)
+            ok = np.all((gpu >= low) & (gpu <= high)) and not np.any(np.isnan(gpu)) and \
+                np.all(np.isfinite(gpu[finite_band]))
+            with np.errstate(divide="ignore", invalid="ignore"):
+                width = np.where(twin > 0, (high - low) / twin, 0.0)
+            report.rows.append(StabilityRow(
+                case.name, case.group, gpu.tolist(), expected.tolist(), twin.tolist(), low.tolist(), high.tolist(),
+                _relative(gpu, expected), float(np.nanmax(width)), bool(ok), int(np.isnan(gpu).sum()),
+                int(np.isinf(gpu).sum()), case.in_range, case.note))
+    finally:
+        with gl:
+            programs.release()
+        if context is None:
+            gl.release()
+    return report

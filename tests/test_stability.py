@@ -1,0 +1,125 @@
+"""The extreme-case suite (issue: numerical stability) and property-based checks of shade()."""
+import json
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from glphong import reference as ref
+from glphong.key import ProgramKey
+from glphong.probe import shade_points
+from glphong.programs import ProgramCache
+from glphong.stability import CASES, oracle, run_stability
+from glphong.tolerances import FLT_MAX, FLT_MIN, point_band
+
+
+def test_suite_covers_what_the_issue_lists():
+    names = " | ".join(c.name for c in CASES)
+    for q in ("q=0 ", "q=0.5 ", "q=1 ", "q=1000 ", "q=10000 ", "q=100000 ", "q=1e+06 ", "q=1e+07 "):
+        assert f"phong {q}peak" in names and f"blinn {q}near" in names, q
+    for needle in ("grazing light", "grazing view", "light behind", "l = -v", "normal zero", "normal tiny 1e-25",
+                   "normal huge 1e25", "distance 1e-19", "distance 2e+19", "distance 1e+30", "power 1e-40",
+                   "power 3e+38", "all coefficients zero", "8 lights"):
+        assert needle in names, needle
+
+
+def test_float64_twin_agrees_with_the_mpmath_oracle():
+    """The twin's stable formulation is exact to float64 on every case inside the valid range."""
+    for case in CASES:
+        key, uniforms = case.inputs()
+        u64 = {k: v.astype(np.float64) for k, v in uniforms.items()}
+        n_valid, n, _ = ref.safe_normalize(np.asarray([case.normal], dtype=np.float32).astype(np.float64))
+        twin = ref.shade_point(np.zeros((1, 3)), n, n_valid, u64.get("u_eye"), key, u64)[0]
+        expected = oracle(case, key, uniforms)
+        if case.in_range:
+            np.testing.assert_allclose(twin, expected, rtol=1e-9, atol=0, err_msg=case.name)
+
+
+@pytest.fixture(scope="module")
+def stable_reports(session_gl):
+    return run_stability(context=session_gl)
+
+
+def test_stable_formulation_passes_every_case(session_gl):
+    report = run_stability(context=session_gl)
+    failed = [r.case for r in report.rows if not r.passed]
+    assert failed == [], report.format_table()
+    assert report.nan_count == 0 and report.inf_count == 0
+    rows = {r.case: r for r in report.rows}
+    # figures that make the table meaningful: the q = 1e7 lobe next to its peak is resolved to 1e-4
+    assert rows["phong q=1e+07 near"].relative_error < 1e-3
+    assert rows["blinn q=1e+07 tail"].relative_error < 1e-3
+    assert rows["normal NaN"].gpu == pytest.approx(rows["normal NaN"].expected, rel=1e-6)
+    assert rows["kd=(1,0,0) under saturating light"].gpu[1:] == [0.0, 0.0]
+
+
+def test_naive_formulation_fails_where_the_design_says(session_gl):
+    report = run_stability(context=session_gl, formulation="naive")
+    rows = {r.case: r for r in report.rows}
+    assert not rows["phong q=1e+07 near"].passed  # pow(dot(v, r), q) overshoots
+    assert not rows["blinn q=1e+06 peak"].passed
+    assert not rows["distance 1e-19, Phi=1 W"].passed  # d*d underflows
+    assert not rows["normal tiny 1e-25"].passed  # normalize() of a tiny vector
+    assert report.passed_count < len(report.rows) - 20
+
+
+def test_json_output_round_trips(session_gl, tmp_path):
+    report = run_stability(context=session_gl, cases=CASES[:5])
+    data = json.loads(report.to_json())
+    assert data["cases"] == 5 and data["passed"] == 5 and len(data["rows"]) == 5
+    assert data["rows"][0]["case"] == CASES[0].name and len(data["rows"][0]["gpu"]) == 3
+
+
+def test_cli_stability_json(tmp_path, capsys):
+    from glphong.cli import main
+
+    assert main(["stability", "--json", str(tmp_path / "s.json")]) == 0
+    out = capsys.readouterr().out
+    assert f"{len(CASES)}/{len(CASES)} cases inside the tolerance band; 0 NaN and 0 Inf channels" in out
+    assert json.loads((tmp_path / "s.json").read_text())[0]["formulation"] == "stable"
+
+
+# --------------------------------------------------------------------------- properties
+def _random_unit(rng, count):
+    v = rng.normal(size=(count, 3))
+    return v / np.linalg.norm(v, axis=1, keepdims=True)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(lobe=st.sampled_from(["phong", "blinn", None]),
+       log_q=st.floats(-1.0, 7.0), q_zero=st.booleans(),
+       log_d=st.floats(-19.0, 19.0), log_power=st.floats(-30.0, 38.0),
+       log_normal=st.floats(-30.0, 30.0), seed=st.integers(0, 2**32 - 1))
+def test_shade_is_in_band_and_finite(session_gl, lobe, log_q, q_zero, log_d, log_power, log_normal, seed):
+    """Random directions and parameters in the documented ranges: GPU within the band, never NaN or Inf."""
+    rng = np.random.default_rng(seed)
+    count = 256
+    d = 10.0 ** log_d
+    power = min(10.0 ** log_power, 4 * np.pi * FLT_MAX)
+    light = _random_unit(rng, 1)[0] * d
+    eye = _random_unit(rng, 1)[0] * d * rng.uniform(0.5, 2.0)
+    # surface points around the origin, well inside the light's distance
+    positions = (_random_unit(rng, count) * d * rng.uniform(0.0, 0.3, size=(count, 1))).astype(np.float32)
+    normals = (_random_unit(rng, count) * 10.0 ** log_normal).astype(np.float32)
+    key = ProgramKey(output="points", lobe=lobe, has_ka=True, has_diffuse=True, num_point_lights=1, two_sided=False)
+    uniforms = {"u_ka": np.float32([1e-3, 2e-3, 0.0]), "u_kd": np.float32([0.3, 0.0, 0.1]),
+                "u_eye": np.float32(eye), "u_point_position": np.float32([light]),
+                "u_point_intensity": np.float32([[power / (4 * np.pi)] * 3])}
+    if lobe:
+        uniforms["u_ks"] = np.float32([0.5, 1.0, 0.0])
+        uniforms["u_q"] = np.float32(0.0 if q_zero else 10.0 ** log_q)
+    programs = ProgramCache(session_gl.mgl)
+    try:
+        gpu = shade_points(session_gl, programs, key, uniforms, positions, normals).astype(np.float64)
+    finally:
+        with session_gl:
+            programs.release()
+    u64 = {k: np.asarray(v, dtype=np.float64) for k, v in uniforms.items()}
+    n_valid, n, _ = ref.safe_normalize(normals.astype(np.float64))
+    low, high = point_band(key, u64, positions.astype(np.float64), n, n_valid)
+    assert not np.isnan(gpu).any()
+    assert np.isfinite(gpu[np.isfinite(high)]).all()
+    bad = (gpu < low) | (gpu > high)
+    assert not bad.any(), np.c_[gpu, low, high][bad.any(axis=1)][:4]
+    assert (gpu >= FLT_MIN).any() or (high < 1e-30).all() or (low == 0).all()
