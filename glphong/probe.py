@@ -162,7 +162,7 @@ def shade_points(gl, programs, key, uniforms, positions, normals, drop_unused=Fa
     mgl = gl.mgl
     with gl:
         program = programs.get(key)
-        program.bind({k: v for k, v in uniforms.items() if k in program.active} if drop_unused else uniforms)
+        program.bind(uniforms, drop_unused=drop_unused)
         position_buffer, normal_buffer = mgl.buffer(positions.tobytes()), mgl.buffer(normals.tobytes())
         result = mgl.buffer(reserve=max(count, 1) * 12)
         content = [(b, "3f", name) for b, name in ((position_buffer, "in_position"), (normal_buffer, "in_normal"))

@@ -98,7 +98,7 @@ class Program:
             raise ShaderCompileError(f"program {key.describe()!r} failed to build:\n{log}") from None
         self.active = {name: self.gl_program[name] for name in self.gl_program if isinstance(self.gl_program[name], moderngl.Uniform)}
 
-    def bind(self, values):
+    def bind(self, values, drop_unused=False):
         """Set every active uniform from ``values``; anything else is an error.
 
         Parameters
@@ -106,6 +106,10 @@ class Program:
         values : dict of str to array_like
             float32 data per uniform name: shape ``()``, ``(k,)``, ``(k, k)`` (row-major
             matrices, transposed here to GL's column-major) or ``(N, 3)`` for arrays.
+        drop_unused : bool
+            Ignore given uniforms that are not active instead of raising: only for the
+            naive formulation, whose never-failing ``safe_normalize`` lets the compiler
+            remove inputs the stable program reads (e.g. ``u_eye`` of a Lambert program).
 
         Raises
         ------
@@ -114,6 +118,8 @@ class Program:
             program (the key leaves out every uniform it does not use), or the data size
             does not match.
         """
+        if drop_unused:
+            values = {k: v for k, v in values.items() if k in self.active}
         missing = sorted(set(self.active) - set(values))
         unknown = sorted(set(values) - set(self.active))
         if missing or unknown:

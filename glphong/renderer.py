@@ -6,13 +6,14 @@ the program reads are bound; the draw goes to an RGBA32F target that is read bac
 as float32 with row 0 at the top.
 """
 import weakref
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import moderngl
 import numpy as np
 
 from . import _validate
 from .contexts import create_context
+from .key import FORMULATIONS
 from .programs import ProgramCache
 
 __all__ = ["Renderer", "Frame", "GBuffer"]
@@ -106,6 +107,9 @@ class Renderer:
         Image size in pixels, 1 to 16384.
     backend : {'auto', 'egl', 'osmesa'}
         OpenGL backend (see `glphong.contexts.create_context`).
+    formulation : {'stable', 'naive'}
+        'stable' (default): DESIGN section 3.  'naive': the textbook float32 formulation,
+        for measuring what stability costs and buys; not for real use.
 
     Examples
     --------
@@ -113,8 +117,9 @@ class Renderer:
     ...     frame = r.render(scene)
     """
 
-    def __init__(self, width, height, backend="auto"):
+    def __init__(self, width, height, backend="auto", formulation="stable"):
         self._size = self._check_size(width, height)
+        self.formulation = _validate.choice("formulation", formulation, FORMULATIONS)
         self.context = create_context(backend)
         self._mgl = self.context.mgl
         self.programs = ProgramCache(self._mgl)
@@ -188,8 +193,10 @@ class Renderer:
             self._mgl.disable(moderngl.CULL_FACE)
             for index, obj in enumerate(scene.objects):
                 key = scene.program_key(obj, output)
+                if self.formulation != key.formulation:
+                    key = replace(key, formulation=self.formulation)
                 program = self.programs.get(key)
-                program.bind(scene.uniform_values(index, key, aspect))
+                program.bind(scene.uniform_values(index, key, aspect), drop_unused=key.formulation == "naive")
                 self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program).render(moderngl.TRIANGLES)
             images = [np.frombuffer(fbo.read(components=4, attachment=i, dtype="f4"), dtype=np.float32)
                       .reshape(self.height, self.width, 4)[::-1] for i in range(len(fbo.color_attachments))]
