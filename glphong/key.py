@@ -7,7 +7,10 @@ nobody reads are left out of the source.  The numpy twin reads the same key.
 """
 from dataclasses import dataclass, fields
 
-__all__ = ["ProgramKey", "program_key", "gbuffer_key"]
+__all__ = ["ProgramKey", "program_key", "gbuffer_key", "uber_key", "UBER_MAX_LIGHTS"]
+
+#: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
+UBER_MAX_LIGHTS = 8
 
 OUTPUTS = ("radiance", "gbuffer", "points")
 LOBES = (None, "phong", "blinn")
@@ -36,6 +39,9 @@ class ProgramKey:
     formulation : {'stable', 'naive'}
         The stable float32 formulation of DESIGN section 3, or the textbook one (``normalize``,
         ``d*d``, ``pow(dot(v, r), q)``) kept only to show why the stable one exists.
+    uber : bool
+        The uber-shader: every term, both lobes and `UBER_MAX_LIGHTS` lights of each kind
+        compiled in and switched by uniforms.  Kept to measure what specialisation buys.
     """
 
     output: str = "radiance"
@@ -49,6 +55,7 @@ class ProgramKey:
     has_normal: bool = True
     two_sided: bool = True
     formulation: str = "stable"
+    uber: bool = False
 
     def __post_init__(self):
         if self.output not in OUTPUTS or self.lobe not in LOBES or self.formulation not in FORMULATIONS:
@@ -57,7 +64,12 @@ class ProgramKey:
     @property
     def has_specular(self):
         """True when the program evaluates a specular lobe."""
-        return self.lobe is not None
+        return self.lobe is not None or self.uber
+
+    @property
+    def needs_view(self):
+        """True when the program needs the view vector (only the specular lobes read it)."""
+        return self.has_specular
 
     @property
     def num_lights(self):
@@ -75,6 +87,9 @@ class ProgramKey:
             ("OUTPUT_GBUFFER", b(self.output == "gbuffer")),
             ("HAS_NORMAL", b(self.has_normal)),
             ("TWO_SIDED", b(self.two_sided)),
+            ("RUNTIME_SWITCHES", b(self.uber)),
+            # SWITCH(u_flag): a float uniform flag in the uber-shader, the constant true otherwise
+            ("SWITCH(flag)", "((flag) > 0.5)" if self.uber else "true"),
         ]
         if self.output != "gbuffer":
             out += [
@@ -82,18 +97,22 @@ class ProgramKey:
                 ("HAS_KD_LA", b(self.has_kd_la)),
                 ("HAS_DIFFUSE", b(self.has_diffuse)),
                 ("HAS_SPECULAR", b(self.has_specular)),
-                ("NUM_POINT_LIGHTS", str(self.num_point_lights)),
-                ("NUM_UNATTENUATED_LIGHTS", str(self.num_unattenuated_lights)),
-                ("NUM_DIRECTIONAL_LIGHTS", str(self.num_directional_lights)),
+                ("NEEDS_VIEW", b(self.needs_view)),
             ]
+            for kind in ("POINT", "UNATTENUATED", "DIRECTIONAL"):
+                size = getattr(self, f"num_{kind.lower()}_lights")
+                out.append((f"NUM_{kind}_LIGHTS", str(size)))
+                out.append((f"{kind}_LIGHT_COUNT", f"int(u_{kind.lower()}_count)" if self.uber else str(size)))
             if self.has_specular:
-                out.append(("SPECULAR_LOBE", f"{self.lobe}_lobe"))
+                out.append(("SPECULAR_LOBE", "uber_lobe" if self.uber else f"{self.lobe}_lobe"))
         return out
 
     def shading_chunks(self):
         """Chunk files that define ``shade()`` and what it calls: only those the key needs."""
         if self.formulation == "naive":
             return ("naive",) + (("lambert",) if self.has_diffuse else ()) + ("shade",)
+        if self.uber:
+            return ("common", "lights", "lambert", "lobe", "phong", "blinn", "uber", "shade")
         chunks = ["common"]
         if self.num_point_lights:
             chunks.append("lights")
@@ -123,11 +142,14 @@ class ProgramKey:
         return ("out_radiance",) if self.output == "points" else ()
 
     def describe(self):
-        """One line naming every field that is set, e.g. ``radiance phong diffuse 2 point``."""
+        """One line naming every field that is set, e.g. ``radiance lobe=phong has_diffuse num_point_lights=2``."""
+        if self.uber:
+            return (f"{self.output} uber (every term, both lobes, {UBER_MAX_LIGHTS} lights per kind, switched by "
+                    f"uniforms){'' if self.formulation == 'stable' else ' formulation=' + self.formulation}")
         parts = [self.output]
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name != "output" and v not in (False, 0, None):
+            if f.name != "output" and v not in (False, 0, None, "stable"):
                 parts.append(f.name if v is True else f"{f.name}={v}")
         return " ".join(parts)
 
@@ -166,6 +188,14 @@ def program_key(material, light_counts, ambient_radiance, output="radiance"):
         has_normal=lit,
         two_sided=material.two_sided and lit,
     )
+
+
+def uber_key(output="radiance", formulation="stable"):
+    """The uber-shader's key: everything compiled in, switched at run time by uniforms."""
+    return ProgramKey(output=output, lobe=None, has_ka=True, has_kd_la=True, has_diffuse=True,
+                      num_point_lights=UBER_MAX_LIGHTS, num_unattenuated_lights=UBER_MAX_LIGHTS,
+                      num_directional_lights=UBER_MAX_LIGHTS, has_normal=True, two_sided=True,
+                      formulation=formulation, uber=True)
 
 
 def gbuffer_key(material):

@@ -13,7 +13,8 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-__all__ = ["ProgramCache", "Program", "ShaderCompileError", "UniformError", "assemble", "chunk_source"]
+__all__ = ["ProgramCache", "Program", "ShaderCompileError", "UniformError", "assemble", "chunk_source",
+           "effective_source"]
 
 GLSL_VERSION = "#version 330 core"
 
@@ -60,6 +61,61 @@ def assemble(chunks, defines):
         lines.append(f"#line 1 {number}")
         lines.append(chunk_source(name).rstrip("\n"))
     return "\n".join(lines) + "\n"
+
+
+_DIRECTIVE = re.compile(r"^\s*#\s*(if|ifdef|ifndef|elif|else|endif|define)\b(.*)$")
+_IDENTIFIER = re.compile(r"[A-Za-z_]\w*")
+
+
+def _evaluate_condition(expression, defines):
+    """Value of a preprocessor condition over integer object-like defines (undefined names are 0)."""
+    expression = re.sub(r"defined\s*\(?\s*([A-Za-z_]\w*)\s*\)?", lambda m: "1" if m.group(1) in defines else "0", expression)
+    python = _IDENTIFIER.sub(lambda m: str(defines.get(m.group(0), 0)), expression)
+    python = python.replace("&&", " and ").replace("||", " or ").replace("!=", " __ne__ ")
+    python = re.sub(r"!(?!=)", " not ", python).replace(" __ne__ ", "!=")
+    return bool(eval(python, {"__builtins__": {}}, {}))  # noqa: S307 - digits and operators only
+
+
+def effective_source(source):
+    """The source the compiler sees: inactive ``#if`` blocks and ``//`` comments removed.
+
+    Evaluates the integer ``#if``/``#elif``/``#else``/``#endif`` conditions of generated sources
+    (``#define`` lines with integer values are honoured; function-like macros are kept as
+    text).  For reading and testing what a program contains; GLSL compilation itself uses the
+    full source.
+    """
+    defines, out, stack = {}, [], []  # stack entries: [this block active, some branch taken, parent active]
+    for line in source.splitlines():
+        m = _DIRECTIVE.match(line)
+        active = all(entry[0] for entry in stack)
+        if m:
+            word, rest = m.group(1), m.group(2).split("//")[0].strip()
+            if word in ("if", "ifdef", "ifndef"):
+                value = (rest in defines) if word == "ifdef" else (rest not in defines) if word == "ifndef" \
+                    else _evaluate_condition(rest, defines)
+                stack.append([active and value, value, active])
+                continue
+            if word == "elif":
+                top = stack[-1]
+                value = not top[1] and _evaluate_condition(rest, defines)
+                top[0], top[1] = top[2] and value, top[1] or value
+                continue
+            if word == "else":
+                top = stack[-1]
+                top[0], top[1] = top[2] and not top[1], True
+                continue
+            if word == "endif":
+                stack.pop()
+                continue
+            if word == "define" and active:
+                name, _, value = rest.partition(" ")
+                if value.strip().lstrip("-").isdigit():
+                    defines[name] = int(value)
+        if active:
+            code = line.split("//")[0].rstrip()
+            if code.strip():
+                out.append(code)
+    return "\n".join(out) + "\n"
 
 
 _LOCATION = re.compile(r"\b(\d+)([:(])(\d+)")

@@ -16,8 +16,8 @@ import numpy as np
 
 __all__ = [
     "safe_normalize", "point_irradiance", "lambert", "log_one_minus", "lobe_from_delta",
-    "phong_delta", "phong_lobe", "blinn_delta", "blinn_lobe", "BLINN_HALF_FLOOR",
-    "incident_light", "light_response", "shade_point", "shade_inputs", "shade",
+    "phong_delta", "phong_lobe", "blinn_delta", "blinn_lobe", "BLINN_HALF_FLOOR", "uber_lobe",
+    "incident_light", "light_response", "view_direction", "shade_point", "shade_inputs", "shade",
 ]
 
 #: common.glsl FLT_MAX: vectors with a larger (or NaN) component do not normalise
@@ -167,6 +167,19 @@ def blinn_lobe(n, wi, wo, q):
     return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype)
 
 
+# --------------------------------------------------------------------------- uber.glsl
+def uber_lobe(n, wi, wo, q, lobe_kind):
+    """The uber-shader's lobe (uber.glsl): Phong for ``lobe_kind == 1``, Blinn for 2, else 0.
+
+    ``lobe_kind`` is the GLSL uniform ``u_lobe_kind``, passed explicitly.
+    """
+    if lobe_kind == 1:
+        return phong_lobe(n, wi, wo, q)
+    if lobe_kind == 2:
+        return blinn_lobe(n, wi, wo, q)
+    return np.zeros(np.shape(n)[:-1], np.asarray(n).dtype)
+
+
 _LOBES = {"phong": phong_lobe, "blinn": blinn_lobe}
 
 
@@ -222,6 +235,22 @@ def ambient_terms(key, uniforms, shape, dtype):
     return radiance
 
 
+def view_direction(position, n_valid, eye, key):
+    """The head of shade.glsl's light loops: ``v`` where a lobe needs it, and which points are lit.
+
+    Returns
+    -------
+    wo : (N, 3) ndarray
+        Unit vectors toward the eye (0 where the key has no specular lobe: not computed).
+    lit : (N,) bool ndarray
+        Valid normal and, where the view is needed, a valid view direction.
+    """
+    if not key.needs_view:
+        return np.zeros_like(position), n_valid
+    ok_v, wo, _ = safe_normalize(eye - position)
+    return wo, n_valid & ok_v
+
+
 def shade_point(position, n, n_valid, eye, key, uniforms):
     """E6 at each point (shade.glsl's ``shade``).
 
@@ -233,8 +262,8 @@ def shade_point(position, n, n_valid, eye, key, uniforms):
         Unit normals.
     n_valid : (N,) bool ndarray
         False where the normal was zero or not finite: ambient terms only.
-    eye : (3,) ndarray
-        Camera centre [m].
+    eye : (3,) ndarray or None
+        Camera centre [m] (None where the key needs no view vector).
     key, uniforms
         As in `incident_light`.
 
@@ -246,8 +275,7 @@ def shade_point(position, n, n_valid, eye, key, uniforms):
     radiance = ambient_terms(key, uniforms, position.shape, position.dtype)
     if key.num_lights == 0:
         return radiance
-    ok_v, wo, _ = safe_normalize(eye - position)
-    lit = n_valid & ok_v
+    wo, lit = view_direction(position, n_valid, eye, key)
     for valid, wi, irradiance in incident_light(position, key, uniforms):
         n_dot_l = _dot(n, wi)
         gate = (lit & valid & (n_dot_l > 0))[..., None]

@@ -13,7 +13,7 @@ import numpy as np
 
 from . import _validate
 from .contexts import create_context
-from .key import FORMULATIONS
+from .key import FORMULATIONS, uber_key
 from .programs import ProgramCache
 
 __all__ = ["Renderer", "Frame", "GBuffer"]
@@ -110,6 +110,11 @@ class Renderer:
     formulation : {'stable', 'naive'}
         'stable' (default): DESIGN section 3.  'naive': the textbook float32 formulation,
         for measuring what stability costs and buys; not for real use.
+    specialise : bool
+        True (default): one program per distinct `ProgramKey`, containing only what the
+        object needs.  False: every object drawn with the uber-shader (all terms, both
+        lobes, up to 8 lights per kind, switched by uniforms), for measuring what
+        specialisation buys.
 
     Examples
     --------
@@ -117,9 +122,12 @@ class Renderer:
     ...     frame = r.render(scene)
     """
 
-    def __init__(self, width, height, backend="auto", formulation="stable"):
+    def __init__(self, width, height, backend="auto", formulation="stable", specialise=True):
         self._size = self._check_size(width, height)
         self.formulation = _validate.choice("formulation", formulation, FORMULATIONS)
+        if not isinstance(specialise, (bool, np.bool_)):
+            raise TypeError(f"specialise must be a bool, True or False (got {specialise!r})")
+        self.specialise = bool(specialise)
         self.context = create_context(backend)
         self._mgl = self.context.mgl
         self.programs = ProgramCache(self._mgl)
@@ -192,9 +200,7 @@ class Renderer:
             self._mgl.enable(moderngl.DEPTH_TEST)
             self._mgl.disable(moderngl.CULL_FACE)
             for index, obj in enumerate(scene.objects):
-                key = scene.program_key(obj, output)
-                if self.formulation != key.formulation:
-                    key = replace(key, formulation=self.formulation)
+                key = self.program_key(scene, obj, output)
                 program = self.programs.get(key)
                 program.bind(scene.uniform_values(index, key, aspect), drop_unused=key.formulation == "naive")
                 self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program).render(moderngl.TRIANGLES)
@@ -202,6 +208,13 @@ class Renderer:
                       .reshape(self.height, self.width, 4)[::-1] for i in range(len(fbo.color_attachments))]
             self.context.check_error(f"rendering {output}")
         return images
+
+    def program_key(self, scene, obj, output="radiance"):
+        """The key this renderer draws ``obj`` of ``scene`` with (its formulation and specialisation)."""
+        if output == "radiance" and not self.specialise:
+            return uber_key(output, self.formulation)
+        key = scene.program_key(obj, output)
+        return key if key.formulation == self.formulation else replace(key, formulation=self.formulation)
 
     def _target(self, output):
         fbo = self._targets.get(output)

@@ -180,6 +180,8 @@ class Scene:
         dict of str to ndarray
         """
         obj = self._objects[index]
+        if key.uber:
+            return self._uber_uniform_values(index, key, aspect)
         view_projection = self.camera.projection_matrix(aspect) @ self.camera.view_matrix()
         values = {"u_model": obj.pose, "u_view_projection": view_projection}
         if key.has_normal:
@@ -187,8 +189,39 @@ class Scene:
         if key.output == "gbuffer":
             values["u_object_id"] = float(index)
         else:
-            if key.num_lights:
+            if key.num_lights and key.needs_view:
                 values["u_eye"] = self.camera.position
             values.update(obj.material.uniform_values(key))
             values.update(self.light_uniform_values(key))
         return {name: np.asarray(v, dtype=np.float32) for name, v in values.items()}
+
+    def _uber_uniform_values(self, index, key, aspect):
+        """The uber-shader's uniforms: the specialised key's values, its switches, padded light arrays."""
+        from .key import UBER_MAX_LIGHTS
+
+        obj = self._objects[index]
+        spec = self.program_key(obj, key.output)
+        counts = {"point": spec.num_point_lights, "unattenuated": spec.num_unattenuated_lights,
+                  "directional": spec.num_directional_lights}
+        if max(self.light_counts().values()) > UBER_MAX_LIGHTS:
+            raise ValueError(f"the uber-shader takes at most {UBER_MAX_LIGHTS} lights of each kind "
+                             f"(scene has {self.light_counts()})")
+        values = self.uniform_values(index, spec, aspect)
+        values["u_normal_matrix"] = np.asarray(obj.normal_matrix, dtype=np.float32)
+        values["u_eye"] = np.asarray(self.camera.position, dtype=np.float32)
+        material = obj.material
+        zero = np.zeros(3, np.float32)
+        for name, value in (("u_ka", material.ka), ("u_kd", material.kd), ("u_ks", getattr(material, "ks", zero)),
+                            ("u_q", getattr(material, "q", 0.0)), ("u_ambient", self.ambient_radiance or zero)):
+            values.setdefault(name, np.asarray(value, dtype=np.float32))
+        for kind, (_, where_name, value_name) in LIGHT_KINDS.items():
+            for name in (where_name, value_name):
+                padded = np.zeros((UBER_MAX_LIGHTS, 3), np.float32)
+                if counts[kind]:
+                    padded[:counts[kind]] = values[name]
+                values[name] = padded
+            values[f"u_{kind}_count"] = np.float32(counts[kind])
+        flags = {"u_use_ka": spec.has_ka, "u_use_kd_la": spec.has_kd_la, "u_use_diffuse": spec.has_diffuse,
+                 "u_two_sided": spec.two_sided, "u_lobe_kind": {None: 0, "phong": 1, "blinn": 2}[spec.lobe]}
+        values.update({name: np.float32(v) for name, v in flags.items()})
+        return values

@@ -223,8 +223,9 @@ def oracle(case, key, uniforms, digits=60):
         return np.array([float(o) for o in out])
     n = vec(raw_n)
     n = [x / norm(n) for x in n]
-    eye = vec(u["u_eye"])
-    v = [x / norm(eye) for x in eye]
+    if key.has_specular:
+        eye = vec(u["u_eye"])
+        v = [x / norm(eye) for x in eye]
     lights = []
     for j in range(key.num_point_lights):
         p = vec(u["u_point_position"][j])

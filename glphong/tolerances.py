@@ -108,8 +108,8 @@ def point_band(key, u, position, n, n_valid, band=BAND):
     lo, hi = ambient * (1 - band.A * EPS), ambient * (1 + band.A * EPS)
     terms = int(key.has_ka) + int(key.has_kd_la)
     if key.num_lights:
-        ok_v, wo, _ = ref.safe_normalize(u["u_eye"] - position)
-        lit = (n_valid & ok_v)[..., None]
+        wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
+        lit = lit[..., None]
         tol = band.D * EPS
         for valid, wi, irradiance in ref.incident_light(position, key, u):
             terms += 1

@@ -4,18 +4,25 @@
 //   radiance output: vec4(shade(v_position, n, n_valid, u_eye), 1)  [W/(m^2 sr)], linear float;
 //   G-buffer outputs (OUTPUT_GBUFFER): position (world, [m]) with w = object id + 1, and the
 //   normal exactly as shade() would use it (0 where it is invalid), w = 1.
-// Key defines read here: HAS_NORMAL, TWO_SIDED, OUTPUT_GBUFFER.
+// Key defines read here: HAS_NORMAL, TWO_SIDED, OUTPUT_GBUFFER, NEEDS_VIEW, SWITCH(flag).
 
 invariant in vec3 v_position;
 #if HAS_NORMAL
 invariant in vec3 v_normal;
+#endif
+#if TWO_SIDED && RUNTIME_SWITCHES
+uniform float u_two_sided;
 #endif
 #if OUTPUT_GBUFFER
 uniform float u_object_id;
 layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
 #else
+#if NEEDS_VIEW
 uniform vec3 u_eye;
+#else
+const vec3 u_eye = vec3(0.0);  // no specular lobe: shade() never reads the eye
+#endif
 layout(location = 0) out vec4 out_radiance;
 #endif
 
@@ -26,7 +33,7 @@ void main()
 #if HAS_NORMAL
     vec3 n_raw = v_normal;
 #if TWO_SIDED
-    if (!gl_FrontFacing) {
+    if (SWITCH(u_two_sided) && !gl_FrontFacing) {
         n_raw = -n_raw;
     }
 #endif

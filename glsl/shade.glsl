@@ -9,8 +9,13 @@
 // Each light kind is a loop of compile-time length; a kind the scene lacks has no loop at all.
 // Light j contributes nothing unless n.l_j > 0 (tested before anything else is evaluated).
 //
-// Key defines read here: HAS_KA, HAS_KD_LA, HAS_DIFFUSE, HAS_SPECULAR, SPECULAR_LOBE,
-// NUM_POINT_LIGHTS, NUM_UNATTENUATED_LIGHTS, NUM_DIRECTIONAL_LIGHTS.
+// The view vector v is computed only where a specular lobe reads it (NEEDS_VIEW).
+// The uber-shader (uber.glsl before this chunk) compiles every term and reads SWITCH(u_use_*)
+// flags, its lobe (SPECULAR_LOBE = uber_lobe) and the *_LIGHT_COUNT light counts from uniforms.
+//
+// Key defines read here: HAS_KA, HAS_KD_LA, HAS_DIFFUSE, HAS_SPECULAR, NEEDS_VIEW, SPECULAR_LOBE,
+// SWITCH(flag), NUM_{POINT,UNATTENUATED,DIRECTIONAL}_LIGHTS (array sizes) and
+// {POINT,UNATTENUATED,DIRECTIONAL}_LIGHT_COUNT (loop bounds).
 
 #if HAS_KA
 uniform vec3 u_ka;                 // [W/(m^2 sr)]
@@ -42,7 +47,7 @@ vec3 light_response(vec3 n, vec3 wi, vec3 wo, float n_dot_l)
 {
     vec3 f = vec3(0.0);
 #if HAS_DIFFUSE
-    f += lambert(u_kd, n_dot_l);
+    if (SWITCH(u_use_diffuse)) f += lambert(u_kd, n_dot_l);
 #endif
 #if HAS_SPECULAR
     f += u_ks * SPECULAR_LOBE(n, wi, wo, u_q);
@@ -54,23 +59,28 @@ vec3 shade(vec3 position, vec3 n, bool n_valid, vec3 eye)
 {
     vec3 radiance = vec3(0.0);
 #if HAS_KA
-    radiance += u_ka;
+    if (SWITCH(u_use_ka)) radiance += u_ka;
 #endif
 #if HAS_KD_LA
-    radiance += u_kd * u_ambient;
+    if (SWITCH(u_use_kd_la)) radiance += u_kd * u_ambient;
 #endif
 #if NUM_POINT_LIGHTS > 0 || NUM_UNATTENUATED_LIGHTS > 0 || NUM_DIRECTIONAL_LIGHTS > 0
-    vec3 wo;
-    float view_distance;
-    if (!n_valid || !safe_normalize(eye - position, wo, view_distance)) {
+    if (!n_valid) {
         return radiance;
     }
+    vec3 wo = vec3(0.0);
+#if NEEDS_VIEW
+    float view_distance;
+    if (!safe_normalize(eye - position, wo, view_distance)) {
+        return radiance;
+    }
+#endif
     vec3 wi;
     float d;
     float n_dot_l;
 #endif
 #if NUM_POINT_LIGHTS > 0
-    for (int j = 0; j < NUM_POINT_LIGHTS; ++j) {
+    for (int j = 0; j < POINT_LIGHT_COUNT; ++j) {
         if (!safe_normalize(u_point_position[j] - position, wi, d)) continue;
         n_dot_l = dot(n, wi);
         if (!(n_dot_l > 0.0)) continue;
@@ -78,7 +88,7 @@ vec3 shade(vec3 position, vec3 n, bool n_valid, vec3 eye)
     }
 #endif
 #if NUM_UNATTENUATED_LIGHTS > 0
-    for (int j = 0; j < NUM_UNATTENUATED_LIGHTS; ++j) {
+    for (int j = 0; j < UNATTENUATED_LIGHT_COUNT; ++j) {
         if (!safe_normalize(u_unattenuated_position[j] - position, wi, d)) continue;
         n_dot_l = dot(n, wi);
         if (!(n_dot_l > 0.0)) continue;
@@ -86,7 +96,7 @@ vec3 shade(vec3 position, vec3 n, bool n_valid, vec3 eye)
     }
 #endif
 #if NUM_DIRECTIONAL_LIGHTS > 0
-    for (int j = 0; j < NUM_DIRECTIONAL_LIGHTS; ++j) {
+    for (int j = 0; j < DIRECTIONAL_LIGHT_COUNT; ++j) {
         wi = u_directional_direction[j];
         n_dot_l = dot(n, wi);
         if (!(n_dot_l > 0.0)) continue;

@@ -7,7 +7,11 @@
 
 in vec3 in_position;
 in vec3 in_normal;
+#if NEEDS_VIEW
 uniform vec3 u_eye;
+#else
+const vec3 u_eye = vec3(0.0);  // no specular lobe: shade() never reads the eye
+#endif
 out vec3 out_radiance;
 
 void main()

@@ -6,7 +6,7 @@ import pytest
 import trimesh
 
 import glphong
-from glphong.key import ProgramKey
+from glphong.key import ProgramKey, uber_key
 from glphong.programs import Program, ShaderCompileError, UniformError, _name_chunks
 
 BACKENDS = ("egl", "osmesa")
@@ -239,13 +239,30 @@ def test_name_chunks_rewrites_both_log_formats():
 
 def test_specialised_sources_leave_out_unused_code():
     lambert = ProgramKey(output="radiance", has_diffuse=True, num_point_lights=2)
-    src = Program.__new__(Program)  # source assembly only, no GL
-    from glphong.programs import assemble
-    fragment = assemble(lambert.fragment_chunks(), lambert.defines())
-    assert "lobe_from_delta" not in fragment and "pow(" not in fragment and "blinn" not in fragment
+    from glphong.programs import assemble, effective_source
+    fragment = effective_source(assemble(lambert.fragment_chunks(), lambert.defines()))
+    for absent in ("lobe_from_delta", "log_one_minus", "pow(", "phong", "blinn", "uber", "in_tangent",
+                   "safe_normalize(eye"):
+        assert absent not in fragment, absent
+    import re
+    declared = set(re.findall(r"uniform \w+ (\w+)", fragment))
+    assert declared == {"u_kd", "u_point_position", "u_point_intensity"}, declared
     assert "#define NUM_POINT_LIGHTS 2" in fragment and "#line 1 " in fragment
     assert lambert.attributes() == ("in_position", "in_normal")
     unlit = ProgramKey(output="radiance", has_ka=True, has_normal=False, two_sided=False)
     assert unlit.attributes() == ("in_position",)
-    assert "light_response(n, wi" in assemble(unlit.fragment_chunks(), unlit.defines())  # defined but never reached
-    del src
+    unlit_fragment = effective_source(assemble(unlit.fragment_chunks(), unlit.defines()))
+    assert "for (int j" not in unlit_fragment and "safe_normalize(eye" not in unlit_fragment
+    assert "u_ka" in unlit_fragment
+    uber = effective_source(assemble(uber_key().fragment_chunks(), uber_key().defines()))
+    for present in ("phong_lobe", "blinn_lobe", "uber_lobe", "u_use_ka", "u_point_count", "u_eye"):
+        assert present in uber, present
+
+
+def test_effective_source_evaluates_conditions():
+    from glphong.programs import effective_source
+
+    src = "#define A 1\n#define B 0\n#if A && !B\nyes1 // c\n#elif A\nno1\n#else\nno2\n#endif\n" \
+          "#if B\nno3\n#if A\nno4\n#endif\n#elif A > 0 || B\nyes2\n#endif\n#if B\nno5\n#else\nyes3\n#endif\n"
+    lines = effective_source(src).split()
+    assert [w for w in lines if w.startswith(("yes", "no"))] == ["yes1", "yes2", "yes3"]

@@ -104,9 +104,10 @@ def test_shade_is_in_band_and_finite(session_gl, lobe, log_q, q_zero, log_d, log
     normals = (_random_unit(rng, count) * 10.0 ** log_normal).astype(np.float32)
     key = ProgramKey(output="points", lobe=lobe, has_ka=True, has_diffuse=True, num_point_lights=1, two_sided=False)
     uniforms = {"u_ka": np.float32([1e-3, 2e-3, 0.0]), "u_kd": np.float32([0.3, 0.0, 0.1]),
-                "u_eye": np.float32(eye), "u_point_position": np.float32([light]),
+                "u_point_position": np.float32([light]),
                 "u_point_intensity": np.float32([[power / (4 * np.pi)] * 3])}
-    if lobe:
+    if lobe:  # only the lobes read the view vector
+        uniforms["u_eye"] = np.float32(eye)
         uniforms["u_ks"] = np.float32([0.5, 1.0, 0.0])
         uniforms["u_q"] = np.float32(0.0 if q_zero else 10.0 ** log_q)
     programs = ProgramCache(session_gl.mgl)
