@@ -14,6 +14,7 @@ Typical use::
 from . import imaging, radiometry, reference
 from .camera import PerspectiveCamera
 from .contexts import BackendUnavailableError, available_backends, create_context
+from .describe import describe, format_descriptions
 from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
 from .materials import BlinnPhong, Lambert, Material, Phong
 from .renderer import Frame, GBuffer, Renderer
@@ -25,6 +26,6 @@ __version__ = "0.1.0"
 __all__ = [
     "PerspectiveCamera", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
     "Material", "Lambert", "Phong", "BlinnPhong", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
-    "verify", "VerifyReport", "create_context", "available_backends", "BackendUnavailableError",
+    "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
     "imaging", "radiometry", "reference",
 ]

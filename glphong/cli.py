@@ -55,8 +55,19 @@ def _stability(args):
     return 0 if stable.passed_count == len(stable.rows) and stable.nan_count == 0 else 1
 
 
+def _describe(args):
+    from .describe import describe, format_descriptions
+    from .figures import LIGHT_ANGLES, Q_VALUES, phong_examples_scene
+    from .materials import BlinnPhong, Phong
+
+    scenes = [phong_examples_scene(m, q, a) for a in LIGHT_ANGLES for m in (Phong, BlinnPhong) for q in Q_VALUES]
+    print(f"the default scene ('Phong Examples', {len(scenes)} tiles) compiles:")
+    print(format_descriptions(describe(scenes, gbuffer=args.gbuffer), source=args.source))
+    return 0
+
+
 def build_parser():
-    """The argument parser (subcommands: render, stability)."""
+    """The argument parser (subcommands: render, stability, describe)."""
     parser = argparse.ArgumentParser(prog="glphong", description=__doc__.strip().splitlines()[0])
     sub = parser.add_subparsers(dest="command")
     render = sub.add_parser("render", help="render the 'Phong Examples' figure (the default command)")
@@ -73,6 +84,10 @@ def build_parser():
                            help="also run the cases through the textbook pow(dot(v, r), q) shader")
     stability.add_argument("--json", default=None, help="write the table(s) as JSON to this path ('-': stdout only)")
     stability.set_defaults(func=_stability)
+    describe = sub.add_parser("describe", help="list the default scene's programs: keys, chunks, what each leaves out")
+    describe.add_argument("--source", action="store_true", help="print each program's effective fragment source")
+    describe.add_argument("--gbuffer", action="store_true", help="include the G-buffer programs")
+    describe.set_defaults(func=_describe)
     return parser
 
 

@@ -58,7 +58,7 @@ def phong_examples_scene(material_class, q, light_angle_deg, sphere_subdivisions
     camera = PerspectiveCamera.look_at((0.0, 0.0, 4.0), (0.0, 0.0, 0.0), yfov=np.radians(32.0))
     scene = Scene(camera, lights=[PointLight(LIGHT_DISTANCE * direction, power)], ambient=AmbientLight(0.15))
     material = material_class(kd=(0.20, 0.05, 0.035), ks=0.5, q=q)
-    scene.add(unit_sphere(sphere_subdivisions), material)
+    scene.add(unit_sphere(sphere_subdivisions), material, name=f"{material_class.__name__} q={q:g} light {light_angle_deg:g} deg")
     return scene
 
 

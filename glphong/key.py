@@ -141,6 +141,40 @@ class ProgramKey:
         """Transform-feedback outputs of a 'points' program."""
         return ("out_radiance",) if self.output == "points" else ()
 
+    def left_out(self):
+        """What this program does not contain, one readable line per item (list of str)."""
+        if self.output == "gbuffer":
+            return ["all shading code and lights (the G-buffer program writes position and normal only)",
+                    "radiance output"]
+        if self.uber:
+            return ["nothing: the uber-shader compiles every term and switches at run time"]
+        out = []
+        if self.lobe is None:
+            out.append("specular lobe: lobe.glsl, phong.glsl, blinn.glsl, u_ks, u_q (no ks, or no light)")
+        else:
+            other = "blinn" if self.lobe == "phong" else "phong"
+            out.append(f"the other lobe: {other}.glsl")
+        if not self.needs_view:
+            out.append("view vector v = normalize(eye - x) and u_eye (only a lobe reads it)")
+        if not self.has_ka:
+            out.append("ambient term k_a (ka = 0)")
+        if not self.has_kd_la:
+            out.append("ambient term k_d L_a (no AmbientLight, or kd = 0)")
+        if not self.has_diffuse:
+            out.append("Lambert term: lambert.glsl (kd = 0, or no light)")
+        for kind, count in (("point", self.num_point_lights), ("unattenuated", self.num_unattenuated_lights),
+                            ("directional", self.num_directional_lights)):
+            if not count:
+                extra = " and lights.glsl" if kind == "point" else ""
+                out.append(f"{kind}-light loop, its uniform arrays{extra} (no {kind} light reaches this material)")
+        if not self.has_normal:
+            out.append("normal attribute, its upload and the normal matrix (nothing reads a normal)")
+        if not self.two_sided:
+            out.append("two-sided normal flip")
+        out.append("tangent attribute (no anisotropic material)")
+        out.append("G-buffer outputs (they exist only in the G-buffer program)")
+        return out
+
     def describe(self):
         """One line naming every field that is set, e.g. ``radiance lobe=phong has_diffuse num_point_lights=2``."""
         if self.uber:

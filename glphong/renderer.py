@@ -74,19 +74,29 @@ class GBuffer:
 
 
 class _MeshBuffers:
-    """GPU buffers of one MeshData and its vertex arrays per program."""
+    """GPU buffers of one MeshData and its vertex arrays per program.
+
+    A vertex attribute is uploaded the first time a program that reads it draws the mesh:
+    a scene whose programs never read normals (no lights) never uploads them.
+    """
+
+    _SOURCES = {"in_position": "positions", "in_normal": "normals"}
 
     def __init__(self, mgl, mesh):
         self.owner = weakref.ref(mesh)
-        self.buffers = {"in_position": mgl.buffer(mesh.positions.tobytes()),
-                        "in_normal": mgl.buffer(mesh.normals.tobytes())}
+        self.buffers = {}
         self.index_buffer = mgl.buffer(mesh.indices.tobytes())
         self.vertex_arrays = {}
+
+    def buffer(self, mgl, name):
+        if name not in self.buffers:
+            self.buffers[name] = mgl.buffer(getattr(self.owner(), self._SOURCES[name]).tobytes())
+        return self.buffers[name]
 
     def vertex_array(self, mgl, program):
         vao = self.vertex_arrays.get(program.key)
         if vao is None:
-            content = [(self.buffers[name], "3f", name) for name in program.key.attributes()]
+            content = [(self.buffer(mgl, name), "3f", name) for name in program.key.attributes()]
             vao = self.vertex_arrays[program.key] = mgl.vertex_array(
                 program.gl_program, content, self.index_buffer, index_element_size=4)
         return vao
@@ -246,7 +256,7 @@ class Renderer:
 
     def gl_object_count(self):
         """Number of GL objects this renderer holds (programs, buffers, vertex arrays, targets)."""
-        meshes = sum(3 + len(e.vertex_arrays) for e in self._meshes.values())
+        meshes = sum(1 + len(e.buffers) + len(e.vertex_arrays) for e in self._meshes.values())
         targets = sum(2 + len(f.color_attachments) for f in self._targets.values())
         return len(self.programs) + meshes + targets
 

@@ -1,0 +1,93 @@
+"""Introspection: which programs a scene compiles, what each contains and what it leaves out."""
+from dataclasses import dataclass
+
+from .programs import assemble, effective_source
+
+__all__ = ["ProgramDescription", "describe", "format_descriptions"]
+
+
+@dataclass(frozen=True)
+class ProgramDescription:
+    """One distinct program of a scene.
+
+    Attributes
+    ----------
+    key : glphong.key.ProgramKey
+    objects : tuple of str
+        Names of the objects drawn with it.
+    vertex_chunks, fragment_chunks : tuple of str
+        Chunk files assembled, in order.
+    defines : list of (str, str)
+        The generated ``#define`` lines.
+    left_out : list of str
+        What the program does not contain.
+    vertex_source, fragment_source : str
+        The generated sources, as compiled.
+    """
+
+    key: object
+    objects: tuple
+    vertex_chunks: tuple
+    fragment_chunks: tuple
+    defines: list
+    left_out: list
+    vertex_source: str
+    fragment_source: str
+
+    @property
+    def effective_fragment_source(self):
+        """The fragment source without inactive ``#if`` blocks and comments."""
+        return effective_source(self.fragment_source)
+
+
+def describe(scenes, renderer=None, gbuffer=False):
+    """The distinct programs that rendering ``scenes`` compiles.
+
+    Parameters
+    ----------
+    scenes : Scene or sequence of Scene
+    renderer : glphong.Renderer, optional
+        Describe the keys this renderer uses (its formulation and specialisation); by
+        default the specialised, stable keys.
+    gbuffer : bool
+        Include the G-buffer programs.
+
+    Returns
+    -------
+    list of ProgramDescription
+        In order of first use.
+    """
+    from .scene import Scene
+
+    scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
+    outputs = ("radiance", "gbuffer") if gbuffer else ("radiance",)
+    users = {}
+    for scene in scenes:
+        for obj in scene.objects:
+            for output in outputs:
+                key = renderer.program_key(scene, obj, output) if renderer else scene.program_key(obj, output)
+                users.setdefault(key, []).append(obj.name)
+    out = []
+    for key, names in users.items():
+        defines = key.defines()
+        fragment = assemble(key.fragment_chunks(), defines) if key.fragment_chunks() else ""
+        out.append(ProgramDescription(key, tuple(dict.fromkeys(names)), key.vertex_chunks(), key.fragment_chunks(),
+                                      defines, key.left_out(), assemble(key.vertex_chunks(), defines), fragment))
+    return out
+
+
+def format_descriptions(descriptions, source=False):
+    """Readable text of `describe`'s result; ``source=True`` adds each effective fragment source."""
+    lines = [f"{len(descriptions)} distinct program(s)"]
+    for i, d in enumerate(descriptions, 1):
+        users = ", ".join(d.objects[:6]) + (f" and {len(d.objects) - 6} more" if len(d.objects) > 6 else "")
+        lines += [f"\n[{i}] {d.key.describe()}", f"    drawn objects: {users}",
+                  f"    vertex chunks:   {' '.join(d.vertex_chunks)}",
+                  f"    fragment chunks: {' '.join(d.fragment_chunks)}",
+                  "    defines:         " + " ".join(f"{n}={v}" for n, v in d.defines),
+                  "    left out:"]
+        lines += [f"      - {item}" for item in d.left_out]
+        if source and d.fragment_source:
+            lines.append("    effective fragment source:")
+            lines += [f"      | {line}" for line in d.effective_fragment_source.splitlines()]
+    return "\n".join(lines)
