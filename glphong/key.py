@@ -7,7 +7,7 @@ nobody reads are left out of the source.  The numpy twin reads the same key.
 """
 from dataclasses import dataclass, fields
 
-__all__ = ["ProgramKey", "program_key", "gbuffer_key", "uber_key", "UBER_MAX_LIGHTS"]
+__all__ = ["ProgramKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "UBER_MAX_LIGHTS"]
 
 #: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
 UBER_MAX_LIGHTS = 8
@@ -42,6 +42,8 @@ class ProgramKey:
     uber : bool
         The uber-shader: every term, both lobes and `UBER_MAX_LIGHTS` lights of each kind
         compiled in and switched by uniforms.  Kept to measure what specialisation buys.
+    shade_per_vertex : bool
+        Gouraud shading: ``shade()`` runs in the vertex stage and its radiance is interpolated.
     """
 
     output: str = "radiance"
@@ -56,6 +58,7 @@ class ProgramKey:
     two_sided: bool = True
     formulation: str = "stable"
     uber: bool = False
+    shade_per_vertex: bool = False
 
     def __post_init__(self):
         if self.output not in OUTPUTS or self.lobe not in LOBES or self.formulation not in FORMULATIONS:
@@ -68,8 +71,9 @@ class ProgramKey:
 
     @property
     def needs_view(self):
-        """True when the program needs the view vector (only the specular lobes read it)."""
-        return self.has_specular
+        """True when the program needs the eye position: a specular lobe reads v, and per-vertex
+        two-sided shading turns the normal toward the eye."""
+        return self.has_specular or (self.shade_per_vertex and self.two_sided and self.has_normal)
 
     @property
     def num_lights(self):
@@ -88,6 +92,7 @@ class ProgramKey:
             ("HAS_NORMAL", b(self.has_normal)),
             ("TWO_SIDED", b(self.two_sided)),
             ("RUNTIME_SWITCHES", b(self.uber)),
+            ("SHADE_PER_VERTEX", b(self.shade_per_vertex)),
             # SWITCH(u_flag): a float uniform flag in the uber-shader, the constant true otherwise
             ("SWITCH(flag)", "((flag) > 0.5)" if self.uber else "true"),
         ]
@@ -127,6 +132,8 @@ class ProgramKey:
         """Chunk files of the vertex stage, in order."""
         if self.output == "points":
             return self.shading_chunks() + ("shade_points",)
+        if self.shade_per_vertex:
+            return self.shading_chunks() + ("mesh_vertex",)
         return ("mesh_vertex",)
 
     def fragment_chunks(self):
@@ -135,6 +142,8 @@ class ProgramKey:
             return ()
         if self.output == "gbuffer":
             return ("common", "mesh_fragment")
+        if self.shade_per_vertex:
+            return ("mesh_fragment",)
         return self.shading_chunks() + ("mesh_fragment",)
 
     def varyings(self):
@@ -224,12 +233,39 @@ def program_key(material, light_counts, ambient_radiance, output="radiance"):
     )
 
 
-def uber_key(output="radiance", formulation="stable"):
+def uber_key(output="radiance", formulation="stable", shade_per_vertex=False):
     """The uber-shader's key: everything compiled in, switched at run time by uniforms."""
     return ProgramKey(output=output, lobe=None, has_ka=True, has_kd_la=True, has_diffuse=True,
                       num_point_lights=UBER_MAX_LIGHTS, num_unattenuated_lights=UBER_MAX_LIGHTS,
                       num_directional_lights=UBER_MAX_LIGHTS, has_normal=True, two_sided=True,
-                      formulation=formulation, uber=True)
+                      formulation=formulation, uber=True, shade_per_vertex=shade_per_vertex)
+
+
+@dataclass(frozen=True)
+class EncodeKey:
+    """Key of the 8-bit output pass (encode.glsl): box filter of ``supersample``^2 texels,
+    exposure, exact sRGB curve."""
+
+    supersample: int = 1
+
+    def defines(self):
+        """The generated ``#define`` lines."""
+        return [("SUPERSAMPLE", str(self.supersample))]
+
+    def vertex_chunks(self):
+        return ("fullscreen_vertex",)
+
+    def fragment_chunks(self):
+        return ("encode",)
+
+    def varyings(self):
+        return ()
+
+    def attributes(self):
+        return ()
+
+    def describe(self):
+        return f"encode srgb8 supersample={self.supersample}"
 
 
 def gbuffer_key(material):

@@ -181,7 +181,8 @@ class Program:
         if missing or unknown:
             raise UniformError(f"program {self.key.describe()!r}: missing uniforms {missing}, unknown uniforms {unknown}")
         for name, uniform in self.active.items():
-            data = np.asarray(values[name], dtype=np.float32)
+            # float uniforms take float32; samplers and int uniforms ('1i' formats) take int32
+            data = np.asarray(values[name], dtype=np.int32 if uniform.fmt.endswith("i") else np.float32)
             if data.ndim == 2 and data.shape[0] == data.shape[1] and uniform.dimension == data.size:
                 data = data.T
             expected = uniform.array_length * uniform.dimension

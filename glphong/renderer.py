@@ -13,7 +13,7 @@ import numpy as np
 
 from . import _validate
 from .contexts import create_context
-from .key import FORMULATIONS, uber_key
+from .key import FORMULATIONS, EncodeKey, uber_key
 from .programs import ProgramCache
 
 __all__ = ["Renderer", "Frame", "GBuffer"]
@@ -26,13 +26,18 @@ class Frame:
     Attributes
     ----------
     radiance : (H, W, 3) float32 ndarray
-        Linear radiance [W/(m^2 sr)], row 0 at the top, never clamped.
+        Linear radiance [W/(m^2 sr)], row 0 at the top, never clamped.  With multisampling
+        or supersampling, pixels on silhouettes hold the coverage-weighted average (the
+        background counts as 0).
     mask : (H, W) bool ndarray
-        Pixels covered by geometry.
+        Pixels covered by geometry (any sample).
+    coverage : (H, W) float32 ndarray
+        Fraction of the pixel's samples covered by geometry (0 or 1 with one sample).
     """
 
     radiance: np.ndarray
     mask: np.ndarray
+    coverage: np.ndarray = None
 
     def to_srgb8(self, exposure=1.0):
         """8-bit sRGB image, (H, W, 3) uint8 (see `glphong.imaging.encode_srgb8`)."""
@@ -117,6 +122,16 @@ class Renderer:
         Image size in pixels, 1 to 16384.
     backend : {'auto', 'egl', 'osmesa'}
         OpenGL backend (see `glphong.contexts.create_context`).
+    shading : {'pixel', 'vertex'}
+        'pixel' (default): the model is evaluated per fragment.  'vertex': per vertex and
+        interpolated (Gouraud): cheaper, and wrong inside triangles where the radiance is not
+        linear (highlights smaller than a triangle vanish).
+    samples : {1, 2, 4, 8}
+        Multisample anti-aliasing samples per pixel (silhouettes only; shading stays one
+        evaluation per pixel and triangle).  At most the context's GL_MAX_SAMPLES (4 on llvmpipe).
+    supersample : int
+        Render at ``supersample`` times the size in each direction and box-filter down
+        (anti-aliases shading too), 1 to 8.
     formulation : {'stable', 'naive'}
         'stable' (default): DESIGN section 3.  'naive': the textbook float32 formulation,
         for measuring what stability costs and buys; not for real use.
@@ -132,7 +147,11 @@ class Renderer:
     ...     frame = r.render(scene)
     """
 
-    def __init__(self, width, height, backend="auto", formulation="stable", specialise=True):
+    def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
+                 formulation="stable", specialise=True):
+        self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
+        self.samples = _validate.choice("samples", samples, (1, 2, 4, 8))
+        self.supersample = _validate.positive_int("supersample", supersample, 1, 8)
         self._size = self._check_size(width, height)
         self.formulation = _validate.choice("formulation", formulation, FORMULATIONS)
         if not isinstance(specialise, (bool, np.bool_)):
@@ -140,13 +159,21 @@ class Renderer:
         self.specialise = bool(specialise)
         self.context = create_context(backend)
         self._mgl = self.context.mgl
+        if self.samples > self._mgl.max_samples:
+            limit = self._mgl.max_samples
+            self.context.release()
+            raise ValueError(f"samples must be at most this context's GL_MAX_SAMPLES = {limit} "
+                             f"({self.context.renderer_name}) (got {self.samples})")
         self.programs = ProgramCache(self._mgl)
         self._meshes = {}
         self._targets = {}
 
-    @staticmethod
-    def _check_size(width, height):
-        return (_validate.positive_int("width", width, 1, 16384), _validate.positive_int("height", height, 1, 16384))
+    def _check_size(self, width, height):
+        size = (_validate.positive_int("width", width, 1, 16384), _validate.positive_int("height", height, 1, 16384))
+        if max(size) * self.supersample > 16384:
+            raise ValueError(f"width and height times supersample must be at most 16384 "
+                             f"(got {size[0]}x{size[1]} x {self.supersample})")
+        return size
 
     @property
     def width(self):
@@ -163,6 +190,10 @@ class Renderer:
         """Name of the OpenGL backend in use ('egl' or 'osmesa')."""
         return self.context.backend
 
+    @property
+    def _internal_size(self):
+        return (self.width * self.supersample, self.height * self.supersample)
+
     def resize(self, width, height):
         """Change the image size; the render targets are rebuilt on next use."""
         size = self._check_size(width, height)
@@ -172,66 +203,145 @@ class Renderer:
             self._size = size
 
     def render(self, scene):
-        """Render the scene's shaded radiance.
+        """Render the scene's shaded radiance (linear float32).
 
         Returns
         -------
         Frame
         """
-        rgba = self._draw(scene, "radiance")[0]
-        return Frame(radiance=np.ascontiguousarray(rgba[..., :3]), mask=rgba[..., 3] > 0.0)
+        self._check_scene(scene)
+        with self.context:
+            fbo = self._draw_radiance(scene)
+            rgba = self._read(fbo, self._internal_size, components=4)
+            self.context.check_error("rendering radiance")
+        s = self.supersample
+        if s > 1:
+            rgba = rgba.reshape(self.height, s, self.width, s, 4).mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
+        coverage = np.ascontiguousarray(rgba[..., 3])
+        return Frame(radiance=np.ascontiguousarray(rgba[..., :3]), mask=coverage > 0.0, coverage=coverage)
+
+    def render_srgb8(self, scene, exposure=1.0):
+        """Render and encode on the GPU: box filter, exposure, exact sRGB curve, 8 bits.
+
+        The shading pass stays linear float; a separate pass (encode.glsl) encodes, and only
+        8-bit RGB is read back.
+
+        Parameters
+        ----------
+        scene : Scene
+        exposure : float
+            Linear scale applied before encoding, > 0.
+
+        Returns
+        -------
+        (H, W, 3) uint8 ndarray
+            Row 0 at the top.
+        """
+        self._check_scene(scene)
+        exposure = _validate.scalar("exposure", exposure, low=0.0, low_inclusive=False)
+        with self.context:
+            texture = self._draw_radiance(scene).color_attachments[0]
+            out = self._target("srgb8")
+            out.use()
+            program = self.programs.get(EncodeKey(self.supersample))
+            texture.use(location=0)
+            program.bind({"u_radiance": 0, "u_exposure": exposure})
+            self._mgl.disable(moderngl.DEPTH_TEST)
+            self._fullscreen(program).render(moderngl.TRIANGLES, vertices=3)
+            rgb = self._read(out, self._size, components=3, dtype="f1")  # 'f1': normalised bytes
+            self.context.check_error("encoding sRGB")
+        return rgb
 
     def gbuffer(self, scene):
-        """Render the per-pixel shading inputs of the scene.
+        """Render the per-pixel shading inputs of the scene (one sample per pixel, output size).
 
         Returns
         -------
         GBuffer
         """
-        position, normal = self._draw(scene, "gbuffer")
+        self._check_scene(scene)
+        with self.context:
+            fbo = self._target("gbuffer")
+            self._draw(scene, "gbuffer", fbo)
+            position, normal = (self._read(fbo, self._size, components=4, attachment=i) for i in (0, 1))
+            self.context.check_error("rendering the G-buffer")
         mask = position[..., 3] > 0.0
         object_index = np.where(mask, np.rint(position[..., 3]).astype(np.int64) - 1, -1)
         return GBuffer(position=np.ascontiguousarray(position[..., :3]), normal=np.ascontiguousarray(normal[..., :3]),
                        object_index=object_index, mask=mask)
 
-    def _draw(self, scene, output):
+    def program_key(self, scene, obj, output="radiance"):
+        """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading)."""
+        per_vertex = output == "radiance" and self.shading == "vertex"
+        if output == "radiance" and not self.specialise:
+            return uber_key(output, self.formulation, per_vertex)
+        key = scene.program_key(obj, output)
+        if key.formulation != self.formulation or key.shade_per_vertex != per_vertex:
+            key = replace(key, formulation=self.formulation, shade_per_vertex=per_vertex)
+        return key
+
+    def _check_scene(self, scene):
         from .scene import Scene
 
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a glphong.Scene (got {type(scene).__name__})")
         if self.context is None:
             raise RuntimeError("this Renderer has been released")
+
+    def _draw_radiance(self, scene):
+        """Draw the radiance; returns the single-sample framebuffer whose color is a texture."""
+        target = self._target("radiance")
+        self._draw(scene, "radiance", target)
+        if self.samples == 1:
+            return target
+        resolved = self._target("resolve")
+        self._mgl.copy_framebuffer(resolved, target)
+        return resolved
+
+    def _draw(self, scene, output, fbo):
         aspect = self.width / self.height
-        with self.context:
-            self._purge_dead_meshes()
-            fbo = self._target(output)
-            fbo.use()
-            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            self._mgl.enable(moderngl.DEPTH_TEST)
-            self._mgl.disable(moderngl.CULL_FACE)
-            for index, obj in enumerate(scene.objects):
-                key = self.program_key(scene, obj, output)
-                program = self.programs.get(key)
-                program.bind(scene.uniform_values(index, key, aspect), drop_unused=key.formulation == "naive")
-                self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program).render(moderngl.TRIANGLES)
-            images = [np.frombuffer(fbo.read(components=4, attachment=i, dtype="f4"), dtype=np.float32)
-                      .reshape(self.height, self.width, 4)[::-1] for i in range(len(fbo.color_attachments))]
-            self.context.check_error(f"rendering {output}")
-        return images
+        self._purge_dead_meshes()
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        self._mgl.enable(moderngl.DEPTH_TEST)
+        self._mgl.disable(moderngl.CULL_FACE)
+        for index, obj in enumerate(scene.objects):
+            key = self.program_key(scene, obj, output)
+            program = self.programs.get(key)
+            program.bind(scene.uniform_values(index, key, aspect), drop_unused=key.formulation == "naive")
+            self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program).render(moderngl.TRIANGLES)
 
-    def program_key(self, scene, obj, output="radiance"):
-        """The key this renderer draws ``obj`` of ``scene`` with (its formulation and specialisation)."""
-        if output == "radiance" and not self.specialise:
-            return uber_key(output, self.formulation)
-        key = scene.program_key(obj, output)
-        return key if key.formulation == self.formulation else replace(key, formulation=self.formulation)
+    @staticmethod
+    def _read(fbo, size, components, attachment=0, dtype="f4"):
+        data = np.frombuffer(fbo.read(components=components, attachment=attachment, dtype=dtype),
+                             dtype=np.float32 if dtype == "f4" else np.uint8)
+        return data.reshape(size[1], size[0], components)[::-1]
 
-    def _target(self, output):
-        fbo = self._targets.get(output)
-        if fbo is None:
-            count = 2 if output == "gbuffer" else 1
-            colors = [self._mgl.renderbuffer(self._size, 4, dtype="f4") for _ in range(count)]
-            fbo = self._targets[output] = self._mgl.framebuffer(colors, self._mgl.depth_renderbuffer(self._size))
+    def _fullscreen(self, program):
+        vao = self._targets.get(("fullscreen", program.key))
+        if vao is None:
+            vao = self._targets[("fullscreen", program.key)] = self._mgl.vertex_array(program.gl_program, [])
+        return vao
+
+    def _target(self, name):
+        fbo = self._targets.get(name)
+        if fbo is not None:
+            return fbo
+        mgl = self._mgl
+        if name == "gbuffer":
+            colors = [mgl.renderbuffer(self._size, 4, dtype="f4") for _ in range(2)]
+            fbo = mgl.framebuffer(colors, mgl.depth_renderbuffer(self._size))
+        elif name == "radiance" and self.samples > 1:
+            fbo = mgl.framebuffer([mgl.renderbuffer(self._internal_size, 4, samples=self.samples, dtype="f4")],
+                                  mgl.depth_renderbuffer(self._internal_size, samples=self.samples))
+        elif name in ("radiance", "resolve"):
+            texture = mgl.texture(self._internal_size, 4, dtype="f4")
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            depth = mgl.depth_renderbuffer(self._internal_size) if name == "radiance" else None
+            fbo = mgl.framebuffer([texture], depth)
+        else:  # srgb8
+            fbo = mgl.framebuffer([mgl.renderbuffer(self._size, 4)])
+        self._targets[name] = fbo
         return fbo
 
     def _mesh_buffers(self, mesh):
@@ -248,16 +358,22 @@ class Renderer:
 
     def _release_targets(self):
         self.context.bind_idle_framebuffer()
-        for fbo in self._targets.values():
-            for attachment in (*fbo.color_attachments, fbo.depth_attachment):
-                attachment.release()
-            fbo.release()
+        for name, obj in self._targets.items():
+            if isinstance(name, tuple):  # a full-screen vertex array
+                obj.release()
+                continue
+            for attachment in (*obj.color_attachments, obj.depth_attachment):
+                if attachment is not None:
+                    attachment.release()
+            obj.release()
         self._targets.clear()
 
     def gl_object_count(self):
         """Number of GL objects this renderer holds (programs, buffers, vertex arrays, targets)."""
         meshes = sum(1 + len(e.buffers) + len(e.vertex_arrays) for e in self._meshes.values())
-        targets = sum(2 + len(f.color_attachments) for f in self._targets.values())
+        targets = sum(1 if isinstance(name, tuple) else
+                      1 + len(f.color_attachments) + (f.depth_attachment is not None)
+                      for name, f in self._targets.items())
         return len(self.programs) + meshes + targets
 
     def release(self):
@@ -281,4 +397,7 @@ class Renderer:
 
     def __repr__(self):
         state = "released" if self.context is None else self.backend
-        return f"Renderer({self.width}x{self.height}, {state})"
+        options = "".join([f", shading={self.shading!r}" if self.shading != "pixel" else "",
+                           f", samples={self.samples}" if self.samples > 1 else "",
+                           f", supersample={self.supersample}" if self.supersample > 1 else ""])
+        return f"Renderer({self.width}x{self.height}, {state}{options})"

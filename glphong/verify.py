@@ -124,7 +124,17 @@ def verify(scene, renderer, band=BAND):
     Returns
     -------
     VerifyReport
+
+    Raises
+    ------
+    ValueError
+        If the renderer shades per vertex, multisamples or supersamples: the twin reproduces
+        one per-pixel evaluation at each pixel centre, which only ``shading='pixel'``,
+        ``samples=1``, ``supersample=1`` render.
     """
+    if renderer.shading != "pixel" or renderer.samples != 1 or renderer.supersample != 1:
+        raise ValueError("verify needs a Renderer with shading='pixel', samples=1 and supersample=1 "
+                         f"(got {renderer!r}); compare other options with glphong.raycast instead")
     frame = renderer.render(scene)
     gbuffer = renderer.gbuffer(scene)
     ref = reference.shade(scene, gbuffer)

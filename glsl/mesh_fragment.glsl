@@ -1,12 +1,24 @@
-// mesh_fragment.glsl -- fragment stage: per-pixel shading, or the G-buffer of its inputs.
+// mesh_fragment.glsl -- fragment stage: per-pixel shading, the G-buffer of its inputs, or the
+// interpolated per-vertex radiance.
 //
 //   n = safe_normalize(+-v_normal)  (flipped on back faces when TWO_SIDED: two-sided shading);
 //   radiance output: vec4(shade(v_position, n, n_valid, u_eye), 1)  [W/(m^2 sr)], linear float;
+//   SHADE_PER_VERTEX: vec4(v_radiance, 1), the Gouraud-interpolated vertex radiance;
 //   G-buffer outputs (OUTPUT_GBUFFER): position (world, [m]) with w = object id + 1, and the
 //   normal exactly as shade() would use it (0 where it is invalid), w = 1.
-// Key defines read here: HAS_NORMAL, TWO_SIDED, OUTPUT_GBUFFER, NEEDS_VIEW, SWITCH(flag).
+// Key defines read here: HAS_NORMAL, TWO_SIDED, OUTPUT_GBUFFER, SHADE_PER_VERTEX, NEEDS_VIEW,
+// RUNTIME_SWITCHES, SWITCH(flag).
 
 invariant in vec3 v_position;
+#if SHADE_PER_VERTEX
+in vec3 v_radiance;
+layout(location = 0) out vec4 out_radiance;
+
+void main()
+{
+    out_radiance = vec4(v_radiance, 1.0);
+}
+#else
 #if HAS_NORMAL
 invariant in vec3 v_normal;
 #endif
@@ -47,3 +59,4 @@ void main()
     out_radiance = vec4(shade(v_position, n, n_valid, u_eye), 1.0);
 #endif
 }
+#endif

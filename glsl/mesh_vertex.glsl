@@ -1,10 +1,13 @@
-// mesh_vertex.glsl -- vertex stage: object -> world -> clip space.
+// mesh_vertex.glsl -- vertex stage: object -> world -> clip space; per-vertex (Gouraud) shading.
 //
 //   world = M p;  n_world = N n  with N = inverse-transpose of M's 3x3 block (host, float64);
 //   gl_Position = (P V) world.
-// Positions in metres.  The normal is passed on unnormalised; the fragment stage renormalises it.
+// Per-pixel shading (default): the normal is passed on unnormalised; the fragment stage shades.
+// SHADE_PER_VERTEX: v_radiance = shade(world, n, n_valid, u_eye) here, interpolated across the
+//   triangle (Gouraud); the normal is flipped toward the eye when TWO_SIDED (a vertex shader has
+//   no gl_FrontFacing).  Positions in metres, radiance in W/(m^2 sr).
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
-// Key defines read here: HAS_NORMAL.
+// Key defines read here: HAS_NORMAL, SHADE_PER_VERTEX, TWO_SIDED, NEEDS_VIEW, SWITCH(flag).
 
 in vec3 in_position;
 uniform mat4 u_model;
@@ -14,6 +17,18 @@ invariant out vec3 v_position;
 #if HAS_NORMAL
 in vec3 in_normal;
 uniform mat3 u_normal_matrix;
+#endif
+#if SHADE_PER_VERTEX
+out vec3 v_radiance;
+#if NEEDS_VIEW
+uniform vec3 u_eye;
+#else
+const vec3 u_eye = vec3(0.0);  // nothing reads the eye
+#endif
+#if TWO_SIDED && RUNTIME_SWITCHES
+uniform float u_two_sided;
+#endif
+#elif HAS_NORMAL
 invariant out vec3 v_normal;
 #endif
 
@@ -21,7 +36,20 @@ void main()
 {
     vec4 world = u_model * vec4(in_position, 1.0);
     v_position = world.xyz;
+#if SHADE_PER_VERTEX
+    vec3 n = vec3(0.0);
+    bool n_valid = false;
 #if HAS_NORMAL
+    float n_len;
+    n_valid = safe_normalize(u_normal_matrix * in_normal, n, n_len);
+#if TWO_SIDED
+    if (SWITCH(u_two_sided) && dot(n, u_eye - world.xyz) < 0.0) {
+        n = -n;
+    }
+#endif
+#endif
+    v_radiance = shade(world.xyz, n, n_valid, u_eye);
+#elif HAS_NORMAL
     v_normal = u_normal_matrix * in_normal;
 #endif
     gl_Position = u_view_projection * world;
