@@ -11,13 +11,13 @@ Run:  python benchmarks/specialisation.py [--size 1024] [--repeats 15] [--backen
 """
 import argparse
 import json
-import statistics
 import time
 
 import numpy as np
 import trimesh
 
 import glphong
+from glphong.timing import alternating_medians
 
 
 def _scene(materials, lights):
@@ -62,7 +62,6 @@ def main():
     try:
         backend = renderers["specialised"].backend
         for name, scene in scenes().items():
-            times = {k: [] for k in renderers}
             compile_s, first_s = {}, {}
             for k, r in renderers.items():
                 before = r.programs.compile_seconds
@@ -71,12 +70,8 @@ def main():
                 first_s[k] = time.perf_counter() - t
                 compile_s[k] = r.programs.compile_seconds - before
                 r.render(scene)
-            for _ in range(args.repeats):
-                for k, r in renderers.items():
-                    t = time.perf_counter()
-                    r.render(scene)
-                    times[k].append(time.perf_counter() - t)
-            med = {k: statistics.median(v) for k, v in times.items()}
+            med = alternating_medians({k: (lambda r=r: r.render(scene)) for k, r in renderers.items()},
+                                      repeats=args.repeats, warmup=0)
             row = {"scene": name, "size": args.size, "backend": backend,
                    "specialised_ms": 1000 * med["specialised"], "uber_ms": 1000 * med["uber"],
                    "ratio_uber_over_specialised": med["uber"] / med["specialised"],

@@ -8,13 +8,12 @@ The stability table itself comes from ``glphong stability --naive``.
 Run:  python benchmarks/stability_cost.py [--size 1024] [--repeats 15] [--backend egl]
 """
 import argparse
-import statistics
-import time
 
 import numpy as np
 import trimesh
 
 import glphong
+from glphong.timing import alternating_medians
 
 
 def plane_scene(material):
@@ -38,16 +37,9 @@ def main():
     try:
         for name, material in materials.items():
             scene = plane_scene(material)
-            times = {f: [] for f in renderers}
-            for r in renderers.values():
-                r.render(scene)  # warm-up: compile, upload
-                r.render(scene)
-            for _ in range(args.repeats):
-                for f, r in renderers.items():
-                    t = time.perf_counter()
-                    r.render(scene)
-                    times[f].append(time.perf_counter() - t)
-            stable, naive = (statistics.median(times[f]) for f in ("stable", "naive"))
+            medians = alternating_medians({f: (lambda r=r: r.render(scene)) for f, r in renderers.items()},
+                                          repeats=args.repeats, warmup=2)
+            stable, naive = medians["stable"], medians["naive"]
             print(f"{name:12s} {args.size}x{args.size}, 4 point lights on {renderers['stable'].backend}: "
                   f"stable {1000 * stable:.1f} ms, naive {1000 * naive:.1f} ms, ratio stable/naive {stable / naive:.3f}")
     finally:
