@@ -66,8 +66,20 @@ def _describe(args):
     return 0
 
 
+def _bench(args):
+    from .bench import methods, quick_cases, run_bench, standard_cases
+
+    report = run_bench(args.width, args.height, cases=quick_cases() if args.quick else standard_cases(),
+                       method_list=methods(quick=args.quick), repeats=args.repeats, progress=not args.no_progress,
+                       reference_samples=3 if args.quick else 6)
+    print(report.format_tables())
+    for path in report.write(args.out):
+        print(f"wrote {path}")
+    return 0
+
+
 def build_parser():
-    """The argument parser (subcommands: render, stability, describe)."""
+    """The argument parser (subcommands: render, stability, describe, bench)."""
     parser = argparse.ArgumentParser(prog="glphong", description=__doc__.strip().splitlines()[0])
     sub = parser.add_subparsers(dest="command")
     render = sub.add_parser("render", help="render the 'Phong Examples' figure (the default command)")
@@ -88,6 +100,14 @@ def build_parser():
     describe.add_argument("--source", action="store_true", help="print each program's effective fragment source")
     describe.add_argument("--gbuffer", action="store_true", help="include the G-buffer programs")
     describe.set_defaults(func=_describe)
+    bench = sub.add_parser("bench", help="work-precision report: error against run time for every method")
+    bench.add_argument("--width", type=int, default=256)
+    bench.add_argument("--height", type=int, default=192)
+    bench.add_argument("--repeats", type=int, default=5, help="timed repeats per point (median)")
+    bench.add_argument("--quick", action="store_true", help="a tiny configuration (2 scenes, 2 knob values)")
+    bench.add_argument("--out", default="glphong_bench", help="output prefix: PREFIX.csv, PREFIX.json, PREFIX.png")
+    bench.add_argument("--no-progress", action="store_true", help="no progress bar")
+    bench.set_defaults(func=_bench)
     return parser
 
 

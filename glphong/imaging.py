@@ -6,7 +6,7 @@ import numpy as np
 
 from . import _validate
 
-__all__ = ["srgb_encode", "encode_srgb8", "save_png", "save_npy"]
+__all__ = ["srgb_encode", "srgb_decode", "encode_srgb8", "save_png", "save_npy"]
 
 
 def srgb_encode(linear):
@@ -24,6 +24,23 @@ def srgb_encode(linear):
     """
     x = np.clip(np.nan_to_num(np.asarray(linear, dtype=np.float64), nan=0.0), 0.0, 1.0)
     return np.where(x <= 0.0031308, 12.92 * x, 1.055 * np.power(x, 1.0 / 2.4) - 0.055)
+
+
+def srgb_decode(encoded):
+    """Inverse of `srgb_encode` on [0, 1]: ``x / 12.92`` for ``x <= 0.04045``, else ``((x + 0.055) / 1.055)^2.4``.
+
+    Parameters
+    ----------
+    encoded : array_like
+        sRGB-encoded values in [0, 1] (e.g. ``uint8 / 255``).
+
+    Returns
+    -------
+    ndarray of float64
+        Linear values.
+    """
+    x = np.clip(np.asarray(encoded, dtype=np.float64), 0.0, 1.0)
+    return np.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
 
 
 def encode_srgb8(radiance, exposure=1.0):

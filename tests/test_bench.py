@@ -1,0 +1,64 @@
+"""The work-precision report's plumbing on a tiny configuration (the full sweep is a benchmark)."""
+import csv
+import json
+
+import numpy as np
+import pytest
+
+from glphong.bench import BenchCase, Method, methods, quick_cases, run_bench
+
+
+@pytest.fixture(scope="module")
+def tiny_report():
+    cases = [BenchCase("phong", 100.0, 1)]
+    chosen = [m for m in methods(quick=True) if m.kind in ("glphong", "twin", "floor")]
+    chosen = [Method(m.name, m.knob, m.values, m.kind, m.options) for m in chosen]
+    return run_bench(64, 48, cases=cases, method_list=chosen, repeats=1, reference_samples=2,
+                     scaling=True, targets=True, progress=False)
+
+
+def test_every_method_and_knob_produces_a_point(tiny_report):
+    got = {(p["method"], p["knob_value"]) for p in tiny_report.points}
+    want = {(m.name, v) for m in methods(quick=True) if m.kind != "pyrender" for v in m.values}
+    assert got == want
+    for p in tiny_report.points:
+        assert p["seconds"] > 0 and np.isfinite(p["relative_rms"]) and p["interior_pixels"] > 100
+
+
+def test_errors_behave_as_the_methods_promise(tiny_report):
+    err = {(p["method"], p["knob_value"]): p["relative_rms"] for p in tiny_report.points}
+    pixel = "per-pixel GLSL, EGL"
+    assert err[(pixel, 4)] < err[(pixel, 2)]  # finer tessellation converges
+    assert err[("Gouraud GLSL, EGL", 2)] > err[(pixel, 2)]  # per-vertex shading is less accurate
+    # the twins shade the same G-buffer: the same error as the GPU up to float32 rounding
+    for dtype in ("float32", "float64"):
+        twin = err[(f"numpy twin {dtype} (on the GPU G-buffer)", 4)]
+        assert twin == pytest.approx(err[(pixel, 4)], rel=1e-3)
+    assert err[("hand-written moderngl floor, EGL", 4)] == pytest.approx(err[(pixel, 4)], rel=1e-6)
+    assert err[("per-pixel GLSL, OSMesa", 4)] == pytest.approx(err[(pixel, 4)], rel=1e-6)
+
+
+def test_tables_and_files(tiny_report, tmp_path):
+    axes = {row["axis"] for row in tiny_report.scaling}
+    assert axes == {"pixels", "triangles", "lights"}
+    names = " ".join(t["name"] for t in tiny_report.targets)
+    assert "hand-written moderngl floor" in names and "throughput" in names
+    text = tiny_report.format_tables()
+    assert "work-precision points" in text and "scaling" in text
+    paths = tiny_report.write(str(tmp_path / "b"))
+    rows = list(csv.DictReader(open(paths[0])))
+    assert len(rows) == len(tiny_report.points)
+    data = json.load(open(paths[1]))
+    assert {"points", "curves", "scaling", "targets"} <= set(data)
+    from PIL import Image
+
+    assert Image.open(paths[2]).size[0] > 400  # the work-precision diagram
+
+
+def test_quick_cases_and_pyrender_reported_when_missing(monkeypatch):
+    assert len(quick_cases()) == 2
+    only_pyrender = [m for m in methods(quick=True) if m.kind == "pyrender"]
+    monkeypatch.setitem(__import__("sys").modules, "pyrender", None)  # import pyrender -> ImportError
+    report = run_bench(32, 24, cases=quick_cases()[:1], method_list=only_pyrender, repeats=1, reference_samples=1,
+                       scaling=False, targets=False, progress=False)
+    assert report.points == [] and "pyrender is not installed" in report.skipped[0]
