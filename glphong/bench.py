@@ -412,14 +412,21 @@ def speed_targets(repeats=7, quick=False):
     for size in ((128,) if quick else (512, 1024)):
         with Renderer(size, size, backend="egl") as r:
             floor = HandWrittenRenderer(size, size, backend="egl")
+            textbook = HandWrittenRenderer(size, size, backend="egl", shader="textbook")
             try:
                 floor.prepare(scene)
-                t = alternating_medians({"glphong": lambda: r.render(scene), "floor": floor.render}, repeats)
+                textbook.prepare(scene)
+                t = alternating_medians({"glphong": lambda: r.render(scene), "floor": floor.render,
+                                         "textbook": textbook.render}, repeats)
             finally:
                 floor.release()
+                textbook.release()
             rows.append({"name": f"glphong / hand-written moderngl floor, {size}x{size}", "value": t["glphong"] / t["floor"],
                          "unit": "x",
-                         "detail": f"{1000 * t['glphong']:.1f} ms vs {1000 * t['floor']:.1f} ms, float32 readback"})
+                         "detail": f"{1000 * t['glphong']:.1f} ms vs {1000 * t['floor']:.1f} ms, same GLSL, float32 readback"})
+            rows.append({"name": f"glphong / hand-written textbook-shader floor, {size}x{size}",
+                         "value": t["glphong"] / t["textbook"], "unit": "x",
+                         "detail": f"{1000 * t['glphong']:.1f} ms vs {1000 * t['textbook']:.1f} ms: the price of the stable formulation"})
         try:
             from .comparisons import PyrenderRenderer
 
