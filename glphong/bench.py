@@ -302,10 +302,12 @@ def _available(method):
     from .contexts import available_backends
 
     if method.kind == "pyrender":
-        try:
-            import pyrender  # noqa: F401
-        except ImportError as exc:
-            return f"{method.name}: pyrender is not installed ({exc}); pip install 'glphong[pyrender]'"
+        import importlib.util
+        import sys
+
+        # find_spec, not import: importing pyrender before PYOPENGL_PLATFORM is set fixes PyOpenGL to GLX
+        if "pyrender" in sys.modules and sys.modules["pyrender"] is None or importlib.util.find_spec("pyrender") is None:
+            return f"{method.name}: pyrender is not installed; pip install 'glphong[pyrender]'"
     backend = method.options.get("backend", "egl")
     reason = available_backends().get(backend)
     return None if reason is None else f"{method.name}: backend {backend} unavailable: {reason}"
