@@ -367,3 +367,52 @@ def available_backends():
         if ctx is not None:
             ctx.release()
     return report
+
+
+class _CurrentContextLoader:
+    """moderngl loader for a context some other library created and made current.
+
+    Entering and leaving do nothing: the owner keeps the context current.
+    """
+
+    def __init__(self, get_proc_address):
+        self._get_proc_address = get_proc_address
+
+    def load_opengl_function(self, name):
+        return self._get_proc_address(name.encode()) or 0
+
+    def __enter__(self):
+        pass
+
+    def __exit__(self, *exc_info):
+        pass
+
+    def release(self):
+        pass
+
+
+def attach_current(platform):
+    """Wrap the OpenGL context another library made current (e.g. pyrender's), without owning it.
+
+    Parameters
+    ----------
+    platform : {'egl', 'osmesa'}
+        How the current context was created; GL functions are loaded with
+        ``eglGetProcAddress`` or ``OSMesaGetProcAddress``.
+
+    Returns
+    -------
+    moderngl.Context
+        Valid while the owner keeps that context current; releasing it is the owner's job.
+    """
+    if platform == "egl":
+        name = ctypes.util.find_library("EGL") or "libEGL.so.1"
+        get_proc_address = ctypes.CDLL(name).eglGetProcAddress
+        get_proc_address.restype = ctypes.c_void_p
+        get_proc_address.argtypes = [ctypes.c_char_p]
+    elif platform == "osmesa":
+        get_proc_address = _osmesa_library().OSMesaGetProcAddress
+    else:
+        raise ValueError(f"platform must be 'egl' or 'osmesa' (got {platform!r})")
+    moderngl.init_context(_CurrentContextLoader(get_proc_address))
+    return moderngl.get_context()

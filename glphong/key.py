@@ -12,7 +12,7 @@ __all__ = ["ProgramKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", 
 #: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
 UBER_MAX_LIGHTS = 8
 
-OUTPUTS = ("radiance", "gbuffer", "points")
+OUTPUTS = ("radiance", "gbuffer", "points", "display")
 LOBES = (None, "phong", "blinn")
 FORMULATIONS = ("stable", "naive")
 
@@ -23,9 +23,10 @@ class ProgramKey:
 
     Attributes
     ----------
-    output : {'radiance', 'gbuffer', 'points'}
-        Shaded radiance, the G-buffer of shading inputs, or radiance at arbitrary points
-        (a vertex-only program whose ``shade()`` result is captured by transform feedback).
+    output : {'radiance', 'gbuffer', 'points', 'display'}
+        Shaded radiance, the G-buffer of shading inputs, radiance at arbitrary points
+        (a vertex-only program whose ``shade()`` result is captured by transform feedback), or
+        display values (exposure and sRGB applied after shading) for pyrender's 8-bit framebuffer.
     lobe : {None, 'phong', 'blinn'}
         Specular lobe, None when the program has no specular term.
     has_ka, has_kd_la, has_diffuse : bool
@@ -89,6 +90,7 @@ class ProgramKey:
         b = lambda flag: "1" if flag else "0"  # noqa: E731
         out = [
             ("OUTPUT_GBUFFER", b(self.output == "gbuffer")),
+            ("OUTPUT_DISPLAY", b(self.output == "display")),
             ("HAS_NORMAL", b(self.has_normal)),
             ("TWO_SIDED", b(self.two_sided)),
             ("RUNTIME_SWITCHES", b(self.uber)),
@@ -144,6 +146,8 @@ class ProgramKey:
             return ("common", "mesh_fragment")
         if self.shade_per_vertex:
             return ("mesh_fragment",)
+        if self.output == "display":
+            return self.shading_chunks() + ("srgb", "mesh_fragment")
         return self.shading_chunks() + ("mesh_fragment",)
 
     def varyings(self):
@@ -207,7 +211,7 @@ def program_key(material, light_counts, ambient_radiance, output="radiance"):
         Number of lights per kind ('point', 'unattenuated', 'directional').
     ambient_radiance : tuple of 3 float or None
         The scene's ``L_a``.
-    output : {'radiance', 'gbuffer'}
+    output : {'radiance', 'gbuffer', 'points', 'display'}
 
     Returns
     -------
@@ -220,7 +224,7 @@ def program_key(material, light_counts, ambient_radiance, output="radiance"):
     lit = sum(light_counts.values()) > 0 and (has_kd or material.has_specular)
     count = lambda kind: light_counts.get(kind, 0) if lit else 0  # noqa: E731
     return ProgramKey(
-        output="radiance",
+        output=output,
         lobe=material.family if (lit and material.has_specular) else None,
         has_ka=any(c > 0.0 for c in material.ka),
         has_kd_la=has_kd and ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance),
@@ -256,7 +260,7 @@ class EncodeKey:
         return ("fullscreen_vertex",)
 
     def fragment_chunks(self):
-        return ("encode",)
+        return ("srgb", "encode")
 
     def varyings(self):
         return ()

@@ -9,13 +9,13 @@
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
 // Key defines read here: HAS_NORMAL, SHADE_PER_VERTEX, TWO_SIDED, NEEDS_VIEW, SWITCH(flag).
 
-in vec3 in_position;
+layout(location = 0) in vec3 in_position;   // fixed locations: pyrender's vertex arrays use 0 and 1
 uniform mat4 u_model;
 uniform mat4 u_view_projection;
 invariant gl_Position;
 invariant out vec3 v_position;
 #if HAS_NORMAL
-in vec3 in_normal;
+layout(location = 1) in vec3 in_normal;
 uniform mat3 u_normal_matrix;
 #endif
 #if SHADE_PER_VERTEX

@@ -1,0 +1,242 @@
+"""glphong shading inside pyrender scenes.
+
+A pyrender user keeps their scene, camera, lights, nodes and ``OffscreenRenderer``, gives the meshes
+they choose a `GlphongMaterial`, and calls `enable` once on the renderer::
+
+    import os
+    os.environ["PYOPENGL_PLATFORM"] = "egl"          # or "osmesa"; before pyrender is imported
+    import pyrender, trimesh, glphong
+    from glphong.integrations.pyrender import GlphongMaterial, enable
+
+    material = GlphongMaterial(glphong.Phong(kd=0.2, ks=0.5, q=80))
+    scene.add(pyrender.Mesh.from_trimesh(tm, material=material))
+    renderer = pyrender.OffscreenRenderer(640, 480)
+    enable(renderer)                                   # once
+    color, depth = renderer.render(scene)
+
+Primitives with a `GlphongMaterial` are drawn by programs generated from glphong's own chunks and
+`ProgramKey` (output ``'display'``: the same linear shading, then the exposure and the exact sRGB
+curve, since pyrender's framebuffer is 8-bit), with glphong's strict uniform binding; every other
+primitive keeps pyrender's shaders.  Lights map with the units of DESIGN section 2:
+
+- ``pyrender.PointLight(color, intensity)``: intensity I [W/sr] per channel ``color * intensity``,
+  so ``Phi = 4 pi I`` (`glphong.PointLight`);
+- ``pyrender.DirectionalLight(color, intensity)``: irradiance ``E = color * intensity`` [W/m^2],
+  travelling along the node's -Z axis (`glphong.DirectionalLight`);
+- ``scene.ambient_light``: ``L_a`` (`glphong.AmbientLight`);
+- ``pyrender.SpotLight``: refused with a ValueError (the lecture's models have no cone).
+
+Importing this module imports pyrender, so set ``PYOPENGL_PLATFORM`` first (pyrender reads it once).
+pyrender 0.1.45's OSMesa platform needs PyOpenGL >= 3.1.5 (``pip install --no-deps PyOpenGL==3.1.10``).
+"""
+import os
+
+import numpy as np
+import pyrender
+from pyrender.constants import ProgramFlags, RenderFlags
+from pyrender.renderer import Renderer as _PyrenderRenderer
+
+from .. import lights as glphong_lights
+from .._validate import scalar
+from ..camera import PerspectiveCamera
+from ..contexts import attach_current
+from ..geometry import MeshData
+from ..key import program_key
+from ..materials import Material
+from ..programs import ProgramCache
+from ..scene import Scene
+
+__all__ = ["GlphongMaterial", "enable", "glphong_lights_of", "scene_from_pyrender"]
+
+
+class GlphongMaterial(pyrender.Material):
+    """A pyrender material that draws its primitives with a glphong material.
+
+    Parameters
+    ----------
+    material : glphong.Material
+        `Lambert`, `Phong` or `BlinnPhong`.
+    exposure : float
+        Linear scale before the sRGB encoding into pyrender's 8-bit framebuffer, > 0.
+    name : str, optional
+    """
+
+    def __init__(self, material, exposure=1.0, name=None):
+        if not isinstance(material, Material):
+            raise TypeError(f"material must be a glphong material such as glphong.Phong (got {type(material).__name__})")
+        super().__init__(name=name, doubleSided=material.two_sided)
+        self.glphong = material
+        self.exposure = scalar("exposure", exposure, low=0.0, low_inclusive=False)
+
+    def __repr__(self):
+        return f"GlphongMaterial({self.glphong!r}, exposure={self.exposure:g})"
+
+
+def glphong_lights_of(scene):
+    """The glphong lights of a pyrender scene (SI units of DESIGN section 2).
+
+    Returns
+    -------
+    lights : list of glphong lights
+    ambient : glphong.AmbientLight or None
+    """
+    out = []
+    for node in scene.light_nodes:
+        light, pose = node.light, scene.get_pose(node)
+        value = np.asarray(light.color, dtype=np.float64) * float(light.intensity)
+        if isinstance(light, pyrender.SpotLight):
+            raise ValueError(f"pyrender.SpotLight {node.name or ''!r} cannot light glphong materials: the lecture's "
+                             "models have point and directional lights only; use a PointLight or remove it")
+        if isinstance(light, pyrender.PointLight):
+            out.append(glphong_lights.PointLight(pose[:3, 3], 4.0 * np.pi * value))
+        elif isinstance(light, pyrender.DirectionalLight):
+            out.append(glphong_lights.DirectionalLight(-pose[:3, 2], value))
+    ambient = np.asarray(scene.ambient_light, dtype=np.float64)
+    return out, (glphong_lights.AmbientLight(ambient) if np.any(ambient > 0) else None)
+
+
+def _glphong_camera(scene):
+    camera = scene.main_camera_node.camera
+    if not isinstance(camera, pyrender.PerspectiveCamera):
+        raise ValueError(f"glphong materials need a pyrender.PerspectiveCamera (got {type(camera).__name__})")
+    return PerspectiveCamera(camera.yfov, pose=scene.get_pose(scene.main_camera_node),
+                             znear=camera.znear, zfar=camera.zfar if camera.zfar is not None else 1e6)
+
+
+def scene_from_pyrender(scene):
+    """The glphong `Scene` of a pyrender scene's `GlphongMaterial` meshes, camera and lights.
+
+    For rendering the same scene with `glphong.Renderer` (comparison, verification).
+    """
+    lights, ambient = glphong_lights_of(scene)
+    out = Scene(_glphong_camera(scene), lights=lights, ambient=ambient)
+    for node in scene.mesh_nodes:
+        for primitive in node.mesh.primitives:
+            if isinstance(primitive.material, GlphongMaterial):
+                # pyrender keeps indices as float32 (exact below 2^24 vertices)
+                indices = np.rint(np.asarray(primitive.indices, dtype=np.float64)).astype(np.int64).reshape(-1, 3)
+                data = MeshData(primitive.positions, primitive.normals, indices)
+                out.add(data, primitive.material.glphong, pose=scene.get_pose(node), name=node.name)
+    return out
+
+
+class _ProgramAdapter:
+    """A glphong program in the shape pyrender's draw loop expects (``_bind``, ``set_uniform``, ...).
+
+    pyrender sets its own uniforms by name; this adapter keeps the camera ones and, when pyrender
+    sets the model matrix ``M`` (its last call before the draw), binds every glphong uniform
+    strictly.  pyrender's PBR material uniforms do not exist in these programs and are ignored.
+    """
+
+    def __init__(self, program):
+        self.program = program
+        self.material = None
+        self.lights = None
+        self._camera = {}
+
+    def _in_context(self):
+        return True
+
+    def _add_to_context(self):
+        pass
+
+    def _remove_from_context(self):
+        pass
+
+    def _bind(self):
+        from OpenGL.GL import glUseProgram
+
+        glUseProgram(self.program.gl_program.glo)
+
+    def _unbind(self):
+        from OpenGL.GL import glUseProgram
+
+        glUseProgram(0)
+
+    def delete(self):
+        pass
+
+    def set_uniform(self, name, value, unsigned=False):
+        if name in ("V", "P", "cam_pos"):
+            self._camera[name] = np.asarray(value, dtype=np.float64)
+        elif name == "M":
+            self._bind_all(np.asarray(value, dtype=np.float64))
+
+    def _bind_all(self, model):
+        key, material = self.program.key, self.material
+        values = {"u_model": model, "u_view_projection": self._camera["P"] @ self._camera["V"]}
+        if key.has_normal:
+            values["u_normal_matrix"] = np.linalg.inv(model[:3, :3]).T
+        if key.num_lights and key.needs_view:
+            values["u_eye"] = self._camera["cam_pos"]
+        values["u_exposure"] = material.exposure
+        values.update(material.glphong.uniform_values(key))
+        values.update(self.lights.light_uniform_values(key))
+        self.program.bind(values)
+
+
+class _GlphongRenderer(_PyrenderRenderer):
+    """pyrender's renderer, drawing `GlphongMaterial` primitives with glphong programs."""
+
+    def render(self, scene, flags, seg_node_map=None):
+        glphong_scene = None
+        if any(isinstance(p.material, GlphongMaterial) for n in scene.mesh_nodes for p in n.mesh.primitives):
+            lights, ambient = glphong_lights_of(scene)
+            glphong_scene = Scene(_glphong_camera(scene), lights=lights, ambient=ambient)
+        self._glphong_scene = glphong_scene
+        return super().render(scene, flags, seg_node_map)
+
+    def _get_primitive_program(self, primitive, flags, program_flags):
+        material = primitive.material
+        shaded = (program_flags & ProgramFlags.USE_MATERIAL
+                  and not flags & (RenderFlags.DEPTH_ONLY | RenderFlags.FLAT | RenderFlags.SEG))
+        if not (isinstance(material, GlphongMaterial) and shaded):
+            return super()._get_primitive_program(primitive, flags, program_flags)
+        if primitive.normals is None:
+            raise ValueError("a primitive with a GlphongMaterial needs vertex normals")
+        if primitive.poses is not None and len(primitive.poses) > 1:
+            raise ValueError("GlphongMaterial primitives cannot be instanced (primitive.poses has "
+                             f"{len(primitive.poses)} poses); use one mesh node per instance")
+        scene = self._glphong_scene
+        key = program_key(material.glphong, scene.light_counts(), scene.ambient_radiance, output="display")
+        if not hasattr(self, "_glphong_programs"):
+            self._glphong_programs = ProgramCache(attach_current(os.environ.get("PYOPENGL_PLATFORM", "egl")))
+            self._glphong_adapters = {}
+        adapter = self._glphong_adapters.get(key)
+        if adapter is None:
+            adapter = self._glphong_adapters[key] = _ProgramAdapter(self._glphong_programs.get(key))
+        adapter.material, adapter.lights = material, scene
+        return adapter
+
+    def _bind_lighting(self, scene, program, node, flags):
+        if not isinstance(program, _ProgramAdapter):  # glphong programs take their lights from the adapter
+            super()._bind_lighting(scene, program, node, flags)
+
+    def delete(self):
+        if hasattr(self, "_glphong_programs"):
+            self._glphong_programs.release()
+            del self._glphong_programs, self._glphong_adapters
+        super().delete()
+
+
+def enable(renderer):
+    """Let a ``pyrender.OffscreenRenderer`` draw `GlphongMaterial` primitives with glphong's shading.
+
+    Parameters
+    ----------
+    renderer : pyrender.OffscreenRenderer
+        Any live offscreen renderer; meshes with pyrender's own materials are unaffected.
+
+    Returns
+    -------
+    pyrender.OffscreenRenderer
+        The same renderer.
+    """
+    if not isinstance(renderer, pyrender.OffscreenRenderer):
+        raise TypeError(f"renderer must be a pyrender.OffscreenRenderer (got {type(renderer).__name__})")
+    inner = renderer._renderer  # pyrender keeps its scene renderer here; swap its class, keep its state
+    if inner is None:
+        raise ValueError("the OffscreenRenderer has been deleted")
+    if not isinstance(inner, _GlphongRenderer):
+        inner.__class__ = _GlphongRenderer
+    return renderer

@@ -1,0 +1,106 @@
+"""Run in a subprocess by test_pyrender_integration.py: pyrender reads PYOPENGL_PLATFORM once per process.
+
+Usage: python pyrender_embedding_check.py PLATFORM; prints one JSON object of measured values.
+"""
+import json
+import os
+import sys
+
+os.environ["PYOPENGL_PLATFORM"] = sys.argv[1]
+
+import numpy as np  # noqa: E402
+import pyrender  # noqa: E402
+import trimesh  # noqa: E402
+
+import glphong  # noqa: E402
+from glphong.integrations.pyrender import GlphongMaterial, enable, glphong_lights_of, scene_from_pyrender  # noqa: E402
+
+
+def translation(x, y, z):
+    pose = np.eye(4)
+    pose[:3, 3] = (x, y, z)
+    return pose
+
+
+def build_scene():
+    scene = pyrender.Scene(ambient_light=[0.03, 0.03, 0.03], bg_color=[0.0, 0.0, 0.0, 1.0])
+    materials = [glphong.Lambert((0.3, 0.2, 0.1)), glphong.Phong(0.2, 0.6, 60.0), glphong.BlinnPhong((0.1, 0.2, 0.3), 0.5, 300.0)]
+    for x, m in zip((-1.3, 0.0, 1.3), materials):
+        mesh = pyrender.Mesh.from_trimesh(trimesh.creation.icosphere(4, radius=0.55), material=GlphongMaterial(m))
+        scene.add(mesh, pose=translation(x, -0.2, 0.0), name=type(m).__name__)
+    pbr = pyrender.MetallicRoughnessMaterial(baseColorFactor=[0.2, 0.8, 0.2, 1.0], metallicFactor=0.0, roughnessFactor=0.5)
+    scene.add(pyrender.Mesh.from_trimesh(trimesh.creation.icosphere(3, radius=0.3), material=pbr),
+              pose=translation(0.0, 0.85, 0.0), name="pbr")
+    scene.add(pyrender.PerspectiveCamera(yfov=0.8, znear=0.05, zfar=100.0), pose=translation(0.0, 0.0, 4.0))
+    scene.add(pyrender.PointLight(color=[1.0, 0.9, 0.8], intensity=25.0), pose=translation(2.0, 2.0, 3.0))
+    light_pose = np.eye(4)
+    light_pose[:3, :3] = trimesh.transformations.rotation_matrix(-0.6, [1, 0, 0])[:3, :3]
+    scene.add(pyrender.DirectionalLight(color=[0.6, 0.7, 1.0], intensity=0.8), pose=light_pose)
+    return scene, light_pose
+
+
+def main(platform):
+    scene, light_pose = build_scene()
+    width, height = 200, 150
+    renderer = pyrender.OffscreenRenderer(width, height)
+    enable(renderer)
+    color, depth = renderer.render(scene)
+    color2, _ = renderer.render(scene)  # a second frame: programs cached, nothing recompiled
+    programs = renderer._renderer._glphong_programs
+    keys = [k for k in programs.keys()]
+    glphong_scene = scene_from_pyrender(scene)
+    samples = 4 if platform == "egl" else 1  # pyrender multisamples on EGL only
+    with glphong.Renderer(width, height, backend=platform, samples=samples) as g:
+        ours = g.render_srgb8(glphong_scene)
+        frame = g.render(glphong_scene)
+        own_chunks = [g.programs.get(glphong_scene.program_key(o)).key.fragment_chunks() for o in glphong_scene.objects]
+    interior = frame.coverage == 1.0
+    for _ in range(2):  # erode by 2 px: silhouettes are compared apart
+        interior[1:-1, 1:-1] &= interior[:-2, 1:-1] & interior[2:, 1:-1] & interior[1:-1, :-2] & interior[1:-1, 2:]
+    diff = np.abs(ours.astype(int) - color.astype(int)).max(axis=-1)
+    pbr_region = (depth > 0) & ~frame.mask
+    lights, ambient = glphong_lights_of(scene)
+    point = next(light for light in lights if isinstance(light, glphong.PointLight))
+    directional = next(light for light in lights if isinstance(light, glphong.DirectionalLight))
+    result = {
+        "interior_pixels": int(interior.sum()),
+        "interior_max_diff": int(diff[interior].max()),
+        "interior_exact_fraction": float((diff[interior] == 0).mean()),
+        "silhouette_pixels": int((frame.mask & ~interior).sum()),
+        "pbr_pixels": int(pbr_region.sum()),
+        "pbr_green": float(color[pbr_region][:, 1].mean()) if pbr_region.any() else 0.0,
+        "second_frame_identical": bool(np.array_equal(color, color2)),
+        "programs": len(programs), "compiled": programs.misses,
+        "keys": sorted(k.describe() for k in keys),
+        "pyrender_chunks": sorted(set(k.fragment_chunks() for k in keys)),
+        "glphong_chunks": sorted(set(own_chunks)),
+        "point_power": list(point.power),
+        "directional": list(directional.direction), "directional_expected": list(light_pose[:3, 2]),
+        "directional_irradiance": list(directional.irradiance),
+        "ambient": list(ambient.radiance),
+    }
+    # refusals
+    spot = pyrender.Scene()
+    spot.add(pyrender.SpotLight(color=[1, 1, 1], intensity=1.0))
+    try:
+        glphong_lights_of(spot)
+        result["spot"] = "accepted"
+    except ValueError as exc:
+        result["spot"] = str(exc)
+    instanced = pyrender.Scene()
+    poses = np.stack([translation(0, 0, 0), translation(1, 0, 0)])
+    instanced.add(pyrender.Mesh.from_trimesh(trimesh.creation.box(), material=GlphongMaterial(glphong.Lambert(0.5)),
+                                             poses=poses))
+    instanced.add(pyrender.PerspectiveCamera(yfov=0.8), pose=translation(0, 0, 4))
+    instanced.add(pyrender.PointLight(intensity=1.0), pose=translation(0, 0, 4))
+    try:
+        renderer.render(instanced)
+        result["instanced"] = "accepted"
+    except ValueError as exc:
+        result["instanced"] = str(exc)
+    renderer.delete()
+    print(json.dumps(result))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])

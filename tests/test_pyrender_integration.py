@@ -1,0 +1,68 @@
+"""glphong materials inside pyrender scenes, on pyrender's EGL and OSMesa platforms.
+
+pyrender fixes its OpenGL platform once per process, so each platform runs
+`pyrender_embedding_check.py` in a subprocess that reports its measurements as JSON.
+"""
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+if importlib.util.find_spec("pyrender") is None:  # find_spec: importing pyrender here would fix its platform
+    pytest.skip("pyrender is not installed (pip install 'glphong[pyrender]')", allow_module_level=True)
+
+CHECK = Path(__file__).with_name("pyrender_embedding_check.py")
+
+
+@pytest.fixture(scope="module", params=("egl", "osmesa"))
+def measured(request):
+    env = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
+    out = subprocess.run([sys.executable, str(CHECK), request.param], capture_output=True, text=True, timeout=300, env=env)
+    if out.returncode != 0 and "BackendUnavailable" in out.stderr and request.param not in os.environ.get(
+            "GLPHONG_REQUIRE_BACKENDS", ""):
+        pytest.skip(f"{request.param} unavailable: {out.stderr.strip().splitlines()[-1]}")
+    assert out.returncode == 0, out.stderr[-3000:]
+    return request.param, json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_image_agrees_with_glphong_renderer(measured):
+    platform, m = measured
+    assert m["interior_pixels"] > 3000
+    assert m["interior_max_diff"] <= 1  # one 8-bit step after the same sRGB encoding
+    assert m["interior_exact_fraction"] > (0.9 if platform == "egl" else 0.999)
+    assert m["silhouette_pixels"] > 100  # compared apart, not hidden in the interior
+    assert m["second_frame_identical"]
+
+
+def test_pyrender_materials_render_beside_glphong_ones(measured):
+    _, m = measured
+    assert m["pbr_pixels"] > 200 and m["pbr_green"] > 60  # pyrender's own PBR sphere, in green
+
+
+def test_same_chunks_and_keys_as_glphong(measured):
+    _, m = measured
+    assert m["programs"] == 3 and m["compiled"] == 3  # Lambert, Phong, Blinn; the second frame compiled nothing
+    assert all(k.startswith("display") for k in m["keys"])
+    # identical shading chunks; the display output only appends the sRGB chunk before the stage file
+    expected = sorted(tuple(c[:-1]) + ("srgb", c[-1]) for c in map(tuple, m["glphong_chunks"]))
+    assert [tuple(c) for c in m["pyrender_chunks"]] == expected
+
+
+def test_light_units(measured):
+    _, m = measured
+    # pyrender stores colours as float32
+    np.testing.assert_allclose(m["point_power"], 4 * np.pi * 25.0 * np.array([1.0, 0.9, 0.8]), rtol=1e-7)
+    np.testing.assert_allclose(m["directional"], -np.array(m["directional_expected"]), atol=1e-12)
+    np.testing.assert_allclose(m["directional_irradiance"], 0.8 * np.array([0.6, 0.7, 1.0]), rtol=1e-7)
+    np.testing.assert_allclose(m["ambient"], 0.03, rtol=1e-7)
+
+
+def test_refusals_name_the_problem(measured):
+    _, m = measured
+    assert "SpotLight" in m["spot"] and "point and directional" in m["spot"]
+    assert "cannot be instanced" in m["instanced"]
