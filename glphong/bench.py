@@ -396,7 +396,7 @@ def scaling_table(repeats=5, quick=False):
 def speed_targets(repeats=7, quick=False):
     """Frame-time ratios measured in one process: glphong against the hand-written moderngl floor
     (same GLSL, float readback) and against pyrender (4x MSAA, 8-bit output), plus the float64 twin's
-    throughput.
+    throughput.  At least 21 alternating repeats per ratio.
 
     Returns
     -------
@@ -409,6 +409,7 @@ def speed_targets(repeats=7, quick=False):
     from .timing import alternating_medians
 
     rows, skipped = [], []
+    repeats = max(repeats, 21)  # ratios of frames ~10 ms apart need many alternating repeats on 2 shared cores
     case = BenchCase("phong", 100.0, 1)
     scene = case.scene(4)
     for size in ((128,) if quick else (512, 1024)):
