@@ -80,3 +80,18 @@ def test_import_does_not_pull_optional_packages():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "[]"
+
+
+def test_setup_cfg_ships_every_subpackage():
+    """Every package directory of glphong is listed in setup.cfg (the wheel would miss it otherwise)."""
+    import configparser
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    if not (root / "setup.cfg").is_file():
+        pytest.skip("not running from a source checkout")
+    config = configparser.ConfigParser()
+    config.read(root / "setup.cfg")
+    listed = set(config["options"]["packages"].split())
+    found = {".".join(p.parent.relative_to(root).parts) for p in (root / "glphong").rglob("__init__.py")}
+    assert found | {"glphong.glsl"} == listed
