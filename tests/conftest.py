@@ -57,26 +57,39 @@ def make_context():
         ctx.release()
 
 
-@pytest.fixture
-def make_renderer():
-    """Factory ``make_renderer(width, height, backend)``: a `glphong.Renderer`, released at teardown.
-
-    A backend that is unavailable skips the test, or fails it when
-    ``GLPHONG_REQUIRE_BACKENDS`` names it (the semantics of `require_backend`).
-    """
+def _renderer_factory():
+    """``(make, made)``: ``make(width, height, backend, **options)`` opens a `glphong.Renderer` with the
+    skip-or-fail semantics of `require_backend`; ``made`` lists what it opened."""
     from glphong import Renderer
 
     made = []
 
-    def make(width, height, backend):
+    def make(width, height, backend, **options):
         try:
-            renderer = Renderer(width, height, backend=backend)
+            renderer = Renderer(width, height, backend=backend, **options)
         except BackendUnavailableError:
             require_backend(backend).release()  # skips or fails; if it now works, report the original error
             raise
         made.append(renderer)
         return renderer
 
+    return make, made
+
+
+@pytest.fixture
+def make_renderer():
+    """Factory ``make_renderer(width, height, backend, **options)``: a `glphong.Renderer`, released at
+    teardown; an unavailable backend skips the test, or fails it when ``GLPHONG_REQUIRE_BACKENDS`` names it."""
+    make, made = _renderer_factory()
+    yield make
+    for renderer in made:
+        renderer.release()
+
+
+@pytest.fixture(scope="module")
+def module_make_renderer():
+    """`make_renderer` whose renderers live for the whole test module."""
+    make, made = _renderer_factory()
     yield make
     for renderer in made:
         renderer.release()

@@ -13,17 +13,8 @@ BACKENDS = ("egl", "osmesa")
 
 
 @pytest.fixture(scope="module", params=BACKENDS)
-def renderer(request):
-    from glphong.contexts import BackendUnavailableError
-    import os
-    try:
-        r = glphong.Renderer(96, 80, backend=request.param)
-    except BackendUnavailableError as exc:
-        if request.param in os.environ.get("GLPHONG_REQUIRE_BACKENDS", ""):
-            pytest.fail(str(exc))
-        pytest.skip(str(exc))
-    yield r
-    r.release()
+def renderer(request, module_make_renderer):
+    return module_make_renderer(96, 80, request.param)
 
 
 def translation(x, y, z):

@@ -1,5 +1,4 @@
 """Per-scene program specialisation (DESIGN section 5): what is left out, and that it changes nothing."""
-import os
 import subprocess
 import sys
 
@@ -9,23 +8,14 @@ import trimesh
 
 import glphong
 from glphong import reference
-from glphong.contexts import BackendUnavailableError
 from glphong.describe import describe, format_descriptions
 from glphong.key import uber_key
 
 
 @pytest.fixture(scope="module", params=("egl", "osmesa"))
-def renderers(request):
-    try:
-        made = (glphong.Renderer(96, 80, backend=request.param),
-                glphong.Renderer(96, 80, backend=request.param, specialise=False))
-    except BackendUnavailableError as exc:
-        if request.param in os.environ.get("GLPHONG_REQUIRE_BACKENDS", ""):
-            pytest.fail(str(exc))
-        pytest.skip(str(exc))
-    yield made
-    for r in made:
-        r.release()
+def renderers(request, module_make_renderer):
+    return (module_make_renderer(96, 80, request.param),
+            module_make_renderer(96, 80, request.param, specialise=False))
 
 
 def scene_with(*materials, lights=None, ambient=0.05):
