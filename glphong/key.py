@@ -25,7 +25,7 @@ class ProgramKey:
     ----------
     output : {'radiance', 'gbuffer', 'points', 'display'}
         Shaded radiance, the G-buffer of shading inputs, radiance at arbitrary points
-        (a vertex-only program whose ``shade()`` result is captured by transform feedback), or
+        (a vertex-only program whose ``shade_point()`` result is captured by transform feedback), or
         display values (exposure and sRGB applied after shading) for pyrender's 8-bit framebuffer.
     lobe : {None, 'phong', 'blinn'}
         Specular lobe, None when the program has no specular term.
@@ -44,7 +44,7 @@ class ProgramKey:
         The uber-shader: every term, both lobes and `UBER_MAX_LIGHTS` lights of each kind
         compiled in and switched by uniforms.  Kept to measure what specialisation buys.
     shade_per_vertex : bool
-        Gouraud shading: ``shade()`` runs in the vertex stage and its radiance is interpolated.
+        Gouraud shading: ``shade_point()`` runs in the vertex stage and its radiance is interpolated.
     """
 
     output: str = "radiance"
@@ -115,7 +115,7 @@ class ProgramKey:
         return out
 
     def shading_chunks(self):
-        """Chunk files that define ``shade()`` and what it calls: only those the key needs."""
+        """Chunk files that define ``shade_point()`` and what it calls: only those the key needs."""
         if self.formulation == "naive":
             return ("naive",) + (("lambert",) if self.has_diffuse else ()) + ("shade",)
         if self.uber:

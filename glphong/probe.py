@@ -129,7 +129,7 @@ def evaluate(gl, name, **inputs):
 
 
 def shade_points(gl, programs, key, uniforms, positions, normals, drop_unused=False):
-    """Evaluate the GLSL ``shade()`` of a 'points' program at arbitrary points.
+    """Evaluate the GLSL ``shade_point()`` of a 'points' program at arbitrary points.
 
     Parameters
     ----------

@@ -226,7 +226,7 @@ def light_response(n, wi, wo, n_dot_l, key, uniforms):
 
 
 def ambient_terms(key, uniforms, shape, dtype):
-    """``k_a + k_d L_a`` (the head of shade.glsl's ``shade``), broadcast to ``shape``."""
+    """``k_a + k_d L_a`` (the head of shade.glsl's ``shade_point``), broadcast to ``shape``."""
     radiance = np.zeros(shape, dtype)
     if key.has_ka:
         radiance = radiance + uniforms["u_ka"]
@@ -252,7 +252,7 @@ def view_direction(position, n_valid, eye, key):
 
 
 def shade_point(position, n, n_valid, eye, key, uniforms):
-    """E6 at each point (shade.glsl's ``shade``).
+    """E6 at each point (shade.glsl's ``shade_point``).
 
     Parameters
     ----------

@@ -4,7 +4,7 @@ Each `Case` is data: one shading point (surface point at the origin, a raw norma
 position), a material and lights.  Its expected value comes from `oracle`, an independent
 60-digit mpmath evaluation of the textbook model E6 on the very float32 inputs the GPU gets
 (so float64 rounding cannot hide in the expectation).  The GPU evaluates the real GLSL
-``shade()`` at that point through a 'points' program; the float64 twin evaluates its mirror;
+``shade_point()`` at that point through a 'points' program; the float64 twin evaluates its mirror;
 the GPU passes when it lies in the tolerance band around the twin and is neither NaN nor Inf
 where the band is finite.
 

@@ -87,7 +87,7 @@ def lobe_band(delta, q, chord_scale=1.0, band=BAND):
 
 
 def point_band(key, u, position, n, n_valid, band=BAND):
-    """Interval the GPU's ``shade()`` must return at given points.
+    """Interval the GPU's ``shade_point()`` must return at given points.
 
     Parameters
     ----------

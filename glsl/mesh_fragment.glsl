@@ -2,11 +2,11 @@
 // interpolated per-vertex radiance.
 //
 //   n = safe_normalize(+-v_normal)  (flipped on back faces when TWO_SIDED: two-sided shading);
-//   radiance output: vec4(shade(v_position, n, n_valid, u_eye), 1)  [W/(m^2 sr)], linear float;
+//   radiance output: vec4(shade_point(v_position, n, n_valid, u_eye), 1)  [W/(m^2 sr)], linear float;
 //   SHADE_PER_VERTEX: vec4(v_radiance, 1), the Gouraud-interpolated vertex radiance;
 //   OUTPUT_DISPLAY (pyrender's 8-bit framebuffer): vec4(srgb_encode(u_exposure * L), 1);
 //   G-buffer outputs (OUTPUT_GBUFFER): position (world, [m]) with w = object id + 1, and the
-//   normal exactly as shade() would use it (0 where it is invalid), w = 1.
+//   normal exactly as shade_point() would use it (0 where it is invalid), w = 1.
 // Key defines read here: HAS_NORMAL, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW,
 // RUNTIME_SWITCHES, SWITCH(flag).
 
@@ -34,7 +34,7 @@ layout(location = 1) out vec4 out_normal;
 #if NEEDS_VIEW
 uniform vec3 u_eye;
 #else
-const vec3 u_eye = vec3(0.0);  // no specular lobe: shade() never reads the eye
+const vec3 u_eye = vec3(0.0);  // no specular lobe: shade_point() never reads the eye
 #endif
 #if OUTPUT_DISPLAY
 uniform float u_exposure;
@@ -60,9 +60,9 @@ void main()
     out_position = vec4(v_position, u_object_id + 1.0);
     out_normal = vec4(n, 1.0);
 #elif OUTPUT_DISPLAY
-    out_radiance = vec4(srgb_encode(u_exposure * shade(v_position, n, n_valid, u_eye)), 1.0);
+    out_radiance = vec4(srgb_encode(u_exposure * shade_point(v_position, n, n_valid, u_eye)), 1.0);
 #else
-    out_radiance = vec4(shade(v_position, n, n_valid, u_eye), 1.0);
+    out_radiance = vec4(shade_point(v_position, n, n_valid, u_eye), 1.0);
 #endif
 }
 #endif

@@ -3,7 +3,7 @@
 //   world = M p;  n_world = N n  with N = inverse-transpose of M's 3x3 block (host, float64);
 //   gl_Position = (P V) world.
 // Per-pixel shading (default): the normal is passed on unnormalised; the fragment stage shades.
-// SHADE_PER_VERTEX: v_radiance = shade(world, n, n_valid, u_eye) here, interpolated across the
+// SHADE_PER_VERTEX: v_radiance = shade_point(world, n, n_valid, u_eye) here, interpolated across the
 //   triangle (Gouraud); the normal is flipped toward the eye when TWO_SIDED (a vertex shader has
 //   no gl_FrontFacing).  Positions in metres, radiance in W/(m^2 sr).
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
@@ -48,7 +48,7 @@ void main()
     }
 #endif
 #endif
-    v_radiance = shade(world.xyz, n, n_valid, u_eye);
+    v_radiance = shade_point(world.xyz, n, n_valid, u_eye);
 #elif HAS_NORMAL
     v_normal = u_normal_matrix * in_normal;
 #endif

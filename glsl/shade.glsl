@@ -3,7 +3,7 @@
 //   L = k_a + k_d L_a + sum_j [n.l_j > 0] (k_d (n.l_j) + k_s lobe_j) E_j
 //
 // light_response(n, wi, wo, n_dot_l) -> k_d (n.l) + k_s lobe          (the bracket, [1/sr] times cos)
-// shade(position, n, n_valid, eye) -> L [W/(m^2 sr)], RGB, linear, never clamped
+// shade_point(position, n, n_valid, eye) -> L [W/(m^2 sr)], RGB, linear, never clamped
 //   position: world-space surface point [m];  n: unit normal (n_valid false: ambient terms only);
 //   eye: world-space camera centre [m].
 // Each light kind is a loop of compile-time length; a kind the scene lacks has no loop at all.
@@ -55,7 +55,7 @@ vec3 light_response(vec3 n, vec3 wi, vec3 wo, float n_dot_l)
     return f;
 }
 
-vec3 shade(vec3 position, vec3 n, bool n_valid, vec3 eye)
+vec3 shade_point(vec3 position, vec3 n, bool n_valid, vec3 eye)
 {
     vec3 radiance = vec3(0.0);
 #if HAS_KA

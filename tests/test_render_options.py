@@ -33,7 +33,7 @@ def test_primitives_have_exact_normals():
 
 def test_gouraud_misses_narrow_highlights_and_is_exact_for_linear_radiance(backend, make_renderer):
     """Gouraud interpolates vertex radiance: too dim inside a highlight narrower than a triangle, exact
-    where the radiance is linear across triangles; it runs shade() in the vertex stage."""
+    where the radiance is linear across triangles; it runs shade_point() in the vertex stage."""
     scene = sphere_scene(glphong.Phong(0.2, 0.8, 500.0), subdivisions=2)
     pixel = make_renderer(96, 80, backend)
     vertex = make_renderer(96, 80, backend, shading="vertex")

@@ -1,4 +1,4 @@
-"""The extreme-case suite (issue: numerical stability) and property-based checks of shade()."""
+"""The extreme-case suite (issue: numerical stability) and property-based checks of shade_point()."""
 import json
 
 import numpy as np
