@@ -55,7 +55,7 @@ def safe_normalize(x):
         y = np.where(valid[..., None], x / s_safe, 0).astype(x.dtype)
         yy = np.where(valid, _dot(y, y), 1).astype(x.dtype)
         length = np.where(valid, s_safe[..., 0] * np.sqrt(yy), 0).astype(x.dtype)
-        x_hat = (y / np.sqrt(yy)[..., None]).astype(x.dtype)
+        x_hat = (y * (1 / np.sqrt(yy))[..., None]).astype(x.dtype)  # y * inversesqrt(y.y), as in GLSL
     return valid, x_hat, length
 
 
@@ -88,7 +88,10 @@ def lambert(kd, n_dot_l):
 
 # --------------------------------------------------------------------------- lobe.glsl
 def _series_terms(dtype):
-    """Terms of the artanh series for sigma <= 1/3 to reach the dtype's precision."""
+    """Terms of the artanh series: 8 in float32, exactly as lobe.glsl; in float64, as many as
+    sigma <= 1/3 needs to reach its precision (16)."""
+    if np.dtype(dtype) == np.float32:
+        return 8
     eps = np.finfo(dtype).eps
     k = 0
     while (1.0 / 9.0) ** k / (2 * k + 1) > eps / 4:

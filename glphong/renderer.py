@@ -150,7 +150,7 @@ class Renderer:
     def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
                  formulation="stable", specialise=True):
         self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
-        self.samples = _validate.choice("samples", samples, (1, 2, 4, 8))
+        self.samples = _validate.choice("samples", _validate.positive_int("samples", samples, 1, 8), (1, 2, 4, 8))
         self.supersample = _validate.positive_int("supersample", supersample, 1, 8)
         self._size = self._check_size(width, height)
         self.formulation = _validate.choice("formulation", formulation, FORMULATIONS)
@@ -196,6 +196,8 @@ class Renderer:
 
     def resize(self, width, height):
         """Change the image size; the render targets are rebuilt on next use."""
+        if self.context is None:
+            raise RuntimeError("this Renderer has been released")
         size = self._check_size(width, height)
         if size != self._size:
             with self.context:

@@ -774,3 +774,26 @@ def test_render_rejects_non_scene_and_released_renderer(make_renderer):
     camera = glphong.PerspectiveCamera.look_at((0, 0, 1), (0, 0, 0))
     with pytest.raises(RuntimeError, match="released"):
         r.render(glphong.Scene(camera))
+
+
+def test_renderer_samples_must_be_an_integer_choice():
+    with pytest.raises(TypeError, match="samples must be an integer"):
+        glphong.Renderer(8, 8, samples=2.0)
+    with pytest.raises(TypeError, match="samples must be an integer"):
+        glphong.Renderer(8, 8, samples=True)
+    with pytest.raises(ValueError, match="samples must be one of"):
+        glphong.Renderer(8, 8, samples=3)
+
+
+def test_resize_after_release_names_the_problem(make_renderer):
+    r = make_renderer(4, 4, "egl")
+    r.release()
+    with pytest.raises(RuntimeError, match="released"):
+        r.resize(8, 8)
+
+
+def test_float32_twin_uses_the_glsl_series_length():
+    from glphong import reference
+
+    assert reference._series_terms(np.float32) == 8  # lobe.glsl sums 8 terms
+    assert reference._series_terms(np.float64) == 16
