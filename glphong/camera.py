@@ -88,6 +88,40 @@ class PerspectiveCamera:
             [0.0, 0.0, -1.0, 0.0],
         ])
 
+    def sample_rays(self, width, height, offsets=None, rows=None):
+        """World-space rays through sub-pixel positions.
+
+        Parameters
+        ----------
+        width, height : int
+            Image size [px].
+        offsets : (S, 2) array_like, optional
+            Sub-pixel positions ``(ox, oy)`` in pixel units from the pixel's top-left corner,
+            ``ox`` rightwards, ``oy`` downwards (row 0 is the top row).  Default: the centre
+            ``[(0.5, 0.5)]``.
+        rows : slice or array_like of int, optional
+            Only these image rows (default all).
+
+        Returns
+        -------
+        origin : (3,) float64 ndarray
+            The camera centre [m].
+        directions : (R, width, S, 3) float64 ndarray
+            Unit ray directions; R is the number of rows selected.
+        """
+        offsets = np.array([[0.5, 0.5]]) if offsets is None else np.asarray(offsets, dtype=np.float64)
+        if offsets.ndim != 2 or offsets.shape[1] != 2:
+            raise ValueError(f"offsets must have shape (S, 2) (got {offsets.shape})")
+        t = np.tan(self.yfov / 2.0)
+        aspect = width / height
+        j = np.arange(height)[rows if rows is not None else slice(None)]
+        i = np.arange(width)
+        x = ((i[None, :, None] + offsets[None, None, :, 0]) / width * 2.0 - 1.0) * t * aspect
+        y = (1.0 - (j[:, None, None] + offsets[None, None, :, 1]) / height * 2.0) * t
+        x, y = np.broadcast_arrays(x, y)
+        d = np.stack([x, y, -np.ones_like(x)], axis=-1) @ self.pose[:3, :3].T
+        return self.position, d / np.linalg.norm(d, axis=-1, keepdims=True)
+
     def pixel_rays(self, width, height):
         """World-space rays through the pixel centres, row 0 at the top of the image.
 
@@ -98,13 +132,8 @@ class PerspectiveCamera:
         directions : (height, width, 3) float64
             Unit ray directions.
         """
-        t = np.tan(self.yfov / 2.0)
-        aspect = width / height
-        x = ((np.arange(width) + 0.5) / width * 2.0 - 1.0) * t * aspect
-        y = (1.0 - (np.arange(height) + 0.5) / height * 2.0) * t
-        d = np.stack(np.broadcast_arrays(x[None, :], y[:, None], -np.ones((1, 1))), axis=-1)
-        d = d @ self.pose[:3, :3].T
-        return self.position, d / np.linalg.norm(d, axis=-1, keepdims=True)
+        origin, directions = self.sample_rays(width, height)
+        return origin, directions[:, :, 0]
 
     def __repr__(self):
         return f"PerspectiveCamera(yfov={self.yfov:.6g}, position={tuple(self.position)}, znear={self.znear:g}, zfar={self.zfar:g})"

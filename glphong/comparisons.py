@@ -183,10 +183,7 @@ class HandWrittenRenderer:
         for program in self._programs.values():
             program.release()
         if self._fbo is not None:
-            self.context.bind_idle_framebuffer()
-            for attachment in (*self._fbo.color_attachments, self._fbo.depth_attachment):
-                attachment.release()
-            self._fbo.release()
+            self.context.release_framebuffer(self._fbo)
         self._programs, self._buffers, self._vaos, self._draws, self._fbo = {}, [], [], (), None
 
     def release(self):

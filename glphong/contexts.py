@@ -135,6 +135,18 @@ class GLContext:
             self._idle_framebuffer = self.mgl.framebuffer([self.mgl.renderbuffer((1, 1))])
         self._idle_framebuffer.use()
 
+    def release_framebuffer(self, fbo):
+        """Release a framebuffer and its attachments; call with the context entered.
+
+        The idle framebuffer is bound first, so the released one does not stay bound (see
+        `bind_idle_framebuffer`).
+        """
+        self.bind_idle_framebuffer()
+        for attachment in (*fbo.color_attachments, fbo.depth_attachment):
+            if attachment is not None:
+                attachment.release()
+        fbo.release()
+
     def release(self):
         """Destroy the context.  Calling it again does nothing."""
         if self._released:

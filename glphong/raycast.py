@@ -9,10 +9,9 @@ work-precision benchmark (error of a render vs its cost).
 
 Conventions
 -----------
-- Rays: `camera_rays` is `PerspectiveCamera.pixel_rays` with sub-pixel offsets: pixel
-  (row j, column i) with row 0 at the top, offset ``(ox, oy)`` in pixel units measured
-  rightwards and downwards from the pixel's top-left corner; ``(0.5, 0.5)`` is the pixel
-  centre and reproduces ``pixel_rays`` exactly.  `render_reference` uses the stratified
+- Rays: `PerspectiveCamera.sample_rays`: pixel (row j, column i) with row 0 at the top,
+  offset ``(ox, oy)`` in pixel units measured rightwards and downwards from the pixel's
+  top-left corner; ``(0.5, 0.5)`` is the pixel centre (`PerspectiveCamera.pixel_rays`).  `render_reference` uses the stratified
   regular grid ``((i + 0.5)/n, (j + 0.5)/n)``, ``i, j = 0..n-1`` (`stratified_offsets`).
 - Hits: the nearest intersection with ``t > 1e-12`` wins.  As the rasteriser clips, only
   hits whose depth along the camera's viewing axis lies in ``[znear, zfar]`` count.
@@ -43,7 +42,7 @@ from .materials import Material
 from .reference import safe_normalize, shade_point
 from .scene import Scene
 
-__all__ = ["Sphere", "Plane", "AnalyticObject", "RayCastImage", "stratified_offsets", "camera_rays",
+__all__ = ["Sphere", "Plane", "AnalyticObject", "RayCastImage", "stratified_offsets",
            "render_reference", "compare_to_reference", "T_MIN", "CHUNK_RAYS"]
 
 #: hits at ``t <= T_MIN`` (in units of the ray direction's length) are ignored
@@ -269,42 +268,6 @@ def stratified_offsets(n):
     return np.stack([ox.ravel(), oy.ravel()], axis=-1)
 
 
-def camera_rays(camera, width, height, offsets=None, rows=None):
-    """World-space rays through sub-pixel positions: `PerspectiveCamera.pixel_rays` with offsets.
-
-    Parameters
-    ----------
-    camera : PerspectiveCamera
-    width, height : int
-        Image size [px].
-    offsets : (S, 2) array_like, optional
-        Sub-pixel positions ``(ox, oy)`` in pixel units from the pixel's top-left corner,
-        ``ox`` rightwards, ``oy`` downwards (row 0 is the top row).  Default: the centre
-        ``[(0.5, 0.5)]``, which reproduces ``pixel_rays``.
-    rows : slice or array_like of int, optional
-        Only these image rows (default all).
-
-    Returns
-    -------
-    origin : (3,) float64 ndarray
-        The camera centre [m].
-    directions : (R, width, S, 3) float64 ndarray
-        Unit ray directions; R is the number of rows selected.
-    """
-    offsets = np.array([[0.5, 0.5]]) if offsets is None else np.asarray(offsets, dtype=np.float64)
-    if offsets.ndim != 2 or offsets.shape[1] != 2:
-        raise ValueError(f"offsets must have shape (S, 2) (got {offsets.shape})")
-    t = np.tan(camera.yfov / 2.0)
-    aspect = width / height
-    j = np.arange(height)[rows if rows is not None else slice(None)]
-    i = np.arange(width)
-    x = ((i[None, :, None] + offsets[None, None, :, 0]) / width * 2.0 - 1.0) * t * aspect
-    y = (1.0 - (j[:, None, None] + offsets[None, None, :, 1]) / height * 2.0) * t
-    x, y = np.broadcast_arrays(x, y)
-    d = np.stack([x, y, -np.ones_like(x)], axis=-1) @ camera.pose[:3, :3].T
-    return camera.position, d / np.linalg.norm(d, axis=-1, keepdims=True)
-
-
 def _dummy_mesh():
     return MeshData([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], [[0.0, 0.0, 1.0]] * 3, [[0, 1, 2]])
 
@@ -368,7 +331,7 @@ def render_reference(camera, objects, lights=(), ambient=None, width=256, height
     rows_per_chunk = max(1, CHUNK_RAYS // (width * s))
     for r0 in range(0, height, rows_per_chunk):
         rows = slice(r0, min(r0 + rows_per_chunk, height))
-        _, d = camera_rays(camera, width, height, offsets, rows)
+        _, d = camera.sample_rays(width, height, offsets, rows)
         shape = d.shape[:-1]  # (R, W, S)
         d = d.reshape(-1, 3)
         # the rasteriser keeps depths (along the viewing axis) in [znear, zfar]

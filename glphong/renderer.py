@@ -359,15 +359,11 @@ class Renderer:
             self._meshes.pop(mesh_id).release()
 
     def _release_targets(self):
-        self.context.bind_idle_framebuffer()
         for name, obj in self._targets.items():
             if isinstance(name, tuple):  # a full-screen vertex array
                 obj.release()
-                continue
-            for attachment in (*obj.color_attachments, obj.depth_attachment):
-                if attachment is not None:
-                    attachment.release()
-            obj.release()
+            else:
+                self.context.release_framebuffer(obj)
         self._targets.clear()
 
     def gl_object_count(self):

@@ -19,6 +19,7 @@ import numpy as np
 
 from .key import ProgramKey
 from .tolerances import FLT_MAX, FLT_MIN, point_band
+from .verify import relative_error
 
 __all__ = ["Case", "CASES", "VALID_RANGES", "oracle", "StabilityRow", "StabilityReport", "run_stability"]
 
@@ -318,13 +319,6 @@ class StabilityReport:
         return "\n".join(lines)
 
 
-def _relative(a, b):
-    a, b = np.asarray(a, dtype=np.float64), np.asarray(b, dtype=np.float64)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rel = np.where(a == b, 0.0, np.abs(a - b) / np.abs(b))
-    return float(np.nanmax(np.where(np.isnan(rel), np.inf, rel)))
-
-
 def run_stability(backend="auto", formulation="stable", cases=CASES, context=None):
     """Run the suite on a backend.
 
@@ -370,7 +364,7 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
                 width = np.where(twin > 0, (high - low) / twin, 0.0)
             report.rows.append(StabilityRow(
                 case.name, case.group, gpu.tolist(), expected.tolist(), twin.tolist(), low.tolist(), high.tolist(),
-                _relative(gpu, expected), float(np.nanmax(width)), bool(ok), int(np.isnan(gpu).sum()),
+                float(np.max(np.nan_to_num(relative_error(gpu, expected), nan=np.inf))), float(np.nanmax(width)), bool(ok), int(np.isnan(gpu).sum()),
                 int(np.isinf(gpu).sum()), case.in_range, case.note))
     finally:
         with gl:

@@ -6,7 +6,7 @@ import numpy as np
 from . import reference
 from .tolerances import BAND, radiance_band
 
-__all__ = ["VerifyReport", "verify", "compare"]
+__all__ = ["VerifyReport", "verify", "compare", "relative_error"]
 
 
 @dataclass(frozen=True)
@@ -88,6 +88,24 @@ class VerifyReport:
                 f"non-finite {s['nonfinite']}, mask mismatch {s['mask_mismatch']}")
 
 
+def relative_error(value, reference):
+    """Elementwise ``|value - reference| / |reference|``: 0 where the two are equal (0 against 0
+    included), ``inf`` where only the reference is 0.
+
+    Parameters
+    ----------
+    value, reference : array_like, same shape
+
+    Returns
+    -------
+    ndarray of float64
+    """
+    value = np.asarray(value, dtype=np.float64)
+    reference = np.asarray(reference, dtype=np.float64)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(value == reference, 0.0, np.abs(value - reference) / np.abs(reference))
+
+
 def compare(gpu, reference_radiance, low, high, mask):
     """Relative error map and out-of-band pixels of ``gpu`` against the twin.
 
@@ -103,10 +121,7 @@ def compare(gpu, reference_radiance, low, high, mask):
     outside : (H, W) bool ndarray
     """
     g = gpu.astype(np.float64)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rel = np.abs(g - reference_radiance) / np.abs(reference_radiance)
-    rel = np.where((g == reference_radiance), 0.0, rel)
-    rel = np.where(mask[..., None], rel, np.nan)
+    rel = np.where(mask[..., None], relative_error(g, reference_radiance), np.nan)
     in_band = (g >= low) & (g <= high)
     outside = mask & ~np.all(in_band, axis=-1)
     return rel, outside

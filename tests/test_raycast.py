@@ -19,7 +19,7 @@ import pytest
 import trimesh
 
 import glphong
-from glphong.raycast import (AnalyticObject, Plane, RayCastImage, Sphere, camera_rays, compare_to_reference,
+from glphong.raycast import (AnalyticObject, Plane, RayCastImage, Sphere, compare_to_reference,
                              render_reference, stratified_offsets)
 
 
@@ -31,22 +31,26 @@ def scale_px(camera, height):
 # --------------------------------------------------------------------------- rays and shapes
 
 
-def test_camera_rays_reproduce_pixel_rays_and_offsets():
+def test_sample_rays_centres_corners_and_rows():
     camera = glphong.PerspectiveCamera.look_at((0.4, -0.3, 2.0), (0.1, 0.2, 0.0), yfov=0.9)
     w, h = 37, 23
-    origin, d = camera_rays(camera, w, h)
+    origin, d = camera.sample_rays(w, h)
     o2, d2 = camera.pixel_rays(w, h)
-    assert d.shape == (h, w, 1, 3)
-    np.testing.assert_array_equal(origin, o2)
-    np.testing.assert_allclose(d[:, :, 0], d2, rtol=0, atol=1e-15)
+    assert d.shape == (h, w, 1, 3) and d2.shape == (h, w, 3)
+    np.testing.assert_array_equal(origin, camera.pose[:3, 3])
+    # odd size: the centre pixel's ray is the viewing axis, -Z of the camera frame
+    np.testing.assert_allclose(d2[h // 2, w // 2], -camera.pose[:3, 2], rtol=0, atol=1e-15)
+    # the vertical field of view: the top edge's centre ray is yfov/2 off the axis
+    _, edge = camera.sample_rays(w, h, [(w / 2 - w // 2, 0.0)], rows=[0])
+    np.testing.assert_allclose(np.arccos(edge[0, w // 2, 0] @ -camera.pose[:3, 2]), 0.45, rtol=1e-12)
     # the top-left corner of pixel (j, i) is the bottom-right corner of pixel (j-1, i-1)
-    _, dc = camera_rays(camera, w, h, [(0.0, 0.0), (1.0, 1.0)])
+    _, dc = camera.sample_rays(w, h, [(0.0, 0.0), (1.0, 1.0)])
     np.testing.assert_allclose(dc[1:, 1:, 0], dc[:-1, :-1, 1], rtol=0, atol=1e-15)
     # row 0 is the top: its rays point further along the camera's up axis than the last row's
     up = camera.pose[:3, 1]
     assert (d[0, :, 0] @ up > d[-1, :, 0] @ up).all()
-    _, rows = camera_rays(camera, w, h, stratified_offsets(3), rows=slice(5, 8))
-    np.testing.assert_array_equal(rows, camera_rays(camera, w, h, stratified_offsets(3))[1][5:8])
+    _, rows = camera.sample_rays(w, h, stratified_offsets(3), rows=slice(5, 8))
+    np.testing.assert_array_equal(rows, camera.sample_rays(w, h, stratified_offsets(3))[1][5:8])
     np.testing.assert_array_equal(stratified_offsets(2), [[0.25, 0.25], [0.75, 0.25], [0.25, 0.75], [0.75, 0.75]])
 
 

@@ -745,13 +745,9 @@ def test_failed_validation_leaves_renderer_and_scene_intact(renderer):
     assert renderer.gl_object_count() == objects_before
 
 
-def test_renderer_accepts_numpy_integer_size(make_renderer):
-    for backend in BACKENDS:
-        if glphong.available_backends()[backend] is None:
-            break
-    else:
-        pytest.skip("no OpenGL backend available")
-    r = make_renderer(np.int64(N), np.int32(N + 2), backend)
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_renderer_accepts_numpy_integer_size(make_renderer, backend):
+    r = make_renderer(np.int64(N), np.int32(N + 2), backend)  # skips or fails per GLPHONG_REQUIRE_BACKENDS
     assert (r.width, r.height) == (N, N + 2) and type(r.width) is int and type(r.height) is int
     frame = r.render(_head_on_scene())
     assert frame.radiance.shape == (N + 2, N, 3)
