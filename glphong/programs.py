@@ -6,6 +6,7 @@ the key's ``#define`` lines, then the key's chunk files, each preceded by a
 """
 import functools
 import importlib.resources
+import os
 import re
 import time
 from pathlib import Path
@@ -28,6 +29,12 @@ class UniformError(ValueError):
 
 
 def _glsl_root():
+    """Folder of the chunk files: ``GLPHONG_GLSL_DIR`` when set (a developer's working copy of the
+    shaders, used by ``benchmarks/mutation.py``), else the installed ``glphong.glsl`` package, else
+    ``glsl/`` beside the package in a source checkout."""
+    override = os.environ.get("GLPHONG_GLSL_DIR")
+    if override:
+        return Path(override)
     try:
         return importlib.resources.files("glphong.glsl")
     except ModuleNotFoundError:  # running from a source checkout: glsl/ beside the package
@@ -118,16 +125,22 @@ def effective_source(source):
     return "\n".join(out) + "\n"
 
 
-_LOCATION = re.compile(r"\b(\d+)([:(])(\d+)")
+#: ``N:L(C)`` (Mesa), ``N:L`` or ``N(L)`` (NVIDIA): source-string number, line, optional column
+_LOCATION = re.compile(r"\b(\d+)(?::(\d+)(?:\((\d+)\))?|\((\d+)\))")
 
 
 def _name_chunks(log, chunks):
-    """Rewrite ``N:L`` / ``N(L)`` source locations in a compiler log as ``chunk.glsl:L``."""
+    """Rewrite compiler-log locations ``N:L(C)``, ``N:L`` and ``N(L)`` as ``chunk.glsl:L:C`` / ``chunk.glsl:L``.
+
+    Source string 0 is the generated ``#version``/``#define`` header; string ``i`` is ``chunks[i - 1]``.
+    """
     def repl(m):
         n = int(m.group(1))
+        line = m.group(2) or m.group(4)
+        where = f":{line}" + (f":{m.group(3)}" if m.group(3) else "")
         if 1 <= n <= len(chunks):
-            return f"{chunks[n - 1]}.glsl:{m.group(3)}"
-        return f"<generated header>:{m.group(3)}" if n == 0 else m.group(0)
+            return f"{chunks[n - 1]}.glsl{where}"
+        return f"<generated header>{where}" if n == 0 else m.group(0)
     return _LOCATION.sub(repl, log)
 
 
