@@ -2,11 +2,14 @@
 
 Each `Case` is data: one shading point (surface point at the origin, a raw normal, an eye
 position), a material and lights.  Its expected value comes from `oracle`, an independent
-60-digit mpmath evaluation of the textbook model E6 on the very float32 inputs the GPU gets
-(so float64 rounding cannot hide in the expectation).  The GPU evaluates the real GLSL
-``shade_point()`` at that point through a 'points' program; the float64 twin evaluates its mirror;
-the GPU passes when it lies in the tolerance band around the twin and is neither NaN nor Inf
-where the band is finite.
+60-digit mpmath evaluation of the textbook model E6 from the material's, lights' and camera's own
+parameters (rounded to float32, the documented input precision, so float64 rounding cannot hide in
+the expectation; never from the uniforms).  The GPU evaluates the real GLSL ``shade_point()`` at
+that point through a 'points' program; the float64 twin evaluates its mirror.  Inside the valid
+range the GPU passes when it lies within the tolerance band's widths of the oracle (the band of
+`glphong.tolerances`, computed around the twin, moved onto the oracle's value) and is neither NaN
+nor Inf; outside it, the documented float32 behaviour (flush to 0, saturation) is what the twin
+mirrors, and the GPU is judged in the band around the twin.
 
 Valid ranges (`VALID_RANGES`): inside them the GPU result equals the textbook value within
 the band.  Outside them it is still never NaN from finite input: results below FLT_MIN flush
@@ -192,68 +195,86 @@ def _build_cases():
 CASES = _build_cases()
 
 
-def oracle(case, key, uniforms, digits=60):
-    """Independent high-precision value of E6 at the case's point.
+def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60):
+    """Independent high-precision value of E6 at one point, from the objects' own parameters.
 
     Evaluates ``L = k_a + k_d L_a + sum_j [n.l_j > 0] (k_d n.l_j + k_s lobe_j) E_j`` in mpmath with
-    ``digits`` significant digits on the float32 inputs in ``uniforms`` and the float32 normal,
-    with the conventions of DESIGN section 1 (q = 0 gives lobe 1; Blinn's lobe is 0 where n.v <= 0
-    or l + v = 0).  It shares no code with the shaders or the twin.
+    ``digits`` significant digits for the first object of ``scene``, reading the public attributes of
+    its material (``kd``, ``ka``, ``ks``, ``q``), of the lights (``position`` and ``power`` with
+    ``E = Phi / (4 pi d^2)``, ``radiance``, ``direction`` and ``irradiance``), of the ambient light and
+    of the camera (``position``): never the uniforms, the twin or the tolerance band, so a wrong value
+    on its way from a constructor to a shader uniform shows.  The conventions are those of DESIGN
+    section 1 (q = 0 gives lobe 1; Blinn's lobe is 0 where n.v <= 0 or l + v = 0; a zero or
+    non-finite normal gives the ambient terms only).
+
+    The GPU computes in float32, so every input coordinate and coefficient is first rounded to
+    float32, the documented input precision; everything after that is exact to ``digits``.
+
+    Parameters
+    ----------
+    scene : glphong.Scene
+        Its first object's material is evaluated.
+    normal : (3,) array_like
+        Raw normal at ``point`` (normalised here; may be zero or non-finite).
+    point : (3,) array_like
+        World-space shading point [m].
+    digits : int
 
     Returns
     -------
     (3,) float64 ndarray
+        Radiance [W/(m^2 sr)].
     """
     import mpmath
+
+    from .lights import DirectionalLight, PointLight, UnattenuatedPointLight
+    from .materials import BlinnPhong
 
     mp = mpmath.mp
     mp.dps = digits
     f = lambda x: mpmath.mpf(float(np.float32(x)))  # noqa: E731
     vec = lambda a: [f(x) for x in np.asarray(a, dtype=np.float64).ravel()[:3]]  # noqa: E731
     dot = lambda a, b: sum(x * y for x, y in zip(a, b))  # noqa: E731
-    norm = lambda a: mpmath.sqrt(dot(a, a))  # noqa: E731
-    u = {k: np.asarray(v, dtype=np.float32) for k, v in uniforms.items()}
-    zero = [mpmath.mpf(0)] * 3
-    out = [mpmath.mpf(0)] * 3
-    if key.has_ka:
-        out = [o + f(k) for o, k in zip(out, u["u_ka"])]
-    if key.has_kd_la:
-        out = [o + f(kd) * f(la) for o, kd, la in zip(out, u["u_kd"], u["u_ambient"])]
-    raw_n = np.asarray(case.normal, dtype=np.float32)
-    if key.num_lights == 0 or not np.all(np.isfinite(raw_n)) or not np.any(raw_n):
+    unit = lambda a: [x / mpmath.sqrt(dot(a, a)) for x in a]  # noqa: E731
+    material = scene.objects[0].material
+    kd, ka = vec(material.kd), vec(material.ka)
+    ks = vec(getattr(material, "ks", (0.0, 0.0, 0.0)))
+    out = list(ka)
+    if scene.ambient is not None:
+        out = [o + a * la for o, a, la in zip(out, kd, vec(scene.ambient.radiance))]
+    raw_n = np.asarray(normal, dtype=np.float32)
+    if not np.all(np.isfinite(raw_n)) or not np.any(raw_n):
         return np.array([float(o) for o in out])
-    n = vec(raw_n)
-    n = [x / norm(n) for x in n]
-    if key.has_specular:
-        eye = vec(u["u_eye"])
-        v = [x / norm(eye) for x in eye]
-    lights = []
-    for j in range(key.num_point_lights):
-        p = vec(u["u_point_position"][j])
-        d = norm(p)
-        lights.append(([x / d for x in p], [f(i) / (d * d) for i in u["u_point_intensity"][j]]))
-    for j in range(key.num_unattenuated_lights):
-        p = vec(u["u_unattenuated_position"][j])
-        lights.append(([x / norm(p) for x in p], vec(u["u_unattenuated_radiance"][j])))
-    for j in range(key.num_directional_lights):
-        lights.append((vec(u["u_directional_direction"][j]), vec(u["u_directional_irradiance"][j])))
-    for l, e in lights:
+    x = vec(point)
+    n = unit(vec(raw_n))
+    v = unit([e - p for e, p in zip(vec(scene.camera.position), x)])
+    blinn = isinstance(material, BlinnPhong)
+    four_pi = 4 * mpmath.pi
+    for light in scene.lights:
+        if isinstance(light, PointLight):
+            to_light = [a - b for a, b in zip(vec(light.position), x)]
+            d2 = dot(to_light, to_light)
+            l, e = unit(to_light), [f(phi) / (four_pi * d2) for phi in light.power]
+        elif isinstance(light, UnattenuatedPointLight):
+            l, e = unit([a - b for a, b in zip(vec(light.position), x)]), vec(light.radiance)
+        elif isinstance(light, DirectionalLight):
+            l, e = unit([-mpmath.mpf(c) for c in light.direction]), vec(light.irradiance)
+        else:
+            raise TypeError(f"oracle: unknown light {light!r}")
         ndl = dot(n, l)
         if ndl <= 0:
             continue
         lobe = mpmath.mpf(0)
-        if key.has_specular:
-            q = f(u["u_q"])
-            if key.lobe == "phong":
+        if any(ks):
+            q = f(material.q)
+            if blinn:
+                s = [a + b for a, b in zip(l, v)]
+                valid = dot(n, v) > 0 and dot(s, s) > 0
+                c = dot(n, unit(s)) if valid else mpmath.mpf(0)
+            else:
                 c = dot(v, [2 * ndl * a - b for a, b in zip(n, l)])
                 valid = True
-            else:
-                s = [a + b for a, b in zip(l, v)]
-                valid = dot(n, v) > 0 and norm(s) > 0
-                c = dot(n, [x / norm(s) for x in s]) if valid else mpmath.mpf(0)
-            lobe = mpmath.mpf(1) if (q == 0 and valid) else (max(c, 0) ** q if valid else mpmath.mpf(0))
-        kd = vec(u["u_kd"]) if key.has_diffuse else zero
-        ks = vec(u["u_ks"]) if key.has_specular else zero
+            lobe = (mpmath.mpf(1) if q == 0 else max(c, 0) ** q) if valid else mpmath.mpf(0)
         out = [o + (a * ndl + b * lobe) * ee for o, a, b, ee in zip(out, kd, ks, e)]
     return np.array([float(o) for o in out])
 
@@ -356,7 +377,14 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
             twin = ref.shade_point(position, n, n_valid, u64.get("u_eye"), key, u64)[0]
             low, high = point_band(key, u64, position, n, n_valid)
             low, high = low[0], high[0]
-            expected = oracle(case, key, uniforms)
+            expected = oracle(case.scene(), case.normal)
+            if case.in_range:
+                # judged against the oracle, with the band's widths as the tolerance: the twin and the
+                # band read the uniforms, the oracle the constructors, so a wrongly wired input shows
+                low = np.where(low > 0, expected - (twin - low), 0.0)
+                high = expected + (high - twin)
+            # outside the valid range: the documented float32 behaviour (flush, saturation), which the
+            # twin mirrors, within the band around it
             finite_band = np.isfinite(high)
             ok = np.all((gpu >= low) & (gpu <= high)) and not np.any(np.isnan(gpu)) and \
                 np.all(np.isfinite(gpu[finite_band]))
