@@ -1,0 +1,535 @@
+"""Mutation check: does the test suite catch small deliberate bugs?
+
+Each entry of `MUTATIONS` is one small bug of the kind a real one would be (a 1 % factor, a
+swapped sign, a dropped transpose, a wrong constant), written as data: an exact text
+substitution in one file of the repository.  The script copies the working tree (every file
+``git ls-files --cached --others --exclude-standard`` lists, uncommitted changes included) into
+a temporary folder, checks that the unmutated copy passes, then for each mutation makes a fresh
+copy, plants that one mutation, runs the test suite on the copy and records whether it was
+caught.  It ends with a markdown table of the bugs caught and missed.  It is not part of the
+test suite.
+
+The suite runs in the copy as ``python -m pytest -x -q -p no:cacheprovider -rfE`` (cwd = the
+copy) with ``PYTHONPATH=<copy>`` prepended, ``GLPHONG_GLSL_DIR=<copy>/glsl`` (glphong reads its
+GLSL chunks from there), ``GLPHONG_REQUIRE_BACKENDS=egl,osmesa`` and
+``PYTHONDONTWRITEBYTECODE=1``.  glphong is usually installed in editable mode pointing at the
+main checkout, so before any run the script checks, in the copy with that environment, that
+both ``glphong.__file__`` and ``glphong.programs._glsl_root()`` lie inside the copy, and stops
+if not.  The temporary copies are removed at the end.
+
+Examples
+--------
+List the mutations and check that each one still applies (runs nothing)::
+
+    python benchmarks/mutation.py --list
+
+Run everything (baseline first, then every mutation), and keep the table::
+
+    python benchmarks/mutation.py --markdown mutation.md
+
+Only the mutations whose name contains one of the substrings (case-insensitive), e.g. every
+GLSL chunk, or everything about the Phong lobe, or one wiring bug::
+
+    python benchmarks/mutation.py --only .glsl:
+    python benchmarks/mutation.py --only phong materials.py:u_ks
+
+Extra pytest arguments go to every run, the baseline included (e.g. a subset of the tests)::
+
+    python benchmarks/mutation.py --only lambert --pytest-args "tests/test_analytic.py"
+
+Notes
+-----
+**Time.**  The baseline costs one full suite run (about a minute on 2 cores with both backends: 53 s measured).
+A caught mutation stops at its first failing test (``-x``): from a few seconds to a minute or
+two, depending on how far down the suite the first catching test is.  A missed mutation costs a
+full suite run.  The whole list takes roughly 15 to 45 minutes; ``--timeout`` (default 900 s)
+bounds each run.
+
+**Verdicts.**  pytest's exit code decides:
+
+- 1 (tests failed or errored): *caught*; the first ``FAILED``/``ERROR`` node id is reported;
+- 2 (interrupted, usually a collection error such as an import that no longer works): counted
+  as caught, shown as ``caught (collection error)``;
+- 0 (all passed): *MISSED*;
+- anything else (3 internal error, 4 usage error, 5 no tests collected, a timeout, a signal):
+  *error*: the run said nothing about the mutation; the tail of its output is printed.
+
+The script exits with 0 when every selected mutation is caught, 1 when any is missed or
+errored, 2 when it cannot run at all (a mutation that no longer applies, a baseline that
+fails, an import path outside the copy, an ``--only`` that selects nothing).
+
+**The list cannot rot silently.**  Every mutation's ``old`` text must occur exactly once in its
+file; if code changes so that it occurs 0 or more than once, ``--list`` and every run stop
+with an error naming the mutation.  Fix its ``old``/``new`` to the new code (or delete it if
+the code it mutated is gone).
+
+**Adding mutations.**  New models add their mutations: when a model, a light kind, a uniform
+or a GLSL chunk lands, append `Mutation` entries to its area of `MUTATIONS` (or open a new
+area) -- at least one for the GLSL, one for its numpy twin in ``glphong/reference.py`` and one
+for each new uniform's wiring on the host.  A mutation is
+``Mutation(name, path, old, new, what)``: ``name`` ``"<file>:<short-slug>"`` and unique;
+``path`` relative to the repository root; ``old`` an exact snippet (whitespace included; add
+surrounding lines to make it unique); ``new`` its mutated text; ``what`` one line saying what
+the bug is.  Run ``--list`` to validate, then ``--only <name>`` to see it caught.  Mutate only
+code the tests can run: the ``naive`` formulation (naive.glsl) is compared only with itself
+and glphong/stability.py is a test tool, so neither is mutated here.
+"""
+import argparse
+import os
+import re
+import shlex
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parent.parent
+
+
+@dataclass(frozen=True)
+class Mutation:
+    """One deliberate bug: replace ``old`` (which must occur exactly once) by ``new`` in ``path``.
+
+    Attributes
+    ----------
+    name : str
+        Unique, ``"<file>:<slug>"``; what ``--only`` matches.
+    path : str
+        File relative to the repository root.
+    old, new : str
+        The exact text and its mutated replacement.
+    what : str
+        One line: the bug.
+    """
+
+    name: str
+    path: str
+    old: str
+    new: str
+    what: str
+
+
+M = Mutation
+MUTATIONS = [
+    # ------------------------------------------------------------------ GLSL chunks (glsl/)
+    M("common.glsl:length-1.01", "glsl/common.glsl",
+      "len = s * sqrt(yy);", "len = 1.01 * s * sqrt(yy);",
+      "safe_normalize: |x| 1% long (every point-light distance)"),
+    M("lights.glsl:falloff-1.01", "glsl/lights.glsl",
+      "return min((intensity / d) / d, vec3(FLT_MAX));", "return min((intensity / d) / (1.01 * d), vec3(FLT_MAX));",
+      "point_irradiance: I / (1.01 d^2)"),
+    M("lambert.glsl:kd-1.01", "glsl/lambert.glsl",
+      "return kd * n_dot_l;", "return 1.01 * kd * n_dot_l;",
+      "lambert: 1.01 kd (n.l)"),
+    M("lobe.glsl:series-1/3", "glsl/lobe.glsl",
+      "float series = 1.0 + t * (1.0 / 3.0 +", "float series = 1.0 + t * (1.0 / 3.03 +",
+      "log_one_minus: artanh series coefficient 1/3 -> 1/3.03"),
+    M("lobe.glsl:q0-rule", "glsl/lobe.glsl",
+      "if (q == 0.0) {", "if (q < 0.0) {",
+      "lobe_from_delta: the q == 0 rule (0^0 := 1) dropped"),
+    M("phong.glsl:reflect-1.9", "glsl/phong.glsl",
+      "vec3 r = 2.0 * dot(n, wi) * n - wi;", "vec3 r = 1.9 * dot(n, wi) * n - wi;",
+      "phong_delta: r = 1.9 (n.l) n - l"),
+    M("blinn.glsl:half-vector", "glsl/blinn.glsl",
+      "safe_normalize(wi + wo, h, h_len)", "safe_normalize(wi + 1.01 * wo, h, h_len)",
+      "blinn_delta: h from l + 1.01 v"),
+    M("blinn.glsl:floor-x10", "glsl/blinn.glsl",
+      "const float BLINN_HALF_FLOOR = 9.5367431640625e-07;", "const float BLINN_HALF_FLOOR = 9.5367431640625e-06;",
+      "BLINN_HALF_FLOOR 2^-20 -> 10 x 2^-20"),
+    M("shade.glsl:point-gate", "glsl/shade.glsl",
+      "if (!(n_dot_l > 0.0)) continue;\n        radiance += light_response(n, wi, wo, n_dot_l) * point_irradiance(",
+      "if (!(n_dot_l > 0.01)) continue;\n        radiance += light_response(n, wi, wo, n_dot_l) * point_irradiance(",
+      "point-light loop: gate n.l > 0.01 instead of n.l > 0"),
+    M("shade.glsl:ka-1.01", "glsl/shade.glsl",
+      "if (SWITCH(u_use_ka)) radiance += u_ka;", "if (SWITCH(u_use_ka)) radiance += 1.01 * u_ka;",
+      "shade_point: ambient term 1.01 k_a"),
+    M("shade.glsl:kd-la-1.01", "glsl/shade.glsl",
+      "radiance += u_kd * u_ambient;", "radiance += 1.01 * u_kd * u_ambient;",
+      "shade_point: ambient term 1.01 k_d L_a"),
+    M("shade.glsl:point-E-1.01", "glsl/shade.glsl",
+      "* point_irradiance(u_point_intensity[j], d);", "* point_irradiance(1.01 * u_point_intensity[j], d);",
+      "point-light loop: irradiance of 1.01 I"),
+    M("shade.glsl:unattenuated-E-1.01", "glsl/shade.glsl",
+      "* u_unattenuated_radiance[j];", "* (1.01 * u_unattenuated_radiance[j]);",
+      "unattenuated-light loop: 1.01 L_i"),
+    M("shade.glsl:directional-E-1.01", "glsl/shade.glsl",
+      "* u_directional_irradiance[j];", "* (1.01 * u_directional_irradiance[j]);",
+      "directional-light loop: 1.01 E"),
+    M("shade.glsl:view-sign", "glsl/shade.glsl",
+      "safe_normalize(eye - position, wo, view_distance)", "safe_normalize(position - eye, wo, view_distance)",
+      "view vector v points away from the eye"),
+    M("srgb.glsl:gamma-2.42", "glsl/srgb.glsl",
+      "pow(x, vec3(1.0 / 2.4))", "pow(x, vec3(1.0 / 2.42))",
+      "srgb_encode: exponent 1/2.42 instead of 1/2.4"),
+    M("encode.glsl:exposure-1.01", "glsl/encode.glsl",
+      "srgb_encode(u_exposure * sum", "srgb_encode(1.01 * u_exposure * sum",
+      "8-bit pass: exposure 1% high"),
+    M("mesh_vertex.glsl:normal-transpose", "glsl/mesh_vertex.glsl",
+      "v_normal = u_normal_matrix * in_normal;", "v_normal = transpose(u_normal_matrix) * in_normal;",
+      "per-pixel normal transform by N^T instead of N"),
+    M("mesh_fragment.glsl:two-sided-flip", "glsl/mesh_fragment.glsl",
+      "if (SWITCH(u_two_sided) && !gl_FrontFacing) {", "if (SWITCH(u_two_sided) && gl_FrontFacing) {",
+      "two-sided: normal flipped on front faces instead of back faces"),
+    M("uber.glsl:lobe-kind", "glsl/uber.glsl",
+      "return phong_lobe(n, wi, wo, q);", "return blinn_lobe(n, wi, wo, q);",
+      "uber-shader: lobe kind 1 (Phong) evaluates Blinn"),
+    # ------------------------------------------------------------------ the numpy twin (glphong/reference.py)
+    M("reference.py:point-irradiance-1.01", "glphong/reference.py",
+      "return np.minimum((intensity / d) / d, FLT_MAX)", "return np.minimum((intensity / d) / (1.01 * d), FLT_MAX)",
+      "twin point_irradiance: I / (1.01 d^2)"),
+    M("reference.py:lambert-1.01", "glphong/reference.py",
+      "return kd * np.asarray(n_dot_l)[..., None]", "return 1.01 * kd * np.asarray(n_dot_l)[..., None]",
+      "twin lambert: 1.01 kd (n.l)"),
+    M("reference.py:lobe-clamp", "glphong/reference.py",
+      "dtype.type(-104)", "dtype.type(-80)",
+      "twin lobe_from_delta: exponent clamp -104 -> -80"),
+    M("reference.py:phong-reflect-1.9", "glphong/reference.py",
+      "r = 2 * _dot(n, wi)[..., None] * n - wi", "r = 1.9 * _dot(n, wi)[..., None] * n - wi",
+      "twin phong_delta: r = 1.9 (n.l) n - l"),
+    M("reference.py:blinn-half-vector", "glphong/reference.py",
+      "ok_h, h, h_len = safe_normalize(wi + wo)", "ok_h, h, h_len = safe_normalize(wi + 1.01 * wo)",
+      "twin blinn_delta: h from l + 1.01 v"),
+    M("reference.py:gate-0.01", "glphong/reference.py",
+      "gate = (lit & valid & (n_dot_l > 0))[..., None]", "gate = (lit & valid & (n_dot_l > 0.01))[..., None]",
+      "twin shade_point: gate n.l > 0.01"),
+    # ------------------------------------------------------------------ material uniforms (glphong/materials.py)
+    M("materials.py:u_ka-1.01", "glphong/materials.py",
+      'values["u_ka"] = f32(self.ka)', 'values["u_ka"] = f32(self.ka) * np.float32(1.01)',
+      "u_ka uploaded 1% high"),
+    M("materials.py:u_kd-1.01", "glphong/materials.py",
+      'values["u_kd"] = f32(self.kd)', 'values["u_kd"] = f32(self.kd) * np.float32(1.01)',
+      "u_kd uploaded 1% high"),
+    M("materials.py:u_ks-1.01", "glphong/materials.py",
+      'values["u_ks"] = f32(self.ks)', 'values["u_ks"] = f32(self.ks) * np.float32(1.01)',
+      "u_ks uploaded 1% high"),
+    M("materials.py:u_q-1.01", "glphong/materials.py",
+      'values["u_q"] = f32(self.q)', 'values["u_q"] = f32(self.q) * np.float32(1.01)',
+      "u_q uploaded 1% high"),
+    # ------------------------------------------------------------------ light uniforms (glphong/lights.py)
+    M("lights.py:point-intensity-1.01", "glphong/lights.py",
+      "return point_intensity(np.asarray(self.power))", "return point_intensity(np.asarray(self.power)) * 1.01",
+      "PointLight.intensity 1% high (Phi / (4 pi) * 1.01)"),
+    M("lights.py:unattenuated-1.01", "glphong/lights.py",
+      "return self.position, self.radiance", "return self.position, tuple(1.01 * c for c in self.radiance)",
+      "UnattenuatedPointLight uploads 1.01 L_i"),
+    M("lights.py:directional-sign", "glphong/lights.py",
+      "return tuple(-c for c in self.direction), self.irradiance",
+      "return tuple(c for c in self.direction), self.irradiance",
+      "DirectionalLight uploads its travel direction, not the direction toward the light"),
+    M("lights.py:directional-E-1.01", "glphong/lights.py",
+      "return tuple(-c for c in self.direction), self.irradiance",
+      "return tuple(-c for c in self.direction), tuple(1.01 * c for c in self.irradiance)",
+      "DirectionalLight uploads 1.01 E"),
+    M("lights.py:ambient-1.01", "glphong/lights.py",
+      '    radiance: tuple\n\n    def __post_init__(self):\n'
+      '        object.__setattr__(self, "radiance", _validate.rgb("radiance", self.radiance))',
+      '    radiance: tuple\n\n    def __post_init__(self):\n'
+      '        object.__setattr__(self, "radiance", tuple(1.01 * c for c in _validate.rgb("radiance", self.radiance)))',
+      "AmbientLight stores 1.01 L_a"),
+    # ------------------------------------------------------------------ scene uniforms (glphong/scene.py)
+    M("scene.py:u_ambient-1.01", "glphong/scene.py",
+      'values["u_ambient"] = np.asarray(self.ambient_radiance, dtype=np.float32)',
+      'values["u_ambient"] = np.asarray(self.ambient_radiance, dtype=np.float32) * np.float32(1.01)',
+      "u_ambient uploaded 1% high"),
+    M("scene.py:u_eye-1.01", "glphong/scene.py",
+      'values["u_eye"] = self.camera.position', 'values["u_eye"] = self.camera.position * 1.01',
+      "u_eye 1% off the camera centre"),
+    M("scene.py:u_model-x-1.01", "glphong/scene.py",
+      'values = {"u_model": obj.pose, "u_view_projection": view_projection}',
+      'values = {"u_model": obj.pose @ np.diag([1.01, 1.0, 1.0, 1.0]), "u_view_projection": view_projection}',
+      "u_model stretches objects 1% along their x"),
+    M("scene.py:normal-matrix-transpose", "glphong/scene.py",
+      "return np.linalg.inv(self.pose[:3, :3]).T", "return np.linalg.inv(self.pose[:3, :3])",
+      "normal matrix: inverse without the transpose"),
+    # ------------------------------------------------------------------ camera (glphong/camera.py)
+    M("camera.py:projection-x-1.01", "glphong/camera.py",
+      "[f / aspect, 0.0, 0.0, 0.0],", "[1.01 * f / aspect, 0.0, 0.0, 0.0],",
+      "projection: x scale 1% high"),
+    M("camera.py:yfov-half", "glphong/camera.py",
+      "f = 1.0 / np.tan(self.yfov / 2.0)", "f = 1.0 / np.tan(self.yfov / 2.02)",
+      "projection: tan(yfov / 2.02)"),
+    M("camera.py:view-translation", "glphong/camera.py",
+      "view[:3, 3] = -r.T @ t", "view[:3, 3] = -r @ t",
+      "view matrix: translation -R t instead of -R^T t"),
+    # ------------------------------------------------------------------ tolerance band (glphong/tolerances.py)
+    M("tolerances.py:A-x100", "glphong/tolerances.py",
+      "    A: float = 16.0", "    A: float = 1600.0", "band constant A x 100"),
+    M("tolerances.py:B-x100", "glphong/tolerances.py",
+      "    B: float = 4.0", "    B: float = 400.0", "band constant B x 100"),
+    M("tolerances.py:C-x100", "glphong/tolerances.py",
+      "    C: float = 6.0", "    C: float = 600.0", "band constant C x 100"),
+    M("tolerances.py:D-x100", "glphong/tolerances.py",
+      "    D: float = 8.0", "    D: float = 800.0", "band constant D x 100"),
+    # ------------------------------------------------------------------ sRGB on the CPU (glphong/imaging.py)
+    M("imaging.py:gamma-2.42", "glphong/imaging.py",
+      "1.055 * np.power(x, 1.0 / 2.4) - 0.055", "1.055 * np.power(x, 1.0 / 2.42) - 0.055",
+      "srgb_encode (numpy): exponent 1/2.42"),
+    # ------------------------------------------------------------------ pyrender lights (glphong/integrations/pyrender.py)
+    M("pyrender.py:point-4pi-1.01", "glphong/integrations/pyrender.py",
+      "glphong_lights.PointLight(pose[:3, 3], 4.0 * np.pi * value)",
+      "glphong_lights.PointLight(pose[:3, 3], 4.04 * np.pi * value)",
+      "pyrender PointLight: Phi = 4.04 pi I"),
+    M("pyrender.py:directional-sign", "glphong/integrations/pyrender.py",
+      "glphong_lights.DirectionalLight(-pose[:3, 2], value)", "glphong_lights.DirectionalLight(pose[:3, 2], value)",
+      "pyrender DirectionalLight: travels along +Z of its node"),
+    M("pyrender.py:ambient-1.01", "glphong/integrations/pyrender.py",
+      "ambient = np.asarray(scene.ambient_light, dtype=np.float64)",
+      "ambient = 1.01 * np.asarray(scene.ambient_light, dtype=np.float64)",
+      "pyrender scene.ambient_light mapped to 1.01 L_a"),
+]
+del M
+
+#: pytest's command line in the copy (``-rfE``: the short summary names failures and errors)
+PYTEST = ["-m", "pytest", "-x", "-q", "-p", "no:cacheprovider", "-rfE"]
+#: result -> counts as caught
+CAUGHT = {"caught": True, "caught (collection error)": True, "MISSED": False}
+
+
+# ---------------------------------------------------------------------------- the list
+def problems(mutations, root):
+    """What is wrong with ``mutations`` against the files under ``root`` (empty list: all apply)."""
+    out = []
+    seen = set()
+    for m in mutations:
+        if m.name in seen:
+            out.append(f"{m.name}: the name is used twice")
+        seen.add(m.name)
+        if m.old == m.new:
+            out.append(f"{m.name}: old and new are the same text")
+        file = root / m.path
+        if not file.is_file():
+            out.append(f"{m.name}: no file {m.path}")
+            continue
+        count = file.read_text(encoding="utf-8").count(m.old)
+        if count != 1:
+            out.append(f"{m.name}: its old text occurs {count} times in {m.path} (must be exactly once): {m.old!r}")
+    return out
+
+
+def validate(mutations, root):
+    """Stop (exit 2) naming every mutation that no longer applies to the files under ``root``."""
+    found = problems(mutations, root)
+    if found:
+        fail("mutations that no longer apply (fix their old/new text in benchmarks/mutation.py):\n  "
+             + "\n  ".join(found))
+
+
+def apply(mutation, root):
+    """Plant ``mutation`` in the copy at ``root`` (its old text is known to occur once)."""
+    file = root / mutation.path
+    with open(file, encoding="utf-8", newline="") as f:
+        text = f.read()
+    if text.count(mutation.old) != 1:
+        fail(f"{mutation.name}: old text does not occur exactly once in {mutation.path} of the copy")
+    with open(file, "w", encoding="utf-8", newline="") as f:
+        f.write(text.replace(mutation.old, mutation.new, 1))
+
+
+def select(mutations, only):
+    """The mutations whose name contains one of ``only`` (case-insensitive); all when ``only`` is empty."""
+    if not only:
+        return list(mutations)
+    keys = [s.lower() for s in only]
+    return [m for m in mutations if any(k in m.name.lower() for k in keys)]
+
+
+# ---------------------------------------------------------------------------- copies and runs
+def fail(message):
+    """Print ``message`` and exit with status 2 (the check could not run)."""
+    print(f"mutation.py: error: {message}", file=sys.stderr, flush=True)
+    raise SystemExit(2)
+
+
+def tracked_files(repo):
+    """Relative paths of the working tree's files as git lists them (tracked and untracked-not-ignored)."""
+    out = subprocess.run(["git", "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=repo,
+                         capture_output=True, check=True).stdout.decode("utf-8")
+    # --cached also lists tracked files deleted from the working tree, and submodules (folders): skip both
+    return sorted(p for p in set(out.split("\0")) if p and (repo / p).is_file())
+
+
+def snapshot(repo, dest):
+    """Copy the working tree's files into the new folder ``dest``."""
+    for rel in tracked_files(repo):
+        target = dest / rel
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copy2(repo / rel, target, follow_symlinks=False)
+
+
+def environment(copy):
+    """The environment the suite runs in, in the copy at ``copy``."""
+    env = dict(os.environ)
+    env["PYTHONPATH"] = os.pathsep.join([str(copy)] + ([env["PYTHONPATH"]] if env.get("PYTHONPATH") else []))
+    env["GLPHONG_GLSL_DIR"] = str(copy / "glsl")
+    env["GLPHONG_REQUIRE_BACKENDS"] = "egl,osmesa"
+    env["PYTHONDONTWRITEBYTECODE"] = "1"
+    return env
+
+
+def check_import_paths(copy):
+    """Stop unless glphong's Python files and GLSL chunks both come from the copy at ``copy``."""
+    code = "import glphong, glphong.programs as p; print(glphong.__file__); print(p._glsl_root())"
+    out = subprocess.run([sys.executable, "-c", code], cwd=copy, env=environment(copy), capture_output=True,
+                         text=True, timeout=300)
+    if out.returncode != 0:
+        fail(f"importing glphong in the copy failed:\n{out.stderr[-3000:]}")
+    lines = out.stdout.strip().splitlines()[-2:]
+    root = copy.resolve()
+    outside = [p for p in lines if not Path(p).resolve().is_relative_to(root)]
+    if len(lines) != 2 or outside:
+        fail(f"in the copy {copy}, glphong does not come from the copy (glphong.__file__ and _glsl_root() "
+             f"gave {lines}); the mutations would not be tested.  Is PYTHONPATH or GLPHONG_GLSL_DIR ignored?")
+    return lines
+
+
+_SUMMARY = re.compile(r"^(FAILED|ERROR) (.+)$")
+
+
+def first_failure(output):
+    """Node id of the first ``FAILED``/``ERROR`` line of pytest's short summary, or ''."""
+    for line in output.splitlines():
+        m = _SUMMARY.match(line.strip())
+        if m:
+            return m.group(2).split(" - ", 1)[0].strip()
+    return ""
+
+
+def run_suite(copy, timeout, extra):
+    """Run the suite in ``copy``; returns ``(exit code or None on timeout, output, seconds)``."""
+    start = time.monotonic()
+    proc = subprocess.Popen([sys.executable, *PYTEST, *extra], cwd=copy, env=environment(copy),
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, errors="replace",
+                            start_new_session=True)  # its own process group: a timeout ends its children too
+    try:
+        output, _ = proc.communicate(timeout=timeout)
+        code = proc.returncode
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        output, _ = proc.communicate()
+        code = None
+    except BaseException:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+        raise
+    return code, output, time.monotonic() - start
+
+
+def verdict(code):
+    """Result text for a pytest exit code (None: timed out)."""
+    if code == 1:
+        return "caught"
+    if code == 2:
+        return "caught (collection error)"
+    if code == 0:
+        return "MISSED"
+    return "error (timeout)" if code is None else f"error (exit {code})"
+
+
+def tail(output, lines=25):
+    return "\n".join("    " + line for line in output.rstrip().splitlines()[-lines:])
+
+
+# ---------------------------------------------------------------------------- report
+def _cell(text):
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def markdown(rows):
+    """The results table and the summary line."""
+    out = ["| mutation | file | what | result | first failing test | s |",
+           "|---|---|---|---|---|---|"]
+    for m, result, test, seconds in rows:
+        out.append("| " + " | ".join(_cell(c) for c in (m.name, m.path, m.what, result, test or "",
+                                                          f"{seconds:.0f}")) + " |")
+    caught = sum(CAUGHT.get(r, False) for _, r, _, _ in rows)
+    missed = sum(r == "MISSED" for _, r, _, _ in rows)
+    errors = len(rows) - caught - missed
+    out += ["", f"caught {caught} of {len(rows)} ({missed} missed, {errors} errors)"]
+    out += ["", "caught: a test failed (pytest exit 1); caught (collection error): pytest exit 2, counted as "
+                "caught; MISSED: every test passed (exit 0); error: timeout or exit 3, 4 or 5, the run said "
+                "nothing about the mutation."]
+    return "\n".join(out) + "\n"
+
+
+def list_mutations(mutations):
+    width = max(len(m.name) for m in mutations)
+    for m in mutations:
+        print(f"{m.name:<{width}}  {m.path:<34}  {m.what}")
+    print(f"{len(mutations)} mutations; each one's old text occurs exactly once in its file")
+
+
+# ---------------------------------------------------------------------------- main
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0],
+                                     epilog="Exit status: 0 all caught, 1 some missed or errored, 2 could not run.")
+    parser.add_argument("--list", action="store_true", help="list the mutations, check they apply, run nothing")
+    parser.add_argument("--only", nargs="+", metavar="SUBSTRING", default=[],
+                        help="only mutations whose name contains one of these (case-insensitive)")
+    parser.add_argument("--timeout", type=float, default=900.0, metavar="S",
+                        help="seconds per suite run, the baseline included (default 900)")
+    parser.add_argument("--pytest-args", default="", metavar='"..."',
+                        help="extra arguments for every pytest run, e.g. a subset of the tests")
+    parser.add_argument("--markdown", metavar="PATH", help="also write the table to PATH")
+    args = parser.parse_args(argv)
+
+    validate(MUTATIONS, REPO)
+    chosen = select(MUTATIONS, args.only)
+    if not chosen:
+        fail(f"--only {' '.join(args.only)} selects none of the {len(MUTATIONS)} mutations (see --list)")
+    if args.list:
+        list_mutations(chosen)
+        return 0
+    extra = shlex.split(args.pytest_args)
+
+    work = Path(tempfile.mkdtemp(prefix="glphong-mutation-"))
+    try:
+        pristine = work / "pristine"  # the working tree as it is now: later edits there do not leak in
+        pristine.mkdir()
+        snapshot(REPO, pristine)
+        validate(chosen, pristine)
+
+        copy = work / "baseline"
+        shutil.copytree(pristine, copy, symlinks=True)
+        module, glsl = check_import_paths(copy)
+        print(f"copy of the working tree: {copy}\n  glphong from {module}\n  GLSL from {glsl}", flush=True)
+        print(f"baseline: python {' '.join(PYTEST + extra)} ...", flush=True)
+        code, output, seconds = run_suite(copy, args.timeout, extra)
+        shutil.rmtree(copy, ignore_errors=True)
+        if code != 0:
+            how = "timed out" if code is None else f"pytest exit {code}"
+            fail(f"the unmutated copy does not pass ({how}, {seconds:.0f} s); fix the suite first:\n{tail(output)}")
+        print(f"baseline: passes ({seconds:.0f} s)\n", flush=True)
+
+        rows = []
+        width = max(len(m.name) for m in chosen)
+        for i, m in enumerate(chosen, start=1):
+            copy = work / f"run{i:03d}"
+            shutil.copytree(pristine, copy, symlinks=True)
+            try:
+                apply(m, copy)
+                code, output, seconds = run_suite(copy, args.timeout, extra)
+            finally:
+                shutil.rmtree(copy, ignore_errors=True)
+            result = verdict(code)
+            test = first_failure(output) if code in (1, 2) else ""
+            rows.append((m, result, test, seconds))
+            print(f"[{i}/{len(chosen)}] {m.name:<{width}}  {result:<9}  {test or '-'}  ({seconds:.0f} s)", flush=True)
+            if result.startswith("error"):
+                print(tail(output), flush=True)
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+    table = markdown(rows)
+    print("\n" + table, end="", flush=True)
+    if args.markdown:
+        Path(args.markdown).write_text(table, encoding="utf-8")
+        print(f"wrote {args.markdown}")
+    return 0 if all(CAUGHT.get(r, False) for _, r, _, _ in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
