@@ -104,6 +104,10 @@ class Mutation:
         The exact text and its mutated replacement.
     what : str
         One line: the bug.
+    also : tuple of (path, old, new)
+        Further edits planted together with the first, for a bug written in two places at once
+        (the same wrong formula in a GLSL chunk and in its numpy twin); each ``old`` must occur
+        exactly once in its file too.
     """
 
     name: str
@@ -111,6 +115,11 @@ class Mutation:
     old: str
     new: str
     what: str
+    also: tuple = ()
+
+    def edits(self):
+        """Every ``(path, old, new)`` edit of this mutation, the first one first."""
+        return ((self.path, self.old, self.new),) + tuple(self.also)
 
 
 M = Mutation
@@ -131,6 +140,9 @@ MUTATIONS = [
     M("lobe.glsl:q0-rule", "glsl/lobe.glsl",
       "if (q == 0.0) {", "if (q < 0.0) {",
       "lobe_from_delta: the q == 0 rule (0^0 := 1) dropped"),
+    M("lobe.glsl:clamp-80", "glsl/lobe.glsl",
+      "return exp(max(q * log_one_minus(delta), -104.0));", "return exp(max(q * log_one_minus(delta), -80.0));",
+      "lobe_from_delta: exponent clamp -104 -> -80 (tails stop at 1.8e-35 instead of flushing)"),
     M("phong.glsl:reflect-1.9", "glsl/phong.glsl",
       "vec3 r = 2.0 * dot(n, wi) * n - wi;", "vec3 r = 1.9 * dot(n, wi) * n - wi;",
       "phong_delta: r = 1.9 (n.l) n - l"),
@@ -187,6 +199,9 @@ MUTATIONS = [
     M("reference.py:lobe-clamp", "glphong/reference.py",
       "dtype.type(-104)", "dtype.type(-80)",
       "twin lobe_from_delta: exponent clamp -104 -> -80"),
+    M("reference.py:series-1/3", "glphong/reference.py",
+      "dtype.type(1.0) / dtype.type(2 * k + 1)", "dtype.type(1.0) / dtype.type(2 * k + 1.01)",
+      "twin log_one_minus: artanh series coefficients 1/(2k + 1.01)"),
     M("reference.py:phong-reflect-1.9", "glphong/reference.py",
       "r = 2 * _dot(n, wi)[..., None] * n - wi", "r = 1.9 * _dot(n, wi)[..., None] * n - wi",
       "twin phong_delta: r = 1.9 (n.l) n - l"),
@@ -255,6 +270,20 @@ MUTATIONS = [
     M("camera.py:view-translation", "glphong/camera.py",
       "view[:3, 3] = -r.T @ t", "view[:3, 3] = -r @ t",
       "view matrix: translation -R t instead of -R^T t"),
+    M("camera.py:znear-1.01", "glphong/camera.py",
+      "2.0 * far * n / (n - far)]", "2.0 * far * (1.01 * n) / (n - far)]",
+      "projection: the near plane 1% off znear"),
+    # ------------------------------------------------------------------ one bug written in two places
+    M("phong.glsl+reference.py:reflect-1.9", "glsl/phong.glsl",
+      "vec3 r = 2.0 * dot(n, wi) * n - wi;", "vec3 r = 1.9 * dot(n, wi) * n - wi;",
+      "Phong's 2 (n.l) -> 1.9 (n.l) in the GLSL and the twin alike",
+      also=(("glphong/reference.py", "r = 2 * _dot(n, wi)[..., None] * n - wi",
+             "r = 1.9 * _dot(n, wi)[..., None] * n - wi"),)),
+    M("lambert.glsl+reference.py:kd-1.01", "glsl/lambert.glsl",
+      "return kd * n_dot_l;", "return 1.01 * kd * n_dot_l;",
+      "Lambert 1.01 kd (n.l) in the GLSL and the twin alike",
+      also=(("glphong/reference.py", "return kd * np.asarray(n_dot_l)[..., None]",
+             "return 1.01 * kd * np.asarray(n_dot_l)[..., None]"),)),
     # ------------------------------------------------------------------ tolerance band (glphong/tolerances.py)
     M("tolerances.py:A-x100", "glphong/tolerances.py",
       "    A: float = 16.0", "    A: float = 1600.0", "band constant A x 100"),
@@ -298,15 +327,16 @@ def problems(mutations, root):
         if m.name in seen:
             out.append(f"{m.name}: the name is used twice")
         seen.add(m.name)
-        if m.old == m.new:
-            out.append(f"{m.name}: old and new are the same text")
-        file = root / m.path
-        if not file.is_file():
-            out.append(f"{m.name}: no file {m.path}")
-            continue
-        count = file.read_text(encoding="utf-8").count(m.old)
-        if count != 1:
-            out.append(f"{m.name}: its old text occurs {count} times in {m.path} (must be exactly once): {m.old!r}")
+        for path, old, new in m.edits():
+            if old == new:
+                out.append(f"{m.name}: old and new are the same text in {path}")
+            file = root / path
+            if not file.is_file():
+                out.append(f"{m.name}: no file {path}")
+                continue
+            count = file.read_text(encoding="utf-8").count(old)
+            if count != 1:
+                out.append(f"{m.name}: its old text occurs {count} times in {path} (must be exactly once): {old!r}")
     return out
 
 
@@ -319,14 +349,15 @@ def validate(mutations, root):
 
 
 def apply(mutation, root):
-    """Plant ``mutation`` in the copy at ``root`` (its old text is known to occur once)."""
-    file = root / mutation.path
-    with open(file, encoding="utf-8", newline="") as f:
-        text = f.read()
-    if text.count(mutation.old) != 1:
-        fail(f"{mutation.name}: old text does not occur exactly once in {mutation.path} of the copy")
-    with open(file, "w", encoding="utf-8", newline="") as f:
-        f.write(text.replace(mutation.old, mutation.new, 1))
+    """Plant ``mutation`` (all its edits) in the copy at ``root`` (each old text is known to occur once)."""
+    for path, old, new in mutation.edits():
+        file = root / path
+        with open(file, encoding="utf-8", newline="") as f:
+            text = f.read()
+        if text.count(old) != 1:
+            fail(f"{mutation.name}: old text does not occur exactly once in {path} of the copy")
+        with open(file, "w", encoding="utf-8", newline="") as f:
+            f.write(text.replace(old, new, 1))
 
 
 def select(mutations, only):

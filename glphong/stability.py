@@ -151,6 +151,9 @@ def _build_cases():
     for family in ("phong", "blinn"):
         cases.append(Case(f"{family} l = -v", "opposite", family=family, q=1.0, eye=tuple(-c for c in light),
                           lights=(("point", light, e_one),), note="n.v < 0: the Blinn half vector is undefined"))
+        cases.append(Case(f"{family} l, v grazing and mirrored, |l + v| = 6e-6", "opposite", family=family, q=1.0,
+                          eye=(-1.0, 0.0, 3e-6), lights=(("directional", (-1.0, 0.0, -3e-6), 1.0),),
+                          note="n.l = n.v = 3e-6: the half vector is n, just above Blinn's |l + v| floor"))
         cases.append(Case(f"{family} q=0 with v.r < 0", "lobe", family=family, q=0.0, eye=_unit(60.0, 90.0),
                           lights=(("point", light, e_one),), note="0^0 := 1 convention, no pow(0, 0)"))
     for label, normal in (("zero", (0.0, 0.0, 0.0)), ("tiny 1e-25", (0.0, 3e-26, 1e-25)), ("huge 1e25", (0.0, 3e24, 1e25)),

@@ -336,6 +336,15 @@ def test_phong_directional_direction_oblique(renderer):
 # --------------------------------------------------------------------------- point lights
 
 
+def positional_lambert(hit, position, value, kd, falloff):
+    """Lambert plane (normal +z) under a light at ``position``: ``kd value cos / (4 pi d^2)`` with the
+    falloff (a `PointLight`, ``value`` = Phi), ``kd value cos`` without (``value`` = L_i), (H, W, 3)."""
+    r = np.asarray(position, float) - hit
+    d = np.linalg.norm(r, axis=-1)
+    scale = r[..., 2] / d / (4.0 * np.pi * d * d if falloff else 1.0)
+    return np.multiply.outer(scale, np.multiply(kd, value))
+
+
 def test_point_light_position_power(renderer):
     """Lambert plane under a point light: ``kd Phi / (4 pi d^2) * (h / d)`` at each ray-plane hit."""
     position, power = (0.4, -0.3, 1.2), (30.0, 60.0, 90.0)
@@ -346,10 +355,7 @@ def test_point_light_position_power(renderer):
     _, _, hit = top_view()
 
     def expected(pos=position, phi=power, kd=KD):
-        r = np.asarray(pos, float) - hit
-        d = np.linalg.norm(r, axis=-1)
-        cos = r[..., 2] / d
-        return np.multiply.outer(cos / (4.0 * np.pi * d * d), np.multiply(kd, phi))
+        return positional_lambert(hit, pos, phi, kd, falloff=True)
 
     # measured 6.9e-7 (float32 interpolated position through 1/d^2 and the cosine); rtol 2e-6
     rtol = 2e-6
@@ -372,10 +378,7 @@ def test_unattenuated_point_light_position_radiance(renderer):
     _, _, hit = top_view()
 
     def expected(pos=position, li=radiance, falloff=False):
-        r = np.asarray(pos, float) - hit
-        d = np.linalg.norm(r, axis=-1)
-        scale = r[..., 2] / d / (4.0 * np.pi * d * d if falloff else 1.0)
-        return np.multiply.outer(scale, np.multiply(KD, li))
+        return positional_lambert(hit, pos, li, KD, falloff)
 
     # measured 2.6e-7 (the cosine from the float32 position); rtol 1e-6
     rtol = 1e-6
