@@ -96,9 +96,12 @@ class Case:
         scene.add(MeshData([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 1]] * 3, [[0, 1, 2]]), material)
         return scene
 
-    def inputs(self):
-        """``(key, uniforms)`` of the case's 'points' program: exactly what the GPU is given (float32)."""
-        scene = self.scene()
+    def inputs(self, scene=None):
+        """``(key, uniforms)`` of the case's 'points' program: exactly what the GPU is given (float32).
+
+        ``scene`` is `scene()` when given (to build it once), else built here.
+        """
+        scene = self.scene() if scene is None else scene
         key = replace(scene.program_key(scene.objects[0]), output="points", two_sided=False)
         uniforms = scene.uniform_values(0, key, 1.0)
         for name in ("u_model", "u_view_projection", "u_normal_matrix"):
@@ -238,7 +241,11 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60):
     f = lambda x: mpmath.mpf(float(np.float32(x)))  # noqa: E731
     vec = lambda a: [f(x) for x in np.asarray(a, dtype=np.float64).ravel()[:3]]  # noqa: E731
     dot = lambda a, b: sum(x * y for x, y in zip(a, b))  # noqa: E731
-    unit = lambda a: [x / mpmath.sqrt(dot(a, a)) for x in a]  # noqa: E731
+
+    def unit(a):
+        length = mpmath.sqrt(dot(a, a))
+        return [x / length for x in a]
+
     material = scene.objects[0].material
     kd, ka = vec(material.kd), vec(material.ka)
     ks = vec(getattr(material, "ks", (0.0, 0.0, 0.0)))
@@ -369,7 +376,8 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
     report = StabilityReport(gl.backend, gl.renderer_name, formulation)
     try:
         for case in cases:
-            key, uniforms = case.inputs()
+            scene = case.scene()
+            key, uniforms = case.inputs(scene)
             key = replace(key, formulation=formulation)
             position = np.zeros((1, 3))
             normal = np.asarray([case.normal], dtype=np.float32)
@@ -380,7 +388,7 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
             twin = ref.shade_point(position, n, n_valid, u64.get("u_eye"), key, u64)[0]
             low, high = point_band(key, u64, position, n, n_valid)
             low, high = low[0], high[0]
-            expected = oracle(case.scene(), case.normal)
+            expected = oracle(scene, case.normal)
             if case.in_range:
                 # judged against the oracle, with the band's widths as the tolerance: the twin and the
                 # band read the uniforms, the oracle the constructors, so a wrongly wired input shows

@@ -69,8 +69,8 @@ def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, unif
 
     original = stability.Case.inputs
 
-    def miswired(case):
-        key, uniforms = original(case)
+    def miswired(case, scene=None):
+        key, uniforms = original(case, scene)
         if uniform in uniforms:
             uniforms[uniform] = uniforms[uniform] * np.float32(1.01)
         return key, uniforms
