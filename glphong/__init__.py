@@ -11,12 +11,12 @@ Typical use::
         frame = r.render(scene)          # frame.radiance: (256, 256, 3) float32, W/(m^2 sr)
         report = glphong.verify(scene, r)
 """
-from . import imaging, radiometry, reference
+from . import imaging, materials, radiometry, reference
 from .camera import PerspectiveCamera
 from .contexts import BackendUnavailableError, available_backends, create_context
 from .describe import describe, format_descriptions
 from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
-from .materials import BlinnPhong, Lambert, Material, Phong
+from .materials import BlinnPhong, Lambert, Material, MaterialModel, MaterialSum, Param, Phong
 from .renderer import Frame, GBuffer, Renderer
 from .scene import Scene, SceneObject
 from .verify import VerifyReport, verify
@@ -25,7 +25,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "PerspectiveCamera", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
-    "Material", "Lambert", "Phong", "BlinnPhong", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
+    "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
-    "imaging", "radiometry", "reference",
+    "imaging", "materials", "radiometry", "reference",
 ]

@@ -52,21 +52,24 @@ def scalar(name, value, low=0.0, high=FLT_MAX, low_inclusive=True, high_inclusiv
     return x
 
 
-def rgb(name, value, low=0.0, high=FLT_MAX):
-    """An RGB triple from a scalar or a length-3 sequence, each finite and in ``[low, high]``.
+def rgb(name, value, low=0.0, high=FLT_MAX, low_inclusive=True, high_inclusive=True):
+    """An RGB triple from a scalar or a length-3 sequence, each finite and in ``[low, high]``
+    (``low_inclusive`` / ``high_inclusive`` False make that end open).
 
     Returns
     -------
     tuple of 3 float
     """
-    interval = f"[{low:g}, {high:g}]"
+    interval = f"{'[' if low_inclusive else '('}{low:g}, {high:g}{']' if high_inclusive else ')'}"
     a = real_array(name, value, f"a real number or an RGB triple of real numbers in {interval}")
     if a.ndim == 0:
         a = np.repeat(a, 3)
     if a.shape != (3,):
         raise ValueError(f"{name} must be a scalar or have shape (3,), each channel in {interval} "
                          f"(got shape {a.shape})")
-    if not (np.all(np.isfinite(a)) and np.all(a >= low) and np.all(a <= high)):
+    ok = np.all(np.isfinite(a)) and np.all(a >= low if low_inclusive else a > low) and \
+        np.all(a <= high if high_inclusive else a < high)
+    if not ok:
         raise ValueError(f"{name} must be finite and in {interval} per channel (got {_fmt(a)})")
     return tuple(float(c) + 0.0 for c in a)
 

@@ -127,21 +127,22 @@ class HandWrittenRenderer:
                 key = self.key(scene, obj)
                 program = self._programs.get(key)
                 if program is None:
-                    defines = key.defines()
+                    defines, generated = key.defines(), key.generated_chunks()
                     program = self._programs[key] = mgl.program(
-                        vertex_shader=assemble(key.vertex_chunks(), defines),
-                        fragment_shader=assemble(key.fragment_chunks(), defines))
+                        vertex_shader=assemble(key.vertex_chunks(), defines, generated),
+                        fragment_shader=assemble(key.fragment_chunks(), defines, generated))
                 mesh = meshes.get(id(obj.mesh))
                 if mesh is None:
                     mesh = meshes[id(obj.mesh)] = {"indices": mgl.buffer(obj.mesh.indices.tobytes())}
                     self._buffers.append(mesh["indices"])
                 content = []
-                for name, source in (("in_position", "positions"), ("in_normal", "normals")):
+                for name, source, fmt in (("in_position", "positions", "3f"), ("in_normal", "normals", "3f"),
+                                          ("in_tangent", "tangents", "4f"), ("in_uv", "uvs", "2f")):
                     if name in key.attributes():
                         if source not in mesh:
                             mesh[source] = mgl.buffer(getattr(obj.mesh, source).tobytes())
                             self._buffers.append(mesh[source])
-                        content.append((mesh[source], "3f", name))
+                        content.append((mesh[source], fmt, name))
                 vao = mgl.vertex_array(program, content, mesh["indices"], index_element_size=4)
                 self._vaos.append(vao)
                 uniforms = []
@@ -252,15 +253,15 @@ def import_pyrender(platform):
 def pyrender_roughness(material):
     """pyrender perceptual roughness for a glphong material (a rough, documented mapping).
 
-    ``(2 / (q_blinn + 2)) ** 0.25`` with ``q_blinn = q`` for `BlinnPhong` and ``4 q`` for
-    `Phong`; 1.0 for a material without a specular lobe.  Derivation: a Blinn lobe of
-    exponent q resembles a Beckmann/GGX lobe of ``alpha = sqrt(2 / (q + 2))``, and pyrender
-    uses ``alpha = roughness**2``.
+    The smallest ``pbr_roughness()`` of the material's non-vanishing terms that define one, 1.0
+    when none does.  The lobe models define ``(2 / (q_blinn + 2)) ** 0.25`` with ``q_blinn = q``
+    for the Blinn lobe and ``4 q`` for the Phong lobe.  Derivation: a Blinn lobe of exponent q
+    resembles a Beckmann/GGX lobe of ``alpha = sqrt(2 / (q + 2))``, and pyrender uses
+    ``alpha = roughness**2``.
     """
-    if not isinstance(material, (Phong, BlinnPhong)) or not material.has_specular:
-        return 1.0
-    q = float(material.q) * (4.0 if isinstance(material, Phong) else 1.0)
-    return float((2.0 / (q + 2.0)) ** 0.25)
+    values = [term.pbr_roughness() for term in material.components
+              if hasattr(term, "pbr_roughness") and not term.vanishes()]
+    return min(values) if values else 1.0
 
 
 def _pyrender_material(pyrender, material):

@@ -61,18 +61,25 @@ def describe(scenes, renderer=None, gbuffer=False):
 
     scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
     outputs = ("radiance", "gbuffer") if gbuffer else ("radiance",)
-    users = {}
+    users, absent = {}, {}
     for scene in scenes:
         for obj in scene.objects:
             for output in outputs:
                 key = renderer.program_key(scene, obj, output) if renderer else scene.program_key(obj, output)
                 users.setdefault(key, []).append(obj.name)
+                present = {t.name for t in key.terms}
+                for term in obj.material.components:
+                    if term.name not in present and output != "gbuffer":
+                        reason = ("its parameters " + ", ".join(f"{p} = 0" for p in term.vanishes_with)
+                                  if term.vanishes() else "no light reaches it and it does not answer L_a")
+                        absent.setdefault(key, {}).setdefault(type(term), reason)
     out = []
     for key, names in users.items():
-        defines = key.defines()
-        fragment = assemble(key.fragment_chunks(), defines) if key.fragment_chunks() else ""
+        defines, generated = key.defines(), key.generated_chunks()
+        fragment = assemble(key.fragment_chunks(), defines, generated) if key.fragment_chunks() else ""
         out.append(ProgramDescription(key, tuple(dict.fromkeys(names)), key.vertex_chunks(), key.fragment_chunks(),
-                                      defines, key.left_out(), assemble(key.vertex_chunks(), defines), fragment))
+                                      defines, key.left_out(list(absent.get(key, {}).items())),
+                                      assemble(key.vertex_chunks(), defines, generated), fragment))
     return out
 
 

@@ -2,13 +2,21 @@
 
 `MeshData` is an immutable float32 copy of a `trimesh.Trimesh`: positions, one
 normal per vertex (smooth: the mesh's vertex normals; flat: each face's normal on
-its own three vertices) and triangle indices.
+its own three vertices) and triangle indices; optionally texture coordinates and
+tangents, for materials whose terms need ``'uv'`` or ``'tangent'`` (DESIGN section 8).
+
+Tangents, where a mesh does not supply them, come from its UVs by the standard method of
+Lengyel (2001, "Computing tangent space basis vectors for an arbitrary mesh"): per triangle
+``T = (e1 dv2 - e2 dv1) / (du1 dv2 - du2 dv1)`` and ``B = (e2 du1 - e1 du2) / (...)``, summed
+at its vertices (triangles with a degenerate UV map are skipped), then per vertex
+``t = normalize(T - (n.T) n)`` and the handedness ``w = sign((n x t) . B)`` (+1 where 0).  A
+vertex with no usable tangent gets t = 0; the shader then uses an orthonormal basis around n.
 """
 import numpy as np
 
 from . import _validate
 
-__all__ = ["MeshData"]
+__all__ = ["MeshData", "tangents_from_uvs"]
 
 
 class MeshData:
@@ -23,9 +31,14 @@ class MeshData:
         normals give ambient-only shading).
     indices : (F, 3) array_like of int
         Triangle vertex indices, counter-clockwise front faces.
+    uvs : (V, 2) array_like, optional
+        Texture coordinates.
+    tangents : (V, 4) or (V, 3) array_like, optional
+        Object-space tangents (any length; orthonormalised against the normal per fragment),
+        handedness in the fourth column (+1 when omitted).  Default: from ``uvs`` (see the module).
     """
 
-    def __init__(self, positions, normals, indices):
+    def __init__(self, positions, normals, indices, uvs=None, tangents=None):
         positions = _validate.real_array("positions", positions, "a (V, 3) array of real numbers")
         normals = _validate.real_array("normals", normals, "a (V, 3) array of real numbers")
         indices = np.asarray(indices)
@@ -48,8 +61,28 @@ class MeshData:
         self.positions = positions
         self.normals = normals
         self.indices = np.ascontiguousarray(indices, dtype=np.uint32)
-        for a in (self.positions, self.normals, self.indices):
-            a.setflags(write=False)
+        self.uvs = None if uvs is None else _vertex_array("uvs", uvs, len(positions), (2,))
+        self._tangents = None if tangents is None else _vertex_array("tangents", tangents, len(positions), (3, 4))
+        if self._tangents is not None and self._tangents.shape[1] == 3:
+            self._tangents = np.ascontiguousarray(np.concatenate(
+                [self._tangents, np.ones((len(positions), 1), np.float32)], axis=1))
+        for a in (self.positions, self.normals, self.indices, self.uvs, self._tangents):
+            if a is not None:
+                a.setflags(write=False)
+
+    @property
+    def has_tangents(self):
+        """True when the mesh supplies tangents or UVs to derive them from."""
+        return self._tangents is not None or self.uvs is not None
+
+    @property
+    def tangents(self):
+        """Per-vertex tangents (V, 4) float32 with handedness in w: the supplied ones, else derived
+        from the UVs (Lengyel's method, see the module), else None.  Computed once."""
+        if self._tangents is None and self.uvs is not None:
+            self._tangents = tangents_from_uvs(self.positions, self.normals, self.indices, self.uvs)
+            self._tangents.setflags(write=False)
+        return self._tangents
 
     @classmethod
     def from_trimesh(cls, mesh, smooth=True):
@@ -68,12 +101,15 @@ class MeshData:
             raise TypeError(f"mesh must be a trimesh.Trimesh (got {type(mesh).__name__})")
         if len(mesh.faces) == 0:
             raise ValueError("mesh must have at least one face")
+        uv = getattr(getattr(mesh, "visual", None), "uv", None)
+        uv = None if uv is None or len(uv) != len(mesh.vertices) else np.asarray(uv, dtype=np.float64)
         if smooth:
-            return cls(mesh.vertices, mesh.vertex_normals, mesh.faces)
+            return cls(mesh.vertices, mesh.vertex_normals, mesh.faces, uvs=uv)
         faces = np.asarray(mesh.faces)
         positions = np.asarray(mesh.vertices)[faces].reshape(-1, 3)
         normals = np.repeat(np.asarray(mesh.face_normals), 3, axis=0)
-        return cls(positions, normals, np.arange(len(positions)).reshape(-1, 3))
+        return cls(positions, normals, np.arange(len(positions)).reshape(-1, 3),
+                   uvs=None if uv is None else uv[faces].reshape(-1, 2))
 
     @property
     def triangle_count(self):
@@ -81,4 +117,54 @@ class MeshData:
         return len(self.indices)
 
     def __repr__(self):
-        return f"MeshData({len(self.positions)} vertices, {self.triangle_count} triangles)"
+        extras = "".join([", uvs" if self.uvs is not None else "", ", tangents" if self._tangents is not None else ""])
+        return f"MeshData({len(self.positions)} vertices, {self.triangle_count} triangles{extras})"
+
+
+def _vertex_array(name, value, count, widths):
+    a = _validate.real_array(name, value, f"a (V, {' or '.join(map(str, widths))}) array of real numbers")
+    if a.ndim != 2 or a.shape[0] != count or a.shape[1] not in widths:
+        raise ValueError(f"{name} must have shape ({count}, {' or '.join(map(str, widths))}) (got {a.shape})")
+    if not (np.all(np.isfinite(a)) and np.all(np.abs(a) <= _validate.FLT_MAX)):
+        raise ValueError(f"{name} must be finite with |components| <= {_validate.FLT_MAX:g} (float32)")
+    return np.ascontiguousarray(a, dtype=np.float32)
+
+
+def tangents_from_uvs(positions, normals, indices, uvs):
+    """Per-vertex tangents from texture coordinates (Lengyel 2001; see the module docstring).
+
+    Parameters
+    ----------
+    positions, normals : (V, 3) array_like
+    indices : (F, 3) array_like of int
+    uvs : (V, 2) array_like
+
+    Returns
+    -------
+    (V, 4) float32 ndarray
+        Unit tangent orthogonal to the normal and the handedness w = +-1; t = 0 where no
+        triangle at the vertex has a usable UV map.
+    """
+    p = np.asarray(positions, dtype=np.float64)
+    n = np.asarray(normals, dtype=np.float64)
+    uv = np.asarray(uvs, dtype=np.float64)
+    f = np.asarray(indices, dtype=np.int64)
+    e1, e2 = p[f[:, 1]] - p[f[:, 0]], p[f[:, 2]] - p[f[:, 0]]
+    d1, d2 = uv[f[:, 1]] - uv[f[:, 0]], uv[f[:, 2]] - uv[f[:, 0]]
+    det = d1[:, 0] * d2[:, 1] - d2[:, 0] * d1[:, 1]
+    usable = np.abs(det) > 1e-300
+    r = np.where(usable, 1.0 / np.where(usable, det, 1.0), 0.0)[:, None]
+    t_face = (e1 * d2[:, 1:2] - e2 * d1[:, 1:2]) * r
+    b_face = (e2 * d1[:, 0:1] - e1 * d2[:, 0:1]) * r
+    t_sum = np.zeros_like(p)
+    b_sum = np.zeros_like(p)
+    for k in range(3):
+        np.add.at(t_sum, f[:, k], t_face)
+        np.add.at(b_sum, f[:, k], b_face)
+    n_len = np.linalg.norm(n, axis=1, keepdims=True)
+    n_hat = np.divide(n, n_len, out=np.zeros_like(n), where=n_len > 0)
+    t = t_sum - np.sum(n_hat * t_sum, axis=1, keepdims=True) * n_hat
+    t_len = np.linalg.norm(t, axis=1, keepdims=True)
+    t = np.divide(t, t_len, out=np.zeros_like(t), where=t_len > 1e-300)
+    w = np.where(np.sum(np.cross(n_hat, t) * b_sum, axis=1) < 0.0, -1.0, 1.0)
+    return np.ascontiguousarray(np.concatenate([t, w[:, None]], axis=1), dtype=np.float32)

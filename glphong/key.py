@@ -1,20 +1,69 @@
-"""Program keys: the one source of truth for what a GLSL program contains (DESIGN section 5).
+"""Program keys: the one source of truth for what a GLSL program contains (DESIGN sections 5 and 8).
 
-A `ProgramKey` is frozen and hashable.  It is the program-cache key, and it alone
-generates the ``#define`` lines and the list of chunks a program is assembled from:
-terms a material does not have, light kinds a scene lacks and vertex attributes
-nobody reads are left out of the source.  The numpy twin reads the same key.
+A `ProgramKey` is frozen and hashable.  It is the program-cache key, and it alone generates
+the ``#define`` lines, the list of chunks a program is assembled from, the generated material
+chunk (the sum of the material's terms), the vertex attributes and what `describe` lists as left
+out.  A material's terms enter as `TermKey` (model name, a hash of its GLSL, what it needs, whether
+it is in the light loop and whether it answers ``L_a``): terms a material does not have or whose
+parameters make them vanish, light kinds a scene lacks and vertex attributes nobody reads are
+left out of the source.  Nothing here knows any model by name; the numpy twin reads the same key.
 """
 from dataclasses import dataclass, fields
 
-__all__ = ["ProgramKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "UBER_MAX_LIGHTS"]
+__all__ = ["ProgramKey", "TermKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "UBER_MAX_LIGHTS",
+           "material_chunk"]
 
 #: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
 UBER_MAX_LIGHTS = 8
 
 OUTPUTS = ("radiance", "gbuffer", "points", "display")
-LOBES = (None, "phong", "blinn")
 FORMULATIONS = ("stable", "naive")
+LIGHT_KINDS = ("point", "unattenuated", "directional")
+#: label of the generated chunk that sums the terms
+MATERIAL_CHUNK = "generated:material"
+
+
+@dataclass(frozen=True)
+class TermKey:
+    """One term of a program's material.
+
+    Attributes
+    ----------
+    name : str
+        The model's name (its GLSL prefix).
+    source_hash : str
+        Hash of the model's GLSL: an edited definition is a different program.
+    needs : tuple of str
+        What the model reads besides n and l ('view', 'tangent', 'uv').
+    lit : bool
+        Evaluated in the light loop.
+    ambient : bool
+        Answers the ambient light ``L_a`` (``k L_a``).
+    uses : tuple of str
+        Library chunks its GLSL calls.
+    defines : tuple of (str, str)
+        The instance's structural defines.
+    ambient_param : str or None
+        The rgb parameter of its ``k L_a`` answer.
+    """
+
+    name: str
+    source_hash: str
+    needs: tuple = ()
+    lit: bool = True
+    ambient: bool = False
+    uses: tuple = ()
+    defines: tuple = ()
+    ambient_param: str = None
+
+    @property
+    def chunk(self):
+        """Chunk label of the model's GLSL (``model:<name>``)."""
+        return f"model:{self.name}"
+
+    def describe(self):
+        flags = [f for f, on in (("lit", self.lit), ("ambient", self.ambient)) if on]
+        return f"{self.name}[{','.join(flags)}]"
 
 
 @dataclass(frozen=True)
@@ -27,54 +76,65 @@ class ProgramKey:
         Shaded radiance, the G-buffer of shading inputs, radiance at arbitrary points
         (a vertex-only program whose ``shade_point()`` result is captured by transform feedback), or
         display values (exposure and sRGB applied after shading) for pyrender's 8-bit framebuffer.
-    lobe : {None, 'phong', 'blinn'}
-        Specular lobe, None when the program has no specular term.
-    has_ka, has_kd_la, has_diffuse : bool
-        Presence of the terms k_a, k_d L_a and k_d (n.l) E of DESIGN E6.
+    terms : tuple of TermKey
+        The material's terms that the program evaluates (lit, or answering ``L_a``), in order.
+    has_ka : bool
+        The constant term ``k_a``.
     num_point_lights, num_unattenuated_lights, num_directional_lights : int
         Compile-time light counts per kind.
     has_normal : bool
         Whether the program reads the normal attribute (not needed without lights).
+    has_tangent, has_uv : bool
+        Whether it reads the tangent (vec4, handedness in w) and uv attributes.  For a G-buffer
+        program: whether it writes them.
     two_sided : bool
         Flip the normal on back faces.
     formulation : {'stable', 'naive'}
         The stable float32 formulation of DESIGN section 3, or the textbook one (``normalize``,
-        ``d*d``, ``pow(dot(v, r), q)``) kept only to show why the stable one exists.
+        ``d*d``, ``pow(dot(v, r), q)``, through the ``NAIVE`` define every chunk may honour) kept
+        only to show why the stable one exists.
     uber : bool
-        The uber-shader: every term, both lobes and `UBER_MAX_LIGHTS` lights of each kind
-        compiled in and switched by uniforms.  Kept to measure what specialisation buys.
+        The uber-shader: its terms and `UBER_MAX_LIGHTS` lights of each kind compiled in and
+        switched by uniforms.  Kept to measure what specialisation buys.
     shade_per_vertex : bool
         Gouraud shading: ``shade_point()`` runs in the vertex stage and its radiance is interpolated.
     """
 
     output: str = "radiance"
-    lobe: str = None
+    terms: tuple = ()
     has_ka: bool = False
-    has_kd_la: bool = False
-    has_diffuse: bool = False
     num_point_lights: int = 0
     num_unattenuated_lights: int = 0
     num_directional_lights: int = 0
     has_normal: bool = True
+    has_tangent: bool = False
+    has_uv: bool = False
     two_sided: bool = True
     formulation: str = "stable"
     uber: bool = False
     shade_per_vertex: bool = False
 
     def __post_init__(self):
-        if self.output not in OUTPUTS or self.lobe not in LOBES or self.formulation not in FORMULATIONS:
+        if self.output not in OUTPUTS or self.formulation not in FORMULATIONS or \
+                not all(isinstance(t, TermKey) for t in self.terms):
             raise ValueError(f"invalid ProgramKey {self}")
 
     @property
-    def has_specular(self):
-        """True when the program evaluates a specular lobe."""
-        return self.lobe is not None or self.uber
+    def lit_terms(self):
+        """Terms in the light loop (tuple of TermKey)."""
+        return tuple(t for t in self.terms if t.lit)
+
+    @property
+    def has_ambient(self):
+        """True when a term answers ``L_a`` (the program reads ``u_ambient``)."""
+        return any(t.ambient for t in self.terms)
 
     @property
     def needs_view(self):
-        """True when the program needs the eye position: a specular lobe reads v, and per-vertex
+        """True when the program needs the eye position: a lit term reads v, or per-vertex
         two-sided shading turns the normal toward the eye."""
-        return self.has_specular or (self.shade_per_vertex and self.two_sided and self.has_normal)
+        return (self.num_lights > 0 and any("view" in t.needs for t in self.lit_terms)) or \
+            (self.shade_per_vertex and self.two_sided and self.has_normal)
 
     @property
     def num_lights(self):
@@ -83,7 +143,11 @@ class ProgramKey:
 
     def attributes(self):
         """Vertex attributes the program reads, in binding order."""
-        return ("in_position", "in_normal") if self.has_normal else ("in_position",)
+        names = ["in_position"]
+        names += ["in_normal"] if self.has_normal else []
+        names += ["in_tangent"] if self.has_tangent else []
+        names += ["in_uv"] if self.has_uv else []
+        return tuple(names)
 
     def defines(self):
         """The generated ``#define`` lines as (name, value) pairs."""
@@ -92,46 +156,41 @@ class ProgramKey:
             ("OUTPUT_GBUFFER", b(self.output == "gbuffer")),
             ("OUTPUT_DISPLAY", b(self.output == "display")),
             ("HAS_NORMAL", b(self.has_normal)),
+            ("HAS_TANGENT", b(self.has_tangent)),
+            ("HAS_UV", b(self.has_uv)),
             ("TWO_SIDED", b(self.two_sided)),
             ("RUNTIME_SWITCHES", b(self.uber)),
             ("SHADE_PER_VERTEX", b(self.shade_per_vertex)),
+            ("NAIVE", b(self.formulation == "naive")),
             # SWITCH(u_flag): a float uniform flag in the uber-shader, the constant true otherwise
             ("SWITCH(flag)", "((flag) > 0.5)" if self.uber else "true"),
         ]
         if self.output != "gbuffer":
-            out += [
-                ("HAS_KA", b(self.has_ka)),
-                ("HAS_KD_LA", b(self.has_kd_la)),
-                ("HAS_DIFFUSE", b(self.has_diffuse)),
-                ("HAS_SPECULAR", b(self.has_specular)),
-                ("NEEDS_VIEW", b(self.needs_view)),
-            ]
-            for kind in ("POINT", "UNATTENUATED", "DIRECTIONAL"):
-                size = getattr(self, f"num_{kind.lower()}_lights")
-                out.append((f"NUM_{kind}_LIGHTS", str(size)))
-                out.append((f"{kind}_LIGHT_COUNT", f"int(u_{kind.lower()}_count)" if self.uber else str(size)))
-            if self.has_specular:
-                out.append(("SPECULAR_LOBE", "uber_lobe" if self.uber else f"{self.lobe}_lobe"))
+            out.append(("NEEDS_VIEW", b(self.needs_view)))
+            for kind in LIGHT_KINDS:
+                size = getattr(self, f"num_{kind}_lights")
+                out.append((f"NUM_{kind.upper()}_LIGHTS", str(size)))
+                out.append((f"{kind.upper()}_LIGHT_COUNT", f"int(u_{kind}_count)" if self.uber else str(size)))
+            for term in self.terms:
+                out += list(term.defines)
         return out
 
+    def library_chunks(self):
+        """Library chunks the terms use, in first-use order."""
+        return tuple(dict.fromkeys(c for t in self.terms for c in t.uses))
+
     def shading_chunks(self):
-        """Chunk files that define ``shade_point()`` and what it calls: only those the key needs."""
-        if self.formulation == "naive":
-            return ("naive",) + (("lambert",) if self.has_diffuse else ()) + ("shade",)
-        if self.uber:
-            return ("common", "lights", "lambert", "lobe", "phong", "blinn", "uber", "shade")
+        """Chunks that define ``shade_point()`` and what it calls: only those the key needs."""
         chunks = ["common"]
         if self.num_point_lights:
             chunks.append("lights")
-        if self.has_diffuse:
-            chunks.append("lambert")
-        if self.has_specular:
-            chunks += ["lobe", self.lobe]
-        chunks.append("shade")
+        chunks += self.library_chunks()
+        chunks += [t.chunk for t in self.terms]
+        chunks += [MATERIAL_CHUNK, "shade"]
         return tuple(chunks)
 
     def vertex_chunks(self):
-        """Chunk files of the vertex stage, in order."""
+        """Chunks of the vertex stage, in order."""
         if self.output == "points":
             return self.shading_chunks() + ("shade_points",)
         if self.shade_per_vertex:
@@ -139,7 +198,7 @@ class ProgramKey:
         return ("mesh_vertex",)
 
     def fragment_chunks(self):
-        """Chunk files of the fragment stage, in order (none for 'points')."""
+        """Chunks of the fragment stage, in order (none for 'points')."""
         if self.output == "points":
             return ()
         if self.output == "gbuffer":
@@ -150,59 +209,139 @@ class ProgramKey:
             return self.shading_chunks() + ("srgb", "mesh_fragment")
         return self.shading_chunks() + ("mesh_fragment",)
 
+    def generated_chunks(self):
+        """Text of the chunks generated from the key (label -> GLSL)."""
+        return {} if self.output == "gbuffer" else {MATERIAL_CHUNK: material_chunk(self)}
+
     def varyings(self):
         """Transform-feedback outputs of a 'points' program."""
         return ("out_radiance",) if self.output == "points" else ()
 
-    def left_out(self):
-        """What this program does not contain, one readable line per item (list of str)."""
+    def left_out(self, absent_terms=()):
+        """What this program does not contain, one readable line per item (list of str).
+
+        Parameters
+        ----------
+        absent_terms : sequence of (MaterialModel subclass, str)
+            Terms of the drawn materials that the key leaves out, with the reason.
+        """
         if self.output == "gbuffer":
-            return ["all shading code and lights (the G-buffer program writes position and normal only)",
-                    "radiance output"]
+            extras = [name for name, on in (("tangent", self.has_tangent), ("uv", self.has_uv)) if not on]
+            return ["all shading code and lights (the G-buffer program writes the shading inputs only)",
+                    "radiance output"] + [f"{name} output (no drawn term needs it)" for name in extras]
         if self.uber:
-            return ["nothing: the uber-shader compiles every term and switches at run time"]
+            return ["nothing: the uber-shader compiles every term of the scene and switches at run time"]
         out = []
-        if self.lobe is None:
-            out.append("specular lobe: lobe.glsl, phong.glsl, blinn.glsl, u_ks, u_q (no ks, or no light)")
-        else:
-            other = "blinn" if self.lobe == "phong" else "phong"
-            out.append(f"the other lobe: {other}.glsl")
+        for model, reason in absent_terms:
+            params = ", ".join(model.uniform_name(p.name) for p in model.params)
+            out.append(f"term {model.name}: {model_chunk_label(model.name)}{', ' + params if params else ''} ({reason})")
+        used = set(self.library_chunks())
+        from .materials.model import LIBRARY_CHUNKS
+
+        for chunk in LIBRARY_CHUNKS:
+            if chunk not in used:
+                out.append(f"library chunk {chunk}.glsl (no term of this program calls it)")
         if not self.needs_view:
-            out.append("view vector v = normalize(eye - x) and u_eye (only a lobe reads it)")
+            out.append("view vector v = normalize(eye - x) and u_eye (no lit term reads it)")
         if not self.has_ka:
-            out.append("ambient term k_a (ka = 0)")
-        if not self.has_kd_la:
-            out.append("ambient term k_d L_a (no AmbientLight, or kd = 0)")
-        if not self.has_diffuse:
-            out.append("Lambert term: lambert.glsl (kd = 0, or no light)")
-        for kind, count in (("point", self.num_point_lights), ("unattenuated", self.num_unattenuated_lights),
-                            ("directional", self.num_directional_lights)):
-            if not count:
+            out.append("constant term k_a (ka = 0)")
+        if not self.has_ambient:
+            out.append("ambient light L_a and u_ambient (no AmbientLight, or no term answers it)")
+        for kind in LIGHT_KINDS:
+            if not getattr(self, f"num_{kind}_lights"):
                 extra = " and lights.glsl" if kind == "point" else ""
                 out.append(f"{kind}-light loop, its uniform arrays{extra} (no {kind} light reaches this material)")
         if not self.has_normal:
             out.append("normal attribute, its upload and the normal matrix (nothing reads a normal)")
         if not self.two_sided:
             out.append("two-sided normal flip")
-        out.append("tangent attribute (no anisotropic material)")
+        if not self.has_tangent:
+            out.append("tangent attribute and the tangent frame (no lit term needs 'tangent')")
+        if not self.has_uv:
+            out.append("uv attribute (no lit term needs 'uv')")
         out.append("G-buffer outputs (they exist only in the G-buffer program)")
         return out
 
     def describe(self):
-        """One line naming every field that is set, e.g. ``radiance lobe=phong has_diffuse num_point_lights=2``."""
+        """One line naming every field that is set, e.g. ``radiance terms=lambert[lit]+phong_lobe[lit] num_point_lights=2``."""
         if self.uber:
-            return (f"{self.output} uber (every term, both lobes, {UBER_MAX_LIGHTS} lights per kind, switched by "
-                    f"uniforms){'' if self.formulation == 'stable' else ' formulation=' + self.formulation}")
+            return (f"{self.output} uber (terms {'+'.join(t.name for t in self.terms) or 'none'}, "
+                    f"{UBER_MAX_LIGHTS} lights per kind, switched by uniforms)"
+                    f"{'' if self.formulation == 'stable' else ' formulation=' + self.formulation}")
         parts = [self.output]
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name != "output" and v not in (False, 0, None, "stable"):
+            if f.name == "terms":
+                if v:
+                    parts.append("terms=" + "+".join(t.describe() for t in v))
+            elif f.name != "output" and v not in (False, 0, None, "stable"):
                 parts.append(f.name if v is True else f"{f.name}={v}")
         return " ".join(parts)
 
 
-def program_key(material, light_counts, ambient_radiance, output="radiance"):
-    """The radiance-program key of one material in a scene.
+def model_chunk_label(name):
+    """Where a model's GLSL comes from, for messages (its file, or its class)."""
+    from .materials.model import model_named, model_source
+
+    return model_source(model_named(name))[1]
+
+
+def _switch(key, flag, statement):
+    return f"    if (SWITCH({flag})) {statement}" if key.uber else f"    {statement}"
+
+
+def material_chunk(key):
+    """The generated GLSL that sums the key's terms (label ``generated:material``).
+
+    ``material_emission() = k_a + sum_terms k_term L_a`` and
+    ``material_response(f, wi, wo, n_dot_l) = sum_lit_terms <model>_response(f, wi, wo, n_dot_l)``;
+    in the uber-shader every term is behind a ``SWITCH(u_use_<model>)`` uniform flag.
+    """
+    lines = ["// material (generated from the program key) -- the material as a sum of its terms (DESIGN section 8):",
+             "//   material_emission() = k_a + sum_terms k L_a                          [W/(m^2 sr)]",
+             "//   material_response(f, wi, wo, n_dot_l) = sum_terms <model>_response    [1/sr], times cos"]
+    if key.uber:
+        lines += ["uniform float u_use_ka;"] + [f"uniform float u_use_{t.name};" for t in key.lit_terms]
+        lines += [f"uniform float u_use_{t.name}_ambient;" for t in key.terms if t.ambient]
+        lines += [f"uniform float u_{kind}_count;" for kind in LIGHT_KINDS]
+    if key.has_ka:
+        lines.append("uniform vec3 u_ka;                 // k_a [W/(m^2 sr)]")
+    if key.has_ambient:
+        lines.append("uniform vec3 u_ambient;            // L_a [W/m^2]")
+    lines += ["", "vec3 material_emission()", "{", "    vec3 radiance = vec3(0.0);"]
+    if key.has_ka:
+        lines.append(_switch(key, "u_use_ka", "radiance += u_ka;"))
+    for t in key.terms:
+        if t.ambient:
+            lines.append(_switch(key, f"u_use_{t.name}_ambient", f"radiance += u_{t.name}_{t.ambient_param} * u_ambient;"))
+    lines += ["    return radiance;", "}", "",
+              "vec3 material_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)", "{",
+              "    vec3 response = vec3(0.0);"]
+    for t in key.lit_terms:
+        lines.append(_switch(key, f"u_use_{t.name}", f"response += {t.name}_response(f, wi, wo, n_dot_l);"))
+    lines += ["    return response;", "}"]
+    return "\n".join(lines) + "\n"
+
+
+def _ambient_present(ambient_radiance):
+    return ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance)
+
+
+def term_keys(material, lit, ambient_present):
+    """The `TermKey` of each term of ``material`` that a program evaluates."""
+    out = []
+    for term in material.components:
+        if term.vanishes():
+            continue
+        answers = ambient_present and term.answers_ambient()
+        if lit or answers:
+            out.append(TermKey(term.name, term.source_hash(), tuple(term.needs), lit=lit, ambient=answers,
+                               uses=tuple(term.uses), defines=tuple(term.defines()), ambient_param=term.ambient))
+    return tuple(out)
+
+
+def program_key(material, light_counts, ambient_radiance, output="radiance", gbuffer_needs=None):
+    """The program key of one material in a scene.
 
     Parameters
     ----------
@@ -212,37 +351,55 @@ def program_key(material, light_counts, ambient_radiance, output="radiance"):
     ambient_radiance : tuple of 3 float or None
         The scene's ``L_a``.
     output : {'radiance', 'gbuffer', 'points', 'display'}
+    gbuffer_needs : set of str, optional
+        For 'gbuffer': the extra outputs ('tangent', 'uv') the scene's G-buffer carries.
 
     Returns
     -------
     ProgramKey
     """
     if output == "gbuffer":
-        return gbuffer_key(material)
-    has_kd = any(c > 0.0 for c in material.kd)
-    # lights matter only to a material that reflects them
-    lit = sum(light_counts.values()) > 0 and (has_kd or material.has_specular)
+        return gbuffer_key(material, gbuffer_needs or ())
+    # lights matter only to a material with a term that reflects them
+    lit = sum(light_counts.values()) > 0 and any(not t.vanishes() for t in material.components)
+    terms = term_keys(material, lit, _ambient_present(ambient_radiance))
+    needs = {n for t in terms if t.lit for n in t.needs}
     count = lambda kind: light_counts.get(kind, 0) if lit else 0  # noqa: E731
     return ProgramKey(
         output=output,
-        lobe=material.family if (lit and material.has_specular) else None,
+        terms=terms,
         has_ka=any(c > 0.0 for c in material.ka),
-        has_kd_la=has_kd and ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance),
-        has_diffuse=lit and has_kd,
         num_point_lights=count("point"),
         num_unattenuated_lights=count("unattenuated"),
         num_directional_lights=count("directional"),
         has_normal=lit,
+        has_tangent="tangent" in needs,
+        has_uv="uv" in needs,
         two_sided=material.two_sided and lit,
     )
 
 
-def uber_key(output="radiance", formulation="stable", shade_per_vertex=False):
-    """The uber-shader's key: everything compiled in, switched at run time by uniforms."""
-    return ProgramKey(output=output, lobe=None, has_ka=True, has_kd_la=True, has_diffuse=True,
+def uber_key(materials, output="radiance", formulation="stable", shade_per_vertex=False):
+    """The uber-shader's key: every term of ``materials``, `UBER_MAX_LIGHTS` lights of each kind,
+    switched at run time by uniforms.
+
+    Parameters
+    ----------
+    materials : sequence of glphong.materials.Material
+        The materials drawn with it (a scene's); their terms are all compiled in.
+    """
+    terms = {}
+    for material in materials:
+        for term in material.components:
+            terms.setdefault(term.name, TermKey(term.name, term.source_hash(), tuple(term.needs), lit=True,
+                                                ambient=term.ambient is not None, uses=tuple(term.uses),
+                                                defines=tuple(term.defines()), ambient_param=term.ambient))
+    needs = {n for t in terms.values() for n in t.needs}
+    return ProgramKey(output=output, terms=tuple(terms[name] for name in sorted(terms)), has_ka=True,
                       num_point_lights=UBER_MAX_LIGHTS, num_unattenuated_lights=UBER_MAX_LIGHTS,
-                      num_directional_lights=UBER_MAX_LIGHTS, has_normal=True, two_sided=True,
-                      formulation=formulation, uber=True, shade_per_vertex=shade_per_vertex)
+                      num_directional_lights=UBER_MAX_LIGHTS, has_normal=True, has_tangent="tangent" in needs,
+                      has_uv="uv" in needs, two_sided=True, formulation=formulation, uber=True,
+                      shade_per_vertex=shade_per_vertex)
 
 
 @dataclass(frozen=True)
@@ -262,6 +419,9 @@ class EncodeKey:
     def fragment_chunks(self):
         return ("srgb", "encode")
 
+    def generated_chunks(self):
+        return {}
+
     def varyings(self):
         return ()
 
@@ -272,6 +432,8 @@ class EncodeKey:
         return f"encode srgb8 supersample={self.supersample}"
 
 
-def gbuffer_key(material):
-    """The G-buffer-program key of one material (only the two-sided flag matters)."""
-    return ProgramKey(output="gbuffer", has_normal=True, two_sided=material.two_sided)
+def gbuffer_key(material, needs=()):
+    """The G-buffer-program key of one material: its two-sided flag, and the scene's extra
+    G-buffer outputs ``needs`` ('tangent', 'uv')."""
+    return ProgramKey(output="gbuffer", has_normal=True, two_sided=material.two_sided,
+                      has_tangent="tangent" in needs, has_uv="uv" in needs)

@@ -1,7 +1,9 @@
 """Built-in primitives with analytic normals, at a chosen tessellation.
 
 The vertex normals are the exact surface normals (not face averages), so refining the
-tessellation converges to the exact surface.
+tessellation converges to the exact surface.  Texture coordinates and tangents are analytic
+too: the sphere's ``u`` runs with the azimuth and its tangent is ``dp/dphi`` (zero at the poles,
+where the shader falls back to an orthonormal basis around n); the plane's tangent is +x.
 """
 import functools
 
@@ -27,8 +29,10 @@ def sphere(subdivisions=4, radius=1.0):
     Returns
     -------
     MeshData
-        Vertex normals are the exact unit normals ``p / radius``.  Cached: calls with the same
-        arguments return the same object, so GPU buffers are shared.
+        Vertex normals are the exact unit normals ``p / radius``; ``uvs`` are
+        ``(phi / (2 pi), theta / pi)`` (azimuth about +z from +x, polar angle from +z) and the
+        tangents the unit ``dp/dphi = (-y, x, 0) / sqrt(x^2 + y^2)``, handedness +1.  Cached: calls
+        with the same arguments return the same object, so GPU buffers are shared.
     """
     import trimesh
 
@@ -37,7 +41,13 @@ def sphere(subdivisions=4, radius=1.0):
     mesh = trimesh.creation.icosphere(subdivisions=subdivisions, radius=radius)
     vertices = np.asarray(mesh.vertices)
     normals = vertices / np.linalg.norm(vertices, axis=1, keepdims=True)
-    return MeshData(normals * radius, normals, mesh.faces)
+    phi = np.arctan2(normals[:, 1], normals[:, 0]) % (2 * np.pi)
+    uvs = np.stack([phi / (2 * np.pi), np.arccos(np.clip(normals[:, 2], -1.0, 1.0)) / np.pi], axis=1)
+    rho = np.hypot(normals[:, 0], normals[:, 1])
+    safe = np.where(rho > 0, rho, 1.0)
+    tangents = np.stack([-normals[:, 1] / safe, normals[:, 0] / safe, np.zeros(len(normals)), np.ones(len(normals))],
+                        axis=1) * np.where(rho > 0, 1.0, 0.0)[:, None] + np.array([0.0, 0.0, 0.0, 1.0]) * (rho == 0)[:, None]
+    return MeshData(normals * radius, normals, mesh.faces, uvs=uvs, tangents=tangents)
 
 
 @functools.lru_cache(maxsize=16)
@@ -54,6 +64,7 @@ def plane(size=2.0, segments=1):
     Returns
     -------
     MeshData
+        Normal +z; ``uvs`` ``(x / size + 1/2, y / size + 1/2)``; tangent +x, handedness +1.
     """
     size = _validate.scalar("size", size, low=0.0, low_inclusive=False)
     segments = _validate.positive_int("segments", segments, 1, 1024)
@@ -65,4 +76,6 @@ def plane(size=2.0, segments=1):
     a = (j * (segments + 1) + i).ravel()
     b, c, d = a + 1, a + segments + 1, a + segments + 2
     faces = np.concatenate([np.stack([a, b, d], axis=1), np.stack([a, d, c], axis=1)])
-    return MeshData(positions, normals, faces)
+    uvs = positions[:, :2] / size + 0.5
+    tangents = np.tile([1.0, 0.0, 0.0, 1.0], (len(positions), 1))
+    return MeshData(positions, normals, faces, uvs=uvs, tangents=tangents)

@@ -9,6 +9,7 @@ import importlib.resources
 import os
 import re
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import moderngl
@@ -28,7 +29,7 @@ class UniformError(ValueError):
     """Uniform values do not match what a program declares (missing, unknown or wrong size)."""
 
 
-def _glsl_root():
+def glsl_root():
     """Folder of the chunk files: ``GLPHONG_GLSL_DIR`` when set (a developer's working copy of the
     shaders, used by ``benchmarks/mutation.py``), else the installed ``glphong.glsl`` package, else
     ``glsl/`` beside the package in a source checkout."""
@@ -43,30 +44,85 @@ def _glsl_root():
 
 @functools.lru_cache(maxsize=None)
 def chunk_source(name):
-    """Text of the chunk file ``glsl/<name>.glsl``."""
-    return (_glsl_root() / f"{name}.glsl").read_text(encoding="utf-8")
+    """Text of the library chunk file ``glsl/<name>.glsl``."""
+    return (glsl_root() / f"{name}.glsl").read_text(encoding="utf-8")
 
 
-def assemble(chunks, defines):
+@dataclass(frozen=True)
+class Chunk:
+    """One chunk of a program's source.
+
+    Attributes
+    ----------
+    label : str
+        As the key names it: a library chunk (``'shade'``), a model (``'model:<name>'``) or a
+        generated chunk (``'generated:material'``).
+    prelude : str
+        Generated declarations placed before it (a model's uniforms), outside its line numbering.
+    text : str
+        The chunk's own source.
+    origin : str
+        Where the text comes from, for compile errors: a file path or a generated chunk's name.
+    first_line : int
+        Line number of the text's first line in ``origin`` (a model defined inline in Python
+        starts at the line of its ``glsl =``).
+    """
+
+    label: str
+    prelude: str
+    text: str
+    origin: str
+    first_line: int = 1
+
+
+def resolve_chunk(label, generated=None):
+    """The `Chunk` a key's chunk label stands for.
+
+    Parameters
+    ----------
+    label : str
+    generated : dict of str to str, optional
+        The key's generated chunks (`ProgramKey.generated_chunks`).
+    """
+    if generated and label in generated:
+        return Chunk(label, "", generated[label], f"<{label}>")
+    if label.startswith("model:"):
+        from .materials.model import model_named, model_source
+
+        model = model_named(label[len("model:"):])
+        text, origin, first, _ = model_source(model)
+        prelude = f"// uniforms of the model {model.name!r}, declared from its params\n" + model.uniform_declarations()
+        return Chunk(label, prelude, text, origin, first)
+    return Chunk(label, "", chunk_source(label), f"{label}.glsl")
+
+
+def assemble(chunks, defines, generated=None):
     """Assemble one stage's source.
 
     Parameters
     ----------
     chunks : sequence of str
-        Chunk names, in order.
+        Chunk labels, in order (see `resolve_chunk`).
     defines : sequence of (str, str)
         ``#define`` name and value pairs.
+    generated : dict of str to str, optional
+        Text of generated chunks by label.
 
     Returns
     -------
     str
-        The source; source-string number ``i + 1`` is chunk ``chunks[i]``.
+        The source; source-string number ``i + 1`` is chunk ``chunks[i]``, its lines numbered as
+        in its origin (``#line``).
     """
     lines = [GLSL_VERSION]
     lines += [f"#define {name} {value}" for name, value in defines]
-    for number, name in enumerate(chunks, start=1):
-        lines.append(f"#line 1 {number}")
-        lines.append(chunk_source(name).rstrip("\n"))
+    for number, label in enumerate(chunks, start=1):
+        chunk = resolve_chunk(label, generated)
+        if chunk.prelude:
+            lines.append("#line 1 0")
+            lines.append(chunk.prelude)
+        lines.append(f"#line {chunk.first_line} {number}")
+        lines.append(chunk.text.rstrip("\n"))
     return "\n".join(lines) + "\n"
 
 
@@ -129,19 +185,36 @@ def effective_source(source):
 _LOCATION = re.compile(r"\b(\d+)(?::(\d+)(?:\((\d+)\))?|\((\d+)\))")
 
 
-def _name_chunks(log, chunks):
-    """Rewrite compiler-log locations ``N:L(C)``, ``N:L`` and ``N(L)`` as ``chunk.glsl:L:C`` / ``chunk.glsl:L``.
+def _name_chunks(log, chunks, generated=None):
+    """Rewrite compiler-log locations ``N:L(C)``, ``N:L`` and ``N(L)`` as ``origin:L:C`` / ``origin:L``,
+    and show each offending line under the message that names it.
 
-    Source string 0 is the generated ``#version``/``#define`` header; string ``i`` is ``chunks[i - 1]``.
+    Source string 0 is the generated ``#version``/``#define`` header (and models' generated uniform
+    declarations); string ``i`` is ``chunks[i - 1]``, whose origin is its file (or a model's Python
+    file, lines counted in that file) or generated chunk.
     """
+    resolved = [resolve_chunk(label, generated) for label in chunks]
+    shown = []
+
     def repl(m):
         n = int(m.group(1))
         line = m.group(2) or m.group(4)
         where = f":{line}" + (f":{m.group(3)}" if m.group(3) else "")
-        if 1 <= n <= len(chunks):
-            return f"{chunks[n - 1]}.glsl{where}"
+        if 1 <= n <= len(resolved):
+            chunk = resolved[n - 1]
+            index = int(line) - chunk.first_line
+            text = chunk.text.splitlines()
+            if 0 <= index < len(text):
+                shown.append(f"    {chunk.origin}:{line} | {text[index].strip()}")
+            return f"{chunk.origin}{where}"
         return f"<generated header>{where}" if n == 0 else m.group(0)
-    return _LOCATION.sub(repl, log)
+
+    out = []
+    for row in log.splitlines():
+        shown.clear()
+        out.append(_LOCATION.sub(repl, row, count=1))
+        out += shown
+    return "\n".join(out)
 
 
 class Program:
@@ -155,15 +228,15 @@ class Program:
 
     def __init__(self, mgl, key):
         self.key = key
-        defines = key.defines()
-        self.vertex_source = assemble(key.vertex_chunks(), defines)
-        self.fragment_source = assemble(key.fragment_chunks(), defines) if key.fragment_chunks() else None
+        defines, generated = key.defines(), key.generated_chunks()
+        self.vertex_source = assemble(key.vertex_chunks(), defines, generated)
+        self.fragment_source = assemble(key.fragment_chunks(), defines, generated) if key.fragment_chunks() else None
         try:
             self.gl_program = mgl.program(vertex_shader=self.vertex_source, fragment_shader=self.fragment_source,
                                           varyings=key.varyings())
         except moderngl.Error as exc:
             stage = key.fragment_chunks() if "fragment" in str(exc).lower() else key.vertex_chunks()
-            log = _name_chunks(str(exc), stage)
+            log = _name_chunks(str(exc), stage, generated)
             raise ShaderCompileError(f"program {key.describe()!r} failed to build:\n{log}") from None
         self.active = {name: self.gl_program[name] for name in self.gl_program if isinstance(self.gl_program[name], moderngl.Uniform)}
 

@@ -17,7 +17,7 @@ Conventions
   hits whose depth along the camera's viewing axis lies in ``[znear, zfar]`` count.
 - Shading: exactly the twin.  A `glphong.Scene` is built from the camera, the lights and
   the ambient light, each object's material is added with a dummy one-triangle mesh, and
-  each hit is shaded by ``reference.shade_point(p, n, valid, u['u_eye'], key, u)`` with
+  each hit is shaded by ``reference.shade_point(p, n, valid, u['u_eye'], key, u, material)`` with
   ``u = scene.uniform_values(index, key, width / height)`` cast to float64: the very
   uniforms the GPU receives, so material and light parameters are the float32-rounded
   inputs (relative rounding <= 2^-24) while positions and normals are exact float64.
@@ -351,7 +351,7 @@ def render_reference(camera, objects, lights=(), ambient=None, width=256, height
             if key.two_sided:
                 back = np.einsum("ij,ij->i", nrm, eye - p) < 0
                 nrm[back] = -nrm[back]
-            sample[sel] = shade_point(p, nrm, np.ones(len(sel), bool), u.get("u_eye"), key, u)
+            sample[sel] = shade_point(p, nrm, np.ones(len(sel), bool), u.get("u_eye"), key, u, objects[k].material)
         radiance[rows] = sample.reshape(*shape, 3).sum(axis=2) / s
         best = best.reshape(shape)
         coverage[rows] = (best >= 0).sum(axis=2) / s

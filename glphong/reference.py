@@ -1,29 +1,42 @@
 """The numpy twin of the GLSL shaders (DESIGN sections 1 and 3).
 
-Every GLSL function has a twin here with the same name, the same argument order
-and the same formulation; only the arithmetic is done in the dtype of the inputs
-(float64 for the reference, float32 to study the GPU's formulation on the CPU).
+Every GLSL function of the library chunks (common, lights, lobe, shade and the generated
+material chunk) has a twin here with the same name, the same argument order and the same
+formulation; a model's functions live with its definition (``glphong.materials.<model>``, its
+``response`` method the twin of ``<model>_response``).  Only the arithmetic is done in the dtype
+of the inputs (float64 for the reference, float32 to study the GPU's formulation on the CPU).
 Conventions of the mirror:
 
 - vectors are arrays of shape ``(..., 3)``, scalars per point of shape ``(...)``;
 - a GLSL function with ``out`` parameters returns ``(return value, *outs)``;
 - uniforms the GLSL reads from globals are passed as the trailing ``uniforms``
-  dictionary (the very float32 values the GPU was given) and the ``key``.
+  dictionary (the very float32 values the GPU was given), the ``key`` and the ``material``
+  (whose terms' twins the generated material chunk calls).
 
 `shade` is the image-level entry: it shades a G-buffer, fragment for fragment.
 """
 import numpy as np
 
 __all__ = [
-    "safe_normalize", "point_irradiance", "lambert", "log_one_minus", "lobe_from_delta",
-    "phong_delta", "phong_lobe", "blinn_delta", "blinn_lobe", "BLINN_HALF_FLOOR", "uber_lobe",
-    "incident_light", "light_response", "view_direction", "shade_point", "shade_inputs", "shade",
+    "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus", "lobe_from_delta",
+    "incident_light", "material_emission", "material_response", "view_direction", "shade_point", "shade_inputs", "shade",
 ]
+
+#: model twins kept importable from here (they live with their models in glphong.materials)
+_MODEL_TWINS = {"lambert": "lambert", "phong_delta": "phong", "phong_lobe": "phong", "blinn_delta": "blinn",
+                "blinn_lobe": "blinn", "BLINN_HALF_FLOOR": "blinn"}
+
+
+def __getattr__(name):
+    if name in _MODEL_TWINS:
+        import importlib
+
+        return getattr(importlib.import_module(f"glphong.materials.{_MODEL_TWINS[name]}"), name)
+    raise AttributeError(f"module 'glphong.reference' has no attribute {name!r}")
+
 
 #: common.glsl FLT_MAX: vectors with a larger (or NaN) component do not normalise
 FLT_MAX = float(np.finfo(np.float32).max)
-#: blinn.glsl BLINN_HALF_FLOOR = 2^-20: |l + v| at or below it gives a zero Blinn lobe
-BLINN_HALF_FLOOR = 2.0 ** -20
 
 
 def _dot(a, b):
@@ -59,6 +72,46 @@ def safe_normalize(x):
     return valid, x_hat, length
 
 
+def frame_from_tangent(n, tangent):
+    """The tangent and bitangent of the shading frame (common.glsl).
+
+    Parameters
+    ----------
+    n : (N, 3) ndarray
+        Unit normals.
+    tangent : (N, 4) ndarray
+        Interpolated tangents, handedness in w.
+
+    Returns
+    -------
+    t, b : (N, 3) ndarray
+        ``t = normalize(tangent.xyz - (n.tangent.xyz) n)``, where that is zero or not finite the
+        tangent of Duff et al.'s orthonormal basis around n; ``b = sign(w) cross(n, t)``.
+    """
+    n = np.asarray(n)
+    tangent = np.asarray(tangent, dtype=n.dtype)
+    xyz = tangent[..., :3]
+    projected, t, _ = safe_normalize(xyz - _dot(n, xyz)[..., None] * n)
+    s = np.where(n[..., 2] >= 0, 1.0, -1.0).astype(n.dtype)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = -1.0 / (s + n[..., 2])
+        fallback = np.stack([1.0 + s * n[..., 0] * n[..., 0] * a, s * n[..., 0] * n[..., 1] * a, -s * n[..., 0]], axis=-1)
+    t = np.where(projected[..., None], t, fallback).astype(n.dtype)
+    b = (np.where(tangent[..., 3] < 0, -1.0, 1.0)[..., None] * np.cross(n, t)).astype(n.dtype)
+    return t, b
+
+
+def shading_frame(n, tangent=None, uv=None, key=None):
+    """The `ShadingFrame` of shading points (common.glsl ``shading_frame``): ``t``, ``b`` from
+    `frame_from_tangent` where ``key.has_tangent``; ``uv`` where ``key.has_uv``."""
+    from .materials.model import ShadingFrame
+
+    if key is not None and key.has_tangent:
+        t, b = frame_from_tangent(n, tangent)
+        return ShadingFrame(n, t, b, uv if key.has_uv else None)
+    return ShadingFrame(n, None, None, uv if key is not None and key.has_uv else None)
+
+
 # --------------------------------------------------------------------------- lights.glsl
 def point_irradiance(intensity, d):
     """E1 as ``min((I / d) / d, FLT_MAX)`` (lights.glsl).
@@ -78,12 +131,6 @@ def point_irradiance(intensity, d):
     d = np.asarray(d)[..., None]
     with np.errstate(over="ignore", under="ignore"):
         return np.minimum((intensity / d) / d, FLT_MAX)
-
-
-# --------------------------------------------------------------------------- lambert.glsl
-def lambert(kd, n_dot_l):
-    """E3 without E: ``kd (n.l)`` (lambert.glsl); kd (3,) [1/sr], n_dot_l (...) -> (..., 3)."""
-    return kd * np.asarray(n_dot_l)[..., None]
 
 
 # --------------------------------------------------------------------------- lobe.glsl
@@ -134,58 +181,6 @@ def lobe_from_delta(delta, q):
     return np.where(q == 0, 1, value).astype(dtype)
 
 
-# --------------------------------------------------------------------------- phong.glsl
-def phong_delta(n, wi, wo):
-    """``|r - v|^2 / 2`` with ``r = 2 (n.l) n - l`` (phong.glsl); unit (..., 3) inputs -> (...)."""
-    r = 2 * _dot(n, wi)[..., None] * n - wi
-    e = r - wo
-    return 0.5 * _dot(e, e)
-
-
-def phong_lobe(n, wi, wo, q):
-    """``max(v.r, 0)^q`` (phong.glsl)."""
-    return lobe_from_delta(phong_delta(n, wi, wo), q)
-
-
-# --------------------------------------------------------------------------- blinn.glsl
-def blinn_delta(n, wi, wo):
-    """Blinn's ``delta = |h - n|^2 / 2`` (blinn.glsl).
-
-    Returns
-    -------
-    valid : (...) bool ndarray
-        ``n.v > 0`` and ``|l + v| > BLINN_HALF_FLOOR``.
-    delta : (...) ndarray
-        ``|h - n|^2 / 2``; 2 where not valid.
-    """
-    ok_h, h, h_len = safe_normalize(wi + wo)
-    valid = (_dot(n, wo) > 0) & ok_h & (h_len > BLINN_HALF_FLOOR)
-    e = h - n
-    return valid, np.where(valid, 0.5 * _dot(e, e), 2).astype(e.dtype)
-
-
-def blinn_lobe(n, wi, wo, q):
-    """``max(n.h, 0)^q``, 0 where `blinn_delta` is not valid (blinn.glsl)."""
-    valid, delta = blinn_delta(n, wi, wo)
-    return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype)
-
-
-# --------------------------------------------------------------------------- uber.glsl
-def uber_lobe(n, wi, wo, q, lobe_kind):
-    """The uber-shader's lobe (uber.glsl): Phong for ``lobe_kind == 1``, Blinn for 2, else 0.
-
-    ``lobe_kind`` is the GLSL uniform ``u_lobe_kind``, passed explicitly.
-    """
-    if lobe_kind == 1:
-        return phong_lobe(n, wi, wo, q)
-    if lobe_kind == 2:
-        return blinn_lobe(n, wi, wo, q)
-    return np.zeros(np.shape(n)[:-1], np.asarray(n).dtype)
-
-
-_LOBES = {"phong": phong_lobe, "blinn": blinn_lobe}
-
-
 # --------------------------------------------------------------------------- shade.glsl
 def incident_light(position, key, uniforms):
     """Direction and irradiance of every light at each point: the head of shade.glsl's loops.
@@ -218,24 +213,30 @@ def incident_light(position, key, uniforms):
     return out
 
 
-def light_response(n, wi, wo, n_dot_l, key, uniforms):
-    """``k_d (n.l) + k_s lobe`` of one light (shade.glsl); (N, 3) in, (N, 3) out."""
-    f = np.zeros_like(n)
-    if key.has_diffuse:
-        f = f + lambert(uniforms["u_kd"], n_dot_l)
-    if key.has_specular:
-        f = f + uniforms["u_ks"] * _LOBES[key.lobe](n, wi, wo, uniforms["u_q"])[..., None]
-    return f
+def _terms(material):
+    return {term.name: term for term in material.components}
 
 
-def ambient_terms(key, uniforms, shape, dtype):
-    """``k_a + k_d L_a`` (the head of shade.glsl's ``shade_point``), broadcast to ``shape``."""
+def material_emission(key, uniforms, shape, dtype, material=None):
+    """``k_a + sum_terms k L_a`` (the generated material chunk's ``material_emission``), broadcast to ``shape``."""
     radiance = np.zeros(shape, dtype)
     if key.has_ka:
         radiance = radiance + uniforms["u_ka"]
-    if key.has_kd_la:
-        radiance = radiance + uniforms["u_kd"] * uniforms["u_ambient"]
+    for term in key.terms:
+        if term.ambient:
+            radiance = radiance + uniforms[f"u_{term.name}_{term.ambient_param}"] * uniforms["u_ambient"]
     return radiance
+
+
+def material_response(f, wi, wo, n_dot_l, key, uniforms, material):
+    """Sum of the lit terms' twins (the generated material chunk's ``material_response``); (N, 3)."""
+    terms = _terms(material)
+    out = np.zeros(np.shape(wi), np.result_type(f.n, wi))
+    for term_key in key.lit_terms:
+        term = terms[term_key.name]
+        p = term.values_from_uniforms(uniforms, dtype=out.dtype)
+        out = out + term.response(f, wi, wo, n_dot_l, p)
+    return out
 
 
 def view_direction(position, n_valid, eye, key):
@@ -244,7 +245,7 @@ def view_direction(position, n_valid, eye, key):
     Returns
     -------
     wo : (N, 3) ndarray
-        Unit vectors toward the eye (0 where the key has no specular lobe: not computed).
+        Unit vectors toward the eye (0 where no lit term needs the view: not computed).
     lit : (N,) bool ndarray
         Valid normal and, where the view is needed, a valid view direction.
     """
@@ -254,37 +255,44 @@ def view_direction(position, n_valid, eye, key):
     return wo, n_valid & ok_v
 
 
-def shade_point(position, n, n_valid, eye, key, uniforms):
+def shade_point(position, n, n_valid, eye, key, uniforms, material):
     """E6 at each point (shade.glsl's ``shade_point``).
 
     Parameters
     ----------
     position : (N, 3) ndarray
         World-space points [m].
-    n : (N, 3) ndarray
-        Unit normals.
+    n : (N, 3) ndarray or ShadingFrame
+        Unit normals, or the whole shading frame (needed where a term reads t, b or uv).
     n_valid : (N,) bool ndarray
-        False where the normal was zero or not finite: ambient terms only.
+        False where the normal was zero or not finite: emission terms only.
     eye : (3,) ndarray or None
         Camera centre [m] (None where the key needs no view vector).
     key, uniforms
         As in `incident_light`.
+    material : glphong.materials.Material
+        The material whose terms' twins are summed.
 
     Returns
     -------
     (N, 3) ndarray
         Radiance [W/(m^2 sr)].
     """
-    radiance = ambient_terms(key, uniforms, position.shape, position.dtype)
+    f = n if hasattr(n, "n") else shading_frame(np.asarray(n), key=key)
+    radiance = material_emission(key, uniforms, position.shape, position.dtype, material)
     if key.num_lights == 0:
         return radiance
     wo, lit = view_direction(position, n_valid, eye, key)
     for valid, wi, irradiance in incident_light(position, key, uniforms):
-        n_dot_l = _dot(n, wi)
-        gate = (lit & valid & (n_dot_l > 0))[..., None]
-        with np.errstate(invalid="ignore", over="ignore"):
-            term = light_response(n, wi, wo, n_dot_l, key, uniforms) * irradiance
-        radiance = radiance + np.where(gate, term, 0)
+        n_dot_l = _dot(f.n, wi)
+        gate = lit & valid & (n_dot_l > 0)
+        term = np.zeros_like(radiance)
+        if gate.any():
+            g = f.select(gate)
+            with np.errstate(invalid="ignore", over="ignore"):
+                term[gate] = material_response(g, wi[gate], wo[gate], n_dot_l[gate], key, uniforms, material) \
+                    * irradiance[gate]
+        radiance = radiance + term
     return radiance
 
 
@@ -296,13 +304,15 @@ def shade_inputs(scene, gbuffer, dtype=np.float64):
     ------
     selection : (H, W) bool ndarray
         The object's pixels.
+    obj : glphong.SceneObject
     key : glphong.key.ProgramKey
         Its radiance-program key.
     uniforms : dict of str to ndarray
         The uniforms the GPU was given, cast to ``dtype``.
     position : (N, 3) ndarray
-    n : (N, 3) ndarray
-        The G-buffer normal renormalised (mesh_fragment.glsl).
+    f : ShadingFrame
+        The G-buffer normal renormalised (mesh_fragment.glsl), and the frame built from the
+        G-buffer's tangent and uv where the key reads them (`shading_frame`).
     n_valid : (N,) bool ndarray
     """
     height, width = gbuffer.mask.shape
@@ -314,7 +324,9 @@ def shade_inputs(scene, gbuffer, dtype=np.float64):
         uniforms = {k: v.astype(dtype) for k, v in scene.uniform_values(index, key, width / height).items()}
         position = gbuffer.position[selection].astype(dtype)
         n_valid, n, _ = safe_normalize(gbuffer.normal[selection].astype(dtype))
-        yield selection, key, uniforms, position, n, n_valid
+        tangent = gbuffer.tangent[selection].astype(dtype) if key.has_tangent else None
+        uv = gbuffer.uv[selection].astype(dtype) if key.has_uv else None
+        yield selection, obj, key, uniforms, position, shading_frame(n, tangent, uv, key), n_valid
 
 
 def shade(scene, gbuffer, dtype=np.float64):
@@ -334,6 +346,6 @@ def shade(scene, gbuffer, dtype=np.float64):
         Radiance [W/(m^2 sr)], 0 where not covered.
     """
     out = np.zeros(gbuffer.position.shape, dtype)
-    for selection, key, uniforms, position, n, n_valid in shade_inputs(scene, gbuffer, dtype):
-        out[selection] = shade_point(position, n, n_valid, uniforms.get("u_eye"), key, uniforms)
+    for selection, obj, key, uniforms, position, f, n_valid in shade_inputs(scene, gbuffer, dtype):
+        out[selection] = shade_point(position, f, n_valid, uniforms.get("u_eye"), key, uniforms, obj.material)
     return out

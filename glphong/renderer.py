@@ -70,12 +70,19 @@ class GBuffer:
         Index into ``scene.objects``, -1 where not covered.
     mask : (H, W) bool ndarray
         Pixels covered by geometry.
+    tangent : (H, W, 4) float32 ndarray or None
+        The interpolated world-space tangent (handedness in w) the frame was built from, where a
+        drawn term needs ``'tangent'``; else None.
+    uv : (H, W, 2) float32 ndarray or None
+        The interpolated texture coordinates, where a drawn term needs ``'uv'``; else None.
     """
 
     position: np.ndarray
     normal: np.ndarray
     object_index: np.ndarray
     mask: np.ndarray
+    tangent: np.ndarray = None
+    uv: np.ndarray = None
 
 
 class _MeshBuffers:
@@ -85,7 +92,9 @@ class _MeshBuffers:
     a scene whose programs never read normals (no lights) never uploads them.
     """
 
-    _SOURCES = {"in_position": "positions", "in_normal": "normals"}
+    #: attribute -> (MeshData attribute, moderngl format)
+    _SOURCES = {"in_position": ("positions", "3f"), "in_normal": ("normals", "3f"), "in_tangent": ("tangents", "4f"),
+                "in_uv": ("uvs", "2f")}
 
     def __init__(self, mgl, mesh):
         self.owner = weakref.ref(mesh)
@@ -95,13 +104,13 @@ class _MeshBuffers:
 
     def buffer(self, mgl, name):
         if name not in self.buffers:
-            self.buffers[name] = mgl.buffer(getattr(self.owner(), self._SOURCES[name]).tobytes())
+            self.buffers[name] = mgl.buffer(getattr(self.owner(), self._SOURCES[name][0]).tobytes())
         return self.buffers[name]
 
     def vertex_array(self, mgl, program):
         vao = self.vertex_arrays.get(program.key)
         if vao is None:
-            content = [(self.buffer(mgl, name), "3f", name) for name in program.key.attributes()]
+            content = [(self.buffer(mgl, name), self._SOURCES[name][1], name) for name in program.key.attributes()]
             vao = self.vertex_arrays[program.key] = mgl.vertex_array(
                 program.gl_program, content, self.index_buffer, index_element_size=4)
         return vao
@@ -262,21 +271,27 @@ class Renderer:
         GBuffer
         """
         self._check_scene(scene)
+        needs = scene.gbuffer_needs()
+        extras = [n for n in ("tangent", "uv") if n in needs]
         with self.context:
-            fbo = self._target("gbuffer")
+            fbo = self._target(("gbuffer", *extras))
             self._draw(scene, "gbuffer", fbo)
-            position, normal = (self._read(fbo, self._size, components=4, attachment=i) for i in (0, 1))
+            planes = [self._read(fbo, self._size, components=4, attachment=i) for i in range(2 + len(extras))]
             self.context.check_error("rendering the G-buffer")
+        position, normal = planes[:2]
+        extra = dict(zip(extras, planes[2:]))
         mask = position[..., 3] > 0.0
         object_index = np.where(mask, np.rint(position[..., 3]).astype(np.int64) - 1, -1)
         return GBuffer(position=np.ascontiguousarray(position[..., :3]), normal=np.ascontiguousarray(normal[..., :3]),
-                       object_index=object_index, mask=mask)
+                       object_index=object_index, mask=mask,
+                       tangent=np.ascontiguousarray(extra["tangent"]) if "tangent" in extra else None,
+                       uv=np.ascontiguousarray(extra["uv"][..., :2]) if "uv" in extra else None)
 
     def program_key(self, scene, obj, output="radiance"):
         """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading)."""
         per_vertex = output == "radiance" and self.shading == "vertex"
         if output == "radiance" and not self.specialise:
-            return uber_key(output, self.formulation, per_vertex)
+            return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex)
         key = scene.program_key(obj, output)
         if key.formulation != self.formulation or key.shade_per_vertex != per_vertex:
             key = replace(key, formulation=self.formulation, shade_per_vertex=per_vertex)
@@ -330,8 +345,8 @@ class Renderer:
         if fbo is not None:
             return fbo
         mgl = self._mgl
-        if name == "gbuffer":
-            colors = [mgl.renderbuffer(self._size, 4, dtype="f4") for _ in range(2)]
+        if isinstance(name, tuple) and name[0] == "gbuffer":
+            colors = [mgl.renderbuffer(self._size, 4, dtype="f4") for _ in range(len(name) + 1)]
             fbo = mgl.framebuffer(colors, mgl.depth_renderbuffer(self._size))
         elif name == "radiance" and self.samples > 1:
             fbo = mgl.framebuffer([mgl.renderbuffer(self._internal_size, 4, samples=self.samples, dtype="f4")],
@@ -360,7 +375,7 @@ class Renderer:
 
     def _release_targets(self):
         for name, obj in self._targets.items():
-            if isinstance(name, tuple):  # a full-screen vertex array
+            if name[0] == "fullscreen":  # a full-screen vertex array
                 obj.release()
             else:
                 self.context.release_framebuffer(obj)
@@ -369,7 +384,7 @@ class Renderer:
     def gl_object_count(self):
         """Number of GL objects this renderer holds (programs, buffers, vertex arrays, targets)."""
         meshes = sum(1 + len(e.buffers) + len(e.vertex_arrays) for e in self._meshes.values())
-        targets = sum(1 if isinstance(name, tuple) else
+        targets = sum(1 if name[0] == "fullscreen" else
                       1 + len(f.color_attachments) + (f.depth_attachment is not None)
                       for name, f in self._targets.items())
         return len(self.programs) + meshes + targets

@@ -101,6 +101,7 @@ class Scene:
         ----------
         mesh : trimesh.Trimesh or MeshData
         material : glphong.materials.Material
+            Any material: a built-in or a user's `glphong.materials.MaterialModel` / `MaterialSum`.
         pose : (4, 4) array_like, optional
             Object-to-world affine transform (default identity).
         smooth : bool
@@ -124,6 +125,7 @@ class Scene:
                 raise TypeError(f"mesh must be a trimesh.Trimesh or a glphong.geometry.MeshData (got {type(mesh).__name__})")
         pose = _validate.affine_transform("pose", np.eye(4) if pose is None else pose)
         data = mesh if isinstance(mesh, MeshData) else MeshData.from_trimesh(mesh, smooth=bool(smooth))
+        _check_mesh_serves(data, material, name or f"object{len(self._objects)}")
         obj = SceneObject(data, material, pose, name or f"object{len(self._objects)}")
         self._objects.append(obj)
         return obj
@@ -139,7 +141,13 @@ class Scene:
 
     def program_key(self, obj, output="radiance"):
         """The `ProgramKey` of one of this scene's objects."""
-        return program_key(obj.material, self.light_counts(), self.ambient_radiance, output)
+        needs = self.gbuffer_needs() if output == "gbuffer" else None
+        return program_key(obj.material, self.light_counts(), self.ambient_radiance, output, needs)
+
+    def gbuffer_needs(self):
+        """Extra G-buffer outputs the scene's radiance programs read ('tangent', 'uv'), a frozenset."""
+        keys = [program_key(o.material, self.light_counts(), self.ambient_radiance) for o in self._objects]
+        return frozenset(n for n in ("tangent", "uv") if any(getattr(k, f"has_{n}") for k in keys))
 
     def light_uniform_values(self, key):
         """The light and ambient uniforms a radiance program with ``key`` declares.
@@ -157,7 +165,7 @@ class Scene:
                 rows = [light.uniform_row() for light in self._lights if light.kind == kind]
                 values[where_name] = np.array([r[0] for r in rows], dtype=np.float32)
                 values[value_name] = np.array([r[1] for r in rows], dtype=np.float32)
-        if key.has_kd_la:
+        if key.has_ambient:
             values["u_ambient"] = np.asarray(self.ambient_radiance, dtype=np.float32)
         return values
 
@@ -189,14 +197,15 @@ class Scene:
         if key.output == "gbuffer":
             values["u_object_id"] = float(index)
         else:
-            if key.num_lights and key.needs_view:
+            if key.needs_view:
                 values["u_eye"] = self.camera.position
             values.update(obj.material.uniform_values(key))
             values.update(self.light_uniform_values(key))
         return {name: np.asarray(v, dtype=np.float32) for name, v in values.items()}
 
     def _uber_uniform_values(self, index, key, aspect):
-        """The uber-shader's uniforms: the specialised key's values, its switches, padded light arrays."""
+        """The uber-shader's uniforms: the specialised key's values, zeros for the terms the object's
+        material lacks, a switch per term, padded light arrays."""
         from .key import UBER_MAX_LIGHTS
 
         obj = self._objects[index]
@@ -208,12 +217,16 @@ class Scene:
                              f"(scene has {self.light_counts()})")
         values = self.uniform_values(index, spec, aspect)
         values["u_normal_matrix"] = np.asarray(obj.normal_matrix, dtype=np.float32)
-        values["u_eye"] = np.asarray(self.camera.position, dtype=np.float32)
-        material = obj.material
-        zero = np.zeros(3, np.float32)
-        for name, value in (("u_ka", material.ka), ("u_kd", material.kd), ("u_ks", getattr(material, "ks", zero)),
-                            ("u_q", getattr(material, "q", 0.0)), ("u_ambient", self.ambient_radiance or zero)):
-            values.setdefault(name, np.asarray(value, dtype=np.float32))
+        if key.needs_view:
+            values["u_eye"] = np.asarray(self.camera.position, dtype=np.float32)
+        values.setdefault("u_ka", np.asarray(obj.material.ka, dtype=np.float32))
+        values.setdefault("u_ambient", np.asarray(self.ambient_radiance or (0.0, 0.0, 0.0), dtype=np.float32))
+        from .materials import model_named
+
+        for term in key.terms:
+            for p in model_named(term.name).params:
+                name = f"u_{term.name}_{p.name}"
+                values.setdefault(name, np.zeros(3 if p.kind == "rgb" else (), np.float32))
         for kind, (_, where_name, value_name) in LIGHT_KINDS.items():
             for name in (where_name, value_name):
                 padded = np.zeros((UBER_MAX_LIGHTS, 3), np.float32)
@@ -221,7 +234,23 @@ class Scene:
                     padded[:counts[kind]] = values[name]
                 values[name] = padded
             values[f"u_{kind}_count"] = np.float32(counts[kind])
-        flags = {"u_use_ka": spec.has_ka, "u_use_kd_la": spec.has_kd_la, "u_use_diffuse": spec.has_diffuse,
-                 "u_two_sided": spec.two_sided, "u_lobe_kind": {None: 0, "phong": 1, "blinn": 2}[spec.lobe]}
+        active = {t.name: t for t in spec.terms}
+        flags = {"u_use_ka": spec.has_ka, "u_two_sided": spec.two_sided}
+        for term in key.terms:
+            flags[f"u_use_{term.name}"] = term.name in active and active[term.name].lit
+            if term.ambient:
+                flags[f"u_use_{term.name}_ambient"] = term.name in active and active[term.name].ambient
         values.update({name: np.float32(v) for name, v in flags.items()})
         return values
+
+
+def _check_mesh_serves(mesh, material, name):
+    """A mesh must carry what the material's terms need (tangents or UVs)."""
+    for term in material.components:
+        if "tangent" in term.needs and not mesh.has_tangents:
+            raise ValueError(f"object {name!r}: the material term {term.name!r} needs a tangent frame, but the mesh has "
+                             "neither tangents nor UVs: give MeshData tangents= or uvs=, a trimesh with UVs, or use "
+                             "glphong.primitives (analytic tangents)")
+        if "uv" in term.needs and mesh.uvs is None:
+            raise ValueError(f"object {name!r}: the material term {term.name!r} needs UVs, but the mesh has none: "
+                             "give MeshData uvs=, a trimesh with UVs, or use glphong.primitives")

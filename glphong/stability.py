@@ -20,7 +20,6 @@ from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
-from .key import ProgramKey
 from .tolerances import FLT_MAX, FLT_MIN, point_band
 from .verify import relative_error
 
@@ -45,10 +44,8 @@ class Case:
     Attributes
     ----------
     name, group : str
-    family : {'lambert', 'phong', 'blinn'}
-    kd, ks, ka : tuple of 3 float
-        Coefficients (ks unused for 'lambert').
-    q : float
+    material : glphong.materials.Material
+        Any material, built-in or user-defined.
     normal : tuple of 3 float
         Raw normal at the origin (renormalised by the shader; may be zero or non-finite).
     eye : tuple of 3 float
@@ -61,28 +58,29 @@ class Case:
     in_range : bool
         Whether the case lies inside `VALID_RANGES` (expected value representable).
     note : str
+    tangent : tuple of 4 float
+        Raw tangent (handedness in w) at the point, for terms that need a tangent frame.
+    uv : tuple of 2 float
+        Texture coordinates at the point, for terms that need them.
     """
 
     name: str
     group: str
-    family: str = "phong"
-    kd: tuple = (0.2, 0.2, 0.2)
-    ks: tuple = (0.5, 0.5, 0.5)
-    ka: tuple = (0.0, 0.0, 0.0)
-    q: float = 50.0
+    material: object = None
     normal: tuple = (0.0, 0.0, 1.0)
     eye: tuple = (0.0, 0.0, 1.0)
     lights: tuple = (("point", (0.0, 0.0, 1.0), 4 * np.pi),)
     ambient: float = None
     in_range: bool = True
     note: str = ""
+    tangent: tuple = (1.0, 0.0, 0.0, 1.0)
+    uv: tuple = (0.5, 0.5)
 
     def scene(self):
         """The case as a one-object `Scene` (a dummy triangle carries the material)."""
         from . import lights as L
         from .camera import PerspectiveCamera
         from .geometry import MeshData
-        from .materials import BlinnPhong, Lambert, Phong
         from .scene import Scene
 
         eye = np.asarray(self.eye)
@@ -91,9 +89,8 @@ class Case:
         kinds = {"point": L.PointLight, "unattenuated": L.UnattenuatedPointLight, "directional": L.DirectionalLight}
         scene = Scene(camera, lights=[kinds[k](w, v) for k, w, v in self.lights],
                       ambient=None if self.ambient is None else L.AmbientLight(self.ambient))
-        material = (Lambert(self.kd, ka=self.ka) if self.family == "lambert" else
-                    {"phong": Phong, "blinn": BlinnPhong}[self.family](self.kd, self.ks, self.q, ka=self.ka))
-        scene.add(MeshData([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 1]] * 3, [[0, 1, 2]]), material)
+        scene.add(MeshData([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 1]] * 3, [[0, 1, 2]],
+                           uvs=[self.uv] * 3, tangents=[self.tangent] * 3), self.material)
         return scene
 
     def inputs(self, scene=None):
@@ -107,7 +104,6 @@ class Case:
         for name in ("u_model", "u_view_projection", "u_normal_matrix"):
             uniforms.pop(name, None)
         return key, uniforms
-
 
 def _unit(angle_deg, azimuth_deg=0.0):
     """Unit vector at polar angle ``angle_deg`` from +z, azimuth ``azimuth_deg`` from +x."""
@@ -131,67 +127,118 @@ def _grazing(n_dot_l):
     return (float(np.sqrt(1.0 - n_dot_l * n_dot_l)), 0.0, float(n_dot_l))
 
 
-def _build_cases():
+def generic_cases(label, material):
+    """The geometry every model is tried on: grazing light and view, light behind, ``l = -v``, and
+    ``l`` and ``v`` grazing and mirrored (list of Case).
+
+    Parameters
+    ----------
+    label : str
+        Prefix of the case names (the model's name).
+    material : glphong.materials.Material
+    """
+    e_one = 4 * np.pi  # a point light at 1 m with E = 1 W/m^2
+    light = _unit(30.0)
     cases = []
+    for cosine in (1e-2, 1e-4, 1e-6, 0.0, -1e-6):
+        cases.append(Case(f"{label} grazing light n.l={cosine:g}", "grazing", material,
+                          eye=_unit(20.0, 90.0), lights=(("point", _grazing(cosine), e_one),)))
+    cases.append(Case(f"{label} grazing view n.v=1e-5", "grazing", material,
+                      eye=_unit(90 - np.degrees(1e-5), 180.0), lights=(("point", _unit(60.0), e_one),)))
+    cases.append(Case(f"{label} light behind the surface", "behind", _with_ka(material, 0.01),
+                      eye=_unit(30.0, 180.0), lights=(("point", _unit(120.0), e_one),),
+                      note="k_a only: the n.l gate removes every term, specular too"))
+    cases.append(Case(f"{label} l = -v", "opposite", material, eye=tuple(-c for c in light),
+                      lights=(("point", light, e_one),), note="n.v < 0: a half vector is undefined"))
+    cases.append(Case(f"{label} l, v grazing and mirrored, |l + v| = 6e-6", "opposite", material,
+                      eye=(-1.0, 0.0, 3e-6), lights=(("directional", (-1.0, 0.0, -3e-6), 1.0),),
+                      note="n.l = n.v = 3e-6: the half vector is n, just above Blinn's |l + v| floor"))
+    return cases
+
+
+def _with_ka(material, ka):
+    """``material`` with the constant term ``ka`` (same class, same parameters)."""
+    values = material.parameter_values()
+    values["ka"] = ka
+    return type(material)(**values)
+
+
+def lobe_cases(label, material_class):
+    """A cosine-power lobe's exponent sweep, at, near and in the tail of its peak, and ``q = 0`` off
+    the peak (list of Case).
+
+    Parameters
+    ----------
+    label : str
+    material_class : type
+        Called as ``material_class(kd, ks, q)`` (`Phong`, `BlinnPhong`).
+    """
+    e_one = 4 * np.pi
+    light = _unit(30.0)
+    cases = []
+    for q in (0.0, 0.5, 1.0, 1e3, 1e4, 1e5, 1e6, 1e7):
+        width = 1.0 / np.sqrt(max(q, 1.0))
+        for where, offset in (("peak", 0.0), ("near", 0.7 * width), ("tail", 3.0 * width)):
+            cases.append(Case(f"{label} q={q:g} {where}", "lobe", material_class(0.1, 1.0, q),
+                              eye=_mirror_eye(30.0, offset), lights=(("point", light, e_one),)))
+    cases.append(Case(f"{label} q=0 with v.r < 0", "lobe", material_class(0.2, 0.5, 0.0), eye=_unit(60.0, 90.0),
+                      lights=(("point", light, e_one),), note="0^0 := 1 convention, no pow(0, 0)"))
+    return cases
+
+
+def cases_for(model):
+    """The stability cases of a model (its ``stability_cases()``), a list of Case.
+
+    Parameters
+    ----------
+    model : MaterialModel subclass or instance
+    """
+    return list((model if isinstance(model, type) else type(model)).stability_cases())
+
+
+def _build_cases():
+    from .materials import BlinnPhong, Phong, registered_models
+
+    cases = []
+    for model in registered_models():
+        if model.__module__.startswith("glphong."):
+            cases += cases_for(model)
     light = _unit(30.0)
     grey = lambda x: (x, x, x)  # noqa: E731
     e_one = 4 * np.pi  # a point light at 1 m with E = 1 W/m^2
-    for family in ("phong", "blinn"):
-        for q in (0.0, 0.5, 1.0, 1e3, 1e4, 1e5, 1e6, 1e7):
-            width = 1.0 / np.sqrt(max(q, 1.0))
-            for label, offset in (("peak", 0.0), ("near", 0.7 * width), ("tail", 3.0 * width)):
-                cases.append(Case(f"{family} q={q:g} {label}", "lobe", family=family, q=q, kd=grey(0.1), ks=grey(1.0),
-                                  eye=_mirror_eye(30.0, offset), lights=(("point", light, e_one),)))
-    for family in ("lambert", "phong", "blinn"):
-        for cosine in (1e-2, 1e-4, 1e-6, 0.0, -1e-6):
-            cases.append(Case(f"{family} grazing light n.l={cosine:g}", "grazing", family=family, q=100.0,
-                              eye=_unit(20.0, 90.0), lights=(("point", _grazing(cosine), e_one),)))
-        cases.append(Case(f"{family} grazing view n.v=1e-5", "grazing", family=family, q=100.0,
-                          eye=_unit(90 - np.degrees(1e-5), 180.0), lights=(("point", _unit(60.0), e_one),)))
-        cases.append(Case(f"{family} light behind the surface", "behind", family=family, q=10.0, ka=grey(0.01),
-                          eye=_unit(30.0, 180.0), lights=(("point", _unit(120.0), e_one),),
-                          note="ambient only: the n.l gate removes the specular highlight too"))
-    for family in ("phong", "blinn"):
-        cases.append(Case(f"{family} l = -v", "opposite", family=family, q=1.0, eye=tuple(-c for c in light),
-                          lights=(("point", light, e_one),), note="n.v < 0: the Blinn half vector is undefined"))
-        cases.append(Case(f"{family} l, v grazing and mirrored, |l + v| = 6e-6", "opposite", family=family, q=1.0,
-                          eye=(-1.0, 0.0, 3e-6), lights=(("directional", (-1.0, 0.0, -3e-6), 1.0),),
-                          note="n.l = n.v = 3e-6: the half vector is n, just above Blinn's |l + v| floor"))
-        cases.append(Case(f"{family} q=0 with v.r < 0", "lobe", family=family, q=0.0, eye=_unit(60.0, 90.0),
-                          lights=(("point", light, e_one),), note="0^0 := 1 convention, no pow(0, 0)"))
+    phong = lambda kd=0.2, ks=0.5, q=50.0, ka=0.0: Phong(kd, ks, q, ka=ka)  # noqa: E731
     for label, normal in (("zero", (0.0, 0.0, 0.0)), ("tiny 1e-25", (0.0, 3e-26, 1e-25)), ("huge 1e25", (0.0, 3e24, 1e25)),
                           ("subnormal-free 1e-37", (0.0, 0.0, 1e-37)), ("NaN", (np.nan, 0.0, 1.0)), ("Inf", (0.0, np.inf, 1.0))):
-        cases.append(Case(f"normal {label}", "normals", ka=grey(0.01), ambient=0.1, eye=_unit(10.0, 90.0),
+        cases.append(Case(f"normal {label}", "normals", phong(ka=0.01), ambient=0.1, eye=_unit(10.0, 90.0),
                           normal=normal, lights=(("point", light, e_one),),
                           note="zero/non-finite normal: ambient terms only" if label in ("zero", "NaN", "Inf") else ""))
     for d in (1e-30, 1e-19, 1e-3, 1e3, 2e19, 1e30):
-        cases.append(Case(f"distance {d:g}, Phi=1 W", "distance", eye=_unit(20.0, 90.0), q=10.0,
-                          lights=(("point", tuple(d * c for c in light), 1.0),),
-                          in_range=FLT_MIN <= 1.0 / (4 * np.pi * d * d) <= FLT_MAX,
-                          note="" if FLT_MIN <= 1.0 / (4 * np.pi * d * d) <= FLT_MAX else
-                          "E outside float32: saturates at FLT_MAX or flushes to 0"))
+        representable = FLT_MIN <= 1.0 / (4 * np.pi * d * d) <= FLT_MAX
+        cases.append(Case(f"distance {d:g}, Phi=1 W", "distance", phong(q=10.0), eye=_unit(20.0, 90.0),
+                          lights=(("point", tuple(d * c for c in light), 1.0),), in_range=representable,
+                          note="" if representable else "E outside float32: saturates at FLT_MAX or flushes to 0"))
         power = 4 * np.pi * d * d
         if 4 * np.pi * FLT_MIN <= power <= 4 * np.pi * FLT_MAX:
-            cases.append(Case(f"distance {d:g}, E=1 W/m^2", "distance", eye=_unit(20.0, 90.0), q=10.0,
+            cases.append(Case(f"distance {d:g}, E=1 W/m^2", "distance", phong(q=10.0), eye=_unit(20.0, 90.0),
                               lights=(("point", tuple(d * c for c in light), power),)))
     for phi in (1e-40, 1e-30, 1.0, 1e30, 3e38):
         i = phi / (4 * np.pi)
-        cases.append(Case(f"power {phi:g} W at 1 m", "power", eye=_unit(20.0, 90.0), q=10.0,
+        cases.append(Case(f"power {phi:g} W at 1 m", "power", phong(q=10.0), eye=_unit(20.0, 90.0),
                           lights=(("point", light, phi),), in_range=i >= FLT_MIN,
                           note="" if i >= FLT_MIN else "intensity below FLT_MIN: flushed to 0"))
-    cases.append(Case("all coefficients zero", "coefficients", kd=grey(0.0), ks=grey(0.0), ka=grey(0.0), eye=_unit(10.0, 90.0),
+    cases.append(Case("all coefficients zero", "coefficients", phong(0.0, 0.0), eye=_unit(10.0, 90.0),
                       lights=(("point", light, e_one),)))
-    cases.append(Case("kd=(1,0,0) under saturating light", "coefficients", kd=(1.0, 0.0, 0.0), ks=grey(0.0),
+    cases.append(Case("kd=(1,0,0) under saturating light", "coefficients", phong((1.0, 0.0, 0.0), 0.0),
                       eye=_unit(10.0, 90.0), lights=(("point", tuple(1e-30 * c for c in light), 1.0),), in_range=False,
                       note="E saturates at FLT_MAX; zero channels stay 0, never 0 * Inf = NaN"))
-    cases.append(Case("ks only, q=1e6 peak", "coefficients", kd=grey(0.0), ks=(0.0, 0.5, 1.0), q=1e6,
+    cases.append(Case("ks only, q=1e6 peak", "coefficients", phong(0.0, (0.0, 0.5, 1.0), 1e6),
                       eye=_mirror_eye(30.0, 0.0), lights=(("point", light, e_one),)))
     # light k at 10^(k-4) m delivering E_k = 10^(6k-20) W/m^2
     many = tuple(("point", tuple(10.0 ** (k - 4) * c for c in _unit(10.0 + 8 * k, 45.0 * k)),
                   4 * np.pi * 10.0 ** (2 * (k - 4)) * 10.0 ** (6 * k - 20)) for k in range(8))
-    cases.append(Case("8 lights, E from 1e-20 to 1e22 W/m^2", "dynamic range", family="blinn", q=200.0,
+    cases.append(Case("8 lights, E from 1e-20 to 1e22 W/m^2", "dynamic range", BlinnPhong(0.2, 0.5, 200.0),
                       eye=_unit(25.0, 200.0), lights=many))
-    cases.append(Case("3 light kinds + ambient", "dynamic range", family="phong", q=500.0, ka=grey(1e-3), ambient=1e-2,
+    cases.append(Case("3 light kinds + ambient", "dynamic range", Phong(0.2, 0.5, 500.0, ka=grey(1e-3)), ambient=1e-2,
                       eye=_mirror_eye(30.0, 0.0), lights=(("point", light, e_one), ("unattenuated", (0.0, 5.0, 5.0), 1e-6),
                                                                  ("directional", (0.0, 0.0, -1.0), 1e6))))
     return tuple(cases)
@@ -201,17 +248,19 @@ def _build_cases():
 CASES = _build_cases()
 
 
-def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60):
-    """Independent high-precision value of E6 at one point, from the objects' own parameters.
+def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0.0, 1.0), uv=(0.5, 0.5)):
+    """Independent high-precision value of the shading equation at one point, from the objects' own parameters.
 
-    Evaluates ``L = k_a + k_d L_a + sum_j [n.l_j > 0] (k_d n.l_j + k_s lobe_j) E_j`` in mpmath with
-    ``digits`` significant digits for the first object of ``scene``, reading the public attributes of
-    its material (``kd``, ``ka``, ``ks``, ``q``), of the lights (``position`` and ``power`` with
-    ``E = Phi / (4 pi d^2)``, ``radiance``, ``direction`` and ``irradiance``), of the ambient light and
-    of the camera (``position``): never the uniforms, the twin or the tolerance band, so a wrong value
-    on its way from a constructor to a shader uniform shows.  The conventions are those of DESIGN
-    section 1 (q = 0 gives lobe 1; Blinn's lobe is 0 where n.v <= 0 or l + v = 0; a zero or
-    non-finite normal gives the ambient terms only).
+    Evaluates ``L = k_a + sum_terms k L_a + sum_j [n.l_j > 0] sum_terms response_term(n, l_j, v) E_j``
+    in mpmath with ``digits`` significant digits for the first object of ``scene``, reading the public
+    attributes of its material (each term's parameters and ``ka``), of the lights (``position`` and
+    ``power`` with ``E = Phi / (4 pi d^2)``, ``radiance``, ``direction`` and ``irradiance``), of the
+    ambient light and of the camera (``position``): never the uniforms, the twin or the tolerance band,
+    so a wrong value on its way from a constructor to a shader uniform shows.  Each term's response
+    comes from its model's ``oracle`` method (mpmath); a model without one is evaluated by its twin
+    in float64 on the oracle's geometry (rounded to float64), and judged as well as that allows.
+    The conventions are those of DESIGN section 1 (a zero or non-finite normal gives the emission
+    terms only).
 
     The GPU computes in float32, so every input coordinate and coefficient is first rounded to
     float32, the documented input precision; everything after that is exact to ``digits``.
@@ -225,6 +274,10 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60):
     point : (3,) array_like
         World-space shading point [m].
     digits : int
+    tangent : (4,) array_like
+        Raw tangent and handedness, for terms that need a tangent frame.
+    uv : (2,) array_like
+        Texture coordinates, for terms that need them.
 
     Returns
     -------
@@ -234,7 +287,7 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60):
     import mpmath
 
     from .lights import DirectionalLight, PointLight, UnattenuatedPointLight
-    from .materials import BlinnPhong
+    from .materials import ParamValues
 
     mp = mpmath.mp
     mp.dps = digits
@@ -246,19 +299,24 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60):
         length = mpmath.sqrt(dot(a, a))
         return [x / length for x in a]
 
+    def mp_values(term):
+        return ParamValues({p.name: (vec(getattr(term, p.name)) if p.kind == "rgb" else f(getattr(term, p.name)))
+                            for p in term.params})
+
     material = scene.objects[0].material
-    kd, ka = vec(material.kd), vec(material.ka)
-    ks = vec(getattr(material, "ks", (0.0, 0.0, 0.0)))
-    out = list(ka)
+    terms = [t for t in material.components if not t.vanishes()]
+    out = vec(material.ka)
     if scene.ambient is not None:
-        out = [o + a * la for o, a, la in zip(out, kd, vec(scene.ambient.radiance))]
+        for term in terms:
+            if term.ambient is not None:
+                k = vec(getattr(term, term.ambient))
+                out = [o + a * la for o, a, la in zip(out, k, vec(scene.ambient.radiance))]
     raw_n = np.asarray(normal, dtype=np.float32)
     if not np.all(np.isfinite(raw_n)) or not np.any(raw_n):
         return np.array([float(o) for o in out])
     x = vec(point)
     n = unit(vec(raw_n))
     v = unit([e - p for e, p in zip(vec(scene.camera.position), x)])
-    blinn = isinstance(material, BlinnPhong)
     four_pi = 4 * mpmath.pi
     for light in scene.lights:
         if isinstance(light, PointLight):
@@ -274,19 +332,28 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60):
         ndl = dot(n, l)
         if ndl <= 0:
             continue
-        lobe = mpmath.mpf(0)
-        if any(ks):
-            q = f(material.q)
-            if blinn:
-                s = [a + b for a, b in zip(l, v)]
-                valid = dot(n, v) > 0 and dot(s, s) > 0
-                c = dot(n, unit(s)) if valid else mpmath.mpf(0)
+        for term in terms:
+            if term.oracle is not None:
+                response = term.oracle(n, l, v, ndl, mp_values(term))
             else:
-                c = dot(v, [2 * ndl * a - b for a, b in zip(n, l)])
-                valid = True
-            lobe = (mpmath.mpf(1) if q == 0 else max(c, 0) ** q) if valid else mpmath.mpf(0)
-        out = [o + (a * ndl + b * lobe) * ee for o, a, b, ee in zip(out, kd, ks, e)]
+                response = _twin_at(term, n, l, v, ndl, tangent, uv)
+            out = [o + r * ee for o, r, ee in zip(out, response, e)]
     return np.array([float(o) for o in out])
+
+
+def _twin_at(term, n, l, v, ndl, tangent, uv):
+    """A term's twin response at one mpmath geometry, in float64 (for models without an oracle)."""
+    import mpmath
+
+    from . import reference as ref
+    from .key import TermKey, ProgramKey
+
+    as64 = lambda a: np.array([[float(c) for c in a]])  # noqa: E731
+    key = ProgramKey(terms=(TermKey(term.name, "", tuple(term.needs)),), has_tangent="tangent" in term.needs,
+                     has_uv="uv" in term.needs)
+    frame = ref.shading_frame(as64(n), np.array([tangent], dtype=np.float64), np.array([uv], dtype=np.float64), key)
+    r = term.response(frame, as64(l), as64(v), np.array([float(ndl)]), term.values())
+    return [mpmath.mpf(float(c)) for c in np.asarray(r, dtype=np.float64)[0]]
 
 
 @dataclass(frozen=True)
@@ -381,14 +448,17 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
             key = replace(key, formulation=formulation)
             position = np.zeros((1, 3))
             normal = np.asarray([case.normal], dtype=np.float32)
-            gpu = shade_points(gl, programs, key, uniforms, position, normal,
+            tangent = np.asarray([case.tangent], dtype=np.float32)
+            uv = np.asarray([case.uv], dtype=np.float32)
+            gpu = shade_points(gl, programs, key, uniforms, position, normal, tangents=tangent, uvs=uv,
                                drop_unused=formulation == "naive")[0].astype(np.float64)
             u64 = {k: v.astype(np.float64) for k, v in uniforms.items()}
             n_valid, n, _ = ref.safe_normalize(normal.astype(np.float64))
-            twin = ref.shade_point(position, n, n_valid, u64.get("u_eye"), key, u64)[0]
-            low, high = point_band(key, u64, position, n, n_valid)
+            frame = ref.shading_frame(n, tangent.astype(np.float64), uv.astype(np.float64), key)
+            twin = ref.shade_point(position, frame, n_valid, u64.get("u_eye"), key, u64, case.material)[0]
+            low, high = point_band(key, u64, position, frame, n_valid, case.material)
             low, high = low[0], high[0]
-            expected = oracle(scene, case.normal)
+            expected = oracle(scene, case.normal, tangent=case.tangent, uv=case.uv)
             if case.in_range:
                 # judged against the oracle, with the band's widths as the tolerance: the twin and the
                 # band read the uniforms, the oracle the constructors, so a wrongly wired input shows

@@ -6,7 +6,10 @@ around the twin's value of each term is:
 - Lambert: ``k_d E [max(n.l - D eps, 0), n.l + D eps] (1 +- A eps)``.
 - Lobe: the chord ``c = sqrt(2 delta)`` widened by ``+-C eps`` (for Blinn scaled by
   ``max(1, 2/|l + v|)``, the conditioning of the half vector), mapped through
-  ``(1 - c^2/2)^q``, then widened by ``(1 +- eps (A + B lambda))``, ``lambda = -ln(lobe)``.
+  ``(1 - c^2/2)^q``, then widened by ``(1 +- eps (A + B lambda))``, ``lambda = -ln(lobe)``
+  (`lobe_band`; the lobe models' ``band`` methods apply it).
+- Other models: their own ``band`` method, or the generic one of
+  `glphong.materials.MaterialModel.band` (the twin's sensitivity to a few ulps of its inputs).
 - Gates: where ``|n.l| <= D eps`` (Blinn: also ``|n.v| <= D eps``, or ``|l + v|`` within
   a factor 4 of its floor) either outcome of the gate is accepted.
 - Ambient terms: ``(1 +- A eps)``.  The sum over terms widens by ``(1 +- m eps)`` for m terms.
@@ -86,8 +89,14 @@ def lobe_band(delta, q, chord_scale=1.0, band=BAND):
     return np.where(low < FLT_MIN, 0.0, low), widen(high, +1.0)
 
 
-def point_band(key, u, position, n, n_valid, band=BAND):
+def point_band(key, u, position, n, n_valid, material, band=BAND):
     """Interval the GPU's ``shade_point()`` must return at given points.
+
+    Each lit term contributes its own band (`glphong.materials.MaterialModel.band`: the model's
+    derived band, or the generic one from the twin's sensitivity), times the irradiance widened
+    by ``(1 +- A eps)``.  Where ``|n.l| <= D eps`` either side of the light gate is accepted: there
+    the lower bound is 0 and a term's band is asked at its (possibly non-positive) ``n.l``, which it
+    must bound over ``(0, n.l + D eps]``.
 
     Parameters
     ----------
@@ -95,41 +104,45 @@ def point_band(key, u, position, n, n_valid, band=BAND):
     u : dict of str to ndarray
         The program's uniforms as float64.
     position : (N, 3) float64 ndarray
-    n : (N, 3) float64 ndarray
-        Unit normals (as `glphong.reference.safe_normalize` returns them).
+    n : (N, 3) float64 ndarray or ShadingFrame
+        Unit normals (as `glphong.reference.safe_normalize` returns them), or the shading frame.
     n_valid : (N,) bool ndarray
+    material : glphong.materials.Material
     band : BandConstants
 
     Returns
     -------
     low, high : (N, 3) float64 ndarray
     """
-    ambient = ref.ambient_terms(key, u, position.shape, np.float64)
+    f = n if hasattr(n, "n") else ref.shading_frame(np.asarray(n), key=key)
+    ambient = ref.material_emission(key, u, position.shape, np.float64)
     lo, hi = ambient * (1 - band.A * EPS), ambient * (1 + band.A * EPS)
-    terms = int(key.has_ka) + int(key.has_kd_la)
+    terms = int(key.has_ka) + sum(1 for t in key.terms if t.ambient)
     if key.num_lights:
+        models = {term.name: term for term in material.components}
         wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
-        lit = lit[..., None]
         tol = band.D * EPS
         for valid, wi, irradiance in ref.incident_light(position, key, u):
             terms += 1
-            n_dot_l = ref._dot(n, wi)
+            n_dot_l = ref._dot(f.n, wi)
+            certain = (lit & valid & (n_dot_l > tol))[..., None]
+            possible = lit & valid & (n_dot_l > -tol)
             f_lo = np.zeros_like(position)
             f_hi = np.zeros_like(position)
-            if key.has_diffuse:
-                f_lo = f_lo + ref.lambert(u["u_kd"], np.maximum(n_dot_l - tol, 0.0))
-                f_hi = f_hi + ref.lambert(u["u_kd"], np.maximum(n_dot_l + tol, 0.0))
-            if key.has_specular:
-                l_lo, l_hi = _specular_band(key.lobe, n, wi, wo, u["u_q"], tol, band)
-                f_lo = f_lo + u["u_ks"] * l_lo[..., None]
-                f_hi = f_hi + u["u_ks"] * l_hi[..., None]
+            if possible.any():
+                g, ndl = f.select(possible), n_dot_l[possible]
+                for term_key in key.lit_terms:
+                    term = models[term_key.name]
+                    p = term.values_from_uniforms(u)
+                    with np.errstate(over="ignore", invalid="ignore"):
+                        t_lo, t_hi = term.band(g, wi[possible], wo[possible], ndl, p, band)
+                    f_lo[possible] += t_lo
+                    f_hi[possible] += t_hi
             with np.errstate(over="ignore", invalid="ignore"):
                 t_lo = np.nan_to_num(f_lo * irradiance * (1 - band.A * EPS), nan=0.0)
                 t_hi = np.nan_to_num(f_hi * irradiance * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
-            certain = lit & valid[..., None] & (n_dot_l > tol)[..., None]
-            possible = lit & valid[..., None] & (n_dot_l > -tol)[..., None]
             lo = lo + np.where(certain, t_lo, 0.0)
-            hi = hi + np.where(possible, t_hi, 0.0)
+            hi = hi + np.where(possible[..., None], t_hi, 0.0)
     low = lo * (1 - terms * EPS)
     high = hi * (1 + terms * EPS)
     return np.where(low < FLT_MIN, 0.0, low), np.where(high > FLT_MAX, np.inf, high)
@@ -151,21 +164,6 @@ def radiance_band(scene, gbuffer, band=BAND):
     """
     low = np.zeros(gbuffer.position.shape)
     high = np.zeros(gbuffer.position.shape)
-    for selection, key, u, position, n, n_valid in ref.shade_inputs(scene, gbuffer):
-        low[selection], high[selection] = point_band(key, u, position, n, n_valid, band)
+    for selection, obj, key, u, position, f, n_valid in ref.shade_inputs(scene, gbuffer):
+        low[selection], high[selection] = point_band(key, u, position, f, n_valid, obj.material, band)
     return low, high
-
-
-def _specular_band(lobe, n, wi, wo, q, tol, band):
-    """Interval of the lobe of one light, gates included (see the module docstring)."""
-    if lobe == "phong":
-        return lobe_band(ref.phong_delta(n, wi, wo), q, 1.0, band)
-    ok_h, _, h_len = ref.safe_normalize(wi + wo)
-    _, h_dir, _ = ref.safe_normalize(wi + wo)
-    delta = 0.5 * ref._dot(h_dir - n, h_dir - n)
-    scale = np.maximum(1.0, 2.0 / np.maximum(h_len, ref.BLINN_HALF_FLOOR))
-    low, high = lobe_band(delta, q, scale, band)
-    n_dot_v = ref._dot(n, wo)
-    certain = ok_h & (n_dot_v > tol) & (h_len > 4 * ref.BLINN_HALF_FLOOR)
-    possible = ok_h & (n_dot_v > -tol) & (h_len > ref.BLINN_HALF_FLOOR / 4)
-    return np.where(certain, low, 0.0), np.where(possible, np.where(certain, high, 1.0), 0.0)

@@ -1,4 +1,4 @@
-// common.glsl -- numeric helpers shared by every chunk (DESIGN section 3).
+// common.glsl -- numeric helpers and the shading frame shared by every chunk (DESIGN sections 3, 8).
 //
 // safe_normalize(x, out x_hat, out len) -> valid
 //   s = max_i |x_i|;  valid  <=>  no x_i is NaN or Inf, and s > 0   (false for zero, NaN, Inf)
@@ -10,8 +10,29 @@
 //   |x|^2 is never formed from raw coordinates, so lengths from FLT_MIN to FLT_MAX (float32)
 //   neither underflow nor overflow.  On failure x_hat = 0 and len = 0.
 //   Units: len has the units of x; x_hat is dimensionless.
+//   NAIVE (the textbook formulation, for the stability report only): x_hat = normalize(x),
+//   len = length(x), always valid.
+//
+// ShadingFrame: the local frame a material's response reads (DESIGN section 8):
+//   n the unit normal; t, b the unit tangent and bitangent (0 unless HAS_TANGENT); uv (0 unless HAS_UV).
+// frame_from_tangent(n, tangent, out t, out b)
+//   t = normalize(tangent.xyz - (n . tangent.xyz) n)   (Gram-Schmidt against the shading normal);
+//   b = sign(tangent.w) cross(n, t)                     (w < 0: mirrored texture space);
+//   where the projection is zero or not finite, t is the tangent of the branchless orthonormal
+//   basis of Duff et al. 2017 ("Building an orthonormal basis, revisited") around n.
+// shading_frame(n, tangent, uv) -> the ShadingFrame of a shading point (t, b only when HAS_TANGENT).
+// Key defines read here: NAIVE, HAS_TANGENT.
 
+const float FLT_MAX = 3.402823466e38;
 
+#if NAIVE
+bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
+{
+    x_hat = normalize(x);
+    len = length(x);
+    return true;
+}
+#else
 bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
 {
     float s = max(max(abs(x.x), abs(x.y)), abs(x.z));
@@ -25,4 +46,36 @@ bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
     len = s * sqrt(yy);
     x_hat = y * inversesqrt(yy);
     return true;
+}
+#endif
+
+struct ShadingFrame {
+    vec3 n;    // unit normal
+    vec3 t;    // unit tangent
+    vec3 b;    // unit bitangent
+    vec2 uv;   // texture coordinates
+};
+
+void frame_from_tangent(vec3 n, vec4 tangent, out vec3 t, out vec3 b)
+{
+    float len;
+    bool projected = safe_normalize(tangent.xyz - dot(n, tangent.xyz) * n, t, len);
+    float s = n.z >= 0.0 ? 1.0 : -1.0;
+    float a = -1.0 / (s + n.z);
+    vec3 fallback = vec3(1.0 + s * n.x * n.x * a, s * n.x * n.y * a, -s * n.x);
+    t = projected ? t : fallback;
+    b = (tangent.w < 0.0 ? -1.0 : 1.0) * cross(n, t);
+}
+
+ShadingFrame shading_frame(vec3 n, vec4 tangent, vec2 uv)
+{
+    ShadingFrame f;
+    f.n = n;
+    f.t = vec3(0.0);
+    f.b = vec3(0.0);
+    f.uv = uv;
+#if HAS_TANGENT
+    frame_from_tangent(n, tangent, f.t, f.b);
+#endif
+    return f;
 }

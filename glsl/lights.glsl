@@ -6,11 +6,18 @@
 //   an irradiance beyond float32 saturates at FLT_MAX instead of becoming Inf (Inf times a zero
 //   coefficient channel would be NaN).
 //   intensity: vec3 [W/sr];  d: distance [m] (> 0);  E: vec3 [W/m^2].
+//   NAIVE (the textbook formulation, for the stability report only): I / (d * d).
 // Lights given directly by L_i (E2) and directional lights use their value as E unchanged.
+// Key defines read here: NAIVE.
 
-const float FLT_MAX = 3.402823466e38;
-
+#if NAIVE
+vec3 point_irradiance(vec3 intensity, float d)
+{
+    return intensity / (d * d);
+}
+#else
 vec3 point_irradiance(vec3 intensity, float d)
 {
     return min((intensity / d) / d, vec3(FLT_MAX));
 }
+#endif

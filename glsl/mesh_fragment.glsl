@@ -2,13 +2,15 @@
 // interpolated per-vertex radiance.
 //
 //   n = safe_normalize(+-v_normal)  (flipped on back faces when TWO_SIDED: two-sided shading);
-//   radiance output: vec4(shade_point(v_position, n, n_valid, u_eye), 1)  [W/(m^2 sr)], linear float;
+//   f = shading_frame(n, v_tangent, v_uv)  (common.glsl: the tangent orthonormalised against n);
+//   radiance output: vec4(shade_point(v_position, f, n_valid, u_eye), 1)  [W/(m^2 sr)], linear float;
 //   SHADE_PER_VERTEX: vec4(v_radiance, 1), the Gouraud-interpolated vertex radiance;
 //   OUTPUT_DISPLAY (pyrender's 8-bit framebuffer): vec4(srgb_encode(u_exposure * L), 1);
-//   G-buffer outputs (OUTPUT_GBUFFER): position (world, [m]) with w = object id + 1, and the
-//   normal exactly as shade_point() would use it (0 where it is invalid), w = 1.
-// Key defines read here: HAS_NORMAL, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW,
-// RUNTIME_SWITCHES, SWITCH(flag).
+//   G-buffer outputs (OUTPUT_GBUFFER): position (world, [m]) with w = object id + 1, the
+//   normal exactly as shade_point() would use it (0 where it is invalid), w = 1; with HAS_TANGENT
+//   the interpolated tangent (xyz, handedness w), with HAS_UV the uv (xy): the inputs of shading_frame().
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY,
+// SHADE_PER_VERTEX, NEEDS_VIEW, RUNTIME_SWITCHES, SWITCH(flag).
 
 invariant in vec3 v_position;
 #if SHADE_PER_VERTEX
@@ -23,6 +25,12 @@ void main()
 #if HAS_NORMAL
 invariant in vec3 v_normal;
 #endif
+#if HAS_TANGENT
+invariant in vec4 v_tangent;
+#endif
+#if HAS_UV
+invariant in vec2 v_uv;
+#endif
 #if TWO_SIDED && RUNTIME_SWITCHES
 uniform float u_two_sided;
 #endif
@@ -30,11 +38,17 @@ uniform float u_two_sided;
 uniform float u_object_id;
 layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
+#if HAS_TANGENT
+layout(location = 2) out vec4 out_tangent;
+#endif
+#if HAS_UV
+layout(location = 3) out vec4 out_uv;
+#endif
 #else
 #if NEEDS_VIEW
 uniform vec3 u_eye;
 #else
-const vec3 u_eye = vec3(0.0);  // no specular lobe: shade_point() never reads the eye
+const vec3 u_eye = vec3(0.0);  // no term reads the view: shade_point() never reads the eye
 #endif
 #if OUTPUT_DISPLAY
 uniform float u_exposure;
@@ -56,13 +70,27 @@ void main()
     float n_len;
     n_valid = safe_normalize(n_raw, n, n_len);
 #endif
+    vec4 tangent = vec4(0.0);
+    vec2 uv = vec2(0.0);
+#if HAS_TANGENT
+    tangent = v_tangent;
+#endif
+#if HAS_UV
+    uv = v_uv;
+#endif
 #if OUTPUT_GBUFFER
     out_position = vec4(v_position, u_object_id + 1.0);
     out_normal = vec4(n, 1.0);
+#if HAS_TANGENT
+    out_tangent = tangent;
+#endif
+#if HAS_UV
+    out_uv = vec4(uv, 0.0, 1.0);
+#endif
 #elif OUTPUT_DISPLAY
-    out_radiance = vec4(srgb_encode(u_exposure * shade_point(v_position, n, n_valid, u_eye)), 1.0);
+    out_radiance = vec4(srgb_encode(u_exposure * shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye)), 1.0);
 #else
-    out_radiance = vec4(shade_point(v_position, n, n_valid, u_eye), 1.0);
+    out_radiance = vec4(shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye), 1.0);
 #endif
 }
 #endif

@@ -1,15 +1,17 @@
 // mesh_vertex.glsl -- vertex stage: object -> world -> clip space; per-vertex (Gouraud) shading.
 //
 //   world = M p;  n_world = N n  with N = inverse-transpose of M's 3x3 block (host, float64);
+//   tangent_world = (M3 t.xyz, t.w)  (tangents move with the surface, not as normals);
 //   gl_Position = (P V) world.
-// Per-pixel shading (default): the normal is passed on unnormalised; the fragment stage shades.
-// SHADE_PER_VERTEX: v_radiance = shade_point(world, n, n_valid, u_eye) here, interpolated across the
+// Per-pixel shading (default): normal, tangent and uv are passed on unnormalised; the fragment stage shades.
+// SHADE_PER_VERTEX: v_radiance = shade_point(world, frame, n_valid, u_eye) here, interpolated across the
 //   triangle (Gouraud); the normal is flipped toward the eye when TWO_SIDED (a vertex shader has
 //   no gl_FrontFacing).  Positions in metres, radiance in W/(m^2 sr).
+// Attribute locations are fixed and match pyrender's: 0 position, 1 normal, 2 tangent, 3 uv.
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
-// Key defines read here: HAS_NORMAL, SHADE_PER_VERTEX, TWO_SIDED, NEEDS_VIEW, SWITCH(flag).
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, SHADE_PER_VERTEX, TWO_SIDED, NEEDS_VIEW, SWITCH(flag).
 
-layout(location = 0) in vec3 in_position;   // fixed locations: pyrender's vertex arrays use 0 and 1
+layout(location = 0) in vec3 in_position;
 uniform mat4 u_model;
 uniform mat4 u_view_projection;
 invariant gl_Position;
@@ -17,6 +19,12 @@ invariant out vec3 v_position;
 #if HAS_NORMAL
 layout(location = 1) in vec3 in_normal;
 uniform mat3 u_normal_matrix;
+#endif
+#if HAS_TANGENT
+layout(location = 2) in vec4 in_tangent;
+#endif
+#if HAS_UV
+layout(location = 3) in vec2 in_uv;
 #endif
 #if SHADE_PER_VERTEX
 out vec3 v_radiance;
@@ -28,14 +36,30 @@ const vec3 u_eye = vec3(0.0);  // nothing reads the eye
 #if TWO_SIDED && RUNTIME_SWITCHES
 uniform float u_two_sided;
 #endif
-#elif HAS_NORMAL
+#else
+#if HAS_NORMAL
 invariant out vec3 v_normal;
+#endif
+#if HAS_TANGENT
+invariant out vec4 v_tangent;
+#endif
+#if HAS_UV
+invariant out vec2 v_uv;
+#endif
 #endif
 
 void main()
 {
     vec4 world = u_model * vec4(in_position, 1.0);
     v_position = world.xyz;
+    vec4 tangent = vec4(0.0);
+    vec2 uv = vec2(0.0);
+#if HAS_TANGENT
+    tangent = vec4(mat3(u_model) * in_tangent.xyz, in_tangent.w);
+#endif
+#if HAS_UV
+    uv = in_uv;
+#endif
 #if SHADE_PER_VERTEX
     vec3 n = vec3(0.0);
     bool n_valid = false;
@@ -48,9 +72,17 @@ void main()
     }
 #endif
 #endif
-    v_radiance = shade_point(world.xyz, n, n_valid, u_eye);
-#elif HAS_NORMAL
+    v_radiance = shade_point(world.xyz, shading_frame(n, tangent, uv), n_valid, u_eye);
+#else
+#if HAS_NORMAL
     v_normal = u_normal_matrix * in_normal;
+#endif
+#if HAS_TANGENT
+    v_tangent = tangent;
+#endif
+#if HAS_UV
+    v_uv = uv;
+#endif
 #endif
     gl_Position = u_view_projection * world;
 }

@@ -98,7 +98,7 @@ def sphere_error(renderer, level):
     hit, position, normal = ray_cast_sphere(scene.camera, w, h)
     exact = np.zeros((h, w, 3))
     exact[hit] = reference.shade_point(position[hit], normal[hit], np.ones(int(hit.sum()), bool),
-                                       scene.camera.position, key, uniforms)
+                                       scene.camera.position, key, uniforms, obj.material)
     interior = erode(hit & frame.mask, 2)
     diff = frame.radiance[interior].astype(np.float64) - exact[interior]
     return float(np.sqrt(np.sum(diff ** 2) / np.sum(exact[interior] ** 2))), int(interior.sum())

@@ -6,12 +6,14 @@ formulas out with literal numbers, (A, B, C, D) = (16, 4, 6, 8) and eps = 2^-24,
 factor fails here even if every image still passes.  The expected values use only ``math``.
 """
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
+import glphong
 from glphong import tolerances
-from glphong.key import ProgramKey
+from glphong.key import program_key
 
 EPS = 2.0 ** -24
 A, B, C, D = 16.0, 4.0, 6.0, 8.0
@@ -61,8 +63,12 @@ def test_lobe_band_is_narrow_where_it_must_be():
     assert 2.4e-3 > width > 2.1e-3
 
 
-def lambert_key(**extra):
-    return ProgramKey(output="points", has_diffuse=True, num_directional_lights=1, **extra)
+LAMBERT = glphong.Lambert(0.25)
+
+
+def lambert_key(material=LAMBERT, ambient=None, **extra):
+    key = program_key(material, {"directional": 1}, ambient, output="points")
+    return replace(key, two_sided=False, **extra)
 
 
 @pytest.mark.parametrize("n_dot_l", [1.0, 0.5, 1e-3])
@@ -71,10 +77,10 @@ def test_lambert_point_band_closed_form(n_dot_l):
     (the last factor: one term in the sum)."""
     kd, e = 0.25, 3.0
     s = math.sqrt(1.0 - n_dot_l * n_dot_l)
-    u = {"u_kd": np.full(3, kd), "u_directional_direction": np.array([[s, 0.0, n_dot_l]]),
+    u = {"u_lambert_kd": np.full(3, kd), "u_directional_direction": np.array([[s, 0.0, n_dot_l]]),
          "u_directional_irradiance": np.full((1, 3), e)}
     low, high = tolerances.point_band(lambert_key(), u, np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]),
-                                      np.array([True]))
+                                      np.array([True]), LAMBERT)
     exp_low = kd * (n_dot_l - D * EPS) * e * (1 - A * EPS) * (1 - EPS)
     exp_high = kd * (n_dot_l + D * EPS) * e * (1 + A * EPS) * (1 + EPS)
     np.testing.assert_allclose(low[0], exp_low, rtol=1e-12)
@@ -84,9 +90,12 @@ def test_lambert_point_band_closed_form(n_dot_l):
 def test_ambient_band_closed_form():
     """k_a + k_d L_a alone: each term (1 -+ A eps), the sum of two terms (1 -+ 2 eps)."""
     ka, kd, la = 0.01, 0.3, 0.5
-    key = ProgramKey(output="points", has_ka=True, has_kd_la=True, has_normal=False)
-    u = {"u_ka": np.full(3, ka), "u_kd": np.full(3, kd), "u_ambient": np.full(3, la)}
-    low, high = tolerances.point_band(key, u, np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([True]))
+    material = glphong.Lambert(kd, ka=ka)
+    key = program_key(material, {}, (la, la, la), output="points")
+    assert [t.name for t in key.terms if t.ambient] == ["lambert"] and key.has_ka and not key.num_lights
+    u = {"u_ka": np.full(3, ka), "u_lambert_kd": np.full(3, kd), "u_ambient": np.full(3, la)}
+    low, high = tolerances.point_band(key, u, np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([True]),
+                                      material)
     total = ka + kd * la
     np.testing.assert_allclose(low[0], total * (1 - A * EPS) * (1 - 2 * EPS), rtol=1e-12)
     np.testing.assert_allclose(high[0], total * (1 + A * EPS) * (1 + 2 * EPS), rtol=1e-12)
@@ -97,14 +106,15 @@ def test_gate_accepts_either_side_only_within_d_eps():
     kd, e = 0.25, 1.0
     for n_dot_l, low_is_zero in ((0.5 * D * EPS, True), (-0.5 * D * EPS, True), (4 * D * EPS, False)):
         s = math.sqrt(1.0 - n_dot_l * n_dot_l)
-        u = {"u_kd": np.full(3, kd), "u_directional_direction": np.array([[s, 0.0, n_dot_l]]),
+        u = {"u_lambert_kd": np.full(3, kd), "u_directional_direction": np.array([[s, 0.0, n_dot_l]]),
              "u_directional_irradiance": np.full((1, 3), e)}
         low, high = tolerances.point_band(lambert_key(), u, np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]),
-                                          np.array([True]))
+                                          np.array([True]), LAMBERT)
         assert (low[0] == 0).all() == low_is_zero, n_dot_l
         np.testing.assert_allclose(high[0], kd * (n_dot_l + D * EPS) * e * (1 + A * EPS) * (1 + EPS), rtol=1e-12)
     # a light clearly behind the surface: nothing is accepted
-    u = {"u_kd": np.full(3, kd), "u_directional_direction": np.array([[0.6, 0.0, -0.8]]),
+    u = {"u_lambert_kd": np.full(3, kd), "u_directional_direction": np.array([[0.6, 0.0, -0.8]]),
          "u_directional_irradiance": np.full((1, 3), e)}
-    low, high = tolerances.point_band(lambert_key(), u, np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([True]))
+    low, high = tolerances.point_band(lambert_key(), u, np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([True]),
+                                      LAMBERT)
     assert (low == 0).all() and (high == 0).all()

@@ -36,12 +36,18 @@ def test_png_and_npy_round_trip(tmp_path):
 
 
 def test_glsl_sources_ship_with_the_package():
-    from glphong.programs import _glsl_root, chunk_source
+    from glphong.materials import registered_models
+    from glphong.programs import chunk_source, glsl_root
 
-    for name in ("common", "lights", "lambert", "lobe", "phong", "blinn", "shade", "mesh_vertex", "mesh_fragment"):
+    for name in ("common", "lights", "lobe", "shade", "mesh_vertex", "mesh_fragment", "shade_points", "srgb", "encode"):
         text = chunk_source(name)
         assert text.startswith(f"// {name}.glsl --"), name  # every chunk opens with its formula header
-    assert (_glsl_root() / "shade.glsl").is_file()
+    builtin = [m for m in registered_models() if m.__module__.startswith("glphong.")]
+    assert {m.name for m in builtin} >= {"lambert", "phong_lobe", "blinn_lobe"}
+    for model in builtin:  # one file per model under glsl/materials/, opening with its formula header
+        path = f"materials/{model.name}.glsl"
+        assert (glsl_root() / path).is_file(), path
+        assert model.source().startswith(f"// {path} -- the model '{model.name}'"), path
 
 
 def test_main_job_from_outside_the_checkout(tmp_path):

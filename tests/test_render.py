@@ -1,12 +1,13 @@
 """Renderer, G-buffer, program cache and pixel parity with the float64 twin (DESIGN section 7, layers 2 and 5)."""
 import gc
+import re
 
 import numpy as np
 import pytest
 import trimesh
 
 import glphong
-from glphong.key import ProgramKey, uber_key
+from glphong.key import ProgramKey, program_key, uber_key
 from glphong.programs import Program, ShaderCompileError, UniformError, _name_chunks
 
 BACKENDS = ("egl", "osmesa")
@@ -211,8 +212,8 @@ def test_uniform_binding_is_strict(renderer):
         program.bind(good)
         with pytest.raises(UniformError, match=r"missing uniforms \['u_ka'\]"):
             program.bind({k: v for k, v in good.items() if k != "u_ka"})
-        with pytest.raises(UniformError, match=r"unknown uniforms \['u_eye', 'u_kd'\]"):
-            program.bind({**good, "u_kd": np.ones(3), "u_eye": np.zeros(3)})  # u_eye: no lights, not used
+        with pytest.raises(UniformError, match=r"unknown uniforms \['u_eye', 'u_lambert_kd'\]"):
+            program.bind({**good, "u_lambert_kd": np.ones(3), "u_eye": np.zeros(3)})  # u_eye: no lights, not used
         with pytest.raises(UniformError, match="u_ka .* takes 3 floats"):
             program.bind({**good, "u_ka": np.ones(4)})
 
@@ -224,42 +225,53 @@ def test_compile_error_names_chunk_file_and_line(renderer, monkeypatch):
 
     def broken(name):
         text = original(name)
-        return text.replace("return kd * n_dot_l;", "return kd * n_dot_l  // missing semicolon\n}") if name == "lambert" else text
+        return text.replace("vec3 radiance = material_emission();", "vec3 radiance = material_emission()  // no ;") \
+            if name == "shade" else text
 
     monkeypatch.setattr(programs, "chunk_source", broken)
-    key = ProgramKey(output="radiance", has_diffuse=True, num_directional_lights=1)
-    with renderer.context, pytest.raises(ShaderCompileError, match=r"lambert\.glsl:\d+"):
+    key = program_key(glphong.Lambert(0.3), {"directional": 1}, None)
+    with renderer.context, pytest.raises(ShaderCompileError) as caught:
         Program(renderer.context.mgl, key)
+    message = str(caught.value)
+    line = next(i for i, text in enumerate(broken("shade").splitlines(), 1) if "// no ;" in text)
+    # the error names the chunk file and a line at or just after the broken one, and shows that line
+    assert re.search(rf"shade\.glsl:({line}|{line + 1}|{line + 2})\b", message), message
+    assert re.search(r"shade\.glsl:\d+ \| ", message), message
 
 
 def test_name_chunks_rewrites_both_log_formats():
     # Mesa: source:line(column); NVIDIA: source(line); string 0 is the generated #version/#define header
-    assert _name_chunks("0:3(7): error: x", ["a"]) == "<generated header>:3:7: error: x"
-    assert _name_chunks("2:12(5): error: y", ["a", "b"]) == "b.glsl:12:5: error: y"
-    assert _name_chunks("1(9) : error C0000: z", ["a"]) == "a.glsl:9 : error C0000: z"
-    assert _name_chunks("0:5: error", ["a"]) == "<generated header>:5: error"
-    assert _name_chunks("7:2(1): error", ["a"]) == "7:2(1): error"  # no such source string: left as it is
+    from glphong.programs import chunk_source
+
+    line12 = chunk_source("lights").splitlines()[11].strip()
+    assert _name_chunks("0:3(7): error: x", ["common"]) == "<generated header>:3:7: error: x"
+    assert _name_chunks("2:12(5): error: y", ["common", "lights"]) == f"lights.glsl:12:5: error: y\n    lights.glsl:12 | {line12}"
+    assert _name_chunks("1(12) : error C0000: z", ["lights"]) == f"lights.glsl:12 : error C0000: z\n    lights.glsl:12 | {line12}"
+    assert _name_chunks("0:5: error", ["common"]) == "<generated header>:5: error"
+    assert _name_chunks("7:2(1): error", ["common"]) == "7:2(1): error"  # no such source string: left as it is
 
 
 def test_specialised_sources_leave_out_unused_code():
-    lambert = ProgramKey(output="radiance", has_diffuse=True, num_point_lights=2)
+    lambert = program_key(glphong.Lambert(0.3), {"point": 2}, None)
     from glphong.programs import assemble, effective_source
-    fragment = effective_source(assemble(lambert.fragment_chunks(), lambert.defines()))
+    fragment = effective_source(assemble(lambert.fragment_chunks(), lambert.defines(), lambert.generated_chunks()))
     for absent in ("lobe_from_delta", "log_one_minus", "pow(", "phong", "blinn", "uber", "in_tangent",
                    "safe_normalize(eye"):
         assert absent not in fragment, absent
     import re
     declared = set(re.findall(r"uniform \w+ (\w+)", fragment))
-    assert declared == {"u_kd", "u_point_position", "u_point_intensity"}, declared
+    assert declared == {"u_lambert_kd", "u_point_position", "u_point_intensity"}, declared
     assert "#define NUM_POINT_LIGHTS 2" in fragment and "#line 1 " in fragment
     assert lambert.attributes() == ("in_position", "in_normal")
     unlit = ProgramKey(output="radiance", has_ka=True, has_normal=False, two_sided=False)
     assert unlit.attributes() == ("in_position",)
-    unlit_fragment = effective_source(assemble(unlit.fragment_chunks(), unlit.defines()))
+    unlit_fragment = effective_source(assemble(unlit.fragment_chunks(), unlit.defines(), unlit.generated_chunks()))
     assert "for (int j" not in unlit_fragment and "safe_normalize(eye" not in unlit_fragment
     assert "u_ka" in unlit_fragment
-    uber = effective_source(assemble(uber_key().fragment_chunks(), uber_key().defines()))
-    for present in ("phong_lobe", "blinn_lobe", "uber_lobe", "u_use_ka", "u_point_count", "u_eye"):
+    both = uber_key([glphong.Phong(0.2, 0.5, 10.0), glphong.BlinnPhong(0.2, 0.5, 10.0)])
+    uber = effective_source(assemble(both.fragment_chunks(), both.defines(), both.generated_chunks()))
+    for present in ("phong_lobe_response", "blinn_lobe_response", "lambert_response", "u_use_ka", "u_use_phong_lobe",
+                    "u_use_lambert_ambient", "u_point_count", "u_eye"):
         assert present in uber, present
 
 

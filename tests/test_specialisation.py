@@ -53,9 +53,12 @@ def test_specialised_image_equals_uber_image(renderers, material):
 def test_uber_renderer_compiles_one_radiance_program(renderers):
     _, uber = renderers
     scene = scene_with(*MATERIALS[:5])
+    before = set(uber.programs.keys())
     uber.render(scene)
-    radiance_keys = [k for k in uber.programs.keys() if k.output == "radiance"]
-    assert radiance_keys == [uber_key()]
+    new = [k for k in uber.programs.keys() if k.output == "radiance" and k not in before]
+    drawn = {uber.program_key(scene, o) for o in scene.objects}
+    assert drawn == {uber_key([o.material for o in scene.objects])} and len(new) <= 1
+    assert [t.name for t in drawn.pop().terms] == ["blinn_lobe", "lambert", "phong_lobe"]
 
 
 def test_mixed_scene_compiles_one_program_per_distinct_key(renderers):
@@ -101,9 +104,11 @@ def test_lambert_program_contains_no_lobe_and_describe_says_so():
     scene = scene_with(glphong.Lambert(0.3), glphong.Phong(0.3, 0.0, 10.0))  # ks = 0: a Lambert program
     (only,) = describe(scene)
     assert only.objects == ("Lambert0", "Phong1")
-    assert any("specular lobe" in item for item in only.left_out)
+    assert any(item.startswith("term phong_lobe: materials/phong_lobe.glsl, u_phong_lobe_ks, u_phong_lobe_q "
+                               "(its parameters ks = 0)") for item in only.left_out), only.left_out
+    assert any("library chunk lobe.glsl" in item for item in only.left_out)
     src = only.effective_fragment_source
-    assert "lobe" not in src and "pow(" not in src and "uniform vec3 u_eye" not in src and "uniform vec3 u_ks" not in src
+    assert "lobe" not in src and "pow(" not in src and "uniform vec3 u_eye" not in src and "u_phong" not in src
     text = format_descriptions(describe(scene, gbuffer=True), source=True)
     assert "2 distinct program(s)" in text and "effective fragment source:" in text
 
@@ -113,13 +118,15 @@ def test_twin_follows_the_key(monkeypatch):
     def forbidden(*args, **kwargs):
         raise AssertionError("lobe evaluated for a key without specular")
 
-    monkeypatch.setattr(reference, "phong_lobe", forbidden)
-    monkeypatch.setattr(reference, "blinn_lobe", forbidden)
-    monkeypatch.setitem(reference._LOBES, "phong", forbidden)
-    scene = scene_with(glphong.Lambert(0.3))
+    from glphong.materials import BlinnLobe, PhongLobe
+
+    monkeypatch.setattr(PhongLobe, "response", forbidden)
+    monkeypatch.setattr(BlinnLobe, "response", forbidden)
+    material = glphong.Phong(0.3, 0.0, 10.0)  # ks = 0: the lobe term vanishes
+    scene = scene_with(material)
     key = scene.program_key(scene.objects[0])
     u = {k: v.astype(np.float64) for k, v in scene.uniform_values(0, key, 1.0).items()}
-    out = reference.shade_point(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([True]), None, key, u)
+    out = reference.shade_point(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([True]), None, key, u, material)
     assert out.shape == (1, 3) and out[0, 0] > 0
 
 
@@ -127,7 +134,7 @@ def test_uber_limit_is_enforced():
     lights = [glphong.PointLight((0, 0, 3 + i), 1.0) for i in range(9)]
     scene = scene_with(glphong.Lambert(0.3), lights=lights)
     with pytest.raises(ValueError, match="at most 8 lights of each kind"):
-        scene.uniform_values(0, uber_key(), 1.0)
+        scene.uniform_values(0, uber_key([glphong.Lambert(0.3)]), 1.0)
 
 
 def test_cli_describe_default_scene():
@@ -135,5 +142,6 @@ def test_cli_describe_default_scene():
                          timeout=120)
     assert out.returncode == 0, out.stderr
     assert "3 distinct program(s)" in out.stdout
-    assert "lobe=phong" in out.stdout and "lobe=blinn" in out.stdout and "gbuffer" in out.stdout
-    assert "the other lobe: blinn.glsl" in out.stdout
+    assert "terms=lambert[lit,ambient]+phong_lobe[lit]" in out.stdout, out.stdout
+    assert "terms=lambert[lit,ambient]+blinn_lobe[lit]" in out.stdout and "gbuffer" in out.stdout
+    assert "fragment chunks: common lights lobe model:lambert model:phong_lobe generated:material shade" in out.stdout

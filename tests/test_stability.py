@@ -1,13 +1,15 @@
 """The extreme-case suite (issue: numerical stability) and property-based checks of shade_point()."""
 import json
+from dataclasses import replace
 
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+import glphong
 from glphong import reference as ref
-from glphong.key import ProgramKey
+from glphong.key import program_key
 from glphong.probe import shade_points
 from glphong.programs import ProgramCache
 from glphong.stability import CASES, oracle, run_stability
@@ -32,7 +34,7 @@ def test_float64_twin_agrees_with_the_mpmath_oracle():
         key, uniforms = case.inputs()
         u64 = {k: v.astype(np.float64) for k, v in uniforms.items()}
         n_valid, n, _ = ref.safe_normalize(np.asarray([case.normal], dtype=np.float32).astype(np.float64))
-        twin = ref.shade_point(np.zeros((1, 3)), n, n_valid, u64.get("u_eye"), key, u64)[0]
+        twin = ref.shade_point(np.zeros((1, 3)), n, n_valid, u64.get("u_eye"), key, u64, case.material)[0]
         expected = oracle(case.scene(), case.normal)
         if case.in_range:
             # the oracle rounds the constructors' values to float32; the uniforms are derived in float64
@@ -61,7 +63,11 @@ def test_stable_formulation_passes_every_case(session_gl):
     assert rows["kd=(1,0,0) under saturating light"].gpu[1:] == [0.0, 0.0]
 
 
-@pytest.mark.parametrize("uniform", ["u_ks", "u_q", "u_kd", "u_point_intensity"])
+WIRED = {"ks": ("u_phong_lobe_ks", "u_blinn_lobe_ks"), "q": ("u_phong_lobe_q", "u_blinn_lobe_q"),
+         "kd": ("u_lambert_kd",), "intensity": ("u_point_intensity",)}
+
+
+@pytest.mark.parametrize("uniform", list(WIRED))
 def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, uniform):
     """Pass/fail is judged against the oracle, which reads the constructors: a uniform uploaded 1% off
     (the twin and the band, reading the same uniforms, would follow it) fails its cases."""
@@ -71,8 +77,9 @@ def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, unif
 
     def miswired(case, scene=None):
         key, uniforms = original(case, scene)
-        if uniform in uniforms:
-            uniforms[uniform] = uniforms[uniform] * np.float32(1.01)
+        for name in WIRED[uniform]:
+            if name in uniforms:
+                uniforms[name] = uniforms[name] * np.float32(1.01)
         return key, uniforms
 
     monkeypatch.setattr(stability.Case, "inputs", miswired)
@@ -81,10 +88,10 @@ def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, unif
     report = run_stability(context=session_gl, cases=cases)
     rows = {r.case: r for r in report.rows}
     assert len(rows) == 5
-    affected = {"u_ks": ["phong q=1000 near", "blinn q=1000 near", "phong q=1 peak", "blinn q=1 peak"],
-                "u_q": ["phong q=1000 near", "blinn q=1000 near"],
-                "u_kd": ["lambert grazing light n.l=0.01", "phong q=1000 near"],
-                "u_point_intensity": [r for r in rows]}[uniform]
+    affected = {"ks": ["phong q=1000 near", "blinn q=1000 near", "phong q=1 peak", "blinn q=1 peak"],
+                "q": ["phong q=1000 near", "blinn q=1000 near"],
+                "kd": ["lambert grazing light n.l=0.01", "phong q=1000 near"],
+                "intensity": [r for r in rows]}[uniform]
     assert affected and all(not rows[name].passed for name in affected), report.format_table()
 
 
@@ -136,14 +143,14 @@ def test_shade_is_in_band_and_finite(session_gl, lobe, log_q, q_zero, log_d, log
     # surface points around the origin, well inside the light's distance
     positions = (_random_unit(rng, count) * d * rng.uniform(0.0, 0.3, size=(count, 1))).astype(np.float32)
     normals = (_random_unit(rng, count) * 10.0 ** log_normal).astype(np.float32)
-    key = ProgramKey(output="points", lobe=lobe, has_ka=True, has_diffuse=True, num_point_lights=1, two_sided=False)
-    uniforms = {"u_ka": np.float32([1e-3, 2e-3, 0.0]), "u_kd": np.float32([0.3, 0.0, 0.1]),
-                "u_point_position": np.float32([light]),
-                "u_point_intensity": np.float32([[power / (4 * np.pi)] * 3])}
-    if lobe:  # only the lobes read the view vector
+    ka, kd, ks, q = (1e-3, 2e-3, 0.0), (0.3, 0.0, 0.1), (0.5, 1.0, 0.0), 0.0 if q_zero else 10.0 ** log_q
+    material = {"phong": glphong.Phong(kd, ks, q, ka=ka), "blinn": glphong.BlinnPhong(kd, ks, q, ka=ka),
+                None: glphong.Lambert(kd, ka=ka)}[lobe]
+    key = replace(program_key(material, {"point": 1}, None, output="points"), two_sided=False)
+    uniforms = {"u_point_position": np.float32([light]), "u_point_intensity": np.float32([[power / (4 * np.pi)] * 3]),
+                **material.uniform_values(key)}
+    if key.needs_view:  # only the lobes read the view vector
         uniforms["u_eye"] = np.float32(eye)
-        uniforms["u_ks"] = np.float32([0.5, 1.0, 0.0])
-        uniforms["u_q"] = np.float32(0.0 if q_zero else 10.0 ** log_q)
     programs = ProgramCache(session_gl.mgl)
     try:
         gpu = shade_points(session_gl, programs, key, uniforms, positions, normals).astype(np.float64)
@@ -152,7 +159,7 @@ def test_shade_is_in_band_and_finite(session_gl, lobe, log_q, q_zero, log_d, log
             programs.release()
     u64 = {k: np.asarray(v, dtype=np.float64) for k, v in uniforms.items()}
     n_valid, n, _ = ref.safe_normalize(normals.astype(np.float64))
-    low, high = point_band(key, u64, positions.astype(np.float64), n, n_valid)
+    low, high = point_band(key, u64, positions.astype(np.float64), n, n_valid, material)
     assert not np.isnan(gpu).any()
     assert np.isfinite(gpu[np.isfinite(high)]).all()
     bad = (gpu < low) | (gpu > high)

@@ -427,14 +427,14 @@ def test_material_valid_edge_values_are_stored(cls):
 def test_glossy_valid_edge_values_are_stored(cls):
     mat = cls(kd=0.2, ks=0.5, q=0)
     assert mat.q == 0.0 and type(mat.q) is float and mat.ks == (0.5, 0.5, 0.5)
-    assert mat.has_specular
+    assert [t.vanishes() for t in mat.components] == [False, False]
     assert cls(0.2, 0.5, -0.0).q == 0.0 and math.copysign(1.0, cls(0.2, 0.5, -0.0).q) == 1.0
     assert cls(0.2, 0.5, np.float32(1e7)).q == 1e7
     assert cls(0.2, 0.5, np.int64(3)).q == 3.0
     assert cls(0.2, 0.5, np.array(64.0)).q == 64.0
     assert cls(0.2, 0.5, FLT_MAX).q == FLT_MAX
     mat = cls(0.2, (0.0, 0.0, 0.0), 5.0)
-    assert mat.ks == (0.0, 0.0, 0.0) and not mat.has_specular
+    assert mat.ks == (0.0, 0.0, 0.0) and [t.vanishes() for t in mat.components] == [False, True]
 
 
 # =========================================================================== Scene

@@ -55,7 +55,7 @@ class GlphongMaterial(pyrender.Material):
     Parameters
     ----------
     material : glphong.Material
-        `Lambert`, `Phong` or `BlinnPhong`.
+        Any glphong material: `Lambert`, `Phong`, `BlinnPhong` or a user's `MaterialModel`/`MaterialSum`.
     exposure : float
         Linear scale before the sRGB encoding into pyrender's 8-bit framebuffer, > 0.
     name : str, optional
@@ -167,7 +167,7 @@ class _ProgramAdapter:
         values = {"u_model": model, "u_view_projection": self._camera["P"] @ self._camera["V"]}
         if key.has_normal:
             values["u_normal_matrix"] = np.linalg.inv(model[:3, :3]).T
-        if key.num_lights and key.needs_view:
+        if key.needs_view:
             values["u_eye"] = self._camera["cam_pos"]
         values["u_exposure"] = material.exposure
         values.update(material.glphong.uniform_values(key))
@@ -199,6 +199,12 @@ class _GlphongRenderer(_PyrenderRenderer):
                              f"{len(primitive.poses)} poses); use one mesh node per instance")
         scene = self._glphong_scene
         key = program_key(material.glphong, scene.light_counts(), scene.ambient_radiance, output="display")
+        # pyrender binds tangents at location 2 and texcoord_0 at 3, the locations mesh_vertex.glsl reads
+        if key.has_tangent and primitive.tangents is None:
+            raise ValueError("a primitive with a GlphongMaterial whose terms need 'tangent' must have tangents "
+                             "(pyrender.Primitive(tangents=...) or a glTF mesh with TANGENT)")
+        if key.has_uv and primitive.texcoord_0 is None:
+            raise ValueError("a primitive with a GlphongMaterial whose terms need 'uv' must have texcoord_0")
         if not hasattr(self, "_glphong_programs"):
             self._glphong_programs = ProgramCache(attach_current(os.environ.get("PYOPENGL_PLATFORM", "egl")))
             self._glphong_adapters = {}

@@ -1,0 +1,118 @@
+"""The model 'blinn_lobe' and the material `BlinnPhong` (DESIGN E5, E6; GLSL: ``glsl/materials/blinn_lobe.glsl``).
+
+The lobe's response is ``k_s max(n.h, 0)^q`` with ``h = (l + v)/|l + v|`` (0 where ``n.v <= 0``
+or ``l + v`` is below a floor), so its BRDF is ``k_s (n.h)^q / (n.l)``: non-negative, not
+reciprocal, isotropic, not energy-conserving.  `BlinnPhong` is ``Lambert + BlinnLobe``.  Evaluated
+in the chord form of DESIGN section 3: ``delta = |h - n|^2 / 2``.
+
+=========  ======  ==========  ======  =============================================
+parameter  kind    range       unit    meaning
+=========  ======  ==========  ======  =============================================
+ks         rgb     >= 0        1/sr    specular coefficient k_s
+q          scalar  >= 0        1       exponent (q = 0: lobe 1 where h is defined)
+=========  ======  ==========  ======  =============================================
+"""
+import numpy as np
+
+from .lambert import Lambert
+from .model import GlslFile, MaterialModel, MaterialSum, Properties
+from .phong import _KS, _Q, _dot, lobe_oracle
+
+__all__ = ["BlinnLobe", "BlinnPhong", "blinn_delta", "blinn_lobe", "BLINN_HALF_FLOOR"]
+
+#: blinn_lobe.glsl BLINN_HALF_FLOOR = 2^-20: |l + v| at or below it gives a zero Blinn lobe
+BLINN_HALF_FLOOR = 2.0 ** -20
+
+
+def blinn_delta(n, wi, wo):
+    """Blinn's ``delta = |h - n|^2 / 2`` (blinn_lobe.glsl).
+
+    Returns
+    -------
+    valid : (...) bool ndarray
+        ``n.v > 0`` and ``|l + v| > BLINN_HALF_FLOOR``.
+    delta : (...) ndarray
+        ``|h - n|^2 / 2``; 2 where not valid.
+    """
+    from ..reference import safe_normalize
+
+    ok_h, h, h_len = safe_normalize(wi + wo)
+    valid = (_dot(n, wo) > 0) & ok_h & (h_len > BLINN_HALF_FLOOR)
+    e = h - n
+    return valid, np.where(valid, 0.5 * _dot(e, e), 2).astype(e.dtype)
+
+
+def blinn_lobe(n, wi, wo, q):
+    """``max(n.h, 0)^q``, 0 where `blinn_delta` is not valid (blinn_lobe.glsl)."""
+    from ..reference import lobe_from_delta
+
+    valid, delta = blinn_delta(n, wi, wo)
+    return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype)
+
+
+class BlinnLobe(MaterialModel):
+    """The Blinn-Torrance lobe alone: response ``k_s max(n.h, 0)^q``.
+
+    Parameters are those of `glphong.materials.PhongLobe`.
+    """
+
+    name = "blinn_lobe"
+    params = (_KS, _Q)
+    needs = ("view",)
+    glsl = GlslFile("materials/blinn_lobe.glsl")
+    uses = ("lobe",)
+    vanishes_with = ("ks",)
+    properties = Properties(reciprocal=False, isotropic=True, energy_conserving=False,
+                            condition="never: the albedo grows without bound at grazing incidence")
+
+    def response(self, f, wi, wo, n_dot_l, p):
+        return p.ks * blinn_lobe(f.n, wi, wo, p.q)[..., None]
+
+    def band(self, f, wi, wo, n_dot_l, p, constants):
+        """``k_s`` times the lobe band of the Blinn delta, its chord widening scaled by the half vector's
+        conditioning ``max(1, 2/|l + v|)``; near the gates (``|n.v| <= D eps``, ``|l + v|`` within a
+        factor 4 of its floor) either outcome is accepted."""
+        from ..reference import safe_normalize
+        from ..tolerances import EPS, lobe_band
+
+        tol = constants.D * EPS
+        ok_h, h_dir, h_len = safe_normalize(wi + wo)
+        delta = 0.5 * _dot(h_dir - f.n, h_dir - f.n)
+        scale = np.maximum(1.0, 2.0 / np.maximum(h_len, BLINN_HALF_FLOOR))
+        low, high = lobe_band(delta, p.q, scale, constants)
+        n_dot_v = _dot(f.n, wo)
+        certain = ok_h & (n_dot_v > tol) & (h_len > 4 * BLINN_HALF_FLOOR)
+        possible = ok_h & (n_dot_v > -tol) & (h_len > BLINN_HALF_FLOOR / 4)
+        low = np.where(certain, low, 0.0)
+        high = np.where(possible, np.where(certain, high, 1.0), 0.0)
+        return p.ks * low[..., None], p.ks * high[..., None]
+
+    def oracle(self, n, wi, wo, n_dot_l, p):
+        import mpmath
+
+        s = [a + b for a, b in zip(wi, wo)]
+        length = mpmath.sqrt(sum(x * x for x in s))
+        if not (sum(a * b for a, b in zip(n, wo)) > 0 and length > 0):
+            return [mpmath.mpf(0)] * 3
+        lobe = lobe_oracle(sum(a * b / length for a, b in zip(n, s)), p.q)
+        return [k * lobe for k in p.ks]
+
+    def pbr_roughness(self):
+        """A rough pyrender roughness for comparisons: ``(2 / (q + 2))^(1/4)`` (Beckmann-like alpha)."""
+        return float((2.0 / (self.q + 2.0)) ** 0.25)
+
+    @classmethod
+    def stability_cases(cls):
+        from ..stability import generic_cases, lobe_cases
+
+        return generic_cases("blinn", BlinnPhong(0.2, 0.5, 100.0)) + lobe_cases("blinn", BlinnPhong)
+
+
+class BlinnPhong(MaterialSum):
+    """The Blinn-Torrance variation (DESIGN E5, E6): ``k_d (n.l) + k_s max(n.h, 0)^q`` per light.
+
+    Parameters are those of `Phong`; the lobe uses the half vector ``h = (l + v)/|l + v|``.
+    """
+
+    name = "blinn_phong"
+    terms = (Lambert, BlinnLobe)

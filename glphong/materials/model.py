@@ -1,0 +1,787 @@
+"""The material mechanism: the lecture's Material class as an open definition (DESIGN section 8).
+
+One reflectance model is one `MaterialModel` subclass: its parameters (`Param`), what it needs
+(the view vector, a tangent frame, UVs), its GLSL response ``<name>_response(f, wi, wo, n_dot_l)``
+and its numpy twin ``response(f, wi, wo, n_dot_l, p)``, both returning
+
+    f_r(wi, wo) (n.wi)    [1/sr], evaluated only where n.wi > 0.
+
+The radiance one light adds is ``response * E``.  A definition also states its answer to the
+ambient light ``L_a`` (``ambient``: the rgb parameter ``k`` of a ``k L_a`` term), which parameter
+values make it vanish (``vanishes_with``), its declared `Properties`, an error band against the
+twin (`MaterialModel.band`; a generic default) and its extreme cases for the stability suite.
+
+A material is a sum of terms: a `MaterialModel` instance is a material of one term, a
+`MaterialSum` subclass names several (``terms = (Lambert, PhongLobe)``).  Every material takes
+the keywords ``ka`` (a constant radiance ``k_a`` [W/(m^2 sr)]) and ``two_sided``.  The built-in
+models use exactly this mechanism; a definition is checked when its class is created, so a
+missing twin, a GLSL function of the wrong name or signature, a parameter without a range or a
+name that clashes fails there, with a message saying what is wrong.
+"""
+import hashlib
+import inspect
+import keyword
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import _validate
+
+__all__ = ["Param", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
+           "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
+
+#: parameter kinds and their GLSL types
+KINDS = {"scalar": "float", "rgb": "vec3"}
+#: what a model may ask for beyond the normal and the light direction
+NEEDS = ("view", "tangent", "uv")
+#: library chunks (glsl/<name>.glsl) a model may use besides common.glsl, which is always there
+LIBRARY_CHUNKS = ("lobe",)
+#: names a model may not take: GLSL prefixes and uniforms of the shading loop and the library
+RESERVED_NAMES = frozenset({
+    "material", "shade", "common", "lights", "light", "point", "unattenuated", "directional", "ambient",
+    "eye", "model", "normal", "view", "use", "ka", "safe", "lobe", "srgb", "encode", "mesh", "uber", "naive",
+    "frame", "gl", "object", "exposure", "radiance", "fullscreen"})
+#: material-level keywords every material takes
+MATERIAL_KEYWORDS = ("ka", "two_sided")
+_GLSL_KEYWORDS = frozenset("""attribute const uniform varying layout centroid flat smooth noperspective break continue
+do for while switch case default if else in out inout float int void bool true false invariant discard return mat2
+mat3 mat4 vec2 vec3 vec4 ivec2 ivec3 ivec4 bvec2 bvec3 bvec4 uint uvec2 uvec3 uvec4 lowp mediump highp precision
+sampler2D struct common partition active asm class union enum typedef template this packed goto inline noinline
+volatile public static extern external interface long short double half fixed unsigned superp input output
+filter sizeof cast namespace using""".split())
+_IDENT = re.compile(r"^[a-z][a-z0-9_]*$")
+
+
+class MaterialDefinitionError(TypeError):
+    """A `MaterialModel` or `MaterialSum` definition is incomplete or inconsistent."""
+
+
+# --------------------------------------------------------------------------- parameters
+@dataclass(frozen=True)
+class Param:
+    """One parameter of a material model.
+
+    Parameters
+    ----------
+    name : str
+        Python keyword and GLSL suffix: the uniform is ``u_<model>_<name>``.
+    kind : {'scalar', 'rgb'}
+        A float, or an RGB triple (a scalar broadcasts to the three channels).
+    low, high : float, optional
+        The valid range; at least one must be given (pass ``low=-numpy.inf`` explicitly for a
+        parameter with no lower bound).  Values must also be finite and representable in float32.
+    default : float or (3,) array_like, optional
+        Value when the parameter is not passed; without one the parameter is required.
+    unit : str
+        Physical unit, for documentation (``'1/sr'``, ``'rad'``, ``''`` for dimensionless).
+    doc : str
+        One line of documentation.
+    low_inclusive, high_inclusive : bool
+        Whether the ends of the range are allowed values.
+    """
+
+    name: str
+    kind: str
+    low: float = None
+    high: float = None
+    default: object = None
+    unit: str = ""
+    doc: str = ""
+    low_inclusive: bool = True
+    high_inclusive: bool = True
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not _IDENT.match(self.name) or self.name in _GLSL_KEYWORDS \
+                or keyword.iskeyword(self.name):
+            raise MaterialDefinitionError(f"Param name must be a lowercase identifier such as 'kd' "
+                                          f"(got {self.name!r})")
+        if self.name in MATERIAL_KEYWORDS:
+            raise MaterialDefinitionError(f"Param {self.name!r}: the name is a keyword every material takes "
+                                          f"({', '.join(MATERIAL_KEYWORDS)}); choose another")
+        if self.kind not in KINDS:
+            raise MaterialDefinitionError(f"Param {self.name!r}: kind must be one of {', '.join(map(repr, KINDS))} "
+                                          f"(got {self.kind!r})")
+        if self.low is None and self.high is None:
+            raise MaterialDefinitionError(
+                f"Param {self.name!r} has no range: give low= and/or high= (for example low=0.0); "
+                "pass low=-numpy.inf explicitly for a parameter without bounds")
+        low = -np.inf if self.low is None else float(self.low)
+        high = np.inf if self.high is None else float(self.high)
+        if np.isnan(low) or np.isnan(high) or not low < high:
+            raise MaterialDefinitionError(f"Param {self.name!r}: low must be below high (got {self.low!r}, {self.high!r})")
+        object.__setattr__(self, "low", low)
+        object.__setattr__(self, "high", high)
+        if self.default is not None:
+            try:
+                object.__setattr__(self, "default", self.validate(self.default))
+            except (TypeError, ValueError) as exc:
+                raise MaterialDefinitionError(f"Param {self.name!r}: default is not a valid value: {exc}") from None
+
+    @property
+    def glsl_type(self):
+        """``'float'`` or ``'vec3'``."""
+        return KINDS[self.kind]
+
+    @property
+    def interval(self):
+        """The valid range as text, e.g. ``'[0, 2]'``."""
+        return (f"{'[' if self.low_inclusive else '('}{self.low:g}, {self.high:g}"
+                f"{']' if self.high_inclusive else ')'}")
+
+    def validate(self, value):
+        """``value`` checked against kind and range: a float, or a tuple of 3 floats for 'rgb'.
+
+        Raises
+        ------
+        TypeError, ValueError
+            Naming the parameter and its valid range.
+        """
+        low = max(self.low, -_validate.FLT_MAX)
+        high = min(self.high, _validate.FLT_MAX)
+        low_inclusive = self.low_inclusive or self.low < -_validate.FLT_MAX
+        high_inclusive = self.high_inclusive or self.high > _validate.FLT_MAX
+        if self.kind == "rgb":
+            return _validate.rgb(self.name, value, low=low, high=high, low_inclusive=low_inclusive,
+                                 high_inclusive=high_inclusive)
+        return _validate.scalar(self.name, value, low=low, high=high, low_inclusive=low_inclusive,
+                                high_inclusive=high_inclusive)
+
+    def example(self):
+        """A representative valid value: the default, else 0.5 moved into the range."""
+        if self.default is not None:
+            return self.default
+        x = min(max(0.5, self.low), self.high)
+        if x == self.low and not self.low_inclusive or x == self.high and not self.high_inclusive:
+            x = self.low + 0.5 * (self.high - self.low) if np.isfinite(self.high - self.low) else \
+                (self.low + 1.0 if np.isfinite(self.low) else self.high - 1.0)
+        return self.validate(x)
+
+
+@dataclass(frozen=True)
+class Properties:
+    """What a model declares about its BRDF, for the analysis to check (DESIGN section 8).
+
+    Attributes
+    ----------
+    reciprocal, isotropic : bool or None
+        ``f_r(wi, wo) = f_r(wo, wi)``; invariance under rotation about the normal.  None: not declared.
+    energy_conserving : bool or None
+        Directional albedo at most 1 for every incident direction, under `condition`.
+    condition : str
+        When energy conservation holds, e.g. ``'pi kd + ks (q + 2)/(2 pi) <= 1'``; '' for always/never.
+    non_negative : bool or None
+    """
+
+    reciprocal: bool = None
+    isotropic: bool = None
+    energy_conserving: bool = None
+    condition: str = ""
+    non_negative: bool = True
+
+
+class ParamValues:
+    """The float32 parameter values the GPU was given, as attributes (``p.kd``, ``p.q``).
+
+    rgb parameters are ``(3,)`` arrays, scalars ``()`` arrays, in the dtype of the computation
+    (float64 in the reference: exactly the float32 values).
+    """
+
+    def __init__(self, values):
+        self.__dict__.update(values)
+
+    def __repr__(self):
+        return "ParamValues(" + ", ".join(f"{k}={np.asarray(v).tolist()}" for k, v in self.__dict__.items()) + ")"
+
+
+@dataclass(frozen=True)
+class ShadingFrame:
+    """The twin's ``ShadingFrame`` (common.glsl): the local frame at each shading point.
+
+    Attributes
+    ----------
+    n : (N, 3) ndarray
+        Unit normal (flipped toward the viewer on back faces when two-sided).
+    t, b : (N, 3) ndarray or None
+        Unit tangent and bitangent, ``(t, b, n)`` right-handed up to the mesh's handedness sign;
+        None unless a term needs ``'tangent'``.
+    uv : (N, 2) ndarray or None
+        Texture coordinates; None unless a term needs ``'uv'``.
+    """
+
+    n: np.ndarray
+    t: np.ndarray = None
+    b: np.ndarray = None
+    uv: np.ndarray = None
+
+    def select(self, mask):
+        """The frame at the points where ``mask`` is true."""
+        pick = lambda a: None if a is None else a[mask]  # noqa: E731
+        return ShadingFrame(self.n[mask], pick(self.t), pick(self.b), pick(self.uv))
+
+
+# --------------------------------------------------------------------------- GLSL sources
+@dataclass(frozen=True)
+class GlslFile:
+    """A built-in model's GLSL file, relative to glphong's shader folder (``glsl/``).
+
+    Read through the same root as every chunk, so ``GLPHONG_GLSL_DIR`` (a working copy of the
+    shaders) applies to model chunks too.
+    """
+
+    path: str
+
+
+_REGISTRY = {}
+_SOURCES = {}
+
+
+def registered_models():
+    """Every defined `MaterialModel` subclass, built-in and user, sorted by name (tuple)."""
+    return tuple(_REGISTRY[name] for name in sorted(_REGISTRY))
+
+
+def model_named(name):
+    """The `MaterialModel` subclass registered as ``name``.
+
+    Raises
+    ------
+    KeyError
+        No model has that name.
+    """
+    try:
+        return _REGISTRY[name]
+    except KeyError:
+        raise KeyError(f"no material model is named {name!r} (defined: {', '.join(sorted(_REGISTRY))})") from None
+
+
+def _is_builtin(cls):
+    return cls.__module__.startswith("glphong.")
+
+
+def _strip_comments(text):
+    text = re.sub(r"/\*.*?\*/", lambda m: "\n" * m.group(0).count("\n"), text, flags=re.S)
+    return re.sub(r"//[^\n]*", "", text)
+
+
+def _resolve_source(cls):
+    """``(text, label, first_line)`` of a model's GLSL: label names the file or the class, and
+    ``first_line`` is the line of the text's first line in that file (1 for .glsl files)."""
+    glsl = cls.__dict__.get("glsl", cls.glsl)
+    if isinstance(glsl, GlslFile):
+        from ..programs import glsl_root
+
+        path = glsl_root() / glsl.path
+        return path.read_text(encoding="utf-8"), glsl.path, 1
+    if isinstance(glsl, Path) or (isinstance(glsl, str) and "\n" not in glsl and glsl.strip().endswith(".glsl")):
+        path = Path(glsl)
+        if not path.is_absolute():
+            module = sys.modules.get(cls.__module__)
+            base = Path(getattr(module, "__file__", None) or ".").resolve().parent
+            path = base / path
+        if not path.is_file():
+            raise MaterialDefinitionError(f"{cls.__qualname__}.glsl names the file {str(path)!r}, which does not exist")
+        return path.read_text(encoding="utf-8"), str(path), 1
+    if not isinstance(glsl, str):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl must be GLSL source text or the path of a .glsl file "
+                                      f"(got {type(glsl).__name__})")
+    label, first = f"{cls.__qualname__}.glsl (material {cls.__dict__.get('name', cls.name)!r})", 1
+    try:  # where the inline string starts in the Python file, so compile errors name that file and line
+        lines, start = inspect.getsourcelines(cls)
+        file = inspect.getsourcefile(cls)
+        for i, line in enumerate(lines):
+            if re.match(r"\s*glsl\s*=\s*[rR]?(\"\"\"|''')", line):
+                label, first = f"{file}", start + i
+                break
+    except (OSError, TypeError):
+        pass
+    return glsl, label, first
+
+
+def model_source(cls):
+    """``(text, label, first_line, source_hash)`` of a model's GLSL (cached per class)."""
+    cached = _SOURCES.get(cls)
+    if cached is None:
+        text, label, first = _resolve_source(cls)
+        digest = hashlib.sha256(text.encode("utf-8")).hexdigest()[:12]
+        cached = _SOURCES[cls] = (text, label, first, digest)
+    return cached
+
+
+def _check_glsl(cls, text):
+    """The definition-time checks of a model's GLSL text."""
+    code = _strip_comments(text)
+    name = cls.name
+    wanted = f"vec3 {name}_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)"
+    pattern = rf"\bvec3\s+{name}_response\s*\(\s*ShadingFrame\s+\w+\s*,\s*vec3\s+\w+\s*,\s*vec3\s+\w+\s*,\s*float\s+\w+\s*\)"
+    if not re.search(pattern, code):
+        found = re.search(rf"\b\w+\s+{name}_response\s*\([^)]*\)", code)
+        functions = sorted(set(re.findall(r"\b(?:vec3|float|bool|vec2|vec4|void)\s+([A-Za-z_]\w*)\s*\(", code)))
+        raise MaterialDefinitionError(
+            f"{cls.__qualname__}.glsl must define `{wanted}` (name = {name!r} gives the prefix); "
+            + (f"found `{found.group(0)}`" if found else
+               f"found no {name}_response (functions defined: {', '.join(functions) or 'none'})"))
+    read = set(re.findall(rf"\bu_{name}_([A-Za-z_]\w*)", code))
+    declared = {p.name for p in cls.params}
+    if read - declared:
+        raise MaterialDefinitionError(
+            f"{cls.__qualname__}.glsl reads {', '.join(f'u_{name}_{x}' for x in sorted(read - declared))}, "
+            f"which no Param declares (params: {', '.join(sorted(declared)) or 'none'})")
+    if declared - read:
+        raise MaterialDefinitionError(
+            f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(declared - read))}: "
+            "every Param is a uniform the response must use (or remove the Param)")
+    if re.search(rf"\buniform\s+\w+\s+u_{name}_", code):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl declares its own u_{name}_* uniforms: glphong "
+                                      "declares them from params; remove the declarations")
+
+
+_TWIN_ARGS = ("f", "wi", "wo", "n_dot_l", "p")
+
+
+def _check_twin(cls):
+    response = cls.__dict__.get("response")
+    if response is None or response is MaterialModel.response:
+        raise MaterialDefinitionError(
+            f"{cls.__qualname__} defines no numpy twin: add `def response(self, f, wi, wo, n_dot_l, p)` "
+            "returning f_r (n.wi) [1/sr] as an (N, 3) array, the same formulation as its GLSL")
+    try:
+        params = list(inspect.signature(response).parameters.values())[1:]
+    except (TypeError, ValueError):
+        return
+    positional = [p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
+    if len(positional) != len(_TWIN_ARGS) and not any(p.kind == p.VAR_POSITIONAL for p in params):
+        raise MaterialDefinitionError(
+            f"{cls.__qualname__}.response must take (self, {', '.join(_TWIN_ARGS)}) "
+            f"(got ({', '.join(['self'] + [p.name for p in params])}))")
+
+
+# --------------------------------------------------------------------------- materials
+class Material:
+    """Base of everything `glphong.Scene.add` accepts: a sum of terms, a constant ``k_a``, sidedness.
+
+    Subclass `MaterialModel` (one term) or `MaterialSum` (several), never this class directly.
+
+    Attributes
+    ----------
+    ka : tuple of 3 float
+        Constant radiance ``k_a`` [W/(m^2 sr)] (the lecture's ambient term), >= 0.
+    two_sided : bool
+        Shade back faces with the normal flipped toward the viewer.
+    """
+
+    #: display name; a model's name is also its GLSL prefix
+    name = None
+    #: declared BRDF properties (for a sum: derived from its terms unless declared)
+    properties = Properties()
+
+    def _set_common(self, ka, two_sided):
+        object.__setattr__(self, "ka", _validate.rgb("ka", ka))
+        if not isinstance(two_sided, (bool, np.bool_)):
+            raise TypeError(f"two_sided must be a bool, True or False (got {two_sided!r})")
+        object.__setattr__(self, "two_sided", bool(two_sided))
+
+    @property
+    def components(self):
+        """The material's terms, as `MaterialModel` instances (tuple)."""
+        raise NotImplementedError
+
+    def parameter_values(self):
+        """Every parameter's validated value by name (dict), ``ka`` and ``two_sided`` included."""
+        out = {}
+        for term in self.components:
+            out.update({p.name: getattr(term, p.name) for p in term.params})
+        out.update(ka=self.ka, two_sided=self.two_sided)
+        return out
+
+    def uniform_values(self, key):
+        """The material's uniforms for a program ``key``, as float32 arrays.
+
+        Parameters
+        ----------
+        key : glphong.key.ProgramKey
+
+        Returns
+        -------
+        dict of str to numpy.ndarray
+            ``u_ka`` where the key has it, and ``u_<model>_<param>`` of the key's terms: every
+            parameter of a term in the light loop, the ambient parameter of a term that only
+            answers ``L_a``.
+        """
+        values = {}
+        if key.has_ka:
+            values["u_ka"] = np.asarray(self.ka, dtype=np.float32)
+        by_name = {term.name: term for term in self.components}
+        for term_key in key.terms:
+            term = by_name.get(term_key.name)
+            if term is None:
+                continue  # the uber-shader's terms this material does not have: the caller fills zeros
+            params = term.params if term_key.lit else [p for p in term.params if p.name == term.ambient]
+            values.update({term.uniform_name(p.name): np.asarray(getattr(term, p.name), dtype=np.float32)
+                           for p in params})
+        return values
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"{type(self).__name__} is immutable: make a new material instead of setting {name!r}")
+
+    def __eq__(self, other):
+        return type(other) is type(self) and other.parameter_values() == self.parameter_values()
+
+    def __hash__(self):
+        return hash((type(self), tuple(self.parameter_values().items())))
+
+    def __repr__(self):
+        values = self.parameter_values()
+        shown = [f"{k}={_short(v)}" for k, v in values.items() if k not in MATERIAL_KEYWORDS]
+        if any(values["ka"]):
+            shown.append(f"ka={_short(values['ka'])}")
+        if not values["two_sided"]:
+            shown.append("two_sided=False")
+        return f"{type(self).__name__}({', '.join(shown)})"
+
+
+def _short(value):
+    if isinstance(value, tuple) and len(set(value)) == 1:
+        return f"{value[0]:g}"
+    return f"({', '.join(f'{c:g}' for c in value)})" if isinstance(value, tuple) else f"{value:g}"
+
+
+def _bind_arguments(cls, params, args, kwargs):
+    """Map positional and keyword arguments onto ``params`` (validated values by name)."""
+    if len(args) > len(params):
+        raise TypeError(f"{cls.__name__}() takes at most {len(params)} positional parameters "
+                        f"({', '.join(p.name for p in params)}) (got {len(args)})")
+    names = [p.name for p in params]
+    given = dict(zip(names, args))
+    for name, value in kwargs.items():
+        if name not in names:
+            raise TypeError(f"{cls.__name__}() got an unexpected parameter {name!r} "
+                            f"(parameters: {', '.join(names + list(MATERIAL_KEYWORDS))})")
+        if name in given:
+            raise TypeError(f"{cls.__name__}() got parameter {name!r} twice")
+        given[name] = value
+    out = {}
+    for p in params:
+        if p.name in given:
+            out[p.name] = p.validate(given[p.name])
+        elif p.default is not None:
+            out[p.name] = p.default
+        else:
+            raise TypeError(f"{cls.__name__}() missing parameter {p.name!r} ({p.kind} in {p.interval}"
+                            f"{', ' + p.unit if p.unit else ''})")
+    return out
+
+
+class MaterialModel(Material):
+    """One reflectance model (a term of a material), defined the way the built-ins are.
+
+    Class attributes a definition sets
+    ----------------------------------
+    name : str
+        Lowercase GLSL prefix, unique: the GLSL defines ``<name>_response`` and reads uniforms
+        ``u_<name>_<param>``; part of the program key.
+    params : tuple of Param
+    needs : tuple of str
+        Any of ``'view'`` (``wo`` is computed), ``'tangent'`` (``f.t``, ``f.b``), ``'uv'`` (``f.uv``).
+        Nothing else is computed or uploaded.
+    glsl : str or GlslFile
+        GLSL source text, or the path of a ``.glsl`` file (relative to the module defining the
+        class).  It defines ``vec3 <name>_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)``.
+        The common chunk (``safe_normalize``, ``ShadingFrame``, ``FLT_MAX``) is always available.
+    uses : tuple of str
+        Library chunks the GLSL calls: ``'lobe'`` (``log_one_minus``, ``lobe_from_delta``).
+    ambient : str or None
+        The rgb parameter ``k`` of the model's answer ``k L_a`` to the ambient light, or None.
+    vanishes_with : tuple of str
+        Parameters that scale the whole term: where any of them is zero in every channel the term
+        is left out of the program.
+    properties : Properties
+
+    Methods a definition provides
+    -----------------------------
+    response(self, f, wi, wo, n_dot_l, p)
+        The numpy twin: same name, argument order and formulation as the GLSL; ``f`` a
+        `ShadingFrame`, ``wi``/``wo`` ``(N, 3)`` unit vectors, ``n_dot_l`` ``(N,)`` (> 0), ``p`` the
+        `ParamValues`; returns ``(N, 3)``.
+    band(self, f, wi, wo, n_dot_l, p, constants)  (optional)
+        Interval of float32 GPU responses consistent with the float64 twin; the default widens
+        the twin by its sensitivity to a few ulps of its inputs (see `MaterialModel.band`).
+    oracle(self, n, wi, wo, n_dot_l, p)  (optional)
+        The response in mpmath at high precision, for the stability suite (default: the twin).
+    stability_cases(cls)  (optional classmethod)
+        The model's extreme cases (default: grazing, behind and opposite geometry at example values).
+    """
+
+    params = ()
+    needs = ()
+    glsl = None
+    uses = ()
+    ambient = None
+    vanishes_with = ()
+    properties = Properties()
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        own = cls.__dict__
+        if "name" not in own:
+            redefined = [a for a in ("glsl", "response", "params", "needs", "uses") if a in own]
+            if redefined and cls.name is not None:
+                raise MaterialDefinitionError(
+                    f"{cls.__qualname__} redefines {', '.join(redefined)} but keeps the name {cls.name!r} of "
+                    f"{cls.__mro__[1].__qualname__}: give it a name of its own (name = '...'), or it would "
+                    "render as its parent")
+            if cls.name is None and ("glsl" in own or "response" in own):
+                raise MaterialDefinitionError(f"{cls.__qualname__} defines a model but no name: add name = '...' "
+                                              "(a lowercase GLSL prefix)")
+            return  # an abstract intermediate, or a pure-Python subclass of a model
+        _check_definition(cls)
+        existing = _REGISTRY.get(cls.name)
+        if existing is not None and existing is not cls:
+            same = (existing.__module__, existing.__qualname__) == (cls.__module__, cls.__qualname__)
+            if _is_builtin(existing) or not same:
+                raise MaterialDefinitionError(
+                    f"{cls.__qualname__}: the name {cls.name!r} is taken by "
+                    f"{'the built-in ' if _is_builtin(existing) else ''}{existing.__module__}.{existing.__qualname__}; "
+                    "choose another name")
+            _SOURCES.pop(existing, None)  # a re-run of the same definition (a notebook cell) replaces it
+        _REGISTRY[cls.name] = cls
+
+    def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
+        if type(self).name is None:
+            raise TypeError(f"{type(self).__name__} is not a material model (it has no name)")
+        for name, value in _bind_arguments(type(self), self.params, args, kwargs).items():
+            object.__setattr__(self, name, value)
+        self._set_common(ka, two_sided)
+
+    @property
+    def components(self):
+        return (self,)
+
+    # ---- what the program key and the uniforms are made of
+    @classmethod
+    def uniform_name(cls, param):
+        """``u_<model>_<param>``."""
+        return f"u_{cls.name}_{param}"
+
+    @classmethod
+    def source(cls):
+        """The model's GLSL text."""
+        return model_source(cls)[0]
+
+    @classmethod
+    def source_hash(cls):
+        """First 12 hex digits of the SHA-256 of the GLSL text (part of the program key)."""
+        return model_source(cls)[3]
+
+    @classmethod
+    def uniform_declarations(cls):
+        """The GLSL declarations of the model's uniforms, generated from `params`."""
+        return "\n".join(f"uniform {p.glsl_type} {cls.uniform_name(p.name)};  // {p.kind} in {p.interval}"
+                         f"{' [' + p.unit + ']' if p.unit else ''}" for p in cls.params)
+
+    def defines(self):
+        """Structural ``#define`` pairs of this instance (part of its key; default none)."""
+        return ()
+
+    def vanishes(self):
+        """True where a `vanishes_with` parameter is zero in every channel: the term is left out."""
+        return any(not np.any(getattr(self, name)) for name in self.vanishes_with)
+
+    def answers_ambient(self):
+        """True where the model answers ``L_a`` with a non-zero ``k``."""
+        return self.ambient is not None and bool(np.any(getattr(self, self.ambient)))
+
+    @classmethod
+    def values_from_uniforms(cls, uniforms, dtype=np.float64, names=None):
+        """`ParamValues` from a program's uniforms (the float32 values the GPU was given).
+
+        ``names`` limits them (an ambient-only term has only its ambient parameter)."""
+        params = [p for p in cls.params if names is None or p.name in names]
+        return ParamValues({p.name: np.asarray(uniforms[cls.uniform_name(p.name)], dtype=dtype) for p in params})
+
+    def values(self, dtype=np.float64):
+        """`ParamValues` of this instance: its values rounded to float32, in ``dtype``."""
+        return ParamValues({p.name: np.asarray(np.asarray(getattr(self, p.name), dtype=np.float32), dtype=dtype)
+                            for p in self.params})
+
+    # ---- the twin and what is built on it
+    def response(self, f, wi, wo, n_dot_l, p):
+        """The numpy twin of ``<name>_response``: ``f_r (n.wi)`` [1/sr], (N, 3)."""
+        raise NotImplementedError
+
+    def band(self, f, wi, wo, n_dot_l, p, constants):
+        """Interval ``(low, high)``, each (N, 3), of float32 GPU responses consistent with the twin.
+
+        The generic default, for models that do not derive their own: the twin's first-order
+        sensitivity to its inputs, each perturbed by a few ulps as float32 arithmetic perturbs
+        them: ``wi`` and ``wo`` rotated by ``D eps`` about two axes each, ``n_dot_l`` moved by
+        ``+-D eps``, every scalar parameter scaled by ``1 +- A eps`` (which also stands for
+        the error of a ``pow`` or ``exp`` it feeds); the deviations add up worst-case,
+        and the result is widened by ``eps (A + B |ln r|)`` relative (``exp``/``pow`` error).
+
+        ``n_dot_l`` may be as low as ``-D eps`` where the light gate is uncertain (the caller then
+        accepts 0 as well); a band must bound the response over ``(0, n.l + D eps]``.  The default
+        evaluates the twin at ``max(n.l, tiny)`` there.
+        """
+        from ..tolerances import EPS
+
+        tiny = np.finfo(np.float64).tiny
+        n_dot_l = np.maximum(n_dot_l, tiny)
+        base = np.asarray(self.response(f, wi, wo, n_dot_l, p), dtype=np.float64)
+        up = np.zeros_like(base)
+        down = np.zeros_like(base)
+
+        def add(value):
+            with np.errstate(invalid="ignore"):
+                delta = np.nan_to_num(np.asarray(value, dtype=np.float64) - base, nan=0.0)
+            np.maximum(up, delta, out=up)
+            np.minimum(down, delta, out=down)
+
+        angle = constants.D * EPS
+        for which in ("wi", "wo"):
+            vector = wi if which == "wi" else wo
+            for axis in _perpendiculars(vector):
+                for sign in (1.0, -1.0):
+                    turned = vector + sign * angle * axis
+                    turned = turned / np.linalg.norm(turned, axis=-1, keepdims=True)
+                    args = (turned, wo) if which == "wi" else (wi, turned)
+                    with np.errstate(all="ignore"):
+                        add(self.response(f, *args, n_dot_l, p))
+        for sign in (1.0, -1.0):
+            moved = np.maximum(n_dot_l + sign * angle, tiny)
+            with np.errstate(all="ignore"):
+                add(self.response(f, wi, wo, moved, p))
+        for param in self.params:
+            if param.kind != "scalar":
+                continue
+            for sign in (1.0, -1.0):
+                scaled = ParamValues({**p.__dict__, param.name: p.__dict__[param.name] * (1.0 + sign * constants.A * EPS)})
+                with np.errstate(all="ignore"):
+                    add(self.response(f, wi, wo, n_dot_l, scaled))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            lam = np.abs(np.log(np.abs(base)))
+        rel = EPS * (constants.A + constants.B * np.nan_to_num(lam, nan=0.0, posinf=0.0))
+        # the worst-case sum of the deviations, widened around the base value
+        return base + down - np.abs(base) * rel, base + up + np.abs(base) * rel
+
+    oracle = None
+
+    @classmethod
+    def example(cls, **overrides):
+        """An instance at representative values (`Param.example`), with ``overrides``."""
+        return cls(**{p.name: p.example() for p in cls.params} | overrides)
+
+    @classmethod
+    def stability_cases(cls):
+        """The model's extreme cases for `glphong.stability` (default: generic geometry, see there)."""
+        from ..stability import generic_cases
+
+        return generic_cases(cls.name, cls.example())
+
+
+def _perpendiculars(v):
+    """Two unit vectors perpendicular to each row of ``v`` (N, 3)."""
+    helper = np.where(np.abs(v[..., :1]) < 0.9, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+    a = np.cross(v, helper)
+    a = a / np.linalg.norm(a, axis=-1, keepdims=True)
+    return a, np.cross(v, a)
+
+
+def _check_definition(cls):
+    """Definition-time checks of a `MaterialModel` subclass (raises MaterialDefinitionError)."""
+    name = cls.name
+    if not isinstance(name, str) or not _IDENT.match(name) or "__" in name or name.endswith("_"):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.name must be a lowercase GLSL identifier such as "
+                                      f"'minnaert' (got {name!r})")
+    if name in RESERVED_NAMES or name in _GLSL_KEYWORDS or name.startswith("gl_"):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.name {name!r} is reserved by glphong's shading code "
+                                      "or GLSL; choose another")
+    params = cls.params
+    if not isinstance(params, tuple) or not all(isinstance(p, Param) for p in params):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.params must be a tuple of glphong.materials.Param")
+    names = [p.name for p in params]
+    if len(set(names)) != len(names):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.params repeats a name ({names})")
+    if not isinstance(cls.needs, tuple) or not set(cls.needs) <= set(NEEDS):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.needs must be a tuple of {', '.join(map(repr, NEEDS))} "
+                                      f"(got {cls.needs!r})")
+    if not isinstance(cls.uses, tuple) or not set(cls.uses) <= set(LIBRARY_CHUNKS):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.uses must be a tuple of library chunks "
+                                      f"{', '.join(map(repr, LIBRARY_CHUNKS))} (got {cls.uses!r})")
+    rgb = {p.name for p in params if p.kind == "rgb"}
+    if cls.ambient is not None and cls.ambient not in rgb:
+        raise MaterialDefinitionError(f"{cls.__qualname__}.ambient must be None or the name of an rgb Param "
+                                      f"({', '.join(sorted(rgb)) or 'none'}) (got {cls.ambient!r})")
+    if not set(cls.vanishes_with) <= set(names):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.vanishes_with names {sorted(set(cls.vanishes_with) - set(names))}, "
+                                      "which are not params")
+    if not isinstance(cls.properties, Properties):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.properties must be a glphong.materials.Properties")
+    if cls.glsl is None:
+        raise MaterialDefinitionError(f"{cls.__qualname__} has no glsl: set glsl to the GLSL source of "
+                                      f"`vec3 {name}_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)` "
+                                      "or to the path of a .glsl file")
+    _check_twin(cls)
+    _SOURCES.pop(cls, None)
+    _check_glsl(cls, model_source(cls)[0])
+
+
+class MaterialSum(Material):
+    """A material made of several terms (a diffuse term plus lobes): ``terms = (Lambert, PhongLobe)``.
+
+    Its parameters are its terms' parameters, in order (their names must differ); positional and
+    keyword arguments map onto them, and each term is built with its own.  The radiance is the
+    sum of the terms' contributions.  `properties` is derived from the terms (a property holds
+    when every term declares it) unless the class declares its own.
+    """
+
+    terms = ()
+
+    def __init_subclass__(cls, **kwargs):
+        super().__init_subclass__(**kwargs)
+        terms = cls.terms
+        if not isinstance(terms, tuple) or not terms or not all(
+                isinstance(t, type) and issubclass(t, MaterialModel) and t.name for t in terms):
+            raise MaterialDefinitionError(f"{cls.__qualname__}.terms must be a non-empty tuple of MaterialModel "
+                                          "subclasses that have a name")
+        models = [t.name for t in terms]
+        if len(set(models)) != len(models):
+            raise MaterialDefinitionError(f"{cls.__qualname__}.terms repeats a model ({models}): their uniforms would clash")
+        names = [p.name for t in terms for p in t.params]
+        if len(set(names)) != len(names):
+            raise MaterialDefinitionError(f"{cls.__qualname__}: its terms' parameter names must differ (got {names})")
+        if "properties" not in cls.__dict__:
+            props = [t.properties for t in terms]
+            both = lambda attr: (all(getattr(p, attr) for p in props) if all(  # noqa: E731
+                getattr(p, attr) is not None for p in props) else None)
+            cls.properties = Properties(reciprocal=both("reciprocal"), isotropic=both("isotropic"),
+                                        non_negative=both("non_negative"))
+        if cls.name is None:
+            cls.name = cls.__name__.lower()
+
+    @classmethod
+    def all_params(cls):
+        """The terms' parameters, in order (tuple of Param)."""
+        return tuple(p for t in cls.terms for p in t.params)
+
+    def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
+        if not type(self).terms:
+            raise TypeError(f"{type(self).__name__} has no terms")
+        values = _bind_arguments(type(self), self.all_params(), args, kwargs)
+        parts = tuple(t(**{p.name: values[p.name] for p in t.params}, two_sided=two_sided) for t in self.terms)
+        object.__setattr__(self, "_parts", parts)
+        self._set_common(ka, two_sided)
+
+    @property
+    def components(self):
+        return self._parts
+
+    def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
+        for part in self.__dict__.get("_parts", ()):
+            if name in {p.name for p in part.params}:
+                return getattr(part, name)
+        raise AttributeError(f"{type(self).__name__} has no attribute {name!r}")

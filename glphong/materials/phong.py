@@ -1,0 +1,114 @@
+"""The model 'phong_lobe' and the material `Phong` (DESIGN E4, E6; GLSL: ``glsl/materials/phong_lobe.glsl``).
+
+The lobe's response is the lecture's ``k_s max(v.r, 0)^q`` with ``r = 2 (n.l) n - l``, so its BRDF
+is ``k_s (v.r)^q / (n.l)``: non-negative with the clamp, not reciprocal, isotropic, not
+energy-conserving (its albedo grows without bound at grazing incidence).  `Phong` is the sum
+``Lambert + PhongLobe``: ``k_d (n.l) + k_s (v.r)^q`` per light.  Evaluated in the chord form of
+DESIGN section 3: ``delta = |r - v|^2 / 2``, ``lobe = (1 - delta)^q`` by `lobe_from_delta`, stable
+for q up to FLT_MAX.
+
+=========  ======  ==========  ======  =============================================
+parameter  kind    range       unit    meaning
+=========  ======  ==========  ======  =============================================
+ks         rgb     >= 0        1/sr    specular coefficient k_s
+q          scalar  >= 0        1       exponent (q = 0: lobe 1, the 0^0 := 1 convention)
+=========  ======  ==========  ======  =============================================
+"""
+import numpy as np
+
+from .lambert import Lambert
+from .model import GlslFile, MaterialModel, MaterialSum, Param, Properties
+
+__all__ = ["PhongLobe", "Phong", "phong_delta", "phong_lobe"]
+
+_KS = Param("ks", "rgb", low=0.0, unit="1/sr", doc="specular coefficient")
+_Q = Param("q", "scalar", low=0.0, doc="specular exponent; q = 0 gives a constant lobe of 1")
+
+
+def _dot(a, b):
+    return np.sum(a * b, axis=-1)
+
+
+def phong_delta(n, wi, wo):
+    """``|r - v|^2 / 2`` with ``r = 2 (n.l) n - l`` (phong_lobe.glsl); unit (..., 3) inputs -> (...)."""
+    r = 2 * _dot(n, wi)[..., None] * n - wi
+    e = r - wo
+    return 0.5 * _dot(e, e)
+
+
+def phong_lobe(n, wi, wo, q):
+    """``max(v.r, 0)^q`` (phong_lobe.glsl)."""
+    from ..reference import lobe_from_delta
+
+    return lobe_from_delta(phong_delta(n, wi, wo), q)
+
+
+def lobe_oracle(cosine, q):
+    """``max(c, 0)^q`` with ``0^0 := 1``, in mpmath (for the stability oracle)."""
+    import mpmath
+
+    return mpmath.mpf(1) if q == 0 else max(cosine, 0) ** q
+
+
+class PhongLobe(MaterialModel):
+    """The Phong lobe alone: response ``k_s max(v.r, 0)^q``, ``r = 2 (n.l) n - l``.
+
+    Parameters
+    ----------
+    ks : float or (3,) array_like
+        Specular coefficient [1/sr], >= 0.
+    q : float
+        Exponent, finite, >= 0.
+    """
+
+    name = "phong_lobe"
+    params = (_KS, _Q)
+    needs = ("view",)
+    glsl = GlslFile("materials/phong_lobe.glsl")
+    uses = ("lobe",)
+    vanishes_with = ("ks",)
+    properties = Properties(reciprocal=False, isotropic=True, energy_conserving=False,
+                            condition="never: the albedo grows without bound at grazing incidence")
+
+    def response(self, f, wi, wo, n_dot_l, p):
+        return p.ks * phong_lobe(f.n, wi, wo, p.q)[..., None]
+
+    def band(self, f, wi, wo, n_dot_l, p, constants):
+        """``k_s`` times `glphong.tolerances.lobe_band` of the Phong delta (DESIGN section 4)."""
+        from ..tolerances import lobe_band
+
+        low, high = lobe_band(phong_delta(f.n, wi, wo), p.q, 1.0, constants)
+        return p.ks * low[..., None], p.ks * high[..., None]
+
+    def oracle(self, n, wi, wo, n_dot_l, p):
+        c = sum(v * (2 * n_dot_l * a - b) for v, a, b in zip(wo, n, wi))
+        lobe = lobe_oracle(c, p.q)
+        return [k * lobe for k in p.ks]
+
+    def pbr_roughness(self):
+        """A rough pyrender roughness for comparisons: the Blinn exponent of a Phong lobe is about 4 q."""
+        return float((2.0 / (4.0 * self.q + 2.0)) ** 0.25)
+
+    @classmethod
+    def stability_cases(cls):
+        from ..stability import generic_cases, lobe_cases
+
+        return generic_cases("phong", Phong(0.2, 0.5, 100.0)) + lobe_cases("phong", Phong)
+
+
+class Phong(MaterialSum):
+    """The Phong model (DESIGN E4, E6): ``k_d (n.l) + k_s max(v.r, 0)^q`` per light, plus ambient.
+
+    Parameters
+    ----------
+    kd, ks : float or (3,) array_like
+        Diffuse and specular coefficients [1/sr], >= 0.
+    q : float
+        Specular exponent, finite, >= 0 (q = 0 gives a constant lobe of 1).
+    ka : float or (3,) array_like, optional
+        Constant term [W/(m^2 sr)], >= 0.
+    two_sided : bool, optional
+    """
+
+    name = "phong"
+    terms = (Lambert, PhongLobe)
