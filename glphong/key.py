@@ -10,13 +10,13 @@ left out of the source.  Nothing here knows any model by name; the numpy twin re
 """
 from dataclasses import dataclass, fields
 
-__all__ = ["ProgramKey", "TermKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "UBER_MAX_LIGHTS",
+__all__ = ["ProgramKey", "TermKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "response_key", "UBER_MAX_LIGHTS",
            "material_chunk"]
 
 #: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
 UBER_MAX_LIGHTS = 8
 
-OUTPUTS = ("radiance", "gbuffer", "points", "display")
+OUTPUTS = ("radiance", "gbuffer", "points", "display", "response")
 FORMULATIONS = ("stable", "naive")
 LIGHT_KINDS = ("point", "unattenuated", "directional")
 #: label of the generated chunk that sums the terms
@@ -75,7 +75,8 @@ class ProgramKey:
     output : {'radiance', 'gbuffer', 'points', 'display'}
         Shaded radiance, the G-buffer of shading inputs, radiance at arbitrary points
         (a vertex-only program whose ``shade_point()`` result is captured by transform feedback), or
-        display values (exposure and sRGB applied after shading) for pyrender's 8-bit framebuffer.
+        display values (exposure and sRGB applied after shading) for pyrender's 8-bit framebuffer,
+        or the material's response at given direction pairs (transform feedback, `glphong.testing`).
     terms : tuple of TermKey
         The material's terms that the program evaluates (lit, or answering ``L_a``), in order.
     has_ka : bool
@@ -191,6 +192,9 @@ class ProgramKey:
 
     def vertex_chunks(self):
         """Chunks of the vertex stage, in order."""
+        if self.output == "response":
+            return ("common",) + self.library_chunks() + tuple(t.chunk for t in self.terms) + \
+                (MATERIAL_CHUNK, "response_points")
         if self.output == "points":
             return self.shading_chunks() + ("shade_points",)
         if self.shade_per_vertex:
@@ -198,8 +202,8 @@ class ProgramKey:
         return ("mesh_vertex",)
 
     def fragment_chunks(self):
-        """Chunks of the fragment stage, in order (none for 'points')."""
-        if self.output == "points":
+        """Chunks of the fragment stage, in order (none for 'points' and 'response')."""
+        if self.output in ("points", "response"):
             return ()
         if self.output == "gbuffer":
             return ("common", "mesh_fragment")
@@ -214,8 +218,8 @@ class ProgramKey:
         return {} if self.output == "gbuffer" else {MATERIAL_CHUNK: material_chunk(self)}
 
     def varyings(self):
-        """Transform-feedback outputs of a 'points' program."""
-        return ("out_radiance",) if self.output == "points" else ()
+        """Transform-feedback outputs of a 'points' or 'response' program."""
+        return {"points": ("out_radiance",), "response": ("out_response",)}.get(self.output, ())
 
     def left_out(self, absent_terms=()):
         """What this program does not contain, one readable line per item (list of str).
@@ -338,6 +342,15 @@ def term_keys(material, lit, ambient_present):
             out.append(TermKey(term.name, term.source_hash(), tuple(term.needs), lit=lit, ambient=answers,
                                uses=tuple(term.uses), defines=tuple(term.defines()), ambient_param=term.ambient))
     return tuple(out)
+
+
+def response_key(material):
+    """The key of a program that evaluates ``material``'s response at direction pairs (`glphong.testing`):
+    every term that does not vanish, in the light loop's place, no light, no emission."""
+    terms = tuple(t for t in term_keys(material, True, False))
+    needs = {n for t in terms for n in t.needs}
+    return ProgramKey(output="response", terms=terms, has_normal=True, has_tangent="tangent" in needs,
+                      has_uv="uv" in needs, two_sided=False)
 
 
 def program_key(material, light_counts, ambient_radiance, output="radiance", gbuffer_needs=None):

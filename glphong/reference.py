@@ -289,7 +289,7 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
         term = np.zeros_like(radiance)
         if gate.any():
             g = f.select(gate)
-            with np.errstate(invalid="ignore", over="ignore"):
+            with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
                 term[gate] = material_response(g, wi[gate], wo[gate], n_dot_l[gate], key, uniforms, material) \
                     * irradiance[gate]
         radiance = radiance + term

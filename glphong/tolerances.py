@@ -25,7 +25,8 @@ import numpy as np
 
 from . import reference as ref
 
-__all__ = ["EPS", "FLT_MIN", "FLT_MAX", "BandConstants", "BAND", "lobe_band", "point_band", "radiance_band"]
+__all__ = ["EPS", "FLT_MIN", "FLT_MAX", "BandConstants", "BAND", "lobe_band", "response_band", "point_band",
+           "radiance_band"]
 
 EPS = 2.0 ** -24
 FLT_MIN = float(np.finfo(np.float32).tiny)
@@ -119,7 +120,6 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
     lo, hi = ambient * (1 - band.A * EPS), ambient * (1 + band.A * EPS)
     terms = int(key.has_ka) + sum(1 for t in key.terms if t.ambient)
     if key.num_lights:
-        models = {term.name: term for term in material.components}
         wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
         tol = band.D * EPS
         for valid, wi, irradiance in ref.incident_light(position, key, u):
@@ -130,14 +130,8 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
             f_lo = np.zeros_like(position)
             f_hi = np.zeros_like(position)
             if possible.any():
-                g, ndl = f.select(possible), n_dot_l[possible]
-                for term_key in key.lit_terms:
-                    term = models[term_key.name]
-                    p = term.values_from_uniforms(u)
-                    with np.errstate(over="ignore", invalid="ignore"):
-                        t_lo, t_hi = term.band(g, wi[possible], wo[possible], ndl, p, band)
-                    f_lo[possible] += t_lo
-                    f_hi[possible] += t_hi
+                f_lo[possible], f_hi[possible] = response_band(key, u, f.select(possible), wi[possible],
+                                                               wo[possible], n_dot_l[possible], material, band)
             with np.errstate(over="ignore", invalid="ignore"):
                 t_lo = np.nan_to_num(f_lo * irradiance * (1 - band.A * EPS), nan=0.0)
                 t_hi = np.nan_to_num(f_hi * irradiance * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
@@ -146,6 +140,38 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
     low = lo * (1 - terms * EPS)
     high = hi * (1 + terms * EPS)
     return np.where(low < FLT_MIN, 0.0, low), np.where(high > FLT_MAX, np.inf, high)
+
+
+def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
+    """Interval of the GLSL ``material_response()``: the sum of the lit terms' bands.
+
+    Parameters
+    ----------
+    key : glphong.key.ProgramKey
+    u : dict of str to ndarray
+        Uniforms as float64 (the terms' parameters are read from them).
+    f : ShadingFrame
+    wi, wo : (N, 3) float64 ndarray
+    n_dot_l : (N,) float64 ndarray
+        May be down to ``-D eps`` where the light gate is uncertain.
+    material : glphong.materials.Material
+    band : BandConstants
+
+    Returns
+    -------
+    low, high : (N, 3) float64 ndarray
+        Widened by ``(1 -+ m eps)`` for the sum of m terms.
+    """
+    models = {term.name: term for term in material.components}
+    low = np.zeros(np.shape(wi))
+    high = np.zeros(np.shape(wi))
+    for term_key in key.lit_terms:
+        term = models[term_key.name]
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            t_lo, t_hi = term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u), band)
+        low, high = low + t_lo, high + t_hi
+    m = max(len(key.lit_terms) - 1, 0)
+    return low * (1 - m * EPS), high * (1 + m * EPS)
 
 
 def radiance_band(scene, gbuffer, band=BAND):

@@ -1,29 +1,19 @@
 """Shared fixtures: OpenGL contexts on each backend, skipped where unavailable."""
 
-import os
-
 import pytest
 
-from glphong.contexts import BACKENDS, BackendUnavailableError, create_context
+from glphong.contexts import BACKENDS
 
-
-def _required_backends():
-    names = os.environ.get("GLPHONG_REQUIRE_BACKENDS", "")
-    return {name.strip() for name in names.split(",") if name.strip()}
+# glphong's own pytest plugin (fixtures glphong_backend, glphong_context, glphong_renderer,
+# glphong_make_renderer): the suite uses it the way a user's conftest.py would
+pytest_plugins = ["glphong.testing"]
 
 
 def require_backend(name):
-    """Return a new `GLContext` on backend ``name``, or skip the test.
+    """`glphong.testing.require_backend` (imported at use: the plugin module loads first)."""
+    from glphong.testing import require_backend as require
 
-    The test fails instead of skipping when the comma-separated environment
-    variable ``GLPHONG_REQUIRE_BACKENDS`` names the backend.
-    """
-    try:
-        return create_context(name)
-    except BackendUnavailableError as exc:
-        if name in _required_backends():
-            pytest.fail(f"GLPHONG_REQUIRE_BACKENDS names {name!r}, but: {exc}")
-        pytest.skip(str(exc))
+    return require(name)
 
 
 @pytest.fixture(params=BACKENDS)
@@ -57,39 +47,18 @@ def make_context():
         ctx.release()
 
 
-def _renderer_factory():
-    """``(make, made)``: ``make(width, height, backend, **options)`` opens a `glphong.Renderer` with the
-    skip-or-fail semantics of `require_backend`; ``made`` lists what it opened."""
-    from glphong import Renderer
-
-    made = []
-
-    def make(width, height, backend, **options):
-        try:
-            renderer = Renderer(width, height, backend=backend, **options)
-        except BackendUnavailableError:
-            require_backend(backend).release()  # skips or fails; if it now works, report the original error
-            raise
-        made.append(renderer)
-        return renderer
-
-    return make, made
-
-
 @pytest.fixture
-def make_renderer():
-    """Factory ``make_renderer(width, height, backend, **options)``: a `glphong.Renderer`, released at
-    teardown; an unavailable backend skips the test, or fails it when ``GLPHONG_REQUIRE_BACKENDS`` names it."""
-    make, made = _renderer_factory()
-    yield make
-    for renderer in made:
-        renderer.release()
+def make_renderer(glphong_make_renderer):
+    """Factory ``make_renderer(width, height, backend, **options)``: the plugin's `glphong_make_renderer`."""
+    return glphong_make_renderer
 
 
 @pytest.fixture(scope="module")
 def module_make_renderer():
     """`make_renderer` whose renderers live for the whole test module."""
-    make, made = _renderer_factory()
+    from glphong.testing import renderer_factory
+
+    make, made = renderer_factory()
     yield make
     for renderer in made:
         renderer.release()

@@ -663,8 +663,13 @@ class MaterialModel(Material):
         with np.errstate(divide="ignore", invalid="ignore"):
             lam = np.abs(np.log(np.abs(base)))
         rel = EPS * (constants.A + constants.B * np.nan_to_num(lam, nan=0.0, posinf=0.0))
-        # the worst-case sum of the deviations, widened around the base value
-        return base + down - np.abs(base) * rel, base + up + np.abs(base) * rel
+        # the worst-case sum of the deviations, widened around the base value; a non-finite twin
+        # value is its own band (the GPU must match it)
+        finite = np.isfinite(base)
+        with np.errstate(invalid="ignore"):
+            low = np.where(finite, base + down - np.abs(base) * rel, base)
+            high = np.where(finite, base + up + np.abs(base) * rel, base)
+        return low, high
 
     oracle = None
 
