@@ -31,7 +31,8 @@ def sphere(subdivisions=4, radius=1.0):
     MeshData
         Vertex normals are the exact unit normals ``p / radius``; ``uvs`` are
         ``(phi / (2 pi), theta / pi)`` (azimuth about +z from +x, polar angle from +z) and the
-        tangents the unit ``dp/dphi = (-y, x, 0) / sqrt(x^2 + y^2)``, handedness +1.  Cached: calls
+        tangents the unit ``dp/dphi = (-y, x, 0) / sqrt(x^2 + y^2)``, handedness -1 (``v`` grows with the
+        polar angle, southward, so ``dp/dv`` is ``-(n x t)``: the sign `tangents_from_uvs` derives).  Cached: calls
         with the same arguments return the same object, so GPU buffers are shared.
     """
     import trimesh
@@ -45,8 +46,8 @@ def sphere(subdivisions=4, radius=1.0):
     uvs = np.stack([phi / (2 * np.pi), np.arccos(np.clip(normals[:, 2], -1.0, 1.0)) / np.pi], axis=1)
     rho = np.hypot(normals[:, 0], normals[:, 1])
     safe = np.where(rho > 0, rho, 1.0)
-    tangents = np.stack([-normals[:, 1] / safe, normals[:, 0] / safe, np.zeros(len(normals)), np.ones(len(normals))],
-                        axis=1) * np.where(rho > 0, 1.0, 0.0)[:, None] + np.array([0.0, 0.0, 0.0, 1.0]) * (rho == 0)[:, None]
+    tangents = np.stack([-normals[:, 1] / safe, normals[:, 0] / safe, np.zeros(len(normals)), -np.ones(len(normals))],
+                        axis=1) * np.where(rho > 0, 1.0, 0.0)[:, None] + np.array([0.0, 0.0, 0.0, -1.0]) * (rho == 0)[:, None]
     return MeshData(normals * radius, normals, mesh.faces, uvs=uvs, tangents=tangents)
 
 

@@ -19,6 +19,8 @@ __all__ = ["ProgramCache", "Program", "ShaderCompileError", "UniformError", "ass
            "effective_source"]
 
 GLSL_VERSION = "#version 330 core"
+#: line numbers of chunk i start at i * LINE_BLOCK (see `assemble`)
+LINE_BLOCK = 100000
 
 
 class ShaderCompileError(RuntimeError):
@@ -111,17 +113,18 @@ def assemble(chunks, defines, generated=None):
     Returns
     -------
     str
-        The source; source-string number ``i + 1`` is chunk ``chunks[i]``, its lines numbered as
-        in its origin (``#line``).
+        The source; source-string number ``i + 1`` is chunk ``chunks[i]``, and its lines are
+        numbered ``(i + 1) * LINE_BLOCK + line in its origin`` (``#line``), so that a compiler
+        location names the chunk even where the compiler reports the wrong source-string number
+        (Mesa gives 0 for some semantic errors).
     """
     lines = [GLSL_VERSION]
     lines += [f"#define {name} {value}" for name, value in defines]
     for number, label in enumerate(chunks, start=1):
         chunk = resolve_chunk(label, generated)
-        if chunk.prelude:
-            lines.append("#line 1 0")
+        if chunk.prelude:  # numbered after the previous chunk's last line (a "#line 1 0" confuses Mesa's locations)
             lines.append(chunk.prelude)
-        lines.append(f"#line {chunk.first_line} {number}")
+        lines.append(f"#line {number * LINE_BLOCK + chunk.first_line} {number}")
         lines.append(chunk.text.rstrip("\n"))
     return "\n".join(lines) + "\n"
 
@@ -189,20 +192,21 @@ def _name_chunks(log, chunks, generated=None):
     """Rewrite compiler-log locations ``N:L(C)``, ``N:L`` and ``N(L)`` as ``origin:L:C`` / ``origin:L``,
     and show each offending line under the message that names it.
 
-    Source string 0 is the generated ``#version``/``#define`` header (and models' generated uniform
-    declarations); string ``i`` is ``chunks[i - 1]``, whose origin is its file (or a model's Python
-    file, lines counted in that file) or generated chunk.
+    Source string 0 is the generated ``#version``/``#define`` header; string ``i`` is ``chunks[i - 1]``,
+    whose origin is its file (or a model's Python file, lines counted in that file) or generated
+    chunk.  Lines at or above `LINE_BLOCK` are decoded as ``(chunk number, line)`` (see `assemble`).
     """
     resolved = [resolve_chunk(label, generated) for label in chunks]
     shown = []
 
     def repl(m):
-        n = int(m.group(1))
-        line = m.group(2) or m.group(4)
+        n, line = int(m.group(1)), int(m.group(2) or m.group(4))
+        if line >= LINE_BLOCK:  # the line names the chunk, whatever source number was reported
+            n, line = line // LINE_BLOCK, line % LINE_BLOCK
         where = f":{line}" + (f":{m.group(3)}" if m.group(3) else "")
         if 1 <= n <= len(resolved):
             chunk = resolved[n - 1]
-            index = int(line) - chunk.first_line
+            index = line - chunk.first_line
             text = chunk.text.splitlines()
             if 0 <= index < len(text):
                 shown.append(f"    {chunk.origin}:{line} | {text[index].strip()}")

@@ -37,6 +37,9 @@ def __getattr__(name):
 
 #: common.glsl FLT_MAX: vectors with a larger (or NaN) component do not normalise
 FLT_MAX = float(np.finfo(np.float32).max)
+#: common.glsl FRAME_PARALLEL_LIMIT (2^-10): a tangent whose part across n is at most this times its
+#: part along n counts as parallel to n in `frame_from_tangent`
+FRAME_PARALLEL_LIMIT = 2.0 ** -10
 
 
 def _dot(a, b):
@@ -85,13 +88,16 @@ def frame_from_tangent(n, tangent):
     Returns
     -------
     t, b : (N, 3) ndarray
-        ``t = normalize(tangent.xyz - (n.tangent.xyz) n)``, where that is zero or not finite the
+        ``t = normalize(tangent.xyz - (n.tangent.xyz) n)``; where that is zero or not finite, or
+        the tangent is parallel to n (``|projection| <= FRAME_PARALLEL_LIMIT |n.tangent.xyz|``), the
         tangent of Duff et al.'s orthonormal basis around n; ``b = sign(w) cross(n, t)``.
     """
     n = np.asarray(n)
     tangent = np.asarray(tangent, dtype=n.dtype)
     xyz = tangent[..., :3]
-    projected, t, _ = safe_normalize(xyz - _dot(n, xyz)[..., None] * n)
+    along = _dot(n, xyz)
+    projected, t, length = safe_normalize(xyz - along[..., None] * n)
+    projected = projected & (length > FRAME_PARALLEL_LIMIT * np.abs(along))
     s = np.where(n[..., 2] >= 0, 1.0, -1.0).astype(n.dtype)
     with np.errstate(divide="ignore", invalid="ignore"):
         a = -1.0 / (s + n[..., 2])

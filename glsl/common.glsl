@@ -18,12 +18,15 @@
 // frame_from_tangent(n, tangent, out t, out b)
 //   t = normalize(tangent.xyz - (n . tangent.xyz) n)   (Gram-Schmidt against the shading normal);
 //   b = sign(tangent.w) cross(n, t)                     (w < 0: mirrored texture space);
-//   where the projection is zero or not finite, t is the tangent of the branchless orthonormal
-//   basis of Duff et al. 2017 ("Building an orthonormal basis, revisited") around n.
+//   where the projection is zero or not finite, or the tangent is parallel to n (its part across n
+//   at most FRAME_PARALLEL_LIMIT = 2^-10 times its part along n: there the projection is rounding
+//   noise, about as long as n's own), t is the tangent of the branchless orthonormal basis of
+//   Duff et al. 2017 ("Building an orthonormal basis, revisited") around n.
 // shading_frame(n, tangent, uv) -> the ShadingFrame of a shading point (t, b only when HAS_TANGENT).
 // Key defines read here: NAIVE, HAS_TANGENT.
 
 const float FLT_MAX = 3.402823466e38;
+const float FRAME_PARALLEL_LIMIT = 0.0009765625;  // 2^-10: frame_from_tangent's test for a tangent along n
 
 #if NAIVE
 bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
@@ -59,7 +62,9 @@ struct ShadingFrame {
 void frame_from_tangent(vec3 n, vec4 tangent, out vec3 t, out vec3 b)
 {
     float len;
-    bool projected = safe_normalize(tangent.xyz - dot(n, tangent.xyz) * n, t, len);
+    float along = dot(n, tangent.xyz);
+    bool projected = safe_normalize(tangent.xyz - along * n, t, len);
+    projected = projected && len > FRAME_PARALLEL_LIMIT * abs(along);
     float s = n.z >= 0.0 ? 1.0 : -1.0;
     float a = -1.0 / (s + n.z);
     vec3 fallback = vec3(1.0 + s * n.x * n.x * a, s * n.x * n.y * a, -s * n.x);

@@ -536,8 +536,7 @@ class MaterialModel(Material):
                 raise MaterialDefinitionError(f"{cls.__qualname__} defines a model but no name: add name = '...' "
                                               "(a lowercase GLSL prefix)")
             return  # an abstract intermediate, or a pure-Python subclass of a model
-        _check_definition(cls)
-        existing = _REGISTRY.get(cls.name)
+        existing = _REGISTRY.get(cls.name) if isinstance(cls.name, str) else None
         if existing is not None and existing is not cls:
             same = (existing.__module__, existing.__qualname__) == (cls.__module__, cls.__qualname__)
             if _is_builtin(existing) or not same:
@@ -545,6 +544,8 @@ class MaterialModel(Material):
                     f"{cls.__qualname__}: the name {cls.name!r} is taken by "
                     f"{'the built-in ' if _is_builtin(existing) else ''}{existing.__module__}.{existing.__qualname__}; "
                     "choose another name")
+        _check_definition(cls)
+        if existing is not None:
             _SOURCES.pop(existing, None)  # a re-run of the same definition (a notebook cell) replaces it
         _REGISTRY[cls.name] = cls
 
@@ -746,6 +747,12 @@ class MaterialSum(Material):
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
+        own = [a for a in ("glsl", "response", "params", "needs") if a in cls.__dict__]
+        if own:
+            raise MaterialDefinitionError(
+                f"{cls.__qualname__} is a MaterialSum and defines {', '.join(own)}, which a sum does not use (it "
+                "would render as the sum of its terms): define a MaterialModel with its own name for new GLSL, "
+                "and list it in terms")
         terms = cls.terms
         if not isinstance(terms, tuple) or not terms or not all(
                 isinstance(t, type) and issubclass(t, MaterialModel) and t.name for t in terms):

@@ -1,0 +1,271 @@
+"""User-defined materials (DESIGN section 8): what a definition is checked for, and that a user's
+material works everywhere a built-in one does.
+
+- A definition with a missing twin, a GLSL function of the wrong name or signature, a parameter
+  without a range, a name that clashes or is reserved, uniforms that no parameter declares (or
+  parameters the GLSL never reads) fails when the class is defined, with a message saying what
+  is wrong; bad values fail at instantiation naming the parameter and its range.
+- A compile error in a user's GLSL names the user's Python file (or .glsl file) and line and
+  shows the offending line.
+- A user model renders per pixel, per vertex, with MSAA and supersampling, through the G-buffer
+  and `verify`, in the uber-shader, in `describe`, in `stability` with its own cases, and as a
+  term of a user `MaterialSum`.
+"""
+import inspect
+import re
+
+import numpy as np
+import pytest
+
+import glphong
+from glphong import primitives
+from glphong.materials import MaterialDefinitionError, MaterialModel, MaterialSum, Param, PhongLobe, model_named
+from glphong.programs import ShaderCompileError
+from glphong.testing import assert_render_matches, assert_twin_matches
+
+
+class Rim(MaterialModel):
+    """A test model: a diffuse term brightened toward the silhouette, f_r = k (1 + a (1 - n.v)^2)."""
+
+    name = "test_rim"
+    params = (Param("k", "rgb", low=0.0, unit="1/sr"), Param("a", "scalar", low=0.0, high=10.0, default=1.0))
+    needs = ("view",)
+    ambient = "k"
+    vanishes_with = ("k",)
+    glsl = """
+    vec3 test_rim_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
+    {
+        float rim = 1.0 - clamp(dot(f.n, wo), 0.0, 1.0);
+        return u_test_rim_k * (n_dot_l * (1.0 + u_test_rim_a * rim * rim));
+    }"""
+
+    def response(self, f, wi, wo, n_dot_l, p):
+        rim = 1.0 - np.clip(np.sum(f.n * wo, axis=-1), 0.0, 1.0)
+        return p.k * (n_dot_l * (1.0 + p.a * rim * rim))[..., None]
+
+
+class RimPhong(MaterialSum):
+    """A user sum: the rim term plus glphong's Phong lobe."""
+
+    terms = (Rim, PhongLobe)
+
+
+def _definition(**attrs):
+    """Define a MaterialModel subclass from ``attrs`` (a valid 'test_def' model unless overridden)."""
+    name = attrs.get("name", "test_def")
+    body = {"name": name, "params": (Param("k", "rgb", low=0.0),),
+            "glsl": f"vec3 {name}_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)\n"
+                    f"{{ return u_{name}_k * n_dot_l; }}",
+            "response": lambda self, f, wi, wo, n_dot_l, p: p.k * n_dot_l[..., None]}
+    body.update(attrs)
+    body = {k: v for k, v in body.items() if v is not ...}
+    return type("Defined", (MaterialModel,), body)
+
+
+def _scene(*materials, lights=None, ambient=None, mesh=None):
+    camera = glphong.PerspectiveCamera.look_at((0.4, 0.6, 3.0), (0.0, 0.0, 0.0))
+    scene = glphong.Scene(camera, lights=lights if lights is not None else
+                          [glphong.PointLight((2.0, 2.0, 3.0), 120.0), glphong.DirectionalLight((0.3, -1.0, -0.5), 0.5)],
+                          ambient=ambient)
+    for i, material in enumerate(materials):
+        pose = np.eye(4)
+        pose[0, 3] = 1.1 * (i - (len(materials) - 1) / 2)
+        scene.add(mesh or primitives.sphere(3, radius=0.5), material, pose=pose)
+    return scene
+
+
+# --------------------------------------------------------------------------- definition-time checks
+def test_a_valid_definition_registers_under_its_name():
+    model = _definition()
+    assert model_named("test_def") is model and model.source_hash() and model(0.5).k == (0.5, 0.5, 0.5)
+
+
+@pytest.mark.parametrize("attrs, message", [
+    ({"response": ...}, r"defines no numpy twin: add `def response\(self, f, wi, wo, n_dot_l, p\)`"),
+    ({"response": lambda self, f, wi: wi}, r"response must take \(self, f, wi, wo, n_dot_l, p\)"),
+    ({"glsl": "vec3 other_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l) { return u_test_def_k; }"},
+     r"must define `vec3 test_def_response\(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l\)`.*"
+     r"found no test_def_response \(functions defined: other_response\)"),
+    ({"glsl": "vec3 test_def_response(vec3 n, vec3 wi, vec3 wo, float n_dot_l) { return u_test_def_k; }"},
+     r"found `vec3 test_def_response\(vec3 n, vec3 wi, vec3 wo, float n_dot_l\)`"),
+    ({"glsl": "vec3 test_def_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l) { return u_test_def_k * u_test_def_x; }"},
+     r"reads u_test_def_x, which no Param declares"),
+    ({"glsl": "vec3 test_def_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l) { return vec3(n_dot_l); }"},
+     r"never reads u_test_def_k"),
+    ({"glsl": "uniform vec3 u_test_def_k;\nvec3 test_def_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l) "
+              "{ return u_test_def_k; }"}, r"declares its own u_test_def_\* uniforms"),
+    ({"name": "lambert"}, r"the name 'lambert' is taken by the built-in glphong\.materials\.lambert\.Lambert"),
+    ({"name": "material"}, r"name 'material' is reserved"),
+    ({"name": "Minnaert"}, r"name must be a lowercase GLSL identifier"),
+    ({"needs": ("normal",)}, r"needs must be a tuple of 'view', 'tangent', 'uv'"),
+    ({"uses": ("fresnel",)}, r"uses must be a tuple of library chunks 'lobe'"),
+    ({"ambient": "q"}, r"ambient must be None or the name of an rgb Param \(k\)"),
+    ({"vanishes_with": ("ks",)}, r"vanishes_with names \['ks'\]"),
+    ({"glsl": ...}, r"has no glsl"),
+    ({"glsl": "no_such_file.glsl"}, r"names the file .*no_such_file\.glsl', which does not exist"),
+    ({"params": (Param("k", "rgb", low=0.0), Param("k", "scalar", low=0.0))}, r"params repeats a name"),
+])
+def test_a_bad_definition_fails_when_the_class_is_defined(attrs, message):
+    with pytest.raises(MaterialDefinitionError, match=message):
+        _definition(**attrs)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"name": "k", "kind": "rgb"}, r"Param 'k' has no range: give low= and/or high="),
+    ({"name": "k", "kind": "vec3", "low": 0.0}, r"kind must be one of 'scalar', 'rgb'"),
+    ({"name": "Ks", "kind": "rgb", "low": 0.0}, r"lowercase identifier"),
+    ({"name": "ka", "kind": "rgb", "low": 0.0}, r"keyword every material takes"),
+    ({"name": "m", "kind": "scalar", "low": 2.0, "high": 1.0}, r"low must be below high"),
+    ({"name": "m", "kind": "scalar", "low": 0.0, "high": 2.0, "default": 3.0}, r"default is not a valid value"),
+])
+def test_a_bad_param_fails_at_once(kwargs, message):
+    with pytest.raises(MaterialDefinitionError, match=message):
+        Param(**kwargs)
+
+
+def test_a_subclass_with_its_own_glsl_must_have_its_own_name():
+    """The issue's bug: a Phong subclass with its own GLSL silently rendered as plain Phong."""
+    with pytest.raises(MaterialDefinitionError, match=r"redefines glsl but keeps the name 'phong_lobe'"):
+        type("MyLobe", (PhongLobe,), {"glsl": PhongLobe.source()})
+    with pytest.raises(MaterialDefinitionError, match=r"is a MaterialSum and defines glsl"):
+        type("MyPhong", (glphong.Phong,), {"glsl": "vec3 x_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)"})
+    plain = type("PlainSubclass", (PhongLobe,), {"__doc__": "a Python-only subclass: same model"})
+    assert plain(0.5, 10.0).name == "phong_lobe"
+
+
+def test_sums_check_their_terms():
+    with pytest.raises(MaterialDefinitionError, match="repeats a model"):
+        type("Twice", (MaterialSum,), {"terms": (Rim, Rim)})
+    with pytest.raises(MaterialDefinitionError, match="parameter names must differ"):
+        type("Clash", (MaterialSum,), {"terms": (glphong.Lambert, _definition(name="test_kd", params=(
+            Param("kd", "rgb", low=0.0),), glsl="vec3 test_kd_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)"
+                                                       " { return u_test_kd_kd; }"))})
+    with pytest.raises(MaterialDefinitionError, match="non-empty tuple of MaterialModel"):
+        type("Empty", (MaterialSum,), {"terms": ()})
+
+
+def test_values_are_validated_at_instantiation_with_the_parameter_and_its_range():
+    with pytest.raises(TypeError, match=r"Rim\(\) missing parameter 'k' \(rgb in \[0, inf\], 1/sr\)"):
+        Rim()
+    with pytest.raises(ValueError, match=r"a must be finite and in \[0, 10\]"):
+        Rim(0.3, a=11.0)
+    with pytest.raises(ValueError, match=r"k must be finite and in \[0, 3.40282e\+38\] per channel"):
+        Rim(-0.1)
+    with pytest.raises(TypeError, match=r"unexpected parameter 'q' \(parameters: k, a, ka, two_sided\)"):
+        Rim(0.3, q=2.0)
+    with pytest.raises(TypeError, match=r"at most 2 positional"):
+        Rim(0.3, 1.0, 2.0)
+    rim = Rim(0.3, ka=0.01, two_sided=False)
+    assert (rim.k, rim.a, rim.ka, rim.two_sided) == ((0.3,) * 3, 1.0, (0.01,) * 3, False)
+    with pytest.raises(AttributeError, match="immutable"):
+        rim.k = 1.0
+    assert rim == Rim(0.3, ka=0.01, two_sided=False) and hash(rim) == hash(Rim(0.3, ka=0.01, two_sided=False))
+    assert rim != Rim(0.3, a=2.0) and repr(RimPhong(0.2, ks=0.5, q=10.0)) == "RimPhong(k=0.2, a=1, ks=0.5, q=10)"
+
+
+def test_redefining_the_same_class_replaces_it_and_another_class_cannot_take_the_name():
+    first = _definition(name="test_redefined")
+    again = _definition(name="test_redefined")  # the same module and qualname: a re-run notebook cell
+    assert model_named("test_redefined") is again is not first
+    with pytest.raises(MaterialDefinitionError, match="the name 'test_rim' is taken by"):
+        type("Other", (MaterialModel,), {"name": "test_rim", "params": Rim.params, "glsl": Rim.glsl,
+                                         "needs": ("view",), "response": Rim.response})
+
+
+# --------------------------------------------------------------------------- compile errors
+class _BrokenBody(MaterialModel):
+    name = "test_broken_body"
+    params = (Param("k", "rgb", low=0.0),)
+    glsl = """
+    vec3 test_broken_body_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
+    {
+        vec3 x = u_test_broken_body_k * n_dot_l;
+        return x * not_declared_anywhere;
+    }"""
+
+    def response(self, f, wi, wo, n_dot_l, p):
+        return p.k * n_dot_l[..., None]
+
+
+def test_a_compile_error_names_the_users_file_and_line_and_shows_it(glphong_renderer):
+    lines, start = inspect.getsourcelines(_BrokenBody)
+    line = start + next(i for i, text in enumerate(lines) if "not_declared_anywhere" in text)
+    with pytest.raises(ShaderCompileError) as caught:
+        glphong_renderer.render(_scene(_BrokenBody(0.3)))
+    message = str(caught.value)
+    assert f"{__file__}:{line}:" in message, message
+    assert f"{__file__}:{line} | return x * not_declared_anywhere;" in message, message
+    assert "not_declared_anywhere" in message and "<generated header>" not in message
+
+
+def test_glsl_from_a_file_beside_the_model(tmp_path, glphong_renderer):
+    good = tmp_path / "test_file_model.glsl"
+    good.write_text("// a model read from a file\nvec3 test_file_model_response(ShadingFrame f, vec3 wi, vec3 wo, "
+                    "float n_dot_l)\n{\n    return u_test_file_model_k * n_dot_l;\n}\n")
+    model = _definition(name="test_file_model", glsl=str(good))
+    assert model.source() == good.read_text()
+    glphong_renderer.resize(48, 48)
+    assert_render_matches(_scene(model(0.2)), glphong_renderer)
+    bad = tmp_path / "test_file_bad.glsl"
+    bad.write_text("vec3 test_file_bad_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)\n{\n"
+                   "    return u_test_file_bad_k * n_dot_l\n}\n")  # line 3: missing semicolon
+    broken = _definition(name="test_file_bad", glsl=str(bad))
+    with pytest.raises(ShaderCompileError, match=re.escape(str(bad)) + r":[34]:"):
+        glphong_renderer.render(_scene(broken(0.2)))
+
+
+# --------------------------------------------------------------------------- works everywhere
+def test_the_toolkit_accepts_the_user_model(glphong_backend):
+    figures = assert_twin_matches(Rim(0.3, a=3.0), backend=glphong_backend)
+    assert figures["nonzero"] > 3000 and figures["max_relative_error"] < 1e-5
+    figures = assert_twin_matches(RimPhong((0.2, 0.1, 0.0), ks=0.5, q=200.0), backend=glphong_backend)
+    assert figures["max_relative_error"] < 1e-4
+
+
+def test_per_pixel_render_and_verify(glphong_renderer):
+    glphong_renderer.resize(96, 72)
+    scene = _scene(Rim(0.25, a=4.0, ka=0.01), RimPhong(0.2, ks=0.6, q=80.0), glphong.Phong(0.2, 0.6, 80.0),
+                   ambient=glphong.AmbientLight(0.05))
+    report = assert_render_matches(scene, glphong_renderer)
+    assert report.covered_pixels > 1500
+    # the rim term is seen: the user sum is brighter than the plain Phong, by its rim brightening
+    rim_sum, phong = (glphong_renderer.render(_scene(m)).radiance.sum()
+                      for m in (RimPhong(0.2, a=2.0, ks=0.6, q=80.0), glphong.Phong(0.2, 0.6, 80.0)))
+    assert rim_sum > 1.1 * phong, (rim_sum, phong)
+
+
+def test_other_render_options_and_the_uber_shader(glphong_make_renderer, glphong_backend):
+    scene = _scene(Rim(0.25, a=4.0), RimPhong(0.2, ks=0.6, q=30.0))
+    pixel = glphong_make_renderer(64, 48, glphong_backend).render(scene)
+    vertex = glphong_make_renderer(64, 48, glphong_backend, shading="vertex").render(scene)
+    msaa = glphong_make_renderer(64, 48, glphong_backend, samples=4).render(scene)
+    ssaa = glphong_make_renderer(64, 48, glphong_backend, supersample=2).render(scene)
+    uber = glphong_make_renderer(64, 48, glphong_backend, specialise=False)
+    for frame in (vertex, msaa, ssaa):
+        assert np.isfinite(frame.radiance).all() and frame.mask.sum() > 400
+        inside = pixel.mask & frame.mask & (frame.coverage == 1) & (pixel.coverage == 1)
+        rel = np.abs(frame.radiance[inside].sum() - pixel.radiance[inside].sum()) / pixel.radiance[inside].sum()
+        assert rel < 0.03, rel  # the same shading, sampled differently
+    np.testing.assert_allclose(uber.render(scene).radiance, pixel.radiance, rtol=2e-6, atol=1e-30)
+    assert_render_matches(scene, uber)
+
+
+def test_describe_and_the_key_name_the_user_model():
+    scene = _scene(Rim(0.25), RimPhong(0.0, ks=0.5, q=10.0))
+    descriptions = glphong.describe(scene)
+    first, second = descriptions
+    assert "model:test_rim" in first.fragment_chunks and first.key.terms[0].source_hash == Rim.source_hash()
+    assert [t.name for t in second.key.terms] == ["phong_lobe"]  # k = 0: the rim term is left out
+    assert any(item.startswith("term test_rim: ") and "u_test_rim_k, u_test_rim_a (its parameters k = 0)" in item
+               for item in second.left_out), second.left_out
+    assert "test_rim_response" in first.effective_fragment_source
+
+
+def test_stability_runs_the_models_own_cases(session_gl):
+    from glphong.stability import cases_for, run_stability
+
+    cases = cases_for(Rim)
+    assert len(cases) >= 8 and all(c.material.name == "test_rim" for c in cases)
+    report = run_stability(context=session_gl, cases=cases)
+    assert report.passed_count == len(cases), report.format_table()
+    assert report.nan_count == 0
