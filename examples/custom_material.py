@@ -12,6 +12,7 @@ directions, renders a scene with it next to glphong's Lambert, cross-checks ever
 the float64 twin, and (where pyrender is installed) draws it inside a pyrender scene.
 
 Run:  python examples/custom_material.py [out.png]
+      glphong stability --import examples/custom_material.py     (its extreme cases next to the built-ins')
 Its tests (written with glphong.testing): tests/test_custom_material_example.py.
 """
 import sys
@@ -46,6 +47,13 @@ class Minnaert(MaterialModel):
         n_dot_v = np.sum(f.n * wo, axis=-1)
         value = p.k * (n_dot_l * (n_dot_l * np.maximum(n_dot_v, 1e-30)) ** (p.m - 1.0))[..., None]
         return np.where((n_dot_v > 0)[..., None], value, 0.0)
+
+    @classmethod
+    def stability_cases(cls):
+        """glphong's generic extreme geometry, at a limb-brightening and a darkening exponent."""
+        from glphong.stability import generic_cases
+
+        return generic_cases("minnaert m=0.6", cls(k=0.25, m=0.6)) + generic_cases("minnaert m=1.5", cls(k=0.25, m=1.5))
 
 
 def build_scene():

@@ -11,7 +11,7 @@ Typical use::
         frame = r.render(scene)          # frame.radiance: (256, 256, 3) float32, W/(m^2 sr)
         report = glphong.verify(scene, r)
 """
-from . import imaging, materials, radiometry, reference
+from . import imaging, materials, primitives, radiometry, reference
 from .camera import PerspectiveCamera
 from .contexts import BackendUnavailableError, available_backends, create_context
 from .describe import describe, format_descriptions
@@ -27,5 +27,5 @@ __all__ = [
     "PerspectiveCamera", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
-    "imaging", "materials", "radiometry", "reference",
+    "imaging", "materials", "primitives", "radiometry", "reference",
 ]

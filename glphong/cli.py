@@ -34,12 +34,37 @@ def _render(args):
     return 0
 
 
-def _stability(args):
-    from .stability import run_stability
+def _import_models(names):
+    """Import modules (dotted names or .py paths) that define material models; returns the new models."""
+    import importlib
+    import importlib.util
+    import os
 
-    reports = [run_stability(args.backend, "stable")]
+    from .materials import registered_models
+
+    before = set(registered_models())
+    for name in names:
+        if name.endswith(".py") or os.sep in name:
+            spec = importlib.util.spec_from_file_location(os.path.splitext(os.path.basename(name))[0], name)
+            if spec is None or not os.path.isfile(name):
+                raise SystemExit(f"glphong: --import {name!r}: no such file")
+            module = importlib.util.module_from_spec(spec)
+            sys.modules[spec.name] = module
+            spec.loader.exec_module(module)
+        else:
+            importlib.import_module(name)
+    return [m for m in registered_models() if m not in before]
+
+
+def _stability(args):
+    from .stability import CASES, cases_for, run_stability
+
+    cases = list(CASES)
+    for model in _import_models(args.imports):
+        cases += cases_for(model)
+    reports = [run_stability(args.backend, "stable", cases=cases)]
     if args.naive:
-        reports.append(run_stability(args.backend, "naive"))
+        reports.append(run_stability(args.backend, "naive", cases=cases))
     if args.json:
         text = "[" + ",\n".join(r.to_json() for r in reports) + "]"
         if args.json == "-":
@@ -95,6 +120,9 @@ def build_parser():
     stability.add_argument("--naive", action="store_true",
                            help="also run the cases through the textbook pow(dot(v, r), q) shader")
     stability.add_argument("--json", default=None, help="write the table(s) as JSON to this path ('-': stdout only)")
+    stability.add_argument("--import", dest="imports", action="append", default=[], metavar="MODULE",
+                           help="import a module (dotted name or .py path) defining material models and add "
+                                "their stability cases (repeatable)")
     stability.set_defaults(func=_stability)
     describe = sub.add_parser("describe", help="list the default scene's programs: keys, chunks, what each leaves out")
     describe.add_argument("--source", action="store_true", help="print each program's effective fragment source")
