@@ -14,7 +14,7 @@ copy) with ``PYTHONPATH=<copy>`` prepended, ``GLPHONG_GLSL_DIR=<copy>/glsl`` (gl
 GLSL chunks from there), ``GLPHONG_REQUIRE_BACKENDS=egl,osmesa`` and
 ``PYTHONDONTWRITEBYTECODE=1``.  glphong is usually installed in editable mode pointing at the
 main checkout, so before any run the script checks, in the copy with that environment, that
-both ``glphong.__file__`` and ``glphong.programs._glsl_root()`` lie inside the copy, and stops
+both ``glphong.__file__`` and ``glphong.programs.glsl_root()`` lie inside the copy, and stops
 if not.  The temporary copies are removed at the end.
 
 Examples
@@ -31,7 +31,7 @@ Only the mutations whose name contains one of the substrings (case-insensitive),
 GLSL chunk, or everything about the Phong lobe, or one wiring bug::
 
     python benchmarks/mutation.py --only .glsl:
-    python benchmarks/mutation.py --only phong materials.py:u_ks
+    python benchmarks/mutation.py --only phong model.py:u_ks
 
 Extra pytest arguments go to every run, the baseline included (e.g. a subset of the tests)::
 
@@ -131,7 +131,7 @@ MUTATIONS = [
     M("lights.glsl:falloff-1.01", "glsl/lights.glsl",
       "return min((intensity / d) / d, vec3(FLT_MAX));", "return min((intensity / d) / (1.01 * d), vec3(FLT_MAX));",
       "point_irradiance: I / (1.01 d^2)"),
-    M("lambert.glsl:kd-1.01", "glsl/lambert.glsl",
+    M("lambert.glsl:kd-1.01", "glsl/materials/lambert.glsl",
       "return kd * n_dot_l;", "return 1.01 * kd * n_dot_l;",
       "lambert: 1.01 kd (n.l)"),
     M("lobe.glsl:series-1/3", "glsl/lobe.glsl",
@@ -143,25 +143,30 @@ MUTATIONS = [
     M("lobe.glsl:clamp-80", "glsl/lobe.glsl",
       "return exp(max(q * log_one_minus(delta), -104.0));", "return exp(max(q * log_one_minus(delta), -80.0));",
       "lobe_from_delta: exponent clamp -104 -> -80 (tails stop at 1.8e-35 instead of flushing)"),
-    M("phong.glsl:reflect-1.9", "glsl/phong.glsl",
+    M("phong_lobe.glsl:reflect-1.9", "glsl/materials/phong_lobe.glsl",
       "vec3 r = 2.0 * dot(n, wi) * n - wi;", "vec3 r = 1.9 * dot(n, wi) * n - wi;",
       "phong_delta: r = 1.9 (n.l) n - l"),
-    M("blinn.glsl:half-vector", "glsl/blinn.glsl",
+    M("blinn_lobe.glsl:half-vector", "glsl/materials/blinn_lobe.glsl",
       "safe_normalize(wi + wo, h, h_len)", "safe_normalize(wi + 1.01 * wo, h, h_len)",
       "blinn_delta: h from l + 1.01 v"),
-    M("blinn.glsl:floor-x10", "glsl/blinn.glsl",
+    M("blinn_lobe.glsl:floor-x10", "glsl/materials/blinn_lobe.glsl",
       "const float BLINN_HALF_FLOOR = 9.5367431640625e-07;", "const float BLINN_HALF_FLOOR = 9.5367431640625e-06;",
       "BLINN_HALF_FLOOR 2^-20 -> 10 x 2^-20"),
     M("shade.glsl:point-gate", "glsl/shade.glsl",
-      "if (!(n_dot_l > 0.0)) continue;\n        radiance += light_response(n, wi, wo, n_dot_l) * point_irradiance(",
-      "if (!(n_dot_l > 0.01)) continue;\n        radiance += light_response(n, wi, wo, n_dot_l) * point_irradiance(",
+      "if (!(n_dot_l > 0.0)) continue;\n        radiance += material_response(f, wi, wo, n_dot_l) * point_irradiance(",
+      "if (!(n_dot_l > 0.01)) continue;\n        radiance += material_response(f, wi, wo, n_dot_l) * point_irradiance(",
       "point-light loop: gate n.l > 0.01 instead of n.l > 0"),
-    M("shade.glsl:ka-1.01", "glsl/shade.glsl",
-      "if (SWITCH(u_use_ka)) radiance += u_ka;", "if (SWITCH(u_use_ka)) radiance += 1.01 * u_ka;",
-      "shade_point: ambient term 1.01 k_a"),
-    M("shade.glsl:kd-la-1.01", "glsl/shade.glsl",
-      "radiance += u_kd * u_ambient;", "radiance += 1.01 * u_kd * u_ambient;",
-      "shade_point: ambient term 1.01 k_d L_a"),
+    M("key.py:ka-1.01", "glphong/key.py",
+      '_switch(key, "u_use_ka", "radiance += u_ka;")', '_switch(key, "u_use_ka", "radiance += 1.01 * u_ka;")',
+      "generated material_emission: 1.01 k_a"),
+    M("key.py:ambient-1.01", "glphong/key.py",
+      'f"radiance += u_{t.name}_{t.ambient_param} * u_ambient;"',
+      'f"radiance += 1.01 * u_{t.name}_{t.ambient_param} * u_ambient;"',
+      "generated material_emission: every term's answer to L_a 1.01 k L_a (k_d L_a for Lambert)"),
+    M("key.py:response-1.01", "glphong/key.py",
+      'f"response += {t.name}_response(f, wi, wo, n_dot_l);"',
+      'f"response += 1.01 * {t.name}_response(f, wi, wo, n_dot_l);"',
+      "generated material_response: every term 1% high (GPU only)"),
     M("shade.glsl:point-E-1.01", "glsl/shade.glsl",
       "* point_irradiance(u_point_intensity[j], d);", "* point_irradiance(1.01 * u_point_intensity[j], d);",
       "point-light loop: irradiance of 1.01 I"),
@@ -186,14 +191,18 @@ MUTATIONS = [
     M("mesh_fragment.glsl:two-sided-flip", "glsl/mesh_fragment.glsl",
       "if (SWITCH(u_two_sided) && !gl_FrontFacing) {", "if (SWITCH(u_two_sided) && gl_FrontFacing) {",
       "two-sided: normal flipped on front faces instead of back faces"),
-    M("uber.glsl:lobe-kind", "glsl/uber.glsl",
-      "return phong_lobe(n, wi, wo, q);", "return blinn_lobe(n, wi, wo, q);",
-      "uber-shader: lobe kind 1 (Phong) evaluates Blinn"),
+    M("scene.py:uber-light-count", "glphong/scene.py",
+      'values[f"u_{kind}_count"] = np.float32(counts[kind])',
+      'values[f"u_{kind}_count"] = np.float32(max(counts[kind] - 1, 0))',
+      "uber-shader: the last light of each kind dropped"),
+    M("common.glsl:frame-fallback", "glsl/common.glsl",
+      "t = projected ? t : fallback;", "t = fallback;",
+      "frame_from_tangent: the mesh's tangent ignored (always the basis around n)"),
     # ------------------------------------------------------------------ the numpy twin (glphong/reference.py)
     M("reference.py:point-irradiance-1.01", "glphong/reference.py",
       "return np.minimum((intensity / d) / d, FLT_MAX)", "return np.minimum((intensity / d) / (1.01 * d), FLT_MAX)",
       "twin point_irradiance: I / (1.01 d^2)"),
-    M("reference.py:lambert-1.01", "glphong/reference.py",
+    M("lambert.py:twin-1.01", "glphong/materials/lambert.py",
       "return kd * np.asarray(n_dot_l)[..., None]", "return 1.01 * kd * np.asarray(n_dot_l)[..., None]",
       "twin lambert: 1.01 kd (n.l)"),
     M("reference.py:lobe-clamp", "glphong/reference.py",
@@ -202,28 +211,41 @@ MUTATIONS = [
     M("reference.py:series-1/3", "glphong/reference.py",
       "dtype.type(1.0) / dtype.type(2 * k + 1)", "dtype.type(1.0) / dtype.type(2 * k + 1.01)",
       "twin log_one_minus: artanh series coefficients 1/(2k + 1.01)"),
-    M("reference.py:phong-reflect-1.9", "glphong/reference.py",
+    M("phong.py:twin-reflect-1.9", "glphong/materials/phong.py",
       "r = 2 * _dot(n, wi)[..., None] * n - wi", "r = 1.9 * _dot(n, wi)[..., None] * n - wi",
       "twin phong_delta: r = 1.9 (n.l) n - l"),
-    M("reference.py:blinn-half-vector", "glphong/reference.py",
+    M("blinn.py:twin-half-vector", "glphong/materials/blinn.py",
       "ok_h, h, h_len = safe_normalize(wi + wo)", "ok_h, h, h_len = safe_normalize(wi + 1.01 * wo)",
       "twin blinn_delta: h from l + 1.01 v"),
     M("reference.py:gate-0.01", "glphong/reference.py",
-      "gate = (lit & valid & (n_dot_l > 0))[..., None]", "gate = (lit & valid & (n_dot_l > 0.01))[..., None]",
+      "gate = lit & valid & (n_dot_l > 0)", "gate = lit & valid & (n_dot_l > 0.01)",
       "twin shade_point: gate n.l > 0.01"),
-    # ------------------------------------------------------------------ material uniforms (glphong/materials.py)
-    M("materials.py:u_ka-1.01", "glphong/materials.py",
-      'values["u_ka"] = f32(self.ka)', 'values["u_ka"] = f32(self.ka) * np.float32(1.01)',
+    M("reference.py:frame-handedness", "glphong/reference.py",
+      "b = (np.where(tangent[..., 3] < 0, -1.0, 1.0)[..., None] * np.cross(n, t)).astype(n.dtype)",
+      "b = np.cross(n, t).astype(n.dtype)",
+      "twin frame_from_tangent: the handedness w ignored"),
+    # ------------------------------------------------------------------ material uniforms (glphong/materials/model.py)
+    # every parameter is uploaded by one generic line: a bug in one parameter's wiring is planted there,
+    # conditioned on the parameter's name
+    M("model.py:u_ka-1.01", "glphong/materials/model.py",
+      'values["u_ka"] = np.asarray(self.ka, dtype=np.float32)',
+      'values["u_ka"] = np.asarray(self.ka, dtype=np.float32) * np.float32(1.01)',
       "u_ka uploaded 1% high"),
-    M("materials.py:u_kd-1.01", "glphong/materials.py",
-      'values["u_kd"] = f32(self.kd)', 'values["u_kd"] = f32(self.kd) * np.float32(1.01)',
-      "u_kd uploaded 1% high"),
-    M("materials.py:u_ks-1.01", "glphong/materials.py",
-      'values["u_ks"] = f32(self.ks)', 'values["u_ks"] = f32(self.ks) * np.float32(1.01)',
-      "u_ks uploaded 1% high"),
-    M("materials.py:u_q-1.01", "glphong/materials.py",
-      'values["u_q"] = f32(self.q)', 'values["u_q"] = f32(self.q) * np.float32(1.01)',
-      "u_q uploaded 1% high"),
+    *[M(f"model.py:u_{param}-1.01", "glphong/materials/model.py",
+        "np.asarray(getattr(term, p.name), dtype=np.float32)\n",
+        f"np.asarray(getattr(term, p.name), dtype=np.float32) * np.float32(1.01 if p.name == {param!r} else 1.0)\n",
+        f"u_<model>_{param} uploaded 1% high") for param in ("kd", "ks", "q")],
+    M("testing.py:band-1.01", "glphong/testing.py",
+      "ok = (gpu >= low) & (gpu <= high) & ~np.isnan(gpu)",
+      "ok = (gpu >= low) & (gpu <= 1.01 * high) & ~np.isnan(gpu)",
+      "assert_twin_matches accepts values 1% above the band"),
+    M("geometry.py:tangent-handedness", "glphong/geometry.py",
+      "w = np.where(np.sum(np.cross(n_hat, t) * b_sum, axis=1) < 0.0, -1.0, 1.0)",
+      "w = np.where(np.sum(np.cross(n_hat, t) * b_sum, axis=1) < 0.0, 1.0, -1.0)",
+      "tangents from UVs: handedness w flipped"),
+    M("model.py:generic-band-x100", "glphong/materials/model.py",
+      "angle = constants.D * EPS", "angle = 100 * constants.D * EPS",
+      "the generic band of user models 100 times too wide in the directions"),
     # ------------------------------------------------------------------ light uniforms (glphong/lights.py)
     M("lights.py:point-intensity-1.01", "glphong/lights.py",
       "return point_intensity(np.asarray(self.power))", "return point_intensity(np.asarray(self.power)) * 1.01",
@@ -274,15 +296,15 @@ MUTATIONS = [
       "2.0 * far * n / (n - far)]", "2.0 * far * (1.01 * n) / (n - far)]",
       "projection: the near plane 1% off znear"),
     # ------------------------------------------------------------------ one bug written in two places
-    M("phong.glsl+reference.py:reflect-1.9", "glsl/phong.glsl",
+    M("phong_lobe.glsl+phong.py:reflect-1.9", "glsl/materials/phong_lobe.glsl",
       "vec3 r = 2.0 * dot(n, wi) * n - wi;", "vec3 r = 1.9 * dot(n, wi) * n - wi;",
       "Phong's 2 (n.l) -> 1.9 (n.l) in the GLSL and the twin alike",
-      also=(("glphong/reference.py", "r = 2 * _dot(n, wi)[..., None] * n - wi",
+      also=(("glphong/materials/phong.py", "r = 2 * _dot(n, wi)[..., None] * n - wi",
              "r = 1.9 * _dot(n, wi)[..., None] * n - wi"),)),
-    M("lambert.glsl+reference.py:kd-1.01", "glsl/lambert.glsl",
+    M("lambert.glsl+lambert.py:kd-1.01", "glsl/materials/lambert.glsl",
       "return kd * n_dot_l;", "return 1.01 * kd * n_dot_l;",
       "Lambert 1.01 kd (n.l) in the GLSL and the twin alike",
-      also=(("glphong/reference.py", "return kd * np.asarray(n_dot_l)[..., None]",
+      also=(("glphong/materials/lambert.py", "return kd * np.asarray(n_dot_l)[..., None]",
              "return 1.01 * kd * np.asarray(n_dot_l)[..., None]"),)),
     # ------------------------------------------------------------------ tolerance band (glphong/tolerances.py)
     M("tolerances.py:A-x100", "glphong/tolerances.py",
@@ -403,7 +425,7 @@ def environment(copy):
 
 def check_import_paths(copy):
     """Stop unless glphong's Python files and GLSL chunks both come from the copy at ``copy``."""
-    code = "import glphong, glphong.programs as p; print(glphong.__file__); print(p._glsl_root())"
+    code = "import glphong, glphong.programs as p; print(glphong.__file__); print(p.glsl_root())"
     out = subprocess.run([sys.executable, "-c", code], cwd=copy, env=environment(copy), capture_output=True,
                          text=True, timeout=300)
     if out.returncode != 0:
@@ -412,7 +434,7 @@ def check_import_paths(copy):
     root = copy.resolve()
     outside = [p for p in lines if not Path(p).resolve().is_relative_to(root)]
     if len(lines) != 2 or outside:
-        fail(f"in the copy {copy}, glphong does not come from the copy (glphong.__file__ and _glsl_root() "
+        fail(f"in the copy {copy}, glphong does not come from the copy (glphong.__file__ and glsl_root() "
              f"gave {lines}); the mutations would not be tested.  Is PYTHONPATH or GLPHONG_GLSL_DIR ignored?")
     return lines
 

@@ -269,3 +269,50 @@ def test_stability_runs_the_models_own_cases(session_gl):
     report = run_stability(context=session_gl, cases=cases)
     assert report.passed_count == len(cases), report.format_table()
     assert report.nan_count == 0
+
+
+# --------------------------------------------------------------------------- the generic band and the toolkit's edge
+class _Linear(MaterialModel):
+    """A test model whose generic band has a closed form: response k (n.l)."""
+
+    name = "test_linear"
+    params = (Param("k", "rgb", low=0.0),)
+    glsl = """
+    vec3 test_linear_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
+    {
+        return u_test_linear_k * n_dot_l;
+    }"""
+
+    def response(self, f, wi, wo, n_dot_l, p):
+        return p.k * n_dot_l[..., None]
+
+
+class _Linear1e4(_Linear):
+    """The same twin, a GLSL 1e-4 relative high: the toolkit must see it."""
+
+    name = "test_linear_high"
+    glsl = _Linear.glsl.replace("test_linear", "test_linear_high").replace("* n_dot_l;", "* (1.0001 * n_dot_l);")
+    response = _Linear.response
+
+
+def test_the_generic_band_has_its_documented_closed_form():
+    """Response k (n.l): the directions do not move it, n.l +- D eps moves it by k D eps, and the
+    result widens by eps (A + B |ln r|) relative (DESIGN section 4's constants (16, 4, 6, 8))."""
+    from glphong.materials import ShadingFrame
+    from glphong.tolerances import BAND, EPS
+
+    model = _Linear(0.5)
+    n_dot_l = np.array([0.8, 0.1, 1e-3])
+    wi = np.stack([np.sqrt(1 - n_dot_l ** 2), np.zeros(3), n_dot_l], axis=1)
+    wo = np.tile([0.0, 0.6, 0.8], (3, 1))
+    low, high = model.band(ShadingFrame(np.tile([0.0, 0.0, 1.0], (3, 1))), wi, wo, n_dot_l, model.values(), BAND)
+    r = 0.5 * n_dot_l
+    rel = EPS * (16.0 + 4.0 * np.abs(np.log(r)))
+    np.testing.assert_allclose(low[:, 0], r - 0.5 * 8.0 * EPS - r * rel, rtol=1e-13)
+    np.testing.assert_allclose(high[:, 0], r + 0.5 * 8.0 * EPS + r * rel, rtol=1e-13)
+
+
+def test_the_toolkit_sees_a_1e4_relative_error(glphong_backend):
+    assert_twin_matches(_Linear(0.5), backend=glphong_backend)
+    with pytest.raises(AssertionError, match="TestLinearHigh|_Linear1e4"):
+        assert_twin_matches(_Linear1e4(0.5), backend=glphong_backend)
