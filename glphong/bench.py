@@ -51,7 +51,7 @@ class BenchCase:
         return f"{self.family} q={self.q:g} lights={self.lights}"
 
     def material(self):
-        cls = Phong if self.family == "phong" else BlinnPhong
+        cls = {"phong": Phong, "blinn": BlinnPhong}[self.family]  # the family's label -> its material class
         return cls(kd=(0.18, 0.12, 0.08), ks=0.6, q=self.q, ka=0.003)
 
     def camera(self):

@@ -146,9 +146,9 @@ class Renderer:
         for measuring what stability costs and buys; not for real use.
     specialise : bool
         True (default): one program per distinct `ProgramKey`, containing only what the
-        object needs.  False: every object drawn with the uber-shader (all terms, both
-        lobes, up to 8 lights per kind, switched by uniforms), for measuring what
-        specialisation buys.
+        object needs.  False: every object drawn with the uber-shader (every term of the
+        scene's materials and up to 8 lights per kind compiled in, switched by uniforms),
+        for measuring what specialisation buys.
 
     Examples
     --------
