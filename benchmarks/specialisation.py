@@ -3,7 +3,7 @@
 Three scenes at 1024x1024 (a sphere on a floor filling the view): Lambert only with one point
 light; Phong with one point light; mixed materials (Lambert, Phong, Blinn, with and without k_a)
 with 8 lights of three kinds plus ambient.  Each is rendered by a specialised renderer and an
-uber-shader renderer (every term, both lobes, 8 lights per kind switched by uniforms), alternating,
+uber-shader renderer (every built-in term: Lambert and both lobes, 8 lights per kind switched by uniforms), alternating,
 after a warm-up; reported: median frame time (render + float32 readback), the ratio uber /
 specialised, compile time and program-cache hits/misses.
 

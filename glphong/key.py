@@ -95,8 +95,9 @@ class ProgramKey:
         ``d*d``, ``pow(dot(v, r), q)``, through the ``NAIVE`` define every chunk may honour) kept
         only to show why the stable one exists.
     uber : bool
-        The uber-shader: its terms and `UBER_MAX_LIGHTS` lights of each kind compiled in and
-        switched by uniforms.  Kept to measure what specialisation buys.
+        The uber-shader: its terms (every built-in one and the scene's own) and `UBER_MAX_LIGHTS`
+        lights of each kind compiled in and switched by uniforms.  Kept to measure what
+        specialisation buys.
     shade_per_vertex : bool
         Gouraud shading: ``shade_point()`` runs in the vertex stage and its radiance is interpolated.
     """
@@ -234,7 +235,7 @@ class ProgramKey:
             return ["all shading code and lights (the G-buffer program writes the shading inputs only)",
                     "radiance output"] + [f"{name} output (no drawn term needs it)" for name in extras]
         if self.uber:
-            return ["nothing: the uber-shader compiles every term of the scene and switches at run time"]
+            return ["nothing: the uber-shader compiles every built-in term and the scene's own and switches at run time"]
         out = []
         for model, reason in absent_terms:
             params = ", ".join(model.uniform_name(p.name) for p in model.params)
@@ -393,20 +394,23 @@ def program_key(material, light_counts, ambient_radiance, output="radiance", gbu
 
 
 def uber_key(materials, output="radiance", formulation="stable", shade_per_vertex=False):
-    """The uber-shader's key: every term of ``materials``, `UBER_MAX_LIGHTS` lights of each kind,
-    switched at run time by uniforms.
+    """The uber-shader's key: every built-in model that needs no more than the view vector, every
+    term of ``materials``, and `UBER_MAX_LIGHTS` lights of each kind, switched at run time by uniforms.
 
     Parameters
     ----------
     materials : sequence of glphong.materials.Material
         The materials drawn with it (a scene's); their terms are all compiled in.
     """
+    from .materials.model import registered_models
+
     terms = {}
-    for material in materials:
-        for term in material.components:
-            terms.setdefault(term.name, TermKey(term.name, term.source_hash(), tuple(term.needs), lit=True,
-                                                ambient=term.ambient is not None, uses=tuple(term.uses),
-                                                defines=tuple(term.defines()), ambient_param=term.ambient))
+    builtin = [m.example() for m in registered_models() if m.__module__.startswith("glphong.")
+               and set(m.needs) <= {"view"} and not m.defines(m.example())]
+    for term in builtin + [term for material in materials for term in material.components]:
+        terms.setdefault(term.name, TermKey(term.name, term.source_hash(), tuple(term.needs), lit=True,
+                                            ambient=term.ambient is not None, uses=tuple(term.uses),
+                                            defines=tuple(term.defines()), ambient_param=term.ambient))
     needs = {n for t in terms.values() for n in t.needs}
     return ProgramKey(output=output, terms=tuple(terms[name] for name in sorted(terms)), has_ka=True,
                       num_point_lights=UBER_MAX_LIGHTS, num_unattenuated_lights=UBER_MAX_LIGHTS,

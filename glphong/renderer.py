@@ -146,8 +146,8 @@ class Renderer:
         for measuring what stability costs and buys; not for real use.
     specialise : bool
         True (default): one program per distinct `ProgramKey`, containing only what the
-        object needs.  False: every object drawn with the uber-shader (every term of the
-        scene's materials and up to 8 lights per kind compiled in, switched by uniforms),
+        object needs.  False: every object drawn with the uber-shader (every built-in term,
+        the scene's own terms and up to 8 lights per kind compiled in, switched by uniforms),
         for measuring what specialisation buys.
 
     Examples
