@@ -169,9 +169,10 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
         term = models[term_key.name]
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             t_lo, t_hi = term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u), band)
-        # a term's float32 result below FLT_MIN may be flushed to 0 (e.g. ks * lobe with the lobe
-        # just above FLT_MIN): its lower bound is 0 there
-        t_lo = np.where(t_lo < FLT_MIN, 0.0, t_lo)
+        # a term's float32 result below FLT_MIN in magnitude may be flushed to 0 (e.g. ks * lobe with
+        # the lobe just above FLT_MIN): the band then reaches 0
+        t_lo = np.where((t_lo > 0) & (t_lo < FLT_MIN), 0.0, t_lo)
+        t_hi = np.where((t_hi < 0) & (t_hi > -FLT_MIN), 0.0, t_hi)
         low, high = low + t_lo, high + t_hi
     m = max(len(key.lit_terms) - 1, 0)
     return low * (1 - m * EPS), high * (1 + m * EPS)

@@ -8,7 +8,8 @@
 //   OUTPUT_DISPLAY (pyrender's 8-bit framebuffer): vec4(srgb_encode(u_exposure * L), 1);
 //   G-buffer outputs (OUTPUT_GBUFFER): position (world, [m]) with w = object id + 1, the
 //   normal exactly as shade_point() would use it (0 where it is invalid), w = 1; with HAS_TANGENT
-//   the interpolated tangent (xyz, handedness w), with HAS_UV the uv (xy): the inputs of shading_frame().
+//   the interpolated tangent (xyz, handedness w), with HAS_UV the uv (xy): the inputs of shading_frame();
+//   locations 0 position, 1 normal, then tangent and uv in that order, packed (uv at 2 without a tangent).
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY,
 // SHADE_PER_VERTEX, NEEDS_VIEW, RUNTIME_SWITCHES, SWITCH(flag).
 
@@ -41,8 +42,10 @@ layout(location = 1) out vec4 out_normal;
 #if HAS_TANGENT
 layout(location = 2) out vec4 out_tangent;
 #endif
-#if HAS_UV
+#if HAS_UV && HAS_TANGENT
 layout(location = 3) out vec4 out_uv;
+#elif HAS_UV
+layout(location = 2) out vec4 out_uv;  // the renderer packs the extra planes: uv follows the normal when there is no tangent
 #endif
 #else
 #if NEEDS_VIEW
