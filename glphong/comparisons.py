@@ -50,7 +50,6 @@ import numpy as np
 
 from .contexts import create_context
 from .lights import DirectionalLight, PointLight, UnattenuatedPointLight
-from .materials import BlinnPhong, Phong
 from .programs import assemble
 
 __all__ = ["HandWrittenRenderer", "PyrenderRenderer", "to_pyrender", "pyrender_roughness", "import_pyrender",
@@ -266,8 +265,9 @@ def pyrender_roughness(material):
 
 def _pyrender_material(pyrender, material):
     ka = np.asarray(material.ka, dtype=np.float64)
+    kd = getattr(material, "kd", (0.0, 0.0, 0.0))  # the diffuse BRDF value of a material with a Lambert term
     return pyrender.MetallicRoughnessMaterial(
-        baseColorFactor=np.append(np.clip(np.pi * np.asarray(material.kd), 0.0, 1.0), 1.0),
+        baseColorFactor=np.append(np.clip(np.pi * np.asarray(kd), 0.0, 1.0), 1.0),
         metallicFactor=0.0,
         roughnessFactor=pyrender_roughness(material),
         emissiveFactor=np.sqrt(ka),  # pyrender 0.1.45 squares the emissive factor

@@ -22,16 +22,17 @@ __all__ = [
     "incident_light", "material_emission", "material_response", "view_direction", "shade_point", "shade_inputs", "shade",
 ]
 
-#: model twins kept importable from here (they live with their models in glphong.materials)
-_MODEL_TWINS = {"lambert": "lambert", "phong_delta": "phong", "phong_lobe": "phong", "blinn_delta": "blinn",
-                "blinn_lobe": "blinn", "BLINN_HALF_FLOOR": "blinn"}
-
-
 def __getattr__(name):
-    if name in _MODEL_TWINS:
-        import importlib
+    """A model's twin function by name (``reference.phong_lobe``): each lives with its model in
+    ``glphong.materials.<module>``; this finds it in the modules of the registered models."""
+    import sys
 
-        return getattr(importlib.import_module(f"glphong.materials.{_MODEL_TWINS[name]}"), name)
+    from .materials import registered_models
+
+    for model in registered_models():
+        module = sys.modules.get(model.__module__)
+        if name in getattr(module, "__all__", ()):
+            return getattr(module, name)
     raise AttributeError(f"module 'glphong.reference' has no attribute {name!r}")
 
 

@@ -32,6 +32,7 @@ from .programs import ProgramCache
 from .tolerances import BAND, EPS, response_band
 
 __all__ = ["evaluate", "direction_sets", "assert_twin_matches", "assert_render_matches", "TwinMismatch",
+           "frame_around", "direction", "rotate_toward", "float32_units", "cosine_power_interval",
            "require_backend", "renderer_factory"]
 
 _POOL = {}
@@ -252,6 +253,57 @@ def direction_sets(n=2000, seed=0):
     sets.append(("n.l just above 0", wi, mirror(wi)))
     labels = np.concatenate([[label] * len(a) for label, a, _ in sets])
     return np.concatenate([a for _, a, _ in sets]), np.concatenate([b for _, _, b in sets]), labels
+
+
+# --------------------------------------------------------------------------- closed-form helpers
+def frame_around(n):
+    """An orthonormal ``(t, b)`` completing the unit normal ``n`` (3,): ``(t, b, n)`` right-handed."""
+    n = np.asarray(n, dtype=np.float64)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    t = np.cross(n, helper)
+    t /= np.linalg.norm(t)
+    return t, np.cross(n, t)
+
+
+def direction(n, theta, phi):
+    """The unit vector at polar angle ``theta`` [rad] from the unit ``n`` and azimuth ``phi`` [rad] about it
+    (measured from `frame_around`'s ``t``)."""
+    t, b = frame_around(n)
+    return np.sin(theta) * (np.cos(phi) * t + np.sin(phi) * b) + np.cos(theta) * np.asarray(n, dtype=np.float64)
+
+
+def rotate_toward(a, target, angle):
+    """Unit ``a`` (3,) rotated by ``angle`` [rad] toward ``target``, in their plane."""
+    axis = target - np.dot(target, a) * a
+    axis /= np.linalg.norm(axis)
+    return np.cos(angle) * a + np.sin(angle) * axis
+
+
+def float32_units(v):
+    """Rows of ``v`` normalised in float64 and rounded to float32 (returned as float64): exactly the unit
+    vectors `evaluate` hands to the GPU and to the twin."""
+    v = np.asarray(v, dtype=np.float64)
+    return np.asarray(v / np.linalg.norm(v, axis=-1, keepdims=True), dtype=np.float32).astype(np.float64)
+
+
+def cosine_power_interval(cos_alpha, q, spread):
+    """The interval of float32 values consistent with ``cos(alpha)^q``, for closed-form tests of lobes.
+
+    ``alpha`` is the angle from the lobe's peak; float32 inputs and arithmetic leave it uncertain by
+    ``+- spread`` [rad] (a few eps: the caller states it for its lobe); ``exp`` is good to
+    ``(3 + 2|x|)`` ulp (GLSL 4.50, 4.7.1) and ``ln(1 - delta)`` to a few ulp relative, so the value is
+    widened by ``eps (8 + 12 lambda)`` relative, ``lambda = -ln(value)``.  The caller accepts 0 below
+    FLT_MIN (flush to zero).
+
+    Returns
+    -------
+    low, high : ndarray
+    """
+    alpha = np.arccos(np.clip(cos_alpha, -1.0, 1.0))
+    low = np.cos(np.minimum(alpha + spread, np.pi / 2)) ** q
+    high = np.cos(np.maximum(alpha - spread, 0.0)) ** q
+    lam = -np.log(np.maximum(low, 1e-300))
+    return low * (1 - EPS * (8 + 12 * lam)), high * (1 + EPS * (8 + 12 * lam))
 
 
 class TwinMismatch(AssertionError):

@@ -12,12 +12,23 @@ Units: ``kd`` and ``ks`` are BRDF values [1/sr] (an albedo rho gives kd = rho/pi
 constant radiance [W/(m^2 sr)]; ``q`` is dimensionless.  Define your own with `MaterialModel` and
 `Param` (see README, "Write your own material").
 """
+import importlib as _importlib
+import pkgutil as _pkgutil
+
 from .model import (GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues,
                     Properties, ShadingFrame, model_named, registered_models)
-from .lambert import Lambert
-from .phong import Phong, PhongLobe
-from .blinn import BlinnLobe, BlinnPhong
 
 __all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "ParamValues", "Properties", "ShadingFrame",
-           "MaterialDefinitionError", "GlslFile", "registered_models", "model_named",
-           "Lambert", "PhongLobe", "Phong", "BlinnLobe", "BlinnPhong"]
+           "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
+
+# every module of this package but the mechanism is one model: importing it registers the model, and
+# the material classes it exports are this package's, so a new model is one file here (with its GLSL
+# and its tests); its twin functions stay in its module (and are found by glphong.reference)
+for _info in sorted(_pkgutil.iter_modules(__path__), key=lambda info: info.name):
+    if _info.name != "model":
+        _module = _importlib.import_module(f"{__name__}.{_info.name}")
+        for _name in _module.__all__:
+            if isinstance(getattr(_module, _name), type):
+                globals()[_name] = getattr(_module, _name)
+                __all__.append(_name)
+del _info, _module, _name

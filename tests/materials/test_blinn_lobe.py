@@ -34,7 +34,8 @@ import glphong.primitives
 from glphong.key import program_key, response_key
 from glphong.materials import BlinnLobe, BlinnPhong, Lambert, Properties
 from glphong.programs import assemble
-from glphong.testing import assert_render_matches, assert_twin_matches, direction_sets, evaluate
+from glphong.testing import (assert_render_matches, assert_twin_matches, cosine_power_interval, direction,
+                             direction_sets, evaluate, float32_units, frame_around, rotate_toward)
 
 EPS = 2.0 ** -24
 FLT_MIN = 2.0 ** -126
@@ -49,12 +50,6 @@ def f32(x):
     return np.asarray(x, dtype=np.float32).astype(np.float64)
 
 
-def unit32(v):
-    """Unit rows rounded to float32, as `evaluate` hands them to both sides."""
-    v = np.asarray(v, dtype=np.float64)
-    return f32(v / np.linalg.norm(v, axis=-1, keepdims=True))
-
-
 # --------------------------------------------------------------------------- twin
 @pytest.mark.parametrize("ks", [1.0, KS], ids=["ks=1", "ks-zero-channel"])
 @pytest.mark.parametrize("q", QS, ids=[f"q={q:g}" for q in QS])
@@ -62,7 +57,7 @@ def test_twin_matches(glphong_backend, q, ks):
     material = BlinnLobe(ks, q)
     figures = assert_twin_matches(material, n=2000, seed=0, backend=glphong_backend)
     wi, wo, _ = direction_sets(2000, 0)
-    l, v = unit32(wi), unit32(wo)
+    l, v = float32_units(wi), float32_units(wo)
     defined = (l[:, 2] > 0) & (v[:, 2] > 0) & (np.linalg.norm(l + v, axis=1) > 2.0 ** -20)
     assert figures["pairs"] == len(wi)
     assert figures["nonzero"] == int(np.sum(defined))  # n.h > 0 wherever n.l > 0 and n.v > 0
@@ -85,44 +80,14 @@ def test_twin_matches_ks_zero(glphong_backend):
 
 
 # --------------------------------------------------------------------------- closed form
-def frame(n):
-    """An orthonormal (t, b) completing the unit normal ``n``."""
-    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    t = np.cross(n, helper)
-    t /= np.linalg.norm(t)
-    return t, np.cross(n, t)
-
-
-def direction(n, theta, phi):
-    """The unit vector at polar angle ``theta`` from ``n`` and azimuth ``phi``."""
-    t, b = frame(n)
-    return np.sin(theta) * (np.cos(phi) * t + np.sin(phi) * b) + np.cos(theta) * n
-
-
-def rotate_toward(a, target, angle):
-    """Unit ``a`` rotated by ``angle`` toward ``target`` (in their plane)."""
-    axis = target - np.dot(target, a) * a
-    axis /= np.linalg.norm(axis)
-    return np.cos(angle) * a + np.sin(angle) * axis
-
-
-def lobe_interval(cos_alpha, q, spread):
-    """Float32 lobe values consistent with ``cos(alpha)^q``, alpha the angle of h from n.
-
-    The GPU's inputs are float32 unit vectors and h = (l + v)/|l + v| is float32 arithmetic: rounding
-    l, v and their sum moves l + v by a few eps, which turns h by that over |l + v|; normalisation
-    and the chord |h - n| add a few eps: the angle it sees is alpha +- ``spread``
-    (8 eps max(1, 2/|l + v|) here; measured at most 0.5 eps times that factor).  ``exp`` is good to
-    (3 + 2 |x|) ulp (GLSL 4.50, 4.7.1) and ``ln(1 - delta)`` to a few ulp relative: at most
-    eps (8 + 12 lambda) relative, lambda = -ln(lobe), with ks's rounding to float32.  A result below
-    FLT_MIN may be flushed to 0.
-    """
-    alpha = np.arccos(np.clip(cos_alpha, -1.0, 1.0))
-    low = np.cos(np.minimum(alpha + spread, np.pi / 2)) ** q
-    high = np.cos(np.maximum(alpha - spread, 0.0)) ** q
-    lam = -np.log(np.maximum(low, 1e-300))
-    low, high = low * (1 - EPS * (8 + 12 * lam)), high * (1 + EPS * (8 + 12 * lam))
-    return low, high
+# The closed form's interval is glphong.testing.cosine_power_interval; its spread for this lobe:
+# The GPU's inputs are float32 unit vectors and h = (l + v)/|l + v| is float32 arithmetic: rounding
+# l, v and their sum moves l + v by a few eps, which turns h by that over |l + v|; normalisation
+# and the chord |h - n| add a few eps: the angle it sees is alpha +- ``spread``
+# (8 eps max(1, 2/|l + v|) here; measured at most 0.5 eps times that factor).  ``exp`` is good to
+# (3 + 2 |x|) ulp (GLSL 4.50, 4.7.1) and ``ln(1 - delta)`` to a few ulp relative: at most
+# eps (8 + 12 lambda) relative, lambda = -ln(lobe), with ks's rounding to float32.  A result below
+# FLT_MIN may be flushed to 0.
 
 
 def closed_form_rows(n, q):
@@ -130,7 +95,7 @@ def closed_form_rows(n, q):
     tilted toward l until the lobe has fallen to 1/2, 1e-3 and 1e-20 (q > 1), or by 0.3 and 0.7 rad
     (q <= 1); v = the reflection of l about h.  Plus views at grazing (n.v = 1e-3) and rows whose v
     falls below the surface (the closed form is 0 there)."""
-    t, _ = frame(n)
+    t, _ = frame_around(n)
     if q > 1:
         offsets = {"peak": 0.0, "half maximum": np.arccos(0.5 ** (1 / q)),
                    "1e-3 of maximum": np.arccos(1e-3 ** (1 / q)), "1e-20 of maximum": np.arccos(1e-20 ** (1 / q))}
@@ -180,7 +145,7 @@ def test_closed_form(glphong_backend, q, normal):
     if q == 0:  # max(n.h, 0)^0 = 1 where h is defined: exactly ks, as float32
         np.testing.assert_array_equal(gpu, np.tile(f32(ks), (len(gpu), 1)))
         return
-    low, high = lobe_interval(cos_alpha, q, 8 * EPS * np.maximum(1.0, 2.0 / h_len))
+    low, high = cosine_power_interval(cos_alpha, q, 8 * EPS * np.maximum(1.0, 2.0 / h_len))
     low, high = ks * low[:, None], ks * high[:, None]
     low = np.where(low < FLT_MIN, 0.0, low)
     high = np.where(high < FLT_MIN, FLT_MIN, high)

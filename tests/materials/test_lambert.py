@@ -26,7 +26,7 @@ import glphong.primitives
 from glphong.key import program_key, response_key
 from glphong.materials import Lambert, Properties
 from glphong.programs import assemble
-from glphong.testing import assert_render_matches, assert_twin_matches, direction_sets, evaluate
+from glphong.testing import assert_render_matches, assert_twin_matches, direction, direction_sets, evaluate
 
 EPS = 2.0 ** -24
 KD = (0.1, 0.0, 0.25)
@@ -53,20 +53,6 @@ def test_twin_matches_kd_zero(glphong_backend):
 
 
 # --------------------------------------------------------------------------- closed form
-def frame(n):
-    """An orthonormal (t, b) completing the unit normal ``n``."""
-    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    t = np.cross(n, helper)
-    t /= np.linalg.norm(t)
-    return t, np.cross(n, t)
-
-
-def direction(n, theta, phi):
-    """The unit vector at polar angle ``theta`` from ``n`` and azimuth ``phi``."""
-    t, b = frame(n)
-    return np.sin(theta) * (np.cos(phi) * t + np.sin(phi) * b) + np.cos(theta) * n
-
-
 #: polar angles of the light: normal, oblique, and grazing (n.l = 1e-2, 1e-4, 1e-6)
 THETAS = [0.0, np.radians(30.0), np.radians(60.0), np.arccos(1e-2), np.arccos(1e-4), np.arccos(1e-6)]
 #: |GPU - kd (n.l)| <= kd (3 eps (n.l) + 8 eps): kd and the directions are rounded to float32 (eps

@@ -34,7 +34,8 @@ import glphong.primitives
 from glphong.key import program_key, response_key
 from glphong.materials import Lambert, Phong, PhongLobe, Properties
 from glphong.programs import assemble
-from glphong.testing import assert_render_matches, assert_twin_matches, direction_sets, evaluate
+from glphong.testing import (assert_render_matches, assert_twin_matches, cosine_power_interval, direction,
+                             direction_sets, evaluate, float32_units, frame_around, rotate_toward)
 
 EPS = 2.0 ** -24
 FLT_MIN = 2.0 ** -126
@@ -49,12 +50,6 @@ def f32(x):
     return np.asarray(x, dtype=np.float32).astype(np.float64)
 
 
-def unit32(v):
-    """Unit rows rounded to float32, as `evaluate` hands them to both sides."""
-    v = np.asarray(v, dtype=np.float64)
-    return f32(v / np.linalg.norm(v, axis=-1, keepdims=True))
-
-
 # --------------------------------------------------------------------------- twin
 @pytest.mark.parametrize("ks", [1.0, KS], ids=["ks=1", "ks-zero-channel"])
 @pytest.mark.parametrize("q", QS, ids=[f"q={q:g}" for q in QS])
@@ -62,7 +57,7 @@ def test_twin_matches(glphong_backend, q, ks):
     material = PhongLobe(ks, q)
     figures = assert_twin_matches(material, n=2000, seed=0, backend=glphong_backend)
     wi, wo, _ = direction_sets(2000, 0)
-    l, v = unit32(wi), unit32(wo)
+    l, v = float32_units(wi), float32_units(wo)
     n_dot_l = l[:, 2]
     v_dot_r = np.sum(v * (2 * n_dot_l[:, None] * np.array([0.0, 0.0, 1.0]) - l), axis=1)
     assert figures["pairs"] == len(wi)
@@ -87,49 +82,19 @@ def test_twin_matches_ks_zero(glphong_backend):
 
 
 # --------------------------------------------------------------------------- closed form
-def frame(n):
-    """An orthonormal (t, b) completing the unit normal ``n``."""
-    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    t = np.cross(n, helper)
-    t /= np.linalg.norm(t)
-    return t, np.cross(n, t)
-
-
-def direction(n, theta, phi):
-    """The unit vector at polar angle ``theta`` from ``n`` and azimuth ``phi``."""
-    t, b = frame(n)
-    return np.sin(theta) * (np.cos(phi) * t + np.sin(phi) * b) + np.cos(theta) * n
-
-
-def rotate_toward(a, target, angle):
-    """Unit ``a`` rotated by ``angle`` toward ``target`` (in their plane)."""
-    axis = target - np.dot(target, a) * a
-    axis /= np.linalg.norm(axis)
-    return np.cos(angle) * a + np.sin(angle) * axis
-
-
-def lobe_interval(cos_alpha, q, spread):
-    """Float32 lobe values consistent with ``cos(alpha)^q``, alpha the angle of v from the peak.
-
-    The GPU's inputs are float32 unit vectors and its reflection and chord are float32 arithmetic:
-    the angle it sees is alpha +- ``spread`` (8 eps here: about eps per rounded unit vector, 2-3 eps
-    for r = 2 (n.l) n - l, one for the chord; measured at most 3 eps).  ``exp`` is good to
-    (3 + 2 |x|) ulp (GLSL 4.50, 4.7.1) and ``ln(1 - delta)`` to a few ulp relative: at most
-    eps (8 + 12 lambda) relative, lambda = -ln(lobe), with ks's rounding to float32.  A result below
-    FLT_MIN may be flushed to 0.
-    """
-    alpha = np.arccos(np.clip(cos_alpha, -1.0, 1.0))
-    low = np.cos(np.minimum(alpha + spread, np.pi / 2)) ** q
-    high = np.cos(np.maximum(alpha - spread, 0.0)) ** q
-    lam = -np.log(np.maximum(low, 1e-300))
-    low, high = low * (1 - EPS * (8 + 12 * lam)), high * (1 + EPS * (8 + 12 * lam))
-    return low, high
+# The closed form's interval is glphong.testing.cosine_power_interval; its spread for this lobe:
+# The GPU's inputs are float32 unit vectors and its reflection and chord are float32 arithmetic:
+# the angle it sees is alpha +- ``spread`` (8 eps here: about eps per rounded unit vector, 2-3 eps
+# for r = 2 (n.l) n - l, one for the chord; measured at most 3 eps).  ``exp`` is good to
+# (3 + 2 |x|) ulp (GLSL 4.50, 4.7.1) and ``ln(1 - delta)`` to a few ulp relative: at most
+# eps (8 + 12 lambda) relative, lambda = -ln(lobe), with ks's rounding to float32.  A result below
+# FLT_MIN may be flushed to 0.
 
 
 def closed_form_rows(n, q):
     """``(wi, wo, labels)``: the light at normal, oblique and grazing incidence, the view at the peak
     and where the lobe has fallen to 1/2, 1e-3 and 1e-20 (q > 1), or at 0.5 and 1.2 rad (q <= 1)."""
-    t, _ = frame(n)
+    t, _ = frame_around(n)
     if q > 1:
         offsets = {"peak": 0.0, "half maximum": np.arccos(0.5 ** (1 / q)),
                    "1e-3 of maximum": np.arccos(1e-3 ** (1 / q)), "1e-20 of maximum": np.arccos(1e-20 ** (1 / q))}
@@ -161,7 +126,7 @@ def test_closed_form(glphong_backend, q, normal):
     r = 2 * (wi @ normal)[:, None] * normal - wi
     cos_alpha = np.sum(wo * r, axis=1)
     expected = ks * np.maximum(cos_alpha, 0.0)[:, None] ** q
-    low, high = lobe_interval(cos_alpha, q, 8 * EPS)
+    low, high = cosine_power_interval(cos_alpha, q, 8 * EPS)
     low, high = ks * low[:, None], ks * high[:, None]
     low = np.where(low < FLT_MIN, 0.0, low)
     high = np.where(high < FLT_MIN, FLT_MIN, high)
