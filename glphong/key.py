@@ -173,8 +173,8 @@ class ProgramKey:
                 size = getattr(self, f"num_{kind}_lights")
                 out.append((f"NUM_{kind.upper()}_LIGHTS", str(size)))
                 out.append((f"{kind.upper()}_LIGHT_COUNT", f"int(u_{kind}_count)" if self.uber else str(size)))
-            for term in self.terms:
-                out += list(term.defines)
+            for term in self.terms:  # a model's structural defines, prefixed with its name
+                out += [(f"{term.name.upper()}_{name}", value) for name, value in term.defines]
         return out
 
     def library_chunks(self):

@@ -316,3 +316,32 @@ def test_the_toolkit_sees_a_1e4_relative_error(glphong_backend):
     assert_twin_matches(_Linear(0.5), backend=glphong_backend)
     with pytest.raises(AssertionError, match="TestLinearHigh|_Linear1e4"):
         assert_twin_matches(_Linear1e4(0.5), backend=glphong_backend)
+
+
+class _Power(MaterialModel):
+    """A test model with a structural define: response k (n.l)^N, N a compile-time integer from n."""
+
+    name = "test_power"
+    params = (Param("k", "rgb", low=0.0), Param("n", "scalar", low=1.0, high=4.0, default=2.0))
+    glsl = """
+    vec3 test_power_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
+    {
+        float value = n_dot_l;
+        for (int i = 1; i < TEST_POWER_N; ++i) value *= n_dot_l;
+        return u_test_power_k * value * step(1.0, u_test_power_n);
+    }"""
+
+    def defines(self):
+        return (("N", str(int(self.n))),)
+
+    def response(self, f, wi, wo, n_dot_l, p):
+        return p.k * (n_dot_l ** int(self.n))[..., None]
+
+
+def test_structural_defines_are_prefixed_and_part_of_the_key(glphong_renderer):
+    squared, cubed = _Power(0.4, n=2.0), _Power(0.4, n=3.0)
+    keys = [glphong.describe(_scene(m))[0].key for m in (squared, cubed)]
+    assert keys[0] != keys[1] and ("TEST_POWER_N", "3") in keys[1].defines()
+    glphong_renderer.resize(48, 48)
+    frames = [assert_render_matches(_scene(m), glphong_renderer).gpu for m in (squared, cubed)]
+    assert frames[1].sum() < frames[0].sum()  # (n.l)^3 < (n.l)^2

@@ -583,7 +583,12 @@ class MaterialModel(Material):
                          f"{' [' + p.unit + ']' if p.unit else ''}" for p in cls.params)
 
     def defines(self):
-        """Structural ``#define`` pairs of this instance (part of its key; default none)."""
+        """Structural ``#define`` pairs ``(NAME, value)`` of this instance (part of its key; default none).
+
+        For what changes the program's shape rather than a uniform's value (a number of lobes, a
+        form).  Each is emitted as ``#define <MODEL>_<NAME> value`` (the model's name upper-cased),
+        so models cannot collide; the model's GLSL reads it under that name.
+        """
         return ()
 
     def vanishes(self):
