@@ -1,7 +1,8 @@
 """A material glphong does not ship, defined with the same public mechanism as the built-ins.
 
 Minnaert's darkening law (Minnaert 1941, the lunar limb): ``f_r = k ((n.l)(n.v))^(m - 1)`` [1/sr],
-so its response is ``f_r (n.l) = k (n.l) ((n.l)(n.v))^(m - 1)``.  ``m = 1`` is Lambert with
+so its response is ``f_r (n.l) = k (n.l)^m (n.v)^(m - 1)``, evaluated as those two powers (the product
+``(n.l)(n.v)`` of two grazing cosines would underflow float32 before the power).  ``m = 1`` is Lambert with
 ``k_d = k``; ``m < 1`` brightens toward the limb (the Moon), ``m > 1`` darkens.  Where the viewer is
 below the surface (``n.v <= 0``, a one-sided material seen from behind) nothing is reflected toward
 it: the response is 0 there, by a select in GLSL and ``np.where`` in the twin (GLSL's
@@ -39,13 +40,13 @@ class Minnaert(MaterialModel):
     vec3 minnaert_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
     {
         float n_dot_v = dot(f.n, wo);
-        vec3 value = u_minnaert_k * (n_dot_l * pow(n_dot_l * max(n_dot_v, 1e-30), u_minnaert_m - 1.0));
+        vec3 value = u_minnaert_k * (pow(n_dot_l, u_minnaert_m) * pow(max(n_dot_v, 1e-30), u_minnaert_m - 1.0));
         return n_dot_v > 0.0 ? value : vec3(0.0);
     }"""
 
     def response(self, f, wi, wo, n_dot_l, p):
         n_dot_v = np.sum(f.n * wo, axis=-1)
-        value = p.k * (n_dot_l * (n_dot_l * np.maximum(n_dot_v, 1e-30)) ** (p.m - 1.0))[..., None]
+        value = p.k * (n_dot_l ** p.m * np.maximum(n_dot_v, 1e-30) ** (p.m - 1.0))[..., None]
         return np.where((n_dot_v > 0)[..., None], value, 0.0)
 
     @classmethod

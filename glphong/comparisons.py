@@ -137,7 +137,7 @@ class HandWrittenRenderer:
                 content = []
                 for name, source, fmt in (("in_position", "positions", "3f"), ("in_normal", "normals", "3f"),
                                           ("in_tangent", "tangents", "4f"), ("in_uv", "uvs", "2f")):
-                    if name in key.attributes():
+                    if name in key.attributes() and name in program:
                         if source not in mesh:
                             mesh[source] = mgl.buffer(getattr(obj.mesh, source).tobytes())
                             self._buffers.append(mesh[source])
@@ -249,6 +249,14 @@ def import_pyrender(platform):
     return importlib.import_module("pyrender")
 
 
+def pyrender_base_color(material):
+    """pyrender base colour (an albedo, RGB) for a glphong material: the sum of ``pbr_base_color()`` over
+    its non-vanishing terms that define one (Lambert: ``pi k_d``), 0 where none does."""
+    values = [np.asarray(term.pbr_base_color(), dtype=np.float64) for term in material.components
+              if hasattr(term, "pbr_base_color") and not term.vanishes()]
+    return np.sum(values, axis=0) if values else np.zeros(3)
+
+
 def pyrender_roughness(material):
     """pyrender perceptual roughness for a glphong material (a rough, documented mapping).
 
@@ -265,9 +273,8 @@ def pyrender_roughness(material):
 
 def _pyrender_material(pyrender, material):
     ka = np.asarray(material.ka, dtype=np.float64)
-    kd = getattr(material, "kd", (0.0, 0.0, 0.0))  # the diffuse BRDF value of a material with a Lambert term
     return pyrender.MetallicRoughnessMaterial(
-        baseColorFactor=np.append(np.clip(np.pi * np.asarray(kd), 0.0, 1.0), 1.0),
+        baseColorFactor=np.append(np.clip(pyrender_base_color(material), 0.0, 1.0), 1.0),
         metallicFactor=0.0,
         roughnessFactor=pyrender_roughness(material),
         emissiveFactor=np.sqrt(ka),  # pyrender 0.1.45 squares the emissive factor

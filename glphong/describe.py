@@ -1,6 +1,8 @@
 """Introspection: which programs a scene compiles, what each contains and what it leaves out."""
 from dataclasses import dataclass
 
+import numpy as np
+
 from .programs import assemble, effective_source
 
 __all__ = ["ProgramDescription", "describe", "format_descriptions"]
@@ -70,8 +72,9 @@ def describe(scenes, renderer=None, gbuffer=False):
                 present = {t.name for t in key.terms}
                 for term in obj.material.components:
                     if term.name not in present and output != "gbuffer":
-                        reason = ("its parameters " + ", ".join(f"{p} = 0" for p in term.vanishes_with)
-                                  if term.vanishes() else "no light reaches it and it does not answer L_a")
+                        zero = [p for p in term.vanishes_with if not np.any(getattr(term, p))]
+                        reason = (", ".join(f"{p} = 0" for p in zero) if term.vanishes()
+                                  else "no light reaches it and it does not answer L_a")
                         absent.setdefault(key, {}).setdefault(type(term), reason)
     out = []
     for key, names in users.items():

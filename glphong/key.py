@@ -58,8 +58,9 @@ class TermKey:
 
     @property
     def chunk(self):
-        """Chunk label of the model's GLSL (``model:<name>``)."""
-        return f"model:{self.name}"
+        """Chunk label of the model's GLSL, ``model:<name>@<source hash>``: the program is built from the
+        very definition the material was made of."""
+        return f"model:{self.name}@{self.source_hash}"
 
     def describe(self):
         flags = [f for f, on in (("lit", self.lit), ("ambient", self.ambient)) if on]
@@ -322,8 +323,9 @@ def material_chunk(key):
     lines += ["    return radiance;", "}", "",
               "vec3 material_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)", "{",
               "    vec3 response = vec3(0.0);"]
-    for t in key.lit_terms:
-        lines.append(_switch(key, f"u_use_{t.name}", f"response += {t.name}_response(f, wi, wo, n_dot_l);"))
+    for t in key.lit_terms:  # a term that does not need the view gets v = 0, whatever the others need
+        view = "wo" if "view" in t.needs else "vec3(0.0)"
+        lines.append(_switch(key, f"u_use_{t.name}", f"response += {t.name}_response(f, wi, {view}, n_dot_l);"))
     lines += ["    return response;", "}"]
     return "\n".join(lines) + "\n"
 
@@ -408,9 +410,13 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
     builtin = [m.example() for m in registered_models() if m.__module__.startswith("glphong.")
                and set(m.needs) <= {"view"} and not m.defines(m.example())]
     for term in builtin + [term for material in materials for term in material.components]:
-        terms.setdefault(term.name, TermKey(term.name, term.source_hash(), tuple(term.needs), lit=True,
-                                            ambient=term.ambient is not None, uses=tuple(term.uses),
-                                            defines=tuple(term.defines()), ambient_param=term.ambient))
+        key = TermKey(term.name, term.source_hash(), tuple(term.needs), lit=True, ambient=term.ambient is not None,
+                      uses=tuple(term.uses), defines=tuple(term.defines()), ambient_param=term.ambient)
+        known = terms.setdefault(term.name, key)
+        if known != key:
+            raise ValueError(f"the uber-shader holds one variant of each model, but the scene has two of "
+                             f"{term.name!r} (defines {known.defines} and {key.defines}, or two definitions): "
+                             "render it with specialise=True")
     needs = {n for t in terms.values() for n in t.needs}
     return ProgramKey(output=output, terms=tuple(terms[name] for name in sorted(terms)), has_ka=True,
                       num_point_lights=UBER_MAX_LIGHTS, num_unattenuated_lights=UBER_MAX_LIGHTS,

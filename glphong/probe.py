@@ -96,7 +96,7 @@ def signatures():
     for chunk in LIBRARY:
         out.update(_parse(chunk_source(chunk), LIBRARY, "glphong.reference"))
     for model in registered_models():
-        chunks = LIBRARY + (f"model:{model.name}",)
+        chunks = LIBRARY + (f"model:{model.name}@{model.source_hash()}",)
         out.update(_parse(model.source(), chunks, model.__module__))
     return out
 

@@ -19,8 +19,10 @@ __all__ = ["ProgramCache", "Program", "ShaderCompileError", "UniformError", "ass
            "effective_source"]
 
 GLSL_VERSION = "#version 330 core"
-#: line numbers of chunk i start at i * LINE_BLOCK (see `assemble`)
+#: line numbers of chunk i start at i * LINE_BLOCK (see `assemble`); a model's generated uniform
+#: declarations are numbered from i * LINE_BLOCK + PRELUDE_LINE
 LINE_BLOCK = 100000
+PRELUDE_LINE = 90000
 
 
 class ShaderCompileError(RuntimeError):
@@ -57,8 +59,8 @@ class Chunk:
     Attributes
     ----------
     label : str
-        As the key names it: a library chunk (``'shade'``), a model (``'model:<name>'``) or a
-        generated chunk (``'generated:material'``).
+        As the key names it: a library chunk (``'shade'``), a model (``'model:<name>@<source hash>'``)
+        or a generated chunk (``'generated:material'``).
     prelude : str
         Generated declarations placed before it (a model's uniforms), outside its line numbering.
     text : str
@@ -89,9 +91,9 @@ def resolve_chunk(label, generated=None):
     if generated and label in generated:
         return Chunk(label, "", generated[label], f"<{label}>")
     if label.startswith("model:"):
-        from .materials.model import model_named, model_source
+        from .materials.model import model_for_key, model_source
 
-        model = model_named(label[len("model:"):])
+        model = model_for_key(*label[len("model:"):].split("@"))
         text, origin, first, _ = model_source(model)
         prelude = f"// uniforms of the model {model.name!r}, declared from its params\n" + model.uniform_declarations()
         return Chunk(label, prelude, text, origin, first)
@@ -122,7 +124,8 @@ def assemble(chunks, defines, generated=None):
     lines += [f"#define {name} {value}" for name, value in defines]
     for number, label in enumerate(chunks, start=1):
         chunk = resolve_chunk(label, generated)
-        if chunk.prelude:  # numbered after the previous chunk's last line (a "#line 1 0" confuses Mesa's locations)
+        if chunk.prelude:  # in the chunk's own block, past any line of its text
+            lines.append(f"#line {number * LINE_BLOCK + PRELUDE_LINE} {number}")
             lines.append(chunk.prelude)
         lines.append(f"#line {number * LINE_BLOCK + chunk.first_line} {number}")
         lines.append(chunk.text.rstrip("\n"))
@@ -206,11 +209,14 @@ def _name_chunks(log, chunks, generated=None):
         where = f":{line}" + (f":{m.group(3)}" if m.group(3) else "")
         if 1 <= n <= len(resolved):
             chunk = resolved[n - 1]
-            index = line - chunk.first_line
-            text = chunk.text.splitlines()
+            origin, index, text = chunk.origin, line - chunk.first_line, chunk.text.splitlines()
+            if line >= PRELUDE_LINE:  # the generated uniform declarations of a model
+                origin = f"<uniforms of {chunk.label}>"
+                index, line, text = line - PRELUDE_LINE, line - PRELUDE_LINE + 1, chunk.prelude.splitlines()
+                where = f":{line}" + (f":{m.group(3)}" if m.group(3) else "")
             if 0 <= index < len(text):
-                shown.append(f"    {chunk.origin}:{line} | {text[index].strip()}")
-            return f"{chunk.origin}{where}"
+                shown.append(f"    {origin}:{line} | {text[index].strip()}")
+            return f"{origin}{where}"
         return f"<generated header>{where}" if n == 0 else m.group(0)
 
     out = []
@@ -243,6 +249,12 @@ class Program:
             log = _name_chunks(str(exc), stage, generated)
             raise ShaderCompileError(f"program {key.describe()!r} failed to build:\n{log}") from None
         self.active = {name: self.gl_program[name] for name in self.gl_program if isinstance(self.gl_program[name], moderngl.Uniform)}
+        # a model's uniforms are declared from its params; one its GLSL does not read for this key (a
+        # structural define left it out) is not active, and a value given for it is not an error
+        from .materials.model import model_for_key
+
+        self.optional = {model_for_key(t.name, t.source_hash).uniform_name(p.name)
+                         for t in getattr(key, "terms", ()) for p in model_for_key(t.name, t.source_hash).params}
 
     def bind(self, values, drop_unused=False):
         """Set every active uniform from ``values``; anything else is an error.
@@ -266,6 +278,7 @@ class Program:
         """
         if drop_unused:
             values = {k: v for k, v in values.items() if k in self.active}
+        values = {k: v for k, v in values.items() if k in self.active or k not in self.optional}
         missing = sorted(set(self.active) - set(values))
         unknown = sorted(set(values) - set(self.active))
         if missing or unknown:

@@ -239,10 +239,11 @@ def material_response(f, wi, wo, n_dot_l, key, uniforms, material):
     """Sum of the lit terms' twins (the generated material chunk's ``material_response``); (N, 3)."""
     terms = _terms(material)
     out = np.zeros(np.shape(wi), np.result_type(f.n, wi))
-    for term_key in key.lit_terms:
+    for term_key in key.lit_terms:  # a term that does not need the view gets v = 0, as in the GLSL
         term = terms[term_key.name]
         p = term.values_from_uniforms(uniforms, dtype=out.dtype)
-        out = out + term.response(f, wi, wo, n_dot_l, p)
+        view = wo if "view" in term.needs else np.zeros_like(wi)
+        out = out + term.response(f, wi, view, n_dot_l, p)
     return out
 
 

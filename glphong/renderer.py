@@ -102,15 +102,25 @@ class _MeshBuffers:
         self.index_buffer = mgl.buffer(mesh.indices.tobytes())
         self.vertex_arrays = {}
 
+    #: what a mesh without tangents or UVs supplies to a program that reads them for another object's
+    #: sake (the G-buffer, the uber-shader): tangent 0 (the shader then uses the basis around n), uv 0
+    _DEFAULTS = {"in_tangent": (0.0, 0.0, 0.0, 1.0), "in_uv": (0.0, 0.0)}
+
     def buffer(self, mgl, name):
         if name not in self.buffers:
-            self.buffers[name] = mgl.buffer(getattr(self.owner(), self._SOURCES[name][0]).tobytes())
+            mesh = self.owner()
+            data = getattr(mesh, self._SOURCES[name][0])
+            if data is None:
+                data = np.tile(np.float32(self._DEFAULTS[name]), (len(mesh.positions), 1))
+            self.buffers[name] = mgl.buffer(np.ascontiguousarray(data, dtype=np.float32).tobytes())
         return self.buffers[name]
 
     def vertex_array(self, mgl, program):
         vao = self.vertex_arrays.get(program.key)
         if vao is None:
-            content = [(self.buffer(mgl, name), self._SOURCES[name][1], name) for name in program.key.attributes()]
+            # only what the linked program reads: a declared need its GLSL never reads is compiled out
+            content = [(self.buffer(mgl, name), self._SOURCES[name][1], name) for name in program.key.attributes()
+                       if name in program.gl_program]
             vao = self.vertex_arrays[program.key] = mgl.vertex_array(
                 program.gl_program, content, self.index_buffer, index_element_size=4)
         return vao
@@ -326,7 +336,10 @@ class Renderer:
             key = self.program_key(scene, obj, output)
             program = self.programs.get(key)
             program.bind(scene.uniform_values(index, key, aspect), drop_unused=key.formulation == "naive")
+            # a mirroring pose (det < 0) reverses the winding: its counter-clockwise faces become clockwise
+            self._mgl.front_face = "cw" if obj.mirrored else "ccw"
             self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program).render(moderngl.TRIANGLES)
+        self._mgl.front_face = "ccw"
 
     @staticmethod
     def _read(fbo, size, components, attachment=0, dtype="f4"):

@@ -38,6 +38,12 @@ class SceneObject:
     name: str
 
     @property
+    def mirrored(self):
+        """True when the pose mirrors (its 3x3 block has a negative determinant): front faces wind
+        clockwise on screen."""
+        return bool(np.linalg.det(self.pose[:3, :3]) < 0)
+
+    @property
     def normal_matrix(self):
         """Inverse-transpose of the pose's 3x3 block, (3, 3) float64."""
         return np.linalg.inv(self.pose[:3, :3]).T

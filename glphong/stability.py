@@ -318,6 +318,7 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
     n = unit(vec(raw_n))
     v = unit([e - p for e, p in zip(vec(scene.camera.position), x)])
     four_pi = 4 * mpmath.pi
+    frame = _oracle_frame(n, vec(tangent[:3]), float(np.float32(tangent[3])), [f(c) for c in uv[:2]], unit, dot)
     for light in scene.lights:
         if isinstance(light, PointLight):
             to_light = [a - b for a, b in zip(vec(light.position), x)]
@@ -333,12 +334,27 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
         if ndl <= 0:
             continue
         for term in terms:
+            view = v if "view" in term.needs else [mpmath.mpf(0)] * 3  # as the shader: v = 0 unless needed
             if term.oracle is not None:
-                response = term.oracle(n, l, v, ndl, mp_values(term))
+                response = term.oracle(frame, l, view, ndl, mp_values(term))
             else:
-                response = _twin_at(term, n, l, v, ndl, tangent, uv)
+                response = _twin_at(term, n, l, view, ndl, tangent, uv)
             out = [o + r * ee for o, r, ee in zip(out, response, e)]
     return np.array([float(o) for o in out])
+
+
+def _oracle_frame(n, tangent, handedness, uv, unit, dot):
+    """The shading frame in mpmath: ``t`` the tangent made orthogonal to n (Gram-Schmidt), ``b = sign(w) n x t``."""
+    from .materials import ShadingFrame
+
+    along = dot(n, tangent)
+    projected = [a - along * b for a, b in zip(tangent, n)]
+    if dot(projected, projected) == 0:
+        return ShadingFrame(n, None, None, uv)
+    t = unit(projected)
+    sign = -1 if handedness < 0 else 1
+    b = [sign * (n[1] * t[2] - n[2] * t[1]), sign * (n[2] * t[0] - n[0] * t[2]), sign * (n[0] * t[1] - n[1] * t[0])]
+    return ShadingFrame(n, t, b, uv)
 
 
 def _twin_at(term, n, l, v, ndl, tangent, uv):

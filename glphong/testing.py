@@ -199,7 +199,8 @@ def direction_sets(n=2000, seed=0):
     With the normal +z: random ``wi``, ``wo`` over the upper hemisphere (and some ``wo`` below it),
     and the edge sets: grazing light (``n.l`` from 1e-2 down to 1e-7, and 0), grazing view, the mirror
     direction (the peak of Phong and Blinn lobes) and small offsets from it, ``l = v`` (the
-    retro-reflection peak), ``l = -v`` mirrored at grazing, and ``n.l`` just above 0.
+    retro-reflection peak), ``l = -v`` mirrored at grazing, ``n.l`` just above 0, and light and view
+    both so grazing (cosines 1e-30 to 1e-19) that ``(n.l)(n.v)`` is below FLT_MIN.
 
     Parameters
     ----------
@@ -251,6 +252,8 @@ def direction_sets(n=2000, seed=0):
     sets.append(("l, v grazing and mirrored", wi, -wi * np.array([1.0, 1.0, -1.0])))
     wi = at(10.0 ** rng.uniform(-7, -3, k), k)
     sets.append(("n.l just above 0", wi, mirror(wi)))
+    wi, wo = at(10.0 ** rng.uniform(-30, -19, k), k), at(10.0 ** rng.uniform(-30, -19, k), k)
+    sets.append(("l and v grazing, (n.l)(n.v) below FLT_MIN", wi, wo))
     labels = np.concatenate([[label] * len(a) for label, a, _ in sets])
     return np.concatenate([a for _, a, _ in sets]), np.concatenate([b for _, _, b in sets]), labels
 

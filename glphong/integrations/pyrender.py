@@ -115,7 +115,8 @@ def scene_from_pyrender(scene):
             if isinstance(primitive.material, GlphongMaterial):
                 # pyrender keeps indices as float32 (exact below 2^24 vertices)
                 indices = np.rint(np.asarray(primitive.indices, dtype=np.float64)).astype(np.int64).reshape(-1, 3)
-                data = MeshData(primitive.positions, primitive.normals, indices)
+                data = MeshData(primitive.positions, primitive.normals, indices, uvs=primitive.texcoord_0,
+                                tangents=primitive.tangents)
                 out.add(data, primitive.material.glphong, pose=scene.get_pose(node), name=node.name)
     return out
 

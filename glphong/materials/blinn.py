@@ -87,14 +87,14 @@ class BlinnLobe(MaterialModel):
         high = np.where(possible, np.where(certain, high, 1.0), 0.0)
         return p.ks * low[..., None], p.ks * high[..., None]
 
-    def oracle(self, n, wi, wo, n_dot_l, p):
+    def oracle(self, f, wi, wo, n_dot_l, p):
         import mpmath
 
         s = [a + b for a, b in zip(wi, wo)]
         length = mpmath.sqrt(sum(x * x for x in s))
-        if not (sum(a * b for a, b in zip(n, wo)) > 0 and length > 0):
+        if not (sum(a * b for a, b in zip(f.n, wo)) > 0 and length > 0):
             return [mpmath.mpf(0)] * 3
-        lobe = lobe_oracle(sum(a * b / length for a, b in zip(n, s)), p.q)
+        lobe = lobe_oracle(sum(a * b / length for a, b in zip(f.n, s)), p.q)
         return [k * lobe for k in p.ks]
 
     def pbr_roughness(self):

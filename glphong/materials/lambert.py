@@ -52,7 +52,11 @@ class Lambert(MaterialModel):
         tol = constants.D * EPS
         return lambert(p.kd, np.maximum(n_dot_l - tol, 0.0)), lambert(p.kd, np.maximum(n_dot_l + tol, 0.0))
 
-    def oracle(self, n, wi, wo, n_dot_l, p):
+    def pbr_base_color(self):
+        """The albedo ``pi k_d`` (RGB), a metallic-roughness base colour for comparisons with pyrender."""
+        return tuple(np.pi * c for c in self.kd)
+
+    def oracle(self, f, wi, wo, n_dot_l, p):
         return [k * n_dot_l for k in p.kd]
 
     @classmethod

@@ -273,8 +273,14 @@ def _resolve_source(cls):
     if isinstance(glsl, GlslFile):
         from ..programs import glsl_root
 
-        path = glsl_root() / glsl.path
-        return path.read_text(encoding="utf-8"), glsl.path, 1
+        path = glsl_root().joinpath(*glsl.path.split("/"))  # a Traversable: one part at a time
+        try:
+            return path.read_text(encoding="utf-8"), glsl.path, 1
+        except OSError as exc:
+            raise MaterialDefinitionError(
+                f"{cls.__qualname__}: cannot read its GLSL {glsl.path!r} from the shader folder {glsl_root()} "
+                f"({exc.strerror}); GLPHONG_GLSL_DIR, when set, must name a full copy of glphong's glsl/ folder, "
+                "and be set before glphong is imported") from None
     if isinstance(glsl, Path) or (isinstance(glsl, str) and "\n" not in glsl and glsl.strip().endswith(".glsl")):
         path = Path(glsl)
         if not path.is_absolute():
@@ -300,14 +306,34 @@ def _resolve_source(cls):
     return glsl, label, first
 
 
+_BY_HASH = {}
+
+
 def model_source(cls):
-    """``(text, label, first_line, source_hash)`` of a model's GLSL (cached per class)."""
+    """``(text, label, first_line, source_hash)`` of a model's GLSL (cached per class).
+
+    The hash covers everything the model's chunk is made of: its uniform declarations (from
+    `params`), the library chunks it uses and its text, so an edited definition is another program.
+    """
     cached = _SOURCES.get(cls)
     if cached is None:
         text, label, first = _resolve_source(cls)
-        digest = hashlib.sha256(text.encode("utf-8")).hexdigest()[:12]
+        whole = "\n".join([cls.uniform_declarations(), " ".join(cls.uses), text])
+        digest = hashlib.sha256(whole.encode("utf-8")).hexdigest()[:12]
         cached = _SOURCES[cls] = (text, label, first, digest)
+        _BY_HASH[(cls.name, digest)] = cls
     return cached
+
+
+def model_for_key(name, source_hash):
+    """The model class a program key's term was made from (by name and source hash): a class that was
+    redefined since (a re-run notebook cell) still builds its own programs."""
+    cls = _BY_HASH.get((name, source_hash))
+    if cls is None:
+        cls = model_named(name)
+        if cls.source_hash() != source_hash:
+            raise KeyError(f"no definition of the material model {name!r} has source hash {source_hash}")
+    return cls
 
 
 def _check_glsl(cls, text):
@@ -336,6 +362,89 @@ def _check_glsl(cls, text):
     if re.search(rf"\buniform\s+\w+\s+u_{name}_", code):
         raise MaterialDefinitionError(f"{cls.__qualname__}.glsl declares its own u_{name}_* uniforms: glphong "
                                       "declares them from params; remove the declarations")
+    _check_needs(cls, code)
+    _check_namespace(cls, code)
+
+
+def _function_body(code, name):
+    """``(parameter names, body text)`` of GLSL function ``name`` in ``code``."""
+    m = re.search(rf"\b{name}\s*\(([^)]*)\)\s*\{{", code)
+    depth, i = 1, m.end()
+    while depth and i < len(code):
+        depth += {"{": 1, "}": -1}.get(code[i], 0)
+        i += 1
+    return [p.split()[-1] for p in m.group(1).split(",")], code[m.end():i]
+
+
+def _check_needs(cls, code):
+    """The response must not read what `needs` does not declare: ``wo`` without 'view', ``f.t``/``f.b``
+    without 'tangent', ``f.uv`` without 'uv' (they would be 0, or set by another term's needs)."""
+    (frame, _, wo, _), body = _function_body(code, f"{cls.name}_response")
+    missing = []
+    if "view" not in cls.needs and re.search(rf"\b{wo}\b", body):
+        missing.append(f"'view' (it reads {wo})")
+    if "tangent" not in cls.needs and re.search(rf"\b{frame}\s*\.\s*[tb]\b", body):
+        missing.append(f"'tangent' (it reads {frame}.t or {frame}.b)")
+    if "uv" not in cls.needs and re.search(rf"\b{frame}\s*\.\s*uv\b", body):
+        missing.append(f"'uv' (it reads {frame}.uv)")
+    if missing:
+        raise MaterialDefinitionError(f"{cls.__qualname__}.needs must include {' and '.join(missing)}: what a model "
+                                      "does not declare is not computed for it")
+
+
+def _top_level_names(code):
+    """Functions, constants and structs a GLSL text defines at file scope."""
+    names, depth, start = set(), 0, 0
+    for i, c in enumerate(code + "\n"):
+        if c == "{":
+            if depth == 0:
+                names.update(re.findall(r"\b([A-Za-z_]\w*)\s*\([^()]*\)\s*$", code[start:i]))
+                names.update(re.findall(r"\bstruct\s+([A-Za-z_]\w*)\s*$", code[start:i]))
+            depth += 1
+        elif c == "}":
+            depth -= 1
+            start = i + 1
+        elif c == ";" and depth == 0:
+            names.update(re.findall(r"\bconst\s+\w+\s+([A-Za-z_]\w*)\s*=", code[start:i]))
+            start = i + 1
+    return names
+
+
+def _generated_names(cls):
+    """The uniform and switch names glphong generates for a model."""
+    return {cls.uniform_name(p.name) for p in cls.params} | {f"u_use_{cls.name}", f"u_use_{cls.name}_ambient"}
+
+
+def _library_names():
+    from ..programs import chunk_source
+
+    names = {"material_emission", "material_response", "shade_point"}
+    for chunk in ("common", "lights", "lobe", "shade", "srgb"):
+        names |= _top_level_names(_strip_comments(chunk_source(chunk)))
+    return names
+
+
+def _check_namespace(cls, code):
+    """What a model defines must not collide with the library or another model (they share a program)."""
+    own = _top_level_names(code)
+    clash = own & _library_names()
+    if clash:
+        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl defines {', '.join(sorted(clash))}, which glphong's "
+                                      f"library chunks define; prefix your functions with {cls.name}_")
+    for other in registered_models():
+        if other.name == cls.name:
+            continue
+        theirs = _top_level_names(_strip_comments(other.source()))
+        both = own & theirs
+        if both:
+            raise MaterialDefinitionError(
+                f"{cls.__qualname__}.glsl defines {', '.join(sorted(both))}, which the model {other.name!r} also "
+                f"defines (both can be in one program): prefix your functions with {cls.name}_")
+        generated = _generated_names(cls) & (_generated_names(other) | theirs)
+        if generated:
+            raise MaterialDefinitionError(
+                f"{cls.__qualname__}: its generated uniforms {', '.join(sorted(generated))} collide with the model "
+                f"{other.name!r}'s names; rename the model or the parameter")
 
 
 _TWIN_ARGS = ("f", "wi", "wo", "n_dot_l", "p")
@@ -508,8 +617,10 @@ class MaterialModel(Material):
     band(self, f, wi, wo, n_dot_l, p, constants)  (optional)
         Interval of float32 GPU responses consistent with the float64 twin; the default widens
         the twin by its sensitivity to a few ulps of its inputs (see `MaterialModel.band`).
-    oracle(self, n, wi, wo, n_dot_l, p)  (optional)
-        The response in mpmath at high precision, for the stability suite (default: the twin).
+    oracle(self, f, wi, wo, n_dot_l, p)  (optional)
+        The response in mpmath at high precision, for the stability suite (default: the twin): the
+        same arguments as lists of mpmath numbers (``f.n``, ``f.t``, ``f.b``, ``f.uv``; ``p`` from the
+        constructor's values rounded to float32), returning a list of 3.
     stability_cases(cls)  (optional classmethod)
         The model's extreme cases (default: grazing, behind and opposite geometry at example values).
     """
@@ -622,10 +733,12 @@ class MaterialModel(Material):
 
         The generic default, for models that do not derive their own: the twin's first-order
         sensitivity to its inputs, each perturbed by a few ulps as float32 arithmetic perturbs
-        them: ``wi`` and ``wo`` rotated by ``D eps`` about two axes each, ``n_dot_l`` moved by
-        ``+-D eps``, every scalar parameter scaled by ``1 +- A eps`` (which also stands for
-        the error of a ``pow`` or ``exp`` it feeds); the deviations add up worst-case,
-        and the result is widened by ``eps (A + B |ln r|)`` relative (``exp``/``pow`` error).
+        them: ``wi`` and ``wo`` rotated by ``D eps`` about two axes each and scaled by
+        ``1 +- D eps`` (so every dot product the model forms with them moves by about ``D eps``,
+        also at normal incidence), the frame's ``n``, ``t`` and ``b`` scaled likewise, ``n_dot_l``
+        moved by ``+-D eps``, every scalar parameter scaled by ``1 +- A eps`` (which also stands
+        for the error of a ``pow`` or ``exp`` it feeds); the deviations add up worst-case, and the
+        result is widened by ``eps (A + B |ln r|)`` relative (``exp``/``pow`` error).
 
         ``n_dot_l`` may be as low as ``-D eps`` where the light gate is uncertain (the caller then
         accepts 0 as well); a band must bound the response over ``(0, n.l + D eps]``.  The default
@@ -655,6 +768,17 @@ class MaterialModel(Material):
                     args = (turned, wo) if which == "wi" else (wi, turned)
                     with np.errstate(all="ignore"):
                         add(self.response(f, *args, n_dot_l, p))
+            for sign in (1.0, -1.0):
+                args = (vector * (1.0 + sign * angle), wo) if which == "wi" else (wi, vector * (1.0 + sign * angle))
+                with np.errstate(all="ignore"):
+                    add(self.response(f, *args, n_dot_l, p))
+        for field in ("n", "t", "b"):
+            if getattr(f, field) is None:
+                continue
+            for sign in (1.0, -1.0):
+                scaled = ShadingFrame(**{**f.__dict__, field: getattr(f, field) * (1.0 + sign * angle)})
+                with np.errstate(all="ignore"):
+                    add(self.response(scaled, wi, wo, n_dot_l, p))
         for sign in (1.0, -1.0):
             moved = np.maximum(n_dot_l + sign * angle, tiny)
             with np.errstate(all="ignore"):
@@ -715,6 +839,10 @@ def _check_definition(cls):
     names = [p.name for p in params]
     if len(set(names)) != len(names):
         raise MaterialDefinitionError(f"{cls.__qualname__}.params repeats a name ({names})")
+    shadowing = sorted(set(names) & set(dir(MaterialModel)))
+    if shadowing:
+        raise MaterialDefinitionError(f"{cls.__qualname__}.params: {', '.join(shadowing)} would shadow a "
+                                      "MaterialModel attribute; choose other parameter names")
     if not isinstance(cls.needs, tuple) or not set(cls.needs) <= set(NEEDS):
         raise MaterialDefinitionError(f"{cls.__qualname__}.needs must be a tuple of {', '.join(map(repr, NEEDS))} "
                                       f"(got {cls.needs!r})")

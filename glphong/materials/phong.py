@@ -80,8 +80,8 @@ class PhongLobe(MaterialModel):
         low, high = lobe_band(phong_delta(f.n, wi, wo), p.q, 1.0, constants)
         return p.ks * low[..., None], p.ks * high[..., None]
 
-    def oracle(self, n, wi, wo, n_dot_l, p):
-        c = sum(v * (2 * n_dot_l * a - b) for v, a, b in zip(wo, n, wi))
+    def oracle(self, f, wi, wo, n_dot_l, p):
+        c = sum(v * (2 * n_dot_l * a - b) for v, a, b in zip(wo, f.n, wi))
         lobe = lobe_oracle(c, p.q)
         return [k * lobe for k in p.ks]
 

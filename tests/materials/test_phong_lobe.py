@@ -56,7 +56,7 @@ def f32(x):
 def test_twin_matches(glphong_backend, q, ks):
     material = PhongLobe(ks, q)
     figures = assert_twin_matches(material, n=2000, seed=0, backend=glphong_backend)
-    wi, wo, _ = direction_sets(2000, 0)
+    wi, wo, labels = direction_sets(2000, 0)
     l, v = float32_units(wi), float32_units(wo)
     n_dot_l = l[:, 2]
     v_dot_r = np.sum(v * (2 * n_dot_l[:, None] * np.array([0.0, 0.0, 1.0]) - l), axis=1)
@@ -71,7 +71,9 @@ def test_twin_matches(glphong_backend, q, ks):
     # away from underflow the GPU follows the twin closely
     gpu = evaluate(material, wi, wo, backend=glphong_backend).astype(np.float64)
     twin = evaluate(material, wi, wo, twin=True)
-    normal = twin >= 2.0 ** -100
+    # away from underflow, and from the set where both directions graze to 1e-19 (there the lobe's
+    # delta is 1 - 1e-38 and float32 resolves it to within eps: judged by the band above, not here)
+    normal = (twin >= 2.0 ** -100) & (labels != "l and v grazing, (n.l)(n.v) below FLT_MIN")[:, None]
     rel = np.abs(gpu - twin)[normal] / twin[normal]
     assert rel.max() < (1e-3 if q <= 1 else 1e-4)  # measured 0 / 2.07e-4 / at most 2.43e-5
 
