@@ -228,7 +228,9 @@ class GlslFile:
     """A built-in model's GLSL file, relative to glphong's shader folder (``glsl/``).
 
     Read through the same root as every chunk, so ``GLPHONG_GLSL_DIR`` (a working copy of the
-    shaders) applies to model chunks too.
+    shaders) applies to model chunks too.  A model's GLSL is read when its class is defined (the
+    definition is checked then), library chunks when first used: set ``GLPHONG_GLSL_DIR`` before
+    importing glphong.
     """
 
     path: str
