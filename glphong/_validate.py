@@ -9,6 +9,19 @@ import numbers
 import numpy as np
 
 FLT_MAX = float(np.finfo(np.float32).max)
+FLT_MIN = float(np.finfo(np.float32).tiny)
+
+
+def float32_uniform(value):
+    """``value`` as the float32 a shader receives: rounded, with subnormal values flushed to 0.
+
+    GPUs flush float32 subnormals (llvmpipe does), so a uniform of 1e-40 acts as 0; flushing here,
+    where uniforms are made, gives the twin the very values the GPU computes with.  Values beyond
+    FLT_MAX (a valid but extreme camera matrix entry) become +-Inf without a warning.
+    """
+    with np.errstate(over="ignore"):
+        a = np.asarray(value, dtype=np.float32)
+    return np.where(np.abs(a) < FLT_MIN, np.float32(0.0), a).astype(np.float32)
 
 
 def _fmt(value):

@@ -19,7 +19,8 @@ import numpy as np
 
 __all__ = [
     "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus", "lobe_from_delta",
-    "incident_light", "material_emission", "material_response", "view_direction", "shade_point", "shade_inputs", "shade",
+    "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
+    "shade_inputs", "shade",
 ]
 
 def __getattr__(name):
@@ -247,6 +248,12 @@ def material_response(f, wi, wo, n_dot_l, key, uniforms, material):
     return out
 
 
+def light_term(response, irradiance):
+    """``response * E``, exactly 0 where ``E = 0`` (shade.glsl): an overflowed response never makes NaN."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        return np.where(irradiance == 0, 0.0, response * irradiance).astype(np.result_type(response, irradiance))
+
+
 def view_direction(position, n_valid, eye, key):
     """The head of shade.glsl's light loops: ``v`` where a lobe needs it, and which points are lit.
 
@@ -298,8 +305,8 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
         if gate.any():
             g = f.select(gate)
             with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
-                term[gate] = material_response(g, wi[gate], wo[gate], n_dot_l[gate], key, uniforms, material) \
-                    * irradiance[gate]
+                term[gate] = light_term(material_response(g, wi[gate], wo[gate], n_dot_l[gate], key, uniforms, material),
+                                        irradiance[gate])
         radiance = radiance + term
     return radiance
 

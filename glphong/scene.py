@@ -207,7 +207,7 @@ class Scene:
                 values["u_eye"] = self.camera.position
             values.update(obj.material.uniform_values(key))
             values.update(self.light_uniform_values(key))
-        return {name: np.asarray(v, dtype=np.float32) for name, v in values.items()}
+        return {name: _validate.float32_uniform(v) for name, v in values.items()}
 
     def _uber_uniform_values(self, index, key, aspect):
         """The uber-shader's uniforms: the specialised key's values, zeros for the terms the object's

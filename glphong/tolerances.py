@@ -133,8 +133,10 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
                 f_lo[possible], f_hi[possible] = response_band(key, u, f.select(possible), wi[possible],
                                                                wo[possible], n_dot_l[possible], material, band)
             with np.errstate(over="ignore", invalid="ignore"):
-                t_lo = np.nan_to_num(f_lo * irradiance * (1 - band.A * EPS), nan=0.0)
-                t_hi = np.nan_to_num(f_hi * irradiance * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
+                # an irradiance below FLT_MIN may be flushed to 0 on the GPU, and the term with it
+                e_lo = np.where(irradiance < FLT_MIN, 0.0, irradiance)
+                t_lo = np.nan_to_num(ref.light_term(f_lo, e_lo) * (1 - band.A * EPS), nan=0.0)
+                t_hi = np.nan_to_num(ref.light_term(f_hi, irradiance) * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
             lo = lo + np.where(certain, t_lo, 0.0)
             hi = hi + np.where(possible[..., None], t_hi, 0.0)
     low = lo * (1 - terms * EPS)

@@ -6,11 +6,14 @@
 // Per-pixel shading (default): normal, tangent and uv are passed on unnormalised; the fragment stage shades.
 // SHADE_PER_VERTEX: v_radiance = shade_point(world, frame, n_valid, u_eye) here, interpolated across the
 //   triangle (Gouraud); the normal is flipped toward the eye when TWO_SIDED (a vertex shader has
-//   no gl_FrontFacing).  Positions in metres, radiance in W/(m^2 sr).
+//   no gl_FrontFacing); a vertex radiance beyond GOURAUD_MAX = 2^100 (about 1.3e30) saturates there, so
+//   the interpolation never meets Inf (Inf times a zero barycentric weight is NaN) nor overflows.
+//   Positions in metres, radiance in W/(m^2 sr).
 // Attribute locations are fixed and match pyrender's: 0 position, 1 normal, 2 tangent, 3 uv.
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, SHADE_PER_VERTEX, TWO_SIDED, NEEDS_VIEW, SWITCH(flag).
 
+const float GOURAUD_MAX = 1.2676506002282294e30;  // 2^100: per-vertex radiance saturates here
 layout(location = 0) in vec3 in_position;
 uniform mat4 u_model;
 uniform mat4 u_view_projection;
@@ -72,7 +75,9 @@ void main()
     }
 #endif
 #endif
-    v_radiance = shade_point(world.xyz, shading_frame(n, tangent, uv), n_valid, u_eye);
+    // saturated at GOURAUD_MAX: interpolating Inf (or values near FLT_MAX, which the perspective-correct
+    // interpolation scales by 1/w and subtracts) would give Inf and NaN inside the triangle
+    v_radiance = min(shade_point(world.xyz, shading_frame(n, tangent, uv), n_valid, u_eye), vec3(GOURAUD_MAX));
 #else
 #if HAS_NORMAL
     v_normal = u_normal_matrix * in_normal;

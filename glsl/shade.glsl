@@ -7,6 +7,8 @@
 // shade_point(position, f, n_valid, eye) -> L [W/(m^2 sr)], RGB, linear, never clamped
 //   position: world-space surface point [m];  f: the ShadingFrame (n_valid false: emission only);
 //   eye: world-space camera centre [m].
+// light_term(response, E) -> response * E, exactly 0 where E = 0 (a response that overflowed to Inf
+//   times an irradiance of 0 would be NaN): a select, no branch.
 // Each light kind is a loop of compile-time length; a kind the scene lacks has no loop at all.
 // Light j contributes nothing unless n.l_j > 0 (tested before anything else is evaluated).
 // The view vector v is computed only where a term reads it (NEEDS_VIEW).
@@ -27,6 +29,11 @@ uniform vec3 u_unattenuated_radiance[NUM_UNATTENUATED_LIGHTS];  // L_i, used as 
 uniform vec3 u_directional_direction[NUM_DIRECTIONAL_LIGHTS];   // unit, toward the light
 uniform vec3 u_directional_irradiance[NUM_DIRECTIONAL_LIGHTS];  // E [W/m^2]
 #endif
+
+vec3 light_term(vec3 response, vec3 irradiance)
+{
+    return mix(response * irradiance, vec3(0.0), equal(irradiance, vec3(0.0)));
+}
 
 vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec3 eye)
 {
@@ -51,7 +58,7 @@ vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec3 eye)
         if (!safe_normalize(u_point_position[j] - position, wi, d)) continue;
         n_dot_l = dot(f.n, wi);
         if (!(n_dot_l > 0.0)) continue;
-        radiance += material_response(f, wi, wo, n_dot_l) * point_irradiance(u_point_intensity[j], d);
+        radiance += light_term(material_response(f, wi, wo, n_dot_l), point_irradiance(u_point_intensity[j], d));
     }
 #endif
 #if NUM_UNATTENUATED_LIGHTS > 0
@@ -59,7 +66,7 @@ vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec3 eye)
         if (!safe_normalize(u_unattenuated_position[j] - position, wi, d)) continue;
         n_dot_l = dot(f.n, wi);
         if (!(n_dot_l > 0.0)) continue;
-        radiance += material_response(f, wi, wo, n_dot_l) * u_unattenuated_radiance[j];
+        radiance += light_term(material_response(f, wi, wo, n_dot_l), u_unattenuated_radiance[j]);
     }
 #endif
 #if NUM_DIRECTIONAL_LIGHTS > 0
@@ -67,7 +74,7 @@ vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec3 eye)
         wi = u_directional_direction[j];
         n_dot_l = dot(f.n, wi);
         if (!(n_dot_l > 0.0)) continue;
-        radiance += material_response(f, wi, wo, n_dot_l) * u_directional_irradiance[j];
+        radiance += light_term(material_response(f, wi, wo, n_dot_l), u_directional_irradiance[j]);
     }
 #endif
     return radiance;

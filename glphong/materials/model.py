@@ -523,14 +523,14 @@ class Material:
         """
         values = {}
         if key.has_ka:
-            values["u_ka"] = np.asarray(self.ka, dtype=np.float32)
+            values["u_ka"] = _validate.float32_uniform(self.ka)
         by_name = {term.name: term for term in self.components}
         for term_key in key.terms:
             term = by_name.get(term_key.name)
             if term is None:
                 continue  # the uber-shader's terms this material does not have: the caller fills zeros
             params = term.params if term_key.lit else [p for p in term.params if p.name == term.ambient]
-            values.update({term.uniform_name(p.name): np.asarray(getattr(term, p.name), dtype=np.float32)
+            values.update({term.uniform_name(p.name): _validate.float32_uniform(getattr(term, p.name))
                            for p in params})
         return values
 
@@ -721,8 +721,9 @@ class MaterialModel(Material):
         return ParamValues({p.name: np.asarray(uniforms[cls.uniform_name(p.name)], dtype=dtype) for p in params})
 
     def values(self, dtype=np.float64):
-        """`ParamValues` of this instance: its values rounded to float32, in ``dtype``."""
-        return ParamValues({p.name: np.asarray(np.asarray(getattr(self, p.name), dtype=np.float32), dtype=dtype)
+        """`ParamValues` of this instance: its values as the GPU receives them (float32, subnormals
+        flushed), in ``dtype``."""
+        return ParamValues({p.name: np.asarray(_validate.float32_uniform(getattr(self, p.name)), dtype=dtype)
                             for p in self.params})
 
     # ---- the twin and what is built on it
