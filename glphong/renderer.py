@@ -5,6 +5,7 @@ program; the scene gives the uniforms, bound strictly; only the vertex attribute
 the program reads are bound; the draw goes to an RGBA32F target that is read back
 as float32 with row 0 at the top.
 """
+import warnings
 import weakref
 from dataclasses import dataclass, replace
 
@@ -420,6 +421,17 @@ class Renderer:
 
     def __exit__(self, *exc):
         self.release()
+
+    def __del__(self):
+        # dropped without release(): free the GL objects and the context now (moderngl never frees them
+        # on garbage collection), and say so the way an unclosed file does
+        if getattr(self, "context", None) is not None:
+            warnings.warn(f"{self!r} was never released: released by the garbage collector (call release() "
+                          "or use 'with glphong.Renderer(...) as r:')", ResourceWarning, stacklevel=2)
+            try:
+                self.release()
+            except Exception:  # noqa: BLE001 - at interpreter exit the GL library may be gone
+                pass
 
     def __repr__(self):
         state = "released" if self.context is None else self.backend
