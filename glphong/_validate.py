@@ -39,6 +39,14 @@ def real_array(name, value, expected):
         raw = np.asarray(value)
     except (TypeError, ValueError):
         raw = None
+    if raw is not None and not isinstance(value, np.ndarray) and raw.dtype.kind in "iu" and raw.size:
+        # numpy turns (True, 0, 0) into integers: look at the elements themselves
+        try:
+            elements = np.asarray(value, dtype=object).ravel()
+        except (TypeError, ValueError):
+            elements = ()
+        if any(isinstance(x, (bool, np.bool_)) for x in elements):
+            raise TypeError(f"{name} must be {expected}, not booleans (got {value!r})")
     ok = raw is not None and (raw.dtype.kind in "iuf" or (raw.dtype.kind == "O" and all(
         isinstance(x, numbers.Real) and not isinstance(x, (bool, np.bool_)) for x in raw.flat)))
     if not ok:

@@ -92,6 +92,12 @@ def _describe(args):
 
 
 def _bench(args):
+    import importlib.util
+
+    missing = [m for m in ("matplotlib",) if importlib.util.find_spec(m) is None]
+    if missing:  # say so at once, not after minutes of measuring
+        print(f"glphong bench needs {', '.join(missing)} for its diagram: pip install 'glphong[bench]'", file=sys.stderr)
+        return 2
     from .bench import methods, quick_cases, run_bench, standard_cases
 
     report = run_bench(args.width, args.height, cases=quick_cases() if args.quick else standard_cases(),
@@ -103,15 +109,42 @@ def _bench(args):
     return 0
 
 
+def _png_path(text):
+    """``--out``: a path ending in .png."""
+    if not text.lower().endswith(".png"):
+        raise argparse.ArgumentTypeError(f"--out must end in .png (got {text!r})")
+    return text
+
+
+def _tile_size(text):
+    """``--tile``: an integer from 1 to 1024 (the figure is 8 x 5 tiles: 1024 makes 8192 x 5120 px, a
+    0.5 GB float32 image in memory)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--tile must be an integer from 1 to 1024 (got {text!r})") from None
+    if not 1 <= value <= 1024:
+        raise argparse.ArgumentTypeError(f"--tile must be from 1 to 1024 pixels (got {value}; the figure is "
+                                         "8 x 5 tiles, held in memory as float32)")
+    return value
+
+
 def build_parser():
     """The argument parser (subcommands: render, stability, describe, bench)."""
-    parser = argparse.ArgumentParser(prog="glphong", description=__doc__.strip().splitlines()[0])
+    from . import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="glphong", description="Classic local-illumination shading (Lambert, Phong, Blinn-Torrance and your "
+        "own materials) in GLSL, rendered offscreen (EGL or OSMesa) and cross-checked against a numpy float64 "
+        "twin. With no command: render the lecture's 'Phong Examples' figure to phong_examples.png.")
+    parser.add_argument("--version", action="version", version=f"glphong {__version__}")
     sub = parser.add_subparsers(dest="command")
     render = sub.add_parser("render", help="render the 'Phong Examples' figure (the default command)")
-    render.add_argument("--out", default="phong_examples.png", help="PNG path (default: phong_examples.png)")
+    render.add_argument("--out", default="phong_examples.png", type=_png_path,
+                        help="PNG path (default: phong_examples.png)")
     render.add_argument("--npy", default=None, help="also write the raw float32 radiance to this .npy path")
     render.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
-    render.add_argument("--tile", type=int, default=128, help="tile size in pixels (default 128)")
+    render.add_argument("--tile", type=_tile_size, default=128, help="tile size in pixels, 1 to 1024 (default 128)")
     render.add_argument("--exposure", type=float, default=0.6, help="linear exposure before sRGB encoding")
     render.add_argument("--verify", action="store_true", help="cross-check every tile against the float64 twin")
     render.set_defaults(func=_render)
@@ -129,8 +162,8 @@ def build_parser():
     describe.add_argument("--gbuffer", action="store_true", help="include the G-buffer programs")
     describe.set_defaults(func=_describe)
     bench = sub.add_parser("bench", help="work-precision report: error against run time for every method")
-    bench.add_argument("--width", type=int, default=256)
-    bench.add_argument("--height", type=int, default=192)
+    bench.add_argument("--width", type=int, default=256, help="image width in pixels (default 256)")
+    bench.add_argument("--height", type=int, default=192, help="image height in pixels (default 192)")
     bench.add_argument("--repeats", type=int, default=5, help="timed repeats per point (median)")
     bench.add_argument("--quick", action="store_true", help="a tiny configuration (2 scenes, 2 knob values)")
     bench.add_argument("--out", default="glphong_bench", help="output prefix: PREFIX.csv, PREFIX.json, PREFIX.png")
@@ -143,7 +176,7 @@ def main(argv=None):
     """Entry point; returns the process exit code."""
     parser = build_parser()
     argv = list(sys.argv[1:] if argv is None else argv)
-    if not argv or argv[0].startswith("-") and argv[0] not in ("-h", "--help"):
+    if not argv or argv[0].startswith("-") and argv[0] not in ("-h", "--help", "--version"):
         argv = ["render", *argv]
     args = parser.parse_args(argv)
     return args.func(args)

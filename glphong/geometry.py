@@ -101,6 +101,13 @@ class MeshData:
             raise TypeError(f"mesh must be a trimesh.Trimesh (got {type(mesh).__name__})")
         if len(mesh.faces) == 0:
             raise ValueError("mesh must have at least one face")
+        vertices, faces = np.asarray(mesh.vertices), np.asarray(mesh.faces)
+        if faces.min() < 0 or faces.max() >= len(vertices):
+            raise ValueError(f"mesh.faces must index its {len(vertices)} vertices, 0 to {len(vertices) - 1} "
+                             f"(got indices from {faces.min()} to {faces.max()})")
+        if not (np.all(np.isfinite(vertices)) and np.all(np.abs(vertices) <= _validate.FLT_MAX)):
+            raise ValueError(f"positions must be finite with |components| <= {_validate.FLT_MAX:g} (float32): "
+                             "the trimesh has a vertex that is not")
         uv = getattr(getattr(mesh, "visual", None), "uv", None)
         uv = None if uv is None or len(uv) != len(mesh.vertices) else np.asarray(uv, dtype=np.float64)
         if smooth:

@@ -65,10 +65,21 @@ def encode_srgb8(radiance, exposure=1.0):
 
 
 def save_png(path, radiance, exposure=1.0):
-    """Write ``encode_srgb8(radiance, exposure)`` as a PNG file with Pillow."""
+    """Write ``encode_srgb8(radiance, exposure)`` as a PNG file with Pillow.
+
+    Raises
+    ------
+    ValueError
+        If ``path`` does not end in ``.png`` (Pillow would pick another, possibly lossy, format).
+    """
+    import os
+
     from PIL import Image
 
-    Image.fromarray(encode_srgb8(radiance, exposure), mode="RGB").save(path)
+    if os.path.splitext(os.fspath(path))[1].lower() != ".png":
+        raise ValueError(f"path must end in .png: save_png writes PNG only (got {os.fspath(path)!r}); "
+                         "use encode_srgb8() and Pillow for other formats")
+    Image.fromarray(encode_srgb8(radiance, exposure), mode="RGB").save(path, format="PNG")
 
 
 def save_npy(path, radiance):

@@ -133,6 +133,18 @@ class _MeshBuffers:
             buf.release()
 
 
+def _available_memory():
+    """``MemAvailable`` of /proc/meminfo [bytes] (llvmpipe's render targets live in host memory), or None."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
+
+
 class Renderer:
     """Offscreen renderer of glphong scenes.
 
@@ -177,16 +189,52 @@ class Renderer:
         if not isinstance(specialise, (bool, np.bool_)):
             raise TypeError(f"specialise must be a bool, True or False (got {specialise!r})")
         self.specialise = bool(specialise)
-        self.context = create_context(backend)
-        self._mgl = self.context.mgl
-        if self.samples > self._mgl.max_samples:
-            limit = self._mgl.max_samples
-            self.context.release()
-            raise ValueError(f"samples must be at most this context's GL_MAX_SAMPLES = {limit} "
-                             f"({self.context.renderer_name}) (got {self.samples})")
+        self.context = None
+        context = create_context(backend)
+        try:
+            with context:
+                info = context.mgl.info
+                self._max_size = min(info["GL_MAX_TEXTURE_SIZE"], info["GL_MAX_RENDERBUFFER_SIZE"],
+                                     *info["GL_MAX_VIEWPORT_DIMS"])
+                max_samples = context.mgl.max_samples
+            if self.samples > max_samples:
+                raise ValueError(f"samples must be at most this context's GL_MAX_SAMPLES = {max_samples} "
+                                 f"({context.renderer_name}) (got {self.samples})")
+            self._check_limits(self._size, context.renderer_name)
+        except BaseException:
+            context.release()
+            raise
+        self.context = context
+        self._mgl = context.mgl
         self.programs = ProgramCache(self._mgl)
         self._meshes = {}
         self._targets = {}
+
+    def render_target_bytes(self, size=None):
+        """Memory the render targets and one float32 readback need at ``size`` (default the current one) [bytes].
+
+        Radiance target RGBA32F plus depth at the internal (supersampled) size, times the samples, a
+        resolve target when multisampling, the G-buffer (up to four RGBA32F planes and depth) at the
+        output size, and the float32 readback of the internal size.
+        """
+        w, h = size or self._size
+        internal = w * h * self.supersample ** 2
+        samples = self.samples
+        radiance = internal * (16 + 4) * samples + (internal * 16 if samples > 1 else 0)
+        return radiance + w * h * (4 * 16 + 4) + internal * 16
+
+    def _check_limits(self, size, renderer_name):
+        """The size against the context's limits and the memory it needs, before any work starts."""
+        internal = (size[0] * self.supersample, size[1] * self.supersample)
+        if max(internal) > self._max_size:
+            raise ValueError(f"width and height times supersample must be at most this context's largest "
+                             f"render target, {self._max_size} pixels ({renderer_name}) (got {internal[0]}x{internal[1]})")
+        needed = self.render_target_bytes(size)
+        available = _available_memory()
+        if available is not None and needed > 0.8 * available:
+            raise ValueError(f"a {size[0]}x{size[1]} renderer (supersample {self.supersample}, samples {self.samples}) "
+                             f"needs about {needed / 2**30:.1f} GiB for its render targets and readback; this machine "
+                             f"has {available / 2**30:.1f} GiB available (at most 80% of it may be used)")
 
     def _check_size(self, width, height):
         size = (_validate.positive_int("width", width, 1, 16384), _validate.positive_int("height", height, 1, 16384))
@@ -208,6 +256,8 @@ class Renderer:
     @property
     def backend(self):
         """Name of the OpenGL backend in use ('egl' or 'osmesa')."""
+        if self.context is None:
+            raise RuntimeError("this Renderer has been released: it has no backend any more")
         return self.context.backend
 
     @property
@@ -219,6 +269,7 @@ class Renderer:
         if self.context is None:
             raise RuntimeError("this Renderer has been released")
         size = self._check_size(width, height)
+        self._check_limits(size, self.context.renderer_name)
         if size != self._size:
             with self.context:
                 self._release_targets()
@@ -358,6 +409,16 @@ class Renderer:
         fbo = self._targets.get(name)
         if fbo is not None:
             return fbo
+        try:
+            fbo = self._targets[name] = self._make_target(name)
+        except moderngl.Error as exc:
+            raise RuntimeError(f"the driver could not make a {self._internal_size[0]}x{self._internal_size[1]} "
+                               f"render target ({self.context.renderer_name}: {exc}); it needs about "
+                               f"{self.render_target_bytes() / 2**30:.2f} GiB with the G-buffer and readback: "
+                               "use a smaller size, supersample or samples") from None
+        return fbo
+
+    def _make_target(self, name):
         mgl = self._mgl
         if isinstance(name, tuple) and name[0] == "gbuffer":
             colors = [mgl.renderbuffer(self._size, 4, dtype="f4") for _ in range(len(name) + 1)]
@@ -372,7 +433,6 @@ class Renderer:
             fbo = mgl.framebuffer([texture], depth)
         else:  # srgb8
             fbo = mgl.framebuffer([mgl.renderbuffer(self._size, 4)])
-        self._targets[name] = fbo
         return fbo
 
     def _mesh_buffers(self, mesh):

@@ -147,6 +147,10 @@ def verify(scene, renderer, band=BAND):
         one per-pixel evaluation at each pixel centre, which only ``shading='pixel'``,
         ``samples=1``, ``supersample=1`` render.
     """
+    from .renderer import Renderer
+
+    if not isinstance(renderer, Renderer):
+        raise TypeError(f"renderer must be a glphong.Renderer (got {type(renderer).__name__})")
     if renderer.shading != "pixel" or renderer.samples != 1 or renderer.supersample != 1:
         raise ValueError("verify needs a Renderer with shading='pixel', samples=1 and supersample=1 "
                          f"(got {renderer!r}); compare other options with glphong.raycast instead")

@@ -107,3 +107,58 @@ def test_renderers_dropped_without_release_are_released(backend, make_context, t
     warned, start, end = out.stdout.split()
     assert int(warned) == 60
     assert float(end) - float(start) < 40.0, (start, end)  # 50 more renderers: < 0.8 MB each
+
+
+# --------------------------------------------------------------------------- sizes and raw errors
+def test_sizes_are_checked_against_the_context_and_memory_before_any_work(glphong_backend, monkeypatch):
+    from glphong import renderer as renderer_module
+
+    with pytest.raises(ValueError, match=r"width must be in \[1, 16384\]"):
+        glphong.Renderer(16385, 8, backend=glphong_backend)
+    with pytest.raises(ValueError, match=r"times supersample must be at most 16384"):
+        glphong.Renderer(4096, 8, backend=glphong_backend, supersample=8)
+    monkeypatch.setattr(renderer_module, "_available_memory", lambda: 2 ** 30)  # a 1 GiB machine
+    with pytest.raises(ValueError, match=r"needs about 1\.6 GiB .* has 1\.0 GiB available"):
+        glphong.Renderer(4096, 4096, backend=glphong_backend)
+    r = glphong.Renderer(512, 512, backend=glphong_backend)
+    try:
+        with pytest.raises(ValueError, match=r"needs about .* GiB"):
+            r.resize(8192, 8192)
+        r._max_size = 1024  # a context whose GL_MAX_TEXTURE_SIZE etc. is 1024 (llvmpipe's is 16384)
+        with pytest.raises(ValueError, match=r"this context's largest render target, 1024 pixels"):
+            r.resize(2048, 8)
+        assert (r.width, r.height) == (512, 512)
+    finally:
+        r.release()
+
+
+def test_clear_errors_instead_of_raw_ones(glphong_backend):
+    import trimesh
+
+    with pytest.raises(TypeError, match="position must be .* not booleans"):
+        glphong.PointLight((True, 0, 0), 1.0)
+    with pytest.raises(TypeError, match="renderer must be a glphong.Renderer"):
+        glphong.verify(_scene(glphong.Lambert(0.2), None), None)
+    bad_faces = trimesh.Trimesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 5]], process=False)
+    with pytest.raises(ValueError, match=r"mesh.faces must index its 3 vertices"):
+        glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0))).add(bad_faces, glphong.Lambert(0.2))
+    r = glphong.Renderer(8, 8, backend=glphong_backend)
+    r.release()
+    with pytest.raises(RuntimeError, match="has been released"):
+        r.backend
+    with pytest.raises(ValueError, match=r"path must end in .png"):
+        glphong.imaging.save_png("x.jpg", np.zeros((2, 2, 3)))
+
+
+def test_command_line_limits_and_version(capsys):
+    from glphong.cli import main
+
+    for argv, message in ((["--tile", "0"], "--tile must be from 1 to 1024 pixels (got 0"),
+                          (["--tile", "5000"], "--tile must be from 1 to 1024 pixels (got 5000"),
+                          (["render", "--out", "figure.jpg"], "--out must end in .png")):
+        with pytest.raises(SystemExit):
+            main(argv)
+        assert message in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["--version"])
+    assert capsys.readouterr().out.strip() == f"glphong {glphong.__version__}"
