@@ -57,6 +57,37 @@ class BackendUnavailableError(RuntimeError):
     """No OpenGL context could be created on the requested backend(s)."""
 
 
+class ForkedProcessError(RuntimeError):
+    """OpenGL used in a process forked from one that had already used OpenGL (it would hang)."""
+
+
+#: the process that first tried to make a context (llvmpipe starts its rasterizer threads then)
+_GL_PID = None
+
+
+def _note_gl_use():
+    global _GL_PID
+    if _GL_PID is None:
+        _GL_PID = os.getpid()
+
+
+def check_not_forked():
+    """Raise `ForkedProcessError` in a process forked after its parent used OpenGL.
+
+    llvmpipe's rasterizer threads are not copied by ``fork``: a context made or used in such a child
+    waits for them forever (in the first read-back).  ``LP_NUM_THREADS=0`` (no rasterizer threads)
+    avoids it, and is honoured.
+    """
+    if _GL_PID is not None and _GL_PID != os.getpid() and os.environ.get("LP_NUM_THREADS") != "0":
+        raise ForkedProcessError(
+            f"this process was forked from process {_GL_PID}, which had already made an OpenGL context: "
+            "Mesa's llvmpipe rasterizer threads do not survive fork, and OpenGL here would hang. Start worker "
+            "processes with multiprocessing's 'spawn' or 'forkserver' method "
+            "(multiprocessing.get_context('spawn')), or make every context in the workers and none before "
+            "forking; setting LP_NUM_THREADS=0 before the parent makes its first context also avoids the "
+            "hang, at a speed cost")
+
+
 def _entered_stack():
     """Return this thread's stack of entered `GLContext` objects."""
     if not hasattr(_entered, "stack"):
@@ -103,6 +134,7 @@ class GLContext:
 
     def __enter__(self):
         """Make this context current on the calling thread."""
+        check_not_forked()
         self._make_current()
         _entered_stack().append(self)
         return self
@@ -245,7 +277,12 @@ def _osmesa_library():
 def _create_egl(require):
     # moderngl itself rejects a context older than ``require``.
     mgl = moderngl.create_context(standalone=True, backend="egl", require=require)
-    return GLContext("egl", mgl)
+    context = GLContext("egl", mgl)
+    # an EGL context can be current on one thread only: leave it current on none, so that the first
+    # ``with`` block may be on any thread (entering and leaving once releases moderngl's binding)
+    mgl.__enter__()
+    mgl.__exit__(None, None, None)
+    return context
 
 
 def _create_osmesa(require):
@@ -288,6 +325,8 @@ def _try_create(backend, require):
 
     The context current before the call stays current if it was entered.
     """
+    check_not_forked()
+    _note_gl_use()
     try:
         return _CREATORS[backend](require), None
     except Exception as exc:
@@ -305,8 +344,11 @@ def _install_hint(backend):
 def create_context(backend="auto", require=330):
     """Create an offscreen OpenGL core-profile context.
 
-    The new context is current unless called inside another context's
-    ``with`` block, which then stays current.
+    Use the context inside a ``with`` block (which makes it current on the calling thread and
+    releases it at the end): an EGL context is left current on no thread, so any thread may enter
+    it, one at a time; an OSMesa context is current unless called inside another context's ``with``
+    block, which then stays current.  In a process forked after its parent made a context,
+    `ForkedProcessError` is raised instead of hanging (see `check_not_forked`).
 
     Parameters
     ----------

@@ -5,6 +5,8 @@ program; the scene gives the uniforms, bound strictly; only the vertex attribute
 the program reads are bound; the draw goes to an RGBA32F target that is read back
 as float32 with row 0 at the top.
 """
+import functools
+import threading
 import warnings
 import weakref
 from dataclasses import dataclass, replace
@@ -145,8 +147,22 @@ def _available_memory():
     return None
 
 
+def _one_call_at_a_time(method):
+    """Run a Renderer method under its lock: a renderer is usable from any thread, one call at a time."""
+    @functools.wraps(method)
+    def locked(self, *args, **kwargs):
+        with self._lock:
+            return method(self, *args, **kwargs)
+    return locked
+
+
 class Renderer:
     """Offscreen renderer of glphong scenes.
+
+    Threads: a renderer may be used from any thread; its calls are serialised by a lock (two threads
+    rendering at once take turns), and its context is current only inside a call.  Processes: a
+    renderer cannot cross ``fork``; in a child forked after any context was made, it raises
+    `glphong.contexts.ForkedProcessError` (use the 'spawn' or 'forkserver' start methods).
 
     Parameters
     ----------
@@ -190,6 +206,7 @@ class Renderer:
             raise TypeError(f"specialise must be a bool, True or False (got {specialise!r})")
         self.specialise = bool(specialise)
         self.context = None
+        self._lock = threading.RLock()
         context = create_context(backend)
         try:
             with context:
@@ -264,6 +281,7 @@ class Renderer:
     def _internal_size(self):
         return (self.width * self.supersample, self.height * self.supersample)
 
+    @_one_call_at_a_time
     def resize(self, width, height):
         """Change the image size; the render targets are rebuilt on next use."""
         if self.context is None:
@@ -275,6 +293,7 @@ class Renderer:
                 self._release_targets()
             self._size = size
 
+    @_one_call_at_a_time
     def render(self, scene):
         """Render the scene's shaded radiance (linear float32).
 
@@ -293,6 +312,7 @@ class Renderer:
         coverage = np.ascontiguousarray(rgba[..., 3])
         return Frame(radiance=np.ascontiguousarray(rgba[..., :3]), mask=coverage > 0.0, coverage=coverage)
 
+    @_one_call_at_a_time
     def render_srgb8(self, scene, exposure=1.0):
         """Render and encode on the GPU: box filter, exposure, exact sRGB curve, 8 bits.
 
@@ -325,6 +345,7 @@ class Renderer:
             self.context.check_error("encoding sRGB")
         return rgb
 
+    @_one_call_at_a_time
     def gbuffer(self, scene):
         """Render the per-pixel shading inputs of the scene (one sample per pixel, output size).
 
@@ -463,6 +484,7 @@ class Renderer:
                       for name, f in self._targets.items())
         return len(self.programs) + meshes + targets
 
+    @_one_call_at_a_time
     def release(self):
         """Release every GL object and the context; idempotent."""
         if self.context is None:

@@ -162,3 +162,72 @@ def test_command_line_limits_and_version(capsys):
     with pytest.raises(SystemExit):
         main(["--version"])
     assert capsys.readouterr().out.strip() == f"glphong {glphong.__version__}"
+
+
+# --------------------------------------------------------------------------- processes and threads
+_POOLS = r'''
+import multiprocessing as mp, sys
+import numpy as np, glphong
+from glphong import primitives
+
+def render_sum(backend):
+    camera = glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0))
+    scene = glphong.Scene(camera, lights=[glphong.PointLight((1, 1, 2), 50.0)])
+    scene.add(primitives.sphere(3), glphong.Phong(0.2, 0.5, 20))
+    try:
+        with glphong.Renderer(32, 32, backend=backend) as r:
+            return "ok", float(r.render(scene).radiance.astype(np.float64).sum())
+    except Exception as exc:
+        return type(exc).__name__, str(exc)
+
+if __name__ == "__main__":
+    backend = sys.argv[1]
+    print("parent", *render_sum(backend), sep="|")   # the parent makes a context first
+    for method in ("fork", "spawn", "forkserver"):
+        with mp.get_context(method).Pool(1) as pool:
+            print(method, *pool.apply_async(render_sum, (backend,)).get(timeout=120), sep="|")
+'''
+
+
+@pytest.mark.parametrize("backend", ["egl", "osmesa"])
+def test_fork_raises_instead_of_hanging_and_spawn_and_forkserver_work(backend, make_context, tmp_path):
+    import subprocess
+    import sys
+
+    make_context(backend).release()
+    script = tmp_path / "pools.py"
+    script.write_text(_POOLS)
+    out = subprocess.run([sys.executable, str(script), backend], capture_output=True, text=True, timeout=400,
+                         cwd=tmp_path)
+    assert out.returncode == 0, out.stderr[-3000:]
+    rows = dict(line.split("|", 1) for line in out.stdout.strip().splitlines())
+    assert rows["parent"].startswith("ok|")
+    kind, message = rows["fork"].split("|", 1)
+    assert kind == "ForkedProcessError" and "'spawn' or 'forkserver'" in message
+    assert rows["spawn"] == rows["parent"] and rows["forkserver"] == rows["parent"]  # the very same image
+
+
+def test_a_renderer_is_usable_from_any_thread_one_call_at_a_time(glphong_make_renderer, glphong_backend):
+    """Created on one thread, used on others, three at once: every frame equals the first (was: EGL's
+    raw 'cannot create texture' on another thread, and NaN or 5e37 frames from two at once)."""
+    import threading
+
+    renderer = glphong_make_renderer(48, 48, glphong_backend)
+    scene = _scene(glphong.Phong(0.3, 0.5, 20.0), glphong.DirectionalLight((0.0, 0.0, -1.0), 1.0))
+    reference = renderer.render(scene).radiance
+    bad, errors = [], []
+
+    def work():
+        try:
+            for _ in range(10):
+                bad.append(not np.array_equal(renderer.render(scene).radiance, reference))
+                renderer.gbuffer(scene)
+        except Exception as exc:  # noqa: BLE001 - reported below
+            errors.append(repr(exc))
+
+    threads = [threading.Thread(target=work) for _ in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    assert errors == [] and len(bad) == 30 and not any(bad)
