@@ -99,7 +99,24 @@ def main(platform):
     except ValueError as exc:
         result["instanced"] = str(exc)
     renderer.delete()
+    # a GlphongMaterial drawn by a renderer glphong was not enabled on: an error, not a black image
+    # (after the first renderer is deleted: on EGL deleting one OffscreenRenderer ends the shared display)
+    plain = pyrender.OffscreenRenderer(32, 32)
+    try:
+        plain.render(_single(GlphongMaterial))
+        result["not_enabled"] = "accepted"
+    except RuntimeError as exc:
+        result["not_enabled"] = str(exc)
+    plain.delete()
     print(json.dumps(result))
+
+
+def _single(material_class):
+    scene = pyrender.Scene()
+    scene.add(pyrender.Mesh.from_trimesh(trimesh.creation.icosphere(1), material=material_class(glphong.Lambert(0.5))))
+    scene.add(pyrender.PerspectiveCamera(yfov=0.8), pose=translation(0, 0, 4))
+    scene.add(pyrender.PointLight(intensity=1.0), pose=translation(0, 0, 4))
+    return scene
 
 
 if __name__ == "__main__":

@@ -66,3 +66,4 @@ def test_refusals_name_the_problem(measured):
     _, m = measured
     assert "SpotLight" in m["spot"] and "point and directional" in m["spot"]
     assert "cannot be instanced" in m["instanced"]
+    assert "not enabled on" in m["not_enabled"] and "enable(renderer)" in m["not_enabled"]

@@ -30,6 +30,7 @@ Importing this module imports pyrender, so set ``PYOPENGL_PLATFORM`` first (pyre
 pyrender 0.1.45's OSMesa platform needs PyOpenGL >= 3.1.5 (``pip install --no-deps PyOpenGL==3.1.10``).
 """
 import os
+import threading
 
 import numpy as np
 import pyrender
@@ -70,6 +71,20 @@ class GlphongMaterial(pyrender.Material):
 
     def __repr__(self):
         return f"GlphongMaterial({self.glphong!r}, exposure={self.exposure:g})"
+
+    @property
+    def tex_flags(self):
+        """pyrender reads this while drawing the primitive: only a renderer `enable` d may draw it."""
+        if not getattr(_DRAWING, "enabled", False):
+            raise RuntimeError(
+                f"{self!r} is drawn by a pyrender renderer that glphong was not enabled on (pyrender would "
+                "draw it black or with garbage): call glphong.integrations.pyrender.enable(renderer) once "
+                "after creating the OffscreenRenderer")
+        return pyrender.Material.tex_flags.fget(self)
+
+
+#: set while an enabled renderer draws (per thread)
+_DRAWING = threading.local()
 
 
 def glphong_lights_of(scene):
@@ -185,7 +200,11 @@ class _GlphongRenderer(_PyrenderRenderer):
             lights, ambient = glphong_lights_of(scene)
             glphong_scene = Scene(_glphong_camera(scene), lights=lights, ambient=ambient)
         self._glphong_scene = glphong_scene
-        return super().render(scene, flags, seg_node_map)
+        _DRAWING.enabled = True
+        try:
+            return super().render(scene, flags, seg_node_map)
+        finally:
+            _DRAWING.enabled = False
 
     def _get_primitive_program(self, primitive, flags, program_flags):
         material = primitive.material
