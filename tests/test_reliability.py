@@ -231,3 +231,51 @@ def test_a_renderer_is_usable_from_any_thread_one_call_at_a_time(glphong_make_re
     for t in threads:
         t.join(timeout=120)
     assert errors == [] and len(bad) == 30 and not any(bad)
+
+
+_RESOURCES = r'''
+import gc, sys
+import numpy as np, glphong
+from glphong import primitives
+
+def rss_mb():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * 4096 / 2**20
+
+def scene(i):
+    camera = glphong.PerspectiveCamera.look_at((0, 0.5 * (i % 3), 3), (0, 0, 0))
+    s = glphong.Scene(camera, lights=[glphong.PointLight((1, 1, 2), 50.0 + i)] * (1 + i % 2))
+    s.add(primitives.sphere(2 + i % 2), [glphong.Lambert(0.3), glphong.Phong(0.2, 0.5, 20 + i)][i % 2])
+    return s
+
+backend = sys.argv[1]
+r = glphong.Renderer(64, 64, backend=backend)
+for i in range(20):
+    r.render(scene(i)); r.gbuffer(scene(i))
+gc.collect(); start, objects = rss_mb(), r.gl_object_count()
+for i in range(300):
+    r.render(scene(i)); r.gbuffer(scene(i))
+gc.collect(); one = rss_mb() - start; objects_after = r.gl_object_count()
+r.release()
+gc.collect(); start = rss_mb()
+for i in range(40):
+    with glphong.Renderer(128, 128, backend=backend) as q:
+        q.render(scene(i))
+gc.collect()
+print(objects, objects_after, one, rss_mb() - start)
+'''
+
+
+@pytest.mark.parametrize("backend", ["egl", "osmesa"])
+def test_memory_and_gl_objects_stay_flat(backend, make_context):
+    """300 renders and G-buffers with one renderer (new scenes, meshes and keys each time): its GL
+    objects do not grow and memory stays within 20 MB; 40 renderers made and released: within 20 MB."""
+    import subprocess
+    import sys
+
+    make_context(backend).release()
+    out = subprocess.run([sys.executable, "-c", _RESOURCES, backend], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    objects, objects_after, one, many = out.stdout.split()
+    assert int(objects_after) == int(objects), (objects, objects_after)
+    assert float(one) < 20.0 and float(many) < 20.0, (one, many)
