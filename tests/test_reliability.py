@@ -279,3 +279,41 @@ def test_memory_and_gl_objects_stay_flat(backend, make_context):
     objects, objects_after, one, many = out.stdout.split()
     assert int(objects_after) == int(objects), (objects, objects_after)
     assert float(one) < 20.0 and float(many) < 20.0, (one, many)
+
+
+def test_no_stray_warnings_before_the_errors_or_from_extreme_valid_input():
+    import warnings
+
+    import trimesh
+
+    inf_vertex = trimesh.Trimesh([[0, 0, np.inf], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]], process=False)
+    camera = glphong.PerspectiveCamera.look_at((1e30, 2e30, 3e30), (0.0, 0.0, 0.0), zfar=1e38)
+    scene = glphong.Scene(camera, lights=[glphong.PointLight((1e30, 1e30, 1e30), 1.0)])
+    scene.add(primitives.sphere(1), glphong.Phong(0.2, 0.5, 10.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # any warning fails
+        with pytest.raises(ValueError, match="positions must be finite"):
+            glphong.geometry.MeshData.from_trimesh(inf_vertex)
+        values = scene.uniform_values(0, scene.program_key(scene.objects[0]), 1.0)
+    assert all(v.dtype == np.float32 for v in values.values())
+
+
+def test_bench_says_at_once_which_extra_it_needs(monkeypatch, capsys):
+    import importlib.util
+
+    from glphong.cli import main
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "matplotlib" else real(name, *a))
+    assert main(["bench", "--quick"]) == 2
+    assert "pip install 'glphong[bench]'" in capsys.readouterr().err
+
+
+def test_stability_needs_nothing_beyond_the_plain_install():
+    """mpmath (the stability oracle) is an install requirement, not a test extra."""
+    import configparser
+    from pathlib import Path
+
+    cfg = configparser.ConfigParser()
+    cfg.read(Path(__file__).resolve().parent.parent / "setup.cfg")
+    assert "mpmath" in cfg["options"]["install_requires"]
