@@ -495,7 +495,7 @@ class Renderer:
             self._meshes.clear()
             self._release_targets()
             self.programs.release()
-        self.context.release()
+        self.context.recycle()  # every GL object of this renderer is released: the context may serve another
         self.context = None
 
     def __enter__(self):
