@@ -39,7 +39,7 @@ def real_array(name, value, expected):
         raw = np.asarray(value)
     except (TypeError, ValueError):
         raw = None
-    if raw is not None and not isinstance(value, np.ndarray) and raw.dtype.kind in "iu" and raw.size:
+    if raw is not None and not isinstance(value, np.ndarray) and raw.dtype.kind in "iuf" and raw.size:
         # numpy turns (True, 0, 0) into integers: look at the elements themselves
         try:
             elements = np.asarray(value, dtype=object).ravel()

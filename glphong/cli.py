@@ -109,11 +109,45 @@ def _bench(args):
     return 0
 
 
+def _writable(text):
+    """An output path whose folder exists (checked before any work)."""
+    import os
+
+    folder = os.path.dirname(os.path.abspath(text))
+    if not os.path.isdir(folder):
+        raise argparse.ArgumentTypeError(f"the folder of {text!r} does not exist")
+    return text
+
+
 def _png_path(text):
-    """``--out``: a path ending in .png."""
+    """``--out``: a path ending in .png, in an existing folder."""
     if not text.lower().endswith(".png"):
         raise argparse.ArgumentTypeError(f"--out must end in .png (got {text!r})")
-    return text
+    return _writable(text)
+
+
+def _positive_float(text):
+    """A finite number > 0."""
+    import math
+
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number > 0 (got {text!r})") from None
+    if not (math.isfinite(value) and value > 0):
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0 (got {text!r})")
+    return value
+
+
+def _positive_int(text):
+    """An integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 1 (got {text!r})") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 1 (got {value})")
+    return value
 
 
 def _tile_size(text):
@@ -142,17 +176,19 @@ def build_parser():
     render = sub.add_parser("render", help="render the 'Phong Examples' figure (the default command)")
     render.add_argument("--out", default="phong_examples.png", type=_png_path,
                         help="PNG path (default: phong_examples.png)")
-    render.add_argument("--npy", default=None, help="also write the raw float32 radiance to this .npy path")
+    render.add_argument("--npy", default=None, type=_writable, help="also write the raw float32 radiance to this .npy path")
     render.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
     render.add_argument("--tile", type=_tile_size, default=128, help="tile size in pixels, 1 to 1024 (default 128)")
-    render.add_argument("--exposure", type=float, default=0.6, help="linear exposure before sRGB encoding")
+    render.add_argument("--exposure", type=_positive_float, default=0.6,
+                        help="linear exposure before sRGB encoding, > 0 (default 0.6)")
     render.add_argument("--verify", action="store_true", help="cross-check every tile against the float64 twin")
     render.set_defaults(func=_render)
     stability = sub.add_parser("stability", help="run the extreme-case suite: GPU vs float64 vs tolerance band")
     stability.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
     stability.add_argument("--naive", action="store_true",
                            help="also run the cases through the textbook pow(dot(v, r), q) shader")
-    stability.add_argument("--json", default=None, help="write the table(s) as JSON to this path ('-': stdout only)")
+    stability.add_argument("--json", default=None, type=lambda t: t if t == "-" else _writable(t),
+                           help="write the table(s) as JSON to this path ('-': stdout only)")
     stability.add_argument("--import", dest="imports", action="append", default=[], metavar="MODULE",
                            help="import a module (dotted name or .py path) defining material models and add "
                                 "their stability cases (repeatable)")
@@ -162,11 +198,12 @@ def build_parser():
     describe.add_argument("--gbuffer", action="store_true", help="include the G-buffer programs")
     describe.set_defaults(func=_describe)
     bench = sub.add_parser("bench", help="work-precision report: error against run time for every method")
-    bench.add_argument("--width", type=int, default=256, help="image width in pixels (default 256)")
-    bench.add_argument("--height", type=int, default=192, help="image height in pixels (default 192)")
-    bench.add_argument("--repeats", type=int, default=5, help="timed repeats per point (median)")
+    bench.add_argument("--width", type=_positive_int, default=256, help="image width in pixels (default 256)")
+    bench.add_argument("--height", type=_positive_int, default=192, help="image height in pixels (default 192)")
+    bench.add_argument("--repeats", type=_positive_int, default=5, help="timed repeats per point (median, >= 1)")
     bench.add_argument("--quick", action="store_true", help="a tiny configuration (2 scenes, 2 knob values)")
-    bench.add_argument("--out", default="glphong_bench", help="output prefix: PREFIX.csv, PREFIX.json, PREFIX.png")
+    bench.add_argument("--out", default="glphong_bench", type=_writable,
+                       help="output prefix: PREFIX.csv, PREFIX.json, PREFIX.png")
     bench.add_argument("--no-progress", action="store_true", help="no progress bar")
     bench.set_defaults(func=_bench)
     return parser

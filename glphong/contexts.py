@@ -92,10 +92,15 @@ def _reuse(backend, require):
     return None
 
 
+_GL_THREADLESS = False
+
+
 def _note_gl_use():
-    global _GL_PID
+    """Record that this process has made a context (and whether llvmpipe runs without threads)."""
+    global _GL_PID, _GL_THREADLESS
     if _GL_PID is None:
         _GL_PID = os.getpid()
+        _GL_THREADLESS = os.environ.get("LP_NUM_THREADS") == "0"  # Mesa reads it at the first context
 
 
 def check_not_forked():
@@ -105,7 +110,7 @@ def check_not_forked():
     waits for them forever (in the first read-back).  ``LP_NUM_THREADS=0`` (no rasterizer threads)
     avoids it, and is honoured.
     """
-    if _GL_PID is not None and _GL_PID != os.getpid() and os.environ.get("LP_NUM_THREADS") != "0":
+    if _GL_PID is not None and _GL_PID != os.getpid() and not _GL_THREADLESS:
         raise ForkedProcessError(
             f"this process was forked from process {_GL_PID}, which had already made an OpenGL context: "
             "Mesa's llvmpipe rasterizer threads do not survive fork, and OpenGL here would hang. Start worker "
@@ -182,6 +187,13 @@ class GLContext:
         self.mgl.__exit__(None, None, None)
         self.mgl.__enter__()
 
+    def detach(self):
+        """Leave the context current on no thread, so that any thread may enter it next (EGL allows a
+        context to be current on one thread only; an OSMesa context needs nothing)."""
+        if self.backend == "egl" and not self._released:
+            self.mgl.__enter__()
+            self.mgl.__exit__(None, None, None)  # leaving moderngl's binding releases it from this thread
+
     def bind_idle_framebuffer(self):
         """Bind a 1x1 framebuffer owned by this context; call with the context entered.
 
@@ -229,6 +241,13 @@ class GLContext:
         for reuse; beyond that, and at exit, they are destroyed.
         """
         if self._released:
+            return
+        try:
+            with self:
+                _ = self.mgl.error  # reading the flag clears it: the next user starts clean
+            self.detach()
+        except Exception:  # noqa: BLE001 - a broken context is destroyed, not recycled
+            self.release()
             return
         with _POOL_LOCK:
             waiting = _POOL.setdefault(self.backend, [])
@@ -326,12 +345,7 @@ def _osmesa_library():
 def _create_egl(require):
     # moderngl itself rejects a context older than ``require``.
     mgl = moderngl.create_context(standalone=True, backend="egl", require=require)
-    context = GLContext("egl", mgl)
-    # an EGL context can be current on one thread only: leave it current on none, so that the first
-    # ``with`` block may be on any thread (entering and leaving once releases moderngl's binding)
-    mgl.__enter__()
-    mgl.__exit__(None, None, None)
-    return context
+    return GLContext("egl", mgl)
 
 
 def _create_osmesa(require):
@@ -375,12 +389,14 @@ def _try_create(backend, require):
     The context current before the call stays current if it was entered.
     """
     check_not_forked()
-    _note_gl_use()
     reused = _reuse(backend, require)
     if reused is not None:
+        reused._make_current()  # as a new context is: current (unless a with block restores another below)
         return reused, None
     try:
-        return _CREATORS[backend](require), None
+        context = _CREATORS[backend](require)
+        _note_gl_use()
+        return context, None
     except Exception as exc:
         return None, str(exc) or type(exc).__name__
     finally:
@@ -397,11 +413,10 @@ def create_context(backend="auto", require=330):
     """Create an offscreen OpenGL core-profile context.
 
     A context a released `glphong.Renderer` recycled (`GLContext.recycle`) is reused when one of the
-    backend is waiting.  Use the context inside a ``with`` block (which makes it current on the calling thread and
-    releases it at the end): an EGL context is left current on no thread, so any thread may enter
-    it, one at a time; an OSMesa context is current unless called inside another context's ``with``
-    block, which then stays current.  In a process forked after its parent made a context,
-    `ForkedProcessError` is raised instead of hanging (see `check_not_forked`).
+    backend is waiting.  The new context is current unless called inside another context's ``with``
+    block, which then stays current; `GLContext.detach` leaves it current on no thread (for use
+    from other threads, as `glphong.Renderer` does).  In a process forked after its parent made a
+    context, `ForkedProcessError` is raised instead of hanging (see `check_not_forked`).
 
     Parameters
     ----------

@@ -5,6 +5,7 @@ program; the scene gives the uniforms, bound strictly; only the vertex attribute
 the program reads are bound; the draw goes to an RGBA32F target that is read back
 as float32 with row 0 at the top.
 """
+import atexit
 import functools
 import threading
 import warnings
@@ -15,7 +16,7 @@ import moderngl
 import numpy as np
 
 from . import _validate
-from .contexts import create_context
+from .contexts import check_not_forked, create_context
 from .key import FORMULATIONS, EncodeKey, uber_key
 from .programs import ProgramCache
 
@@ -148,12 +149,35 @@ def _available_memory():
 
 
 def _one_call_at_a_time(method):
-    """Run a Renderer method under its lock: a renderer is usable from any thread, one call at a time."""
+    """Run a Renderer method under its lock: a renderer is usable from any thread, one call at a time.
+
+    The fork check comes first (a lock copied by fork while held would hang the child), then the GL
+    objects of renderers the garbage collector found unreleased are released (`_ORPHANS`)."""
     @functools.wraps(method)
     def locked(self, *args, **kwargs):
+        check_not_forked()
+        _release_orphans()
         with self._lock:
             return method(self, *args, **kwargs)
     return locked
+
+
+#: the resources of renderers dropped without release(), released at the next glphong call: the
+#: garbage collector may run anywhere (inside pyrender's draw, on another thread), where GL work is unsafe
+_ORPHANS = []
+_ORPHANS_LOCK = threading.Lock()
+
+
+@atexit.register
+def _release_orphans():
+    with _ORPHANS_LOCK:
+        orphans = _ORPHANS[:]
+        _ORPHANS.clear()
+    for release in orphans:
+        try:
+            release()
+        except Exception:  # noqa: BLE001 - a context the driver lost cannot be released further
+            pass
 
 
 class Renderer:
@@ -207,6 +231,8 @@ class Renderer:
         self.specialise = bool(specialise)
         self.context = None
         self._lock = threading.RLock()
+        check_not_forked()
+        _release_orphans()
         context = create_context(backend)
         try:
             with context:
@@ -221,6 +247,7 @@ class Renderer:
         except BaseException:
             context.release()
             raise
+        context.detach()  # current only inside a call, on whichever thread makes it
         self.context = context
         self._mgl = context.mgl
         self.programs = ProgramCache(self._mgl)
@@ -505,15 +532,32 @@ class Renderer:
         self.release()
 
     def __del__(self):
-        # dropped without release(): free the GL objects and the context now (moderngl never frees them
-        # on garbage collection), and say so the way an unclosed file does
-        if getattr(self, "context", None) is not None:
-            warnings.warn(f"{self!r} was never released: released by the garbage collector (call release() "
-                          "or use 'with glphong.Renderer(...) as r:')", ResourceWarning, stacklevel=2)
-            try:
-                self.release()
-            except Exception:  # noqa: BLE001 - at interpreter exit the GL library may be gone
-                pass
+        # dropped without release(): moderngl never frees GL objects on garbage collection, so hand them
+        # to the next glphong call (GL work here could run inside someone else's draw), and say so the way
+        # an unclosed file does
+        if getattr(self, "context", None) is None:
+            return
+        state = (self.context, self._meshes, self._targets, self.programs)
+        self.context = None
+
+        def release(state=state):
+            context, meshes, targets, programs = state
+            with context:
+                for entry in meshes.values():
+                    entry.release()
+                for name, obj in targets.items():
+                    obj.release() if name[0] == "fullscreen" else context.release_framebuffer(obj)
+                programs.release()
+            context.recycle()
+
+        with _ORPHANS_LOCK:
+            _ORPHANS.append(release)
+        try:
+            warnings.warn("a glphong.Renderer was never released: its GL objects are released at the next "
+                          "glphong call (call release() or use 'with glphong.Renderer(...) as r:')",
+                          ResourceWarning, stacklevel=2)
+        except Exception:  # noqa: BLE001 - warnings turned into errors must not keep the resources
+            pass
 
     def __repr__(self):
         state = "released" if self.context is None else self.backend

@@ -45,13 +45,14 @@ def _pooled(backend):
         entry = _POOL.get(backend)
         if entry is None or entry[0].mgl is None:
             gl = create_context(backend)
-            entry = _POOL[backend] = (gl, ProgramCache(gl.mgl))
+            gl.detach()  # entered per call, from any thread
+            entry = _POOL[backend] = (gl, ProgramCache(gl.mgl), threading.RLock())
         return entry
 
 
 @atexit.register
 def _release_pool():
-    for gl, programs in _POOL.values():
+    for gl, programs, _ in _POOL.values():
         try:
             with gl:
                 programs.release()
@@ -159,16 +160,16 @@ def _gpu(material, key, uniforms, wi, wo, normal, tangent, uv, backend, context)
     if count == 0 or not key.terms:
         return np.zeros((count, 3), np.float32)
     if context is None:
-        gl, programs = _pooled(backend)
+        gl, programs, lock = _pooled(backend)
     else:
-        gl, programs = context, ProgramCache(context.mgl)
+        gl, programs, lock = context, ProgramCache(context.mgl), threading.RLock()
     columns = {"in_wi": (wi, "3f"), "in_wo": (wo, "3f"), "in_normal": (normal, "3f")}
     if key.has_tangent:
         columns["in_tangent"] = (tangent, "4f")
     if key.has_uv:
         columns["in_uv"] = (uv, "2f")
     mgl = gl.mgl
-    with gl:
+    with lock, gl:  # one evaluation at a time on a pooled context, from any thread
         program = programs.get(key)
         program.bind(uniforms)
         buffers = {name: mgl.buffer(data.tobytes()) for name, (data, _) in columns.items()}

@@ -154,8 +154,9 @@ def verify(scene, renderer, band=BAND):
     if renderer.shading != "pixel" or renderer.samples != 1 or renderer.supersample != 1:
         raise ValueError("verify needs a Renderer with shading='pixel', samples=1 and supersample=1 "
                          f"(got {renderer!r}); compare other options with glphong.raycast instead")
-    frame = renderer.render(scene)
-    gbuffer = renderer.gbuffer(scene)
+    with renderer._lock:  # one call: no resize from another thread between the two passes
+        frame = renderer.render(scene)
+        gbuffer = renderer.gbuffer(scene)
     ref = reference.shade(scene, gbuffer)
     low, high = radiance_band(scene, gbuffer, band)
     mask = frame.mask & gbuffer.mask

@@ -334,3 +334,60 @@ def test_stability_needs_nothing_beyond_the_plain_install():
     cfg = configparser.ConfigParser()
     cfg.read(Path(__file__).resolve().parent.parent / "setup.cfg")
     assert "mpmath" in cfg["options"]["install_requires"]
+
+
+_FORK_HELD = r'''
+import os, signal, sys
+import glphong
+r = glphong.Renderer(16, 16, backend=sys.argv[1])
+r._lock.acquire()          # a call in progress on another thread when the parent forks
+pid = os.fork()
+if pid == 0:
+    signal.alarm(20)       # a hang ends the child with SIGALRM
+    try:
+        r.render(glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0))))
+        os._exit(3)
+    except glphong.contexts.ForkedProcessError:
+        os._exit(0)
+_, status = os.waitpid(pid, 0)
+print(os.waitstatus_to_exitcode(status))
+r._lock.release()
+r.release()
+'''
+
+
+@pytest.mark.parametrize("backend", ["egl", "osmesa"])
+def test_a_fork_during_a_call_raises_in_the_child_instead_of_waiting_for_the_lock(backend, make_context):
+    import subprocess
+    import sys
+
+    make_context(backend).release()
+    out = subprocess.run([sys.executable, "-c", _FORK_HELD, backend], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "0", out.stdout + out.stderr[-2000:]
+
+
+def test_dropped_renderers_are_released_even_when_warnings_are_errors(backend="egl"):
+    import subprocess
+    import sys
+
+    code = _DROPPED.replace('warnings.simplefilter("always", ResourceWarning)', 'warnings.simplefilter("error")')
+    code = code.replace("with warnings.catch_warnings(record=True) as caught:", "if True:\n    caught = []")
+    out = subprocess.run([sys.executable, "-c", code, "osmesa"], capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-2000:]
+    _, start, end = out.stdout.split()
+    assert float(end) - float(start) < 40.0, (start, end)
+
+
+def test_more_clear_errors(capsys, tmp_path):
+    from glphong.cli import main
+
+    for bad in ((True, 0.5, 0.0), (0.5, True, 0.2)):
+        with pytest.raises(TypeError, match="not booleans"):
+            glphong.Lambert(bad)
+    for argv, message in ((["--exposure", "-1"], "--exposure: must be a finite number > 0"),
+                          (["--out", str(tmp_path / "missing" / "x.png")], "does not exist"),
+                          (["bench", "--repeats", "0"], "--repeats: must be an integer >= 1"),
+                          (["stability", "--json", str(tmp_path / "missing" / "s.json")], "does not exist")):
+        with pytest.raises(SystemExit):
+            main(argv)
+        assert message in capsys.readouterr().err, argv
