@@ -391,3 +391,28 @@ def test_more_clear_errors(capsys, tmp_path):
         with pytest.raises(SystemExit):
             main(argv)
         assert message in capsys.readouterr().err, argv
+
+
+def test_the_toolkit_is_usable_from_threads(glphong_backend):
+    import threading
+
+    from glphong.testing import direction_sets, evaluate
+
+    wi, wo, _ = direction_sets(100, seed=5)
+    material = glphong.Phong(0.2, 0.5, 30.0)
+    reference = evaluate(material, wi, wo, backend=glphong_backend)
+    results, errors = [], []
+
+    def work():
+        try:
+            for _ in range(10):
+                results.append(np.array_equal(evaluate(material, wi, wo, backend=glphong_backend), reference))
+        except Exception as exc:  # noqa: BLE001 - reported below
+            errors.append(repr(exc))
+
+    threads = [threading.Thread(target=work) for _ in range(3)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join(timeout=120)
+    assert errors == [] and len(results) == 30 and all(results)
