@@ -210,19 +210,30 @@ def test_fork_raises_instead_of_hanging_and_spawn_and_forkserver_work(backend, m
 def test_a_renderer_is_usable_from_any_thread_one_call_at_a_time(glphong_make_renderer, glphong_backend):
     """Created on one thread, used on others, three at once: every frame equals the first (was: EGL's
     raw 'cannot create texture' on another thread, and NaN or 5e37 frames from two at once)."""
-    import threading
-
     renderer = glphong_make_renderer(48, 48, glphong_backend)
     scene = _scene(glphong.Phong(0.3, 0.5, 20.0), glphong.DirectionalLight((0.0, 0.0, -1.0), 1.0))
     reference = renderer.render(scene).radiance
-    bad, errors = [], []
+
+    def once():
+        same = np.array_equal(renderer.render(scene).radiance, reference)
+        renderer.gbuffer(scene)
+        return same
+
+    results, errors = _on_three_threads(once)
+    assert errors == [] and len(results) == 30 and all(results)
+
+
+def _on_three_threads(call, times=10):
+    """Run ``call`` ``times`` times on each of three threads at once: (results, errors)."""
+    import threading
+
+    results, errors = [], []
 
     def work():
         try:
-            for _ in range(10):
-                bad.append(not np.array_equal(renderer.render(scene).radiance, reference))
-                renderer.gbuffer(scene)
-        except Exception as exc:  # noqa: BLE001 - reported below
+            for _ in range(times):
+                results.append(call())
+        except Exception as exc:  # noqa: BLE001 - reported to the caller
             errors.append(repr(exc))
 
     threads = [threading.Thread(target=work) for _ in range(3)]
@@ -230,7 +241,7 @@ def test_a_renderer_is_usable_from_any_thread_one_call_at_a_time(glphong_make_re
         t.start()
     for t in threads:
         t.join(timeout=120)
-    assert errors == [] and len(bad) == 30 and not any(bad)
+    return results, errors
 
 
 _RESOURCES = r'''
@@ -394,25 +405,11 @@ def test_more_clear_errors(capsys, tmp_path):
 
 
 def test_the_toolkit_is_usable_from_threads(glphong_backend):
-    import threading
-
     from glphong.testing import direction_sets, evaluate
 
     wi, wo, _ = direction_sets(100, seed=5)
     material = glphong.Phong(0.2, 0.5, 30.0)
     reference = evaluate(material, wi, wo, backend=glphong_backend)
-    results, errors = [], []
-
-    def work():
-        try:
-            for _ in range(10):
-                results.append(np.array_equal(evaluate(material, wi, wo, backend=glphong_backend), reference))
-        except Exception as exc:  # noqa: BLE001 - reported below
-            errors.append(repr(exc))
-
-    threads = [threading.Thread(target=work) for _ in range(3)]
-    for t in threads:
-        t.start()
-    for t in threads:
-        t.join(timeout=120)
+    results, errors = _on_three_threads(
+        lambda: np.array_equal(evaluate(material, wi, wo, backend=glphong_backend), reference))
     assert errors == [] and len(results) == 30 and all(results)
