@@ -395,6 +395,22 @@ def program_key(material, light_counts, ambient_radiance, output="radiance", gbu
     )
 
 
+_UBER_BUILTINS = {}
+
+
+def _uber_builtins():
+    """Example instances of the built-in models the uber-shader always holds (those that need no more
+    than the view and have no structural defines), computed once per state of the registry."""
+    from .materials.model import registered_models
+
+    models = registered_models()
+    cached = _UBER_BUILTINS.get(models)
+    if cached is None:
+        examples = [m.example() for m in models if m.__module__.startswith("glphong.") and set(m.needs) <= {"view"}]
+        cached = _UBER_BUILTINS[models] = [e for e in examples if not e.defines()]
+    return cached
+
+
 def uber_key(materials, output="radiance", formulation="stable", shade_per_vertex=False):
     """The uber-shader's key: every built-in model that needs no more than the view vector, every
     term of ``materials``, and `UBER_MAX_LIGHTS` lights of each kind, switched at run time by uniforms.
@@ -404,12 +420,8 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
     materials : sequence of glphong.materials.Material
         The materials drawn with it (a scene's); their terms are all compiled in.
     """
-    from .materials.model import registered_models
-
     terms = {}
-    builtin = [m.example() for m in registered_models() if m.__module__.startswith("glphong.")
-               and set(m.needs) <= {"view"} and not m.defines(m.example())]
-    for term in builtin + [term for material in materials for term in material.components]:
+    for term in _uber_builtins() + [term for material in materials for term in material.components]:
         key = TermKey(term.name, term.source_hash(), tuple(term.needs), lit=True, ambient=term.ambient is not None,
                       uses=tuple(term.uses), defines=tuple(term.defines()), ambient_param=term.ambient)
         known = terms.setdefault(term.name, key)

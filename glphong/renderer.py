@@ -168,6 +168,28 @@ _ORPHANS = []
 _ORPHANS_LOCK = threading.Lock()
 
 
+def _release_targets(context, targets):
+    """Release a renderer's framebuffers and full-screen vertex arrays (context entered)."""
+    for name, obj in targets.items():
+        if name[0] == "fullscreen":  # a full-screen vertex array
+            obj.release()
+        else:
+            context.release_framebuffer(obj)
+    targets.clear()
+
+
+def _release_resources(context, meshes, targets, programs):
+    """Release every GL object of a renderer, then recycle its context (`Renderer.release` and the
+    orphans of renderers dropped without it)."""
+    with context:
+        for entry in meshes.values():
+            entry.release()
+        meshes.clear()
+        _release_targets(context, targets)
+        programs.release()
+    context.recycle()  # every GL object is released: the context may serve another renderer
+
+
 @atexit.register
 def _release_orphans():
     with _ORPHANS_LOCK:
@@ -496,12 +518,7 @@ class Renderer:
             self._meshes.pop(mesh_id).release()
 
     def _release_targets(self):
-        for name, obj in self._targets.items():
-            if name[0] == "fullscreen":  # a full-screen vertex array
-                obj.release()
-            else:
-                self.context.release_framebuffer(obj)
-        self._targets.clear()
+        _release_targets(self.context, self._targets)
 
     def gl_object_count(self):
         """Number of GL objects this renderer holds (programs, buffers, vertex arrays, targets)."""
@@ -516,13 +533,7 @@ class Renderer:
         """Release every GL object and the context; idempotent."""
         if self.context is None:
             return
-        with self.context:
-            for entry in self._meshes.values():
-                entry.release()
-            self._meshes.clear()
-            self._release_targets()
-            self.programs.release()
-        self.context.recycle()  # every GL object of this renderer is released: the context may serve another
+        _release_resources(self.context, self._meshes, self._targets, self.programs)
         self.context = None
 
     def __enter__(self):
@@ -539,19 +550,8 @@ class Renderer:
             return
         state = (self.context, self._meshes, self._targets, self.programs)
         self.context = None
-
-        def release(state=state):
-            context, meshes, targets, programs = state
-            with context:
-                for entry in meshes.values():
-                    entry.release()
-                for name, obj in targets.items():
-                    obj.release() if name[0] == "fullscreen" else context.release_framebuffer(obj)
-                programs.release()
-            context.recycle()
-
         with _ORPHANS_LOCK:
-            _ORPHANS.append(release)
+            _ORPHANS.append(functools.partial(_release_resources, *state))
         try:
             warnings.warn("a glphong.Renderer was never released: its GL objects are released at the next "
                           "glphong call (call release() or use 'with glphong.Renderer(...) as r:')",

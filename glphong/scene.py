@@ -151,9 +151,18 @@ class Scene:
         return program_key(obj.material, self.light_counts(), self.ambient_radiance, output, needs)
 
     def gbuffer_needs(self):
-        """Extra G-buffer outputs the scene's radiance programs read ('tangent', 'uv'), a frozenset."""
-        keys = [program_key(o.material, self.light_counts(), self.ambient_radiance) for o in self._objects]
-        return frozenset(n for n in ("tangent", "uv") if any(getattr(k, f"has_{n}") for k in keys))
+        """Extra G-buffer outputs the scene's radiance programs read ('tangent', 'uv'), a frozenset.
+
+        Computed once per state of the scene (objects and lights are only ever added; the ambient
+        light may be replaced), not once per object drawn."""
+        state = (len(self._objects), len(self._lights), self.ambient_radiance)
+        cached = getattr(self, "_gbuffer_needs", None)
+        if cached is None or cached[0] != state:
+            counts, ambient = self.light_counts(), self.ambient_radiance
+            keys = [program_key(o.material, counts, ambient) for o in self._objects]
+            needs = frozenset(n for n in ("tangent", "uv") if any(getattr(k, f"has_{n}") for k in keys))
+            cached = self._gbuffer_needs = (state, needs)
+        return cached[1]
 
     def light_uniform_values(self, key):
         """The light and ambient uniforms a radiance program with ``key`` declares.
