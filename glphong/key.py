@@ -45,6 +45,8 @@ class TermKey:
         The instance's structural defines.
     ambient_param : str or None
         The rgb parameter of its ``k L_a`` answer.
+    ambient_scale : float
+        The answer is ``ambient_scale * k * L_a`` (``1/pi`` for an albedo ``rho``: ``rho/pi L_a``).
     """
 
     name: str
@@ -55,6 +57,7 @@ class TermKey:
     uses: tuple = ()
     defines: tuple = ()
     ambient_param: str = None
+    ambient_scale: float = 1.0
 
     @property
     def chunk(self):
@@ -296,6 +299,14 @@ def _switch(key, flag, statement):
     return f"    if (SWITCH({flag})) {statement}" if key.uber else f"    {statement}"
 
 
+def _glsl_float(value):
+    """A GLSL float literal that reads back as ``value`` rounded to float32."""
+    import numpy as np
+
+    return repr(float(np.float32(value))) if "e" in repr(float(np.float32(value))) or "." in repr(
+        float(np.float32(value))) else repr(float(np.float32(value))) + ".0"
+
+
 def material_chunk(key):
     """The generated GLSL that sums the key's terms (label ``generated:material``).
 
@@ -319,7 +330,8 @@ def material_chunk(key):
         lines.append(_switch(key, "u_use_ka", "radiance += u_ka;"))
     for t in key.terms:
         if t.ambient:
-            lines.append(_switch(key, f"u_use_{t.name}_ambient", f"radiance += u_{t.name}_{t.ambient_param} * u_ambient;"))
+            scaled = "u_ambient" if t.ambient_scale == 1.0 else f"({_glsl_float(t.ambient_scale)} * u_ambient)"
+            lines.append(_switch(key, f"u_use_{t.name}_ambient", f"radiance += u_{t.name}_{t.ambient_param} * {scaled};"))
     lines += ["    return radiance;", "}", "",
               "vec3 material_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)", "{",
               "    vec3 response = vec3(0.0);"]
@@ -334,6 +346,12 @@ def _ambient_present(ambient_radiance):
     return ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance)
 
 
+def _term_key(term, lit, ambient):
+    return TermKey(term.name, term.source_hash(), tuple(term.needs), lit=lit, ambient=ambient,
+                   uses=term.library_uses(), defines=term.structural_defines(), ambient_param=term.ambient,
+                   ambient_scale=float(term.ambient_scale))
+
+
 def term_keys(material, lit, ambient_present):
     """The `TermKey` of each term of ``material`` that a program evaluates."""
     out = []
@@ -342,8 +360,7 @@ def term_keys(material, lit, ambient_present):
             continue
         answers = ambient_present and term.answers_ambient()
         if lit or answers:
-            out.append(TermKey(term.name, term.source_hash(), tuple(term.needs), lit=lit, ambient=answers,
-                               uses=tuple(term.uses), defines=tuple(term.defines()), ambient_param=term.ambient))
+            out.append(_term_key(term, lit=lit, ambient=answers))
     return tuple(out)
 
 
@@ -407,7 +424,7 @@ def _uber_builtins():
     cached = _UBER_BUILTINS.get(models)
     if cached is None:
         examples = [m.example() for m in models if m.__module__.startswith("glphong.") and set(m.needs) <= {"view"}]
-        cached = _UBER_BUILTINS[models] = [e for e in examples if not e.defines()]
+        cached = _UBER_BUILTINS[models] = [e for e in examples if not e.structural_defines()]
     return cached
 
 
@@ -422,8 +439,7 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
     """
     terms = {}
     for term in _uber_builtins() + [term for material in materials for term in material.components]:
-        key = TermKey(term.name, term.source_hash(), tuple(term.needs), lit=True, ambient=term.ambient is not None,
-                      uses=tuple(term.uses), defines=tuple(term.defines()), ambient_param=term.ambient)
+        key = _term_key(term, lit=True, ambient=term.ambient is not None)
         known = terms.setdefault(term.name, key)
         if known != key:
             raise ValueError(f"the uber-shader holds one variant of each model, but the scene has two of "

@@ -254,7 +254,7 @@ class Program:
         from .materials.model import model_for_key
 
         self.optional = {model_for_key(t.name, t.source_hash).uniform_name(p.name)
-                         for t in getattr(key, "terms", ()) for p in model_for_key(t.name, t.source_hash).params}
+                         for t in getattr(key, "terms", ()) for p in model_for_key(t.name, t.source_hash).uniform_params()}
 
     def bind(self, values, drop_unused=False):
         """Set every active uniform from ``values``; anything else is an error.

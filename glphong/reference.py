@@ -1,6 +1,6 @@
 """The numpy twin of the GLSL shaders (DESIGN sections 1 and 3).
 
-Every GLSL function of the library chunks (common, lights, lobe, shade and the generated
+Every GLSL function of the library chunks (common, lights, lobe, fresnel, shade and the generated
 material chunk) has a twin here with the same name, the same argument order and the same
 formulation; a model's functions live with its definition (``glphong.materials.<model>``, its
 ``response`` method the twin of ``<model>_response``).  Only the arithmetic is done in the dtype
@@ -19,7 +19,7 @@ import numpy as np
 
 __all__ = [
     "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus", "lobe_from_delta",
-    "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
+    "fresnel_schlick", "fresnel_dielectric", "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
     "shade_inputs", "shade",
 ]
 
@@ -189,6 +189,40 @@ def lobe_from_delta(delta, q):
     return np.where(q == 0, 1, value).astype(dtype)
 
 
+# --------------------------------------------------------------------------- fresnel.glsl
+def fresnel_schlick(f0, c):
+    """Schlick's ``f0 + (1 - f0)(1 - c)^5`` with ``c`` clamped to [0, 1] (fresnel.glsl).
+
+    f0 (3,) in [0, 1], c (...) -> (..., 3), dimensionless.
+    """
+    c = np.asarray(c)
+    m = np.clip(1 - c, 0, 1)
+    m2 = m * m
+    return f0 + (1 - f0) * (m2 * m2 * m)[..., None]
+
+
+def fresnel_dielectric(ior, c):
+    """The exact unpolarised dielectric reflectance (fresnel.glsl): ior () > 0, c (...) -> (...).
+
+    ``(g - c)^2 / (2 (g + c)^2) (1 + (c (g + c) - 1)^2 / (c (g - c) + 1)^2)``, ``g^2 = ior^2 + c^2 - 1``,
+    with ``g - c = (ior^2 - 1)/(g + c)``; 1 under total internal reflection and at ``c = 0``.
+    """
+    c = np.clip(np.asarray(c), 0, 1)
+    dtype = c.dtype if c.dtype.kind == "f" else np.float64
+    ior = np.asarray(ior, dtype)
+    a = (ior - 1) * (ior + 1)
+    g2 = a + c * c
+    g = np.sqrt(np.maximum(g2, 0))
+    g_plus_c = g + c
+    safe = np.maximum(g_plus_c, dtype.type(1e-30))
+    with np.errstate(over="ignore", invalid="ignore"):
+        ratio = (a / safe) / safe
+        g_minus_c = a / safe
+        q = (c * g_plus_c - 1) / (c * g_minus_c + 1)
+        f = 0.5 * (ratio * ratio) * (1 + q * q)
+    return np.where((g2 < 0) | (g_plus_c <= 0), 1, np.minimum(f, 1)).astype(dtype)
+
+
 # --------------------------------------------------------------------------- shade.glsl
 def incident_light(position, key, uniforms):
     """Direction and irradiance of every light at each point: the head of shade.glsl's loops.
@@ -232,7 +266,8 @@ def material_emission(key, uniforms, shape, dtype, material=None):
         radiance = radiance + uniforms["u_ka"]
     for term in key.terms:
         if term.ambient:
-            radiance = radiance + uniforms[f"u_{term.name}_{term.ambient_param}"] * uniforms["u_ambient"]
+            scale = np.float32(term.ambient_scale).astype(dtype)
+            radiance = radiance + uniforms[f"u_{term.name}_{term.ambient_param}"] * (scale * uniforms["u_ambient"])
     return radiance
 
 

@@ -239,7 +239,7 @@ class Scene:
         from .materials import model_named
 
         for term in key.terms:
-            for p in model_named(term.name).params:
+            for p in model_named(term.name).uniform_params():
                 name = f"u_{term.name}_{p.name}"
                 values.setdefault(name, np.zeros(3 if p.kind == "rgb" else (), np.float32))
         for kind, (_, where_name, value_name) in LIGHT_KINDS.items():

@@ -300,8 +300,10 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
         return [x / length for x in a]
 
     def mp_values(term):
-        return ParamValues({p.name: (vec(getattr(term, p.name)) if p.kind == "rgb" else f(getattr(term, p.name)))
-                            for p in term.params})
+        structure = term.values().__dict__
+        return ParamValues({p.name: (vec(term.uniform_value(p.name)) if p.kind == "rgb" else f(term.uniform_value(p.name)))
+                            for p in term.uniform_params()}
+                           | {k: v for k, v in structure.items() if k not in {p.name for p in term.uniform_params()}})
 
     material = scene.objects[0].material
     terms = [t for t in material.components if not t.vanishes()]
@@ -310,7 +312,8 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
         for term in terms:
             if term.ambient is not None:
                 k = vec(getattr(term, term.ambient))
-                out = [o + a * la for o, a, la in zip(out, k, vec(scene.ambient.radiance))]
+                scale = mpmath.mpf(term.ambient_scale)
+                out = [o + scale * a * la for o, a, la in zip(out, k, vec(scene.ambient.radiance))]
     raw_n = np.asarray(normal, dtype=np.float32)
     if not np.all(np.isfinite(raw_n)) or not np.any(raw_n):
         return np.array([float(o) for o in out])

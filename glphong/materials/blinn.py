@@ -14,11 +14,12 @@ q          scalar  >= 0        1       exponent (q = 0: lobe 1 where h is define
 """
 import numpy as np
 
+from .fresnel import FresnelSlot, fresnel_band, fresnel_factor
 from .lambert import Lambert
 from .model import GlslFile, MaterialModel, MaterialSum, Properties
 from .phong import _KS, _Q, _dot, lobe_oracle
 
-__all__ = ["BlinnLobe", "BlinnPhong", "blinn_delta", "blinn_lobe", "BLINN_HALF_FLOOR"]
+__all__ = ["BlinnLobe", "BlinnPhong", "blinn_delta", "blinn_lobe", "half_cosine", "BLINN_HALF_FLOOR"]
 
 #: blinn_lobe.glsl BLINN_HALF_FLOOR = 2^-20: |l + v| at or below it gives a zero Blinn lobe
 BLINN_HALF_FLOOR = 2.0 ** -20
@@ -50,10 +51,19 @@ def blinn_lobe(n, wi, wo, q):
     return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype)
 
 
+def half_cosine(wi, wo):
+    """``h.l`` with ``h = (l + v)/|l + v|``, 0 where ``l + v`` does not normalise (blinn_lobe.glsl's response)."""
+    from ..reference import safe_normalize
+
+    ok, h, _ = safe_normalize(wi + wo)
+    return np.where(ok, _dot(h, wi), 0).astype(h.dtype)
+
+
 class BlinnLobe(MaterialModel):
     """The Blinn-Torrance lobe alone: response ``k_s max(n.h, 0)^q``.
 
-    Parameters are those of `glphong.materials.PhongLobe`.
+    Parameters are those of `glphong.materials.PhongLobe`; ``fresnel`` multiplies the lobe by
+    ``F(h.l)``.
     """
 
     name = "blinn_lobe"
@@ -62,11 +72,12 @@ class BlinnLobe(MaterialModel):
     glsl = GlslFile("materials/blinn_lobe.glsl")
     uses = ("lobe",)
     vanishes_with = ("ks",)
+    fresnel_slot = FresnelSlot(cosine="h.l")
     properties = Properties(reciprocal=False, isotropic=True, energy_conserving=False,
                             condition="never: the albedo grows without bound at grazing incidence")
 
     def response(self, f, wi, wo, n_dot_l, p):
-        return p.ks * blinn_lobe(f.n, wi, wo, p.q)[..., None]
+        return p.ks * fresnel_factor(p, half_cosine(wi, wo)) * blinn_lobe(f.n, wi, wo, p.q)[..., None]
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
         """``k_s`` times the lobe band of the Blinn delta, its chord widening scaled by the half vector's
@@ -85,7 +96,8 @@ class BlinnLobe(MaterialModel):
         possible = ok_h & (n_dot_v > -tol) & (h_len > BLINN_HALF_FLOOR / 4)
         low = np.where(certain, low, 0.0)
         high = np.where(possible, np.where(certain, high, 1.0), 0.0)
-        return p.ks * low[..., None], p.ks * high[..., None]
+        f_low, f_high = fresnel_band(p, half_cosine(wi, wo), 4 * tol * scale)
+        return p.ks * f_low * low[..., None], p.ks * f_high * high[..., None]
 
     def oracle(self, f, wi, wo, n_dot_l, p):
         import mpmath
@@ -94,8 +106,11 @@ class BlinnLobe(MaterialModel):
         length = mpmath.sqrt(sum(x * x for x in s))
         if not (sum(a * b for a, b in zip(f.n, wo)) > 0 and length > 0):
             return [mpmath.mpf(0)] * 3
+        from .fresnel import fresnel_oracle
+
         lobe = lobe_oracle(sum(a * b / length for a, b in zip(f.n, s)), p.q)
-        return [k * lobe for k in p.ks]
+        fresnel = fresnel_oracle(p, sum(a * b / length for a, b in zip(wi, s)))
+        return [k * F * lobe for k, F in zip(p.ks, fresnel)]
 
     def pbr_roughness(self):
         """A rough pyrender roughness for comparisons: ``(2 / (q + 2))^(1/4)`` (Beckmann-like alpha)."""

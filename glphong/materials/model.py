@@ -30,7 +30,7 @@ import numpy as np
 
 from .. import _validate
 
-__all__ = ["Param", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
+__all__ = ["Param", "Choice", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
            "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
 
 #: parameter kinds and their GLSL types
@@ -38,12 +38,12 @@ KINDS = {"scalar": "float", "rgb": "vec3"}
 #: what a model may ask for beyond the normal and the light direction
 NEEDS = ("view", "tangent", "uv")
 #: library chunks (glsl/<name>.glsl) a model may use besides common.glsl, which is always there
-LIBRARY_CHUNKS = ("lobe",)
+LIBRARY_CHUNKS = ("lobe", "fresnel")
 #: names a model may not take: GLSL prefixes and uniforms of the shading loop and the library
 RESERVED_NAMES = frozenset({
     "material", "shade", "common", "lights", "light", "point", "unattenuated", "directional", "ambient",
     "eye", "model", "normal", "view", "use", "ka", "safe", "lobe", "srgb", "encode", "mesh", "uber", "naive",
-    "frame", "gl", "object", "exposure", "radiance", "fullscreen"})
+    "frame", "gl", "object", "exposure", "radiance", "fullscreen", "fresnel"})
 #: material-level keywords every material takes
 MATERIAL_KEYWORDS = ("ka", "two_sided")
 _GLSL_KEYWORDS = frozenset("""attribute const uniform varying layout centroid flat smooth noperspective break continue
@@ -158,6 +158,49 @@ class Param:
             x = self.low + 0.5 * (self.high - self.low) if np.isfinite(self.high - self.low) else \
                 (self.low + 1.0 if np.isfinite(self.low) else self.high - 1.0)
         return self.validate(x)
+
+
+@dataclass(frozen=True)
+class Choice:
+    """A structural option of a material model: which form of its formula the program compiles.
+
+    Parameters
+    ----------
+    name : str
+        Python keyword; the define is ``<MODEL>_<NAME>`` (upper-cased), its value the index of the
+        chosen value in `values` (so the GLSL reads ``#if COOK_TORRANCE_LOBE_FORM == 1``).
+    values : tuple of str
+        The allowed values, in index order.
+    default : str
+    doc : str
+    """
+
+    name: str
+    values: tuple
+    default: str
+    doc: str = ""
+
+    def __post_init__(self):
+        if not isinstance(self.name, str) or not _IDENT.match(self.name) or keyword.iskeyword(self.name):
+            raise MaterialDefinitionError(f"Choice name must be a lowercase identifier (got {self.name!r})")
+        if not isinstance(self.values, tuple) or not self.values or not all(isinstance(v, str) for v in self.values):
+            raise MaterialDefinitionError(f"Choice {self.name!r}: values must be a non-empty tuple of str")
+        if self.default not in self.values:
+            raise MaterialDefinitionError(f"Choice {self.name!r}: default {self.default!r} is not one of {self.values}")
+
+    @property
+    def interval(self):
+        return " or ".join(map(repr, self.values))
+
+    def validate(self, value):
+        """``value`` if it is one of `values`, else ValueError naming them."""
+        if not isinstance(value, str) or value not in self.values:
+            raise ValueError(f"{self.name} must be {self.interval} (got {value!r})")
+        return value
+
+    def define(self, value):
+        """``(NAME, index)`` of the chosen value."""
+        return self.name.upper(), str(self.values.index(value))
 
 
 @dataclass(frozen=True)
@@ -352,18 +395,25 @@ def _check_glsl(cls, text):
             + (f"found `{found.group(0)}`" if found else
                f"found no {name}_response (functions defined: {', '.join(functions) or 'none'})"))
     read = set(re.findall(rf"\bu_{name}_([A-Za-z_]\w*)", code))
-    declared = {p.name for p in cls.params}
+    declared = {p.name for p in cls.uniform_params()}
     if read - declared:
         raise MaterialDefinitionError(
             f"{cls.__qualname__}.glsl reads {', '.join(f'u_{name}_{x}' for x in sorted(read - declared))}, "
             f"which no Param declares (params: {', '.join(sorted(declared)) or 'none'})")
-    if declared - read:
+    if declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]}:
         raise MaterialDefinitionError(
-            f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(declared - read))}: "
+            f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(declared - read - {'fresnel_f0', 'fresnel_ior'}))}: "
             "every Param is a uniform the response must use (or remove the Param)")
     if re.search(rf"\buniform\s+\w+\s+u_{name}_", code):
         raise MaterialDefinitionError(f"{cls.__qualname__}.glsl declares its own u_{name}_* uniforms: glphong "
                                       "declares them from params; remove the declarations")
+    calls = re.search(rf"\b{name}_fresnel\s*\(", code)
+    if cls.fresnel_slot is not None and not calls:
+        raise MaterialDefinitionError(f"{cls.__qualname__} has a fresnel_slot, so its GLSL must call "
+                                      f"{name}_fresnel(c) (generated by glphong) with the cosine {cls.fresnel_slot.cosine}")
+    if cls.fresnel_slot is None and calls:
+        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl calls {name}_fresnel, which glphong generates only "
+                                      "for a model with fresnel_slot = FresnelSlot(...)")
     _check_needs(cls, code)
     _check_namespace(cls, code)
 
@@ -414,14 +464,15 @@ def _top_level_names(code):
 
 def _generated_names(cls):
     """The uniform and switch names glphong generates for a model."""
-    return {cls.uniform_name(p.name) for p in cls.params} | {f"u_use_{cls.name}", f"u_use_{cls.name}_ambient"}
+    names = {cls.uniform_name(p.name) for p in cls.uniform_params()} | {f"u_use_{cls.name}", f"u_use_{cls.name}_ambient"}
+    return names | ({f"{cls.name}_fresnel"} if cls.fresnel_slot is not None else set())
 
 
 def _library_names():
     from ..programs import chunk_source
 
     names = {"material_emission", "material_response", "shade_point"}
-    for chunk in ("common", "lights", "lobe", "shade", "srgb"):
+    for chunk in ("common", "lights", "lobe", "fresnel", "shade", "srgb"):
         names |= _top_level_names(_strip_comments(chunk_source(chunk)))
     return names
 
@@ -503,7 +554,7 @@ class Material:
         """Every parameter's validated value by name (dict), ``ka`` and ``two_sided`` included."""
         out = {}
         for term in self.components:
-            out.update({p.name: getattr(term, p.name) for p in term.params})
+            out.update({a.name: getattr(term, a.name) for a in term.arguments()})
         out.update(ka=self.ka, two_sided=self.two_sided)
         return out
 
@@ -529,8 +580,8 @@ class Material:
             term = by_name.get(term_key.name)
             if term is None:
                 continue  # the uber-shader's terms this material does not have: the caller fills zeros
-            params = term.params if term_key.lit else [p for p in term.params if p.name == term.ambient]
-            values.update({term.uniform_name(p.name): _validate.float32_uniform(getattr(term, p.name))
+            params = term.active_params() if term_key.lit else [p for p in term.params if p.name == term.ambient]
+            values.update({term.uniform_name(p.name): _validate.float32_uniform(term.uniform_value(p.name))
                            for p in params})
         return values
 
@@ -545,7 +596,8 @@ class Material:
 
     def __repr__(self):
         values = self.parameter_values()
-        shown = [f"{k}={_short(v)}" for k, v in values.items() if k not in MATERIAL_KEYWORDS]
+        hidden = {"fresnel"} if values.get("fresnel", 0) is None else set()  # fresnel=None: F = 1, the default
+        shown = [f"{k}={_short(v)}" for k, v in values.items() if k not in MATERIAL_KEYWORDS and k not in hidden]
         if any(values["ka"]):
             shown.append(f"ka={_short(values['ka'])}")
         if not values["two_sided"]:
@@ -554,15 +606,20 @@ class Material:
 
 
 def _short(value):
+    if value is None or isinstance(value, str) or not isinstance(value, (tuple, float, int)):
+        return repr(value)
     if isinstance(value, tuple) and len(set(value)) == 1:
         return f"{value[0]:g}"
     return f"({', '.join(f'{c:g}' for c in value)})" if isinstance(value, tuple) else f"{value:g}"
 
 
 def _bind_arguments(cls, params, args, kwargs):
-    """Map positional and keyword arguments onto ``params`` (validated values by name)."""
+    """Map positional and keyword arguments onto ``params`` (validated values by name).
+
+    ``params`` are the constructor's arguments in positional order: `Param`, `Choice` and a
+    `FresnelSlot` (whose default may be None, a valid value)."""
     if len(args) > len(params):
-        raise TypeError(f"{cls.__name__}() takes at most {len(params)} positional parameters "
+        raise TypeError(f"{cls.__name__}() takes at most {len(params)} positional arguments "
                         f"({', '.join(p.name for p in params)}) (got {len(args)})")
     names = [p.name for p in params]
     given = dict(zip(names, args))
@@ -577,7 +634,7 @@ def _bind_arguments(cls, params, args, kwargs):
     for p in params:
         if p.name in given:
             out[p.name] = p.validate(given[p.name])
-        elif p.default is not None:
+        elif p.default is not None or not isinstance(p, Param):
             out[p.name] = p.default
         else:
             raise TypeError(f"{cls.__name__}() missing parameter {p.name!r} ({p.kind} in {p.interval}"
@@ -634,6 +691,9 @@ class MaterialModel(Material):
     ambient = None
     vanishes_with = ()
     properties = Properties()
+    choices = ()
+    fresnel_slot = None
+    ambient_scale = 1.0
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -665,9 +725,55 @@ class MaterialModel(Material):
     def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
         if type(self).name is None:
             raise TypeError(f"{type(self).__name__} is not a material model (it has no name)")
-        for name, value in _bind_arguments(type(self), self.params, args, kwargs).items():
+        for name, value in _bind_arguments(type(self), self.arguments(), args, kwargs).items():
             object.__setattr__(self, name, value)
         self._set_common(ka, two_sided)
+
+    @classmethod
+    def arguments(cls):
+        """The constructor's arguments in positional order: `params`, then ``fresnel`` (where the model
+        has a `fresnel_slot`), then `choices` (tuple)."""
+        return cls.params + ((cls.fresnel_slot,) if cls.fresnel_slot is not None else ()) + cls.choices
+
+    @classmethod
+    def uniform_params(cls):
+        """Every uniform the model's chunk declares, as `Param`: `params`, and ``fresnel_f0`` and
+        ``fresnel_ior`` where the model has a `fresnel_slot` (tuple)."""
+        if cls.fresnel_slot is None:
+            return cls.params
+        from .fresnel import FRESNEL_PARAMS
+
+        return cls.params + FRESNEL_PARAMS
+
+    def active_params(self):
+        """The uniforms this instance's programs read: `uniform_params` less the Fresnel factor's where
+        it has none (tuple of Param)."""
+        return self.params if getattr(self, "fresnel", None) is None else self.uniform_params()
+
+    def uniform_value(self, name):
+        """The value of the uniform ``u_<model>_<name>`` (a param, or the Fresnel factor's)."""
+        if name.startswith("fresnel_") and self.fresnel_slot is not None and name not in {p.name for p in self.params}:
+            from .fresnel import FRESNEL_PARAMS
+
+            if self.fresnel is None:
+                return {p.name: p.default for p in FRESNEL_PARAMS}[name]
+            return self.fresnel.uniform_values()[name]
+        return getattr(self, name)
+
+    def structural_defines(self):
+        """Every ``(NAME, value)`` define of this instance (un-prefixed): its `choices`' indices, its
+        Fresnel form (``FRESNEL_SCHLICK`` or ``FRESNEL_DIELECTRIC``, none for ``fresnel=None``) and
+        `defines`.  The key emits each as ``<MODEL>_<NAME>``."""
+        out = [c.define(getattr(self, c.name)) for c in self.choices]
+        if self.fresnel_slot is not None and self.fresnel is not None:
+            out.append((f"FRESNEL_{self.fresnel.form.upper()}", "1"))
+        return tuple(out) + tuple(self.defines())
+
+    def library_uses(self):
+        """Library chunks this instance's program needs: `uses`, and ``'fresnel'`` where it has a
+        Fresnel factor (tuple)."""
+        extra = ("fresnel",) if self.fresnel_slot is not None and self.fresnel is not None else ()
+        return tuple(dict.fromkeys(tuple(self.uses) + extra))
 
     @property
     def components(self):
@@ -691,9 +797,20 @@ class MaterialModel(Material):
 
     @classmethod
     def uniform_declarations(cls):
-        """The GLSL declarations of the model's uniforms, generated from `params`."""
-        return "\n".join(f"uniform {p.glsl_type} {cls.uniform_name(p.name)};  // {p.kind} in {p.interval}"
-                         f"{' [' + p.unit + ']' if p.unit else ''}" for p in cls.params)
+        """The GLSL declarations of the model's uniforms, generated from `params`; where the model has
+        a `fresnel_slot`, also its Fresnel uniforms and ``vec3 <name>_fresnel(float c)``."""
+        lines = [f"uniform {p.glsl_type} {cls.uniform_name(p.name)};  // {p.kind} in {p.interval}"
+                 f"{' [' + p.unit + ']' if p.unit else ''}" for p in cls.uniform_params()]
+        if cls.fresnel_slot is not None:
+            upper, name = cls.name.upper(), cls.name
+            lines += [f"// the Fresnel factor F(c) of fresnel= (glphong/materials/fresnel.py), c = {cls.fresnel_slot.cosine}",
+                      f"vec3 {name}_fresnel(float c)", "{",
+                      f"#if defined({upper}_FRESNEL_SCHLICK)",
+                      f"    return fresnel_schlick(u_{name}_fresnel_f0, c);",
+                      f"#elif defined({upper}_FRESNEL_DIELECTRIC)",
+                      f"    return vec3(fresnel_dielectric(u_{name}_fresnel_ior, c));",
+                      "#else", "    return vec3(1.0);", "#endif", "}"]
+        return "\n".join(lines)
 
     def defines(self):
         """Structural ``#define`` pairs ``(NAME, value)`` of this instance (part of its key; default none).
@@ -712,19 +829,27 @@ class MaterialModel(Material):
         """True where the model answers ``L_a`` with a non-zero ``k``."""
         return self.ambient is not None and bool(np.any(getattr(self, self.ambient)))
 
-    @classmethod
-    def values_from_uniforms(cls, uniforms, dtype=np.float64, names=None):
-        """`ParamValues` from a program's uniforms (the float32 values the GPU was given).
+    def values_from_uniforms(self, uniforms, dtype=np.float64, names=None):
+        """`ParamValues` from a program's uniforms (the float32 values the GPU was given), with this
+        instance's structure: its choices (by value) and ``fresnel_form`` (0 none, 1 Schlick, 2 dielectric).
 
         ``names`` limits them (an ambient-only term has only its ambient parameter)."""
-        params = [p for p in cls.params if names is None or p.name in names]
-        return ParamValues({p.name: np.asarray(uniforms[cls.uniform_name(p.name)], dtype=dtype) for p in params})
+        params = [p for p in self.uniform_params() if names is None or p.name in names]
+        values = {p.name: np.asarray(uniforms[self.uniform_name(p.name)] if p in self.active_params() else
+                                     _validate.float32_uniform(self.uniform_value(p.name)), dtype=dtype) for p in params}
+        return ParamValues(values | self._structure())
 
     def values(self, dtype=np.float64):
         """`ParamValues` of this instance: its values as the GPU receives them (float32, subnormals
-        flushed), in ``dtype``."""
-        return ParamValues({p.name: np.asarray(_validate.float32_uniform(getattr(self, p.name)), dtype=dtype)
-                            for p in self.params})
+        flushed), in ``dtype``, with its structure as in `values_from_uniforms`."""
+        return ParamValues({p.name: np.asarray(_validate.float32_uniform(self.uniform_value(p.name)), dtype=dtype)
+                            for p in self.uniform_params()} | self._structure())
+
+    def _structure(self):
+        out = {c.name: getattr(self, c.name) for c in self.choices}
+        if self.fresnel_slot is not None:
+            out["fresnel_form"] = 0 if self.fresnel is None else self.fresnel.index
+        return out
 
     # ---- the twin and what is built on it
     def response(self, f, wi, wo, n_dot_l, p):
@@ -786,7 +911,7 @@ class MaterialModel(Material):
             moved = np.maximum(n_dot_l + sign * angle, tiny)
             with np.errstate(all="ignore"):
                 add(self.response(f, wi, wo, moved, p))
-        for param in self.params:
+        for param in self.uniform_params():
             if param.kind != "scalar":
                 continue
             for sign in (1.0, -1.0):
@@ -861,6 +986,21 @@ def _check_definition(cls):
                                       "which are not params")
     if not isinstance(cls.properties, Properties):
         raise MaterialDefinitionError(f"{cls.__qualname__}.properties must be a glphong.materials.Properties")
+    if not isinstance(cls.choices, tuple) or not all(isinstance(c, Choice) for c in cls.choices):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.choices must be a tuple of glphong.materials.Choice")
+    from .fresnel import FresnelSlot
+
+    if cls.fresnel_slot is not None and not isinstance(cls.fresnel_slot, FresnelSlot):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.fresnel_slot must be None or a "
+                                      f"glphong.materials.FresnelSlot (got {cls.fresnel_slot!r})")
+    arguments = [a.name for a in cls.arguments()]
+    if len(set(arguments)) != len(arguments) or any(n.startswith("fresnel_") for n in names):
+        raise MaterialDefinitionError(f"{cls.__qualname__}: params, choices and fresnel must have distinct names, "
+                                      f"and no param may start with fresnel_ (got {arguments})")
+    scale = cls.ambient_scale
+    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0 < scale < np.inf:
+        raise MaterialDefinitionError(f"{cls.__qualname__}.ambient_scale must be a positive finite float "
+                                      f"(the answer to L_a is ambient_scale * <ambient param> * L_a; got {scale!r})")
     if cls.glsl is None:
         raise MaterialDefinitionError(f"{cls.__qualname__} has no glsl: set glsl to the GLSL source of "
                                       f"`vec3 {name}_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)` "
@@ -897,7 +1037,7 @@ class MaterialSum(Material):
         models = [t.name for t in terms]
         if len(set(models)) != len(models):
             raise MaterialDefinitionError(f"{cls.__qualname__}.terms repeats a model ({models}): their uniforms would clash")
-        names = [p.name for t in terms for p in t.params]
+        names = [a.name for t in terms for a in t.arguments() if a.name != "fresnel"]
         if len(set(names)) != len(names):
             raise MaterialDefinitionError(f"{cls.__qualname__}: its terms' parameter names must differ (got {names})")
         if "properties" not in cls.__dict__:
@@ -914,11 +1054,18 @@ class MaterialSum(Material):
         """The terms' parameters, in order (tuple of Param)."""
         return tuple(p for t in cls.terms for p in t.params)
 
+    @classmethod
+    def arguments(cls):
+        """The constructor's arguments in positional order: the terms' params, then ``fresnel`` (passed
+        to every term with a fresnel slot), then the terms' choices."""
+        slots = [t.fresnel_slot for t in cls.terms if t.fresnel_slot is not None]
+        return cls.all_params() + tuple(slots[:1]) + tuple(c for t in cls.terms for c in t.choices)
+
     def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
         if not type(self).terms:
             raise TypeError(f"{type(self).__name__} has no terms")
-        values = _bind_arguments(type(self), self.all_params(), args, kwargs)
-        parts = tuple(t(**{p.name: values[p.name] for p in t.params}, two_sided=two_sided) for t in self.terms)
+        values = _bind_arguments(type(self), self.arguments(), args, kwargs)
+        parts = tuple(t(**{a.name: values[a.name] for a in t.arguments()}, two_sided=two_sided) for t in self.terms)
         object.__setattr__(self, "_parts", parts)
         self._set_common(ka, two_sided)
 
@@ -930,6 +1077,6 @@ class MaterialSum(Material):
         if name.startswith("_"):
             raise AttributeError(name)
         for part in self.__dict__.get("_parts", ()):
-            if name in {p.name for p in part.params}:
+            if name in {a.name for a in part.arguments()}:
                 return getattr(part, name)
         raise AttributeError(f"{type(self).__name__} has no attribute {name!r}")

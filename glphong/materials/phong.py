@@ -16,6 +16,7 @@ q          scalar  >= 0        1       exponent (q = 0: lobe 1, the 0^0 := 1 con
 """
 import numpy as np
 
+from .fresnel import FresnelSlot, fresnel_band, fresnel_factor
 from .lambert import Lambert
 from .model import GlslFile, MaterialModel, MaterialSum, Param, Properties
 
@@ -59,6 +60,8 @@ class PhongLobe(MaterialModel):
         Specular coefficient [1/sr], >= 0.
     q : float
         Exponent, finite, >= 0.
+    fresnel : SchlickFresnel, DielectricFresnel or None
+        Fresnel factor ``F(n.l)`` multiplying the lobe (default None: ``F = 1``, the lecture's lobe).
     """
 
     name = "phong_lobe"
@@ -67,23 +70,28 @@ class PhongLobe(MaterialModel):
     glsl = GlslFile("materials/phong_lobe.glsl")
     uses = ("lobe",)
     vanishes_with = ("ks",)
+    fresnel_slot = FresnelSlot(cosine="n.l")
     properties = Properties(reciprocal=False, isotropic=True, energy_conserving=False,
                             condition="never: the albedo grows without bound at grazing incidence")
 
     def response(self, f, wi, wo, n_dot_l, p):
-        return p.ks * phong_lobe(f.n, wi, wo, p.q)[..., None]
+        return p.ks * fresnel_factor(p, n_dot_l) * phong_lobe(f.n, wi, wo, p.q)[..., None]
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
-        """``k_s`` times `glphong.tolerances.lobe_band` of the Phong delta (DESIGN section 4)."""
-        from ..tolerances import lobe_band
+        """``k_s`` times `glphong.tolerances.lobe_band` of the Phong delta (DESIGN section 4), times the
+        Fresnel band at ``n.l +- D eps``."""
+        from ..tolerances import EPS, lobe_band
 
         low, high = lobe_band(phong_delta(f.n, wi, wo), p.q, 1.0, constants)
-        return p.ks * low[..., None], p.ks * high[..., None]
+        f_low, f_high = fresnel_band(p, n_dot_l, constants.D * EPS)
+        return p.ks * f_low * low[..., None], p.ks * f_high * high[..., None]
 
     def oracle(self, f, wi, wo, n_dot_l, p):
+        from .fresnel import fresnel_oracle
+
         c = sum(v * (2 * n_dot_l * a - b) for v, a, b in zip(wo, f.n, wi))
         lobe = lobe_oracle(c, p.q)
-        return [k * lobe for k in p.ks]
+        return [k * F * lobe for k, F in zip(p.ks, fresnel_oracle(p, n_dot_l))]
 
     def pbr_roughness(self):
         """A rough pyrender roughness for comparisons: the Blinn exponent of a Phong lobe is about 4 q."""
@@ -105,6 +113,8 @@ class Phong(MaterialSum):
         Diffuse and specular coefficients [1/sr], >= 0.
     q : float
         Specular exponent, finite, >= 0 (q = 0 gives a constant lobe of 1).
+    fresnel : SchlickFresnel, DielectricFresnel or None
+        Fresnel factor ``F(n.l)`` of the lobe (default None: ``F = 1``).
     ka : float or (3,) array_like, optional
         Constant term [W/(m^2 sr)], >= 0.
     two_sided : bool, optional
