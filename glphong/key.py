@@ -346,9 +346,9 @@ def _ambient_present(ambient_radiance):
     return ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance)
 
 
-def _term_key(term, lit, ambient):
+def _term_key(term, lit, ambient, uber=False):
     return TermKey(term.name, term.source_hash(), tuple(term.needs), lit=lit, ambient=ambient,
-                   uses=term.library_uses(), defines=term.structural_defines(), ambient_param=term.ambient,
+                   uses=term.library_uses(uber), defines=term.structural_defines(uber), ambient_param=term.ambient,
                    ambient_scale=float(term.ambient_scale))
 
 
@@ -424,7 +424,8 @@ def _uber_builtins():
     cached = _UBER_BUILTINS.get(models)
     if cached is None:
         examples = [m.example() for m in models if m.__module__.startswith("glphong.") and set(m.needs) <= {"view"}]
-        cached = _UBER_BUILTINS[models] = [e for e in examples if not e.structural_defines()]
+        cached = _UBER_BUILTINS[models] = [e for e in examples if not e.structural_defines()]  # the uber-shader's
+        # Fresnel is a runtime choice, so a glossy model whose only define is its Fresnel form is in
     return cached
 
 
@@ -439,7 +440,7 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
     """
     terms = {}
     for term in _uber_builtins() + [term for material in materials for term in material.components]:
-        key = _term_key(term, lit=True, ambient=term.ambient is not None)
+        key = _term_key(term, lit=True, ambient=term.ambient is not None, uber=True)
         known = terms.setdefault(term.name, key)
         if known != key:
             raise ValueError(f"the uber-shader holds one variant of each model, but the scene has two of "

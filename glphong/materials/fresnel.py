@@ -12,7 +12,9 @@ the model states (``n.l`` for Phong-type lobes, ``h.l`` for half-vector lobes an
 
 The choice is structural (a ``#define`` of the term's program: ``<MODEL>_FRESNEL_SCHLICK`` or
 ``<MODEL>_FRESNEL_DIELECTRIC``); ``f0`` and ``ior`` are uniforms ``u_<model>_fresnel_f0`` and
-``u_<model>_fresnel_ior``.  A user's model takes ``fresnel=`` by declaring ``fresnel_slot =
+``u_<model>_fresnel_ior``.  The uber-shader, which holds one variant of each model for every
+material of a scene, compiles both forms and selects by the uniform ``u_<model>_fresnel_form``
+(``<MODEL>_FRESNEL_RUNTIME``).  A user's model takes ``fresnel=`` by declaring ``fresnel_slot =
 FresnelSlot(cosine='h.l')`` and calling ``<name>_fresnel(c)`` in its GLSL and `fresnel_factor` in its twin.
 """
 from dataclasses import dataclass
@@ -27,7 +29,9 @@ __all__ = ["Fresnel", "SchlickFresnel", "DielectricFresnel", "FresnelSlot", "fre
 #: the uniforms a Fresnel slot adds to its model (``u_<model>_fresnel_f0``, ``u_<model>_fresnel_ior``)
 FRESNEL_PARAMS = (Param("fresnel_f0", "rgb", low=0.0, high=1.0, default=0.0, doc="Schlick's f0 (fresnel=SchlickFresnel)"),
                   Param("fresnel_ior", "scalar", low=0.0, high=1e6, low_inclusive=False, default=1.5,
-                        doc="relative index of refraction (fresnel=DielectricFresnel)"))
+                        doc="relative index of refraction (fresnel=DielectricFresnel)"),
+                  Param("fresnel_form", "scalar", low=0.0, high=2.0, default=0.0,
+                        doc="the form by index, read only by the uber-shader (0 none, 1 Schlick, 2 dielectric)"))
 #: forms by index (ParamValues.fresnel_form): 0 none (F = 1), 1 Schlick, 2 dielectric
 FORMS = ("none", "schlick", "dielectric")
 
@@ -63,7 +67,7 @@ class SchlickFresnel(Fresnel):
         object.__setattr__(self, "f0", _f0(self.f0))
 
     def uniform_values(self):
-        return {"fresnel_f0": self.f0, "fresnel_ior": 1.5}
+        return {"fresnel_f0": self.f0, "fresnel_ior": 1.5, "fresnel_form": 1.0}
 
     def __repr__(self):
         f0 = f"{self.f0[0]:g}" if len(set(self.f0)) == 1 else "(" + ", ".join(f"{c:g}" for c in self.f0) + ")"
@@ -98,7 +102,7 @@ class DielectricFresnel(Fresnel):
             raise type(exc)(f"DielectricFresnel: {str(exc).replace('fresnel_ior', 'ior')}") from None
 
     def uniform_values(self):
-        return {"fresnel_f0": (0.0, 0.0, 0.0), "fresnel_ior": self.ior}
+        return {"fresnel_f0": (0.0, 0.0, 0.0), "fresnel_ior": self.ior, "fresnel_form": 2.0}
 
     def __repr__(self):
         return f"DielectricFresnel(ior={self.ior:g})"

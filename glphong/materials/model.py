@@ -760,19 +760,22 @@ class MaterialModel(Material):
             return self.fresnel.uniform_values()[name]
         return getattr(self, name)
 
-    def structural_defines(self):
+    def structural_defines(self, uber=False):
         """Every ``(NAME, value)`` define of this instance (un-prefixed): its `choices`' indices, its
-        Fresnel form (``FRESNEL_SCHLICK`` or ``FRESNEL_DIELECTRIC``, none for ``fresnel=None``) and
-        `defines`.  The key emits each as ``<MODEL>_<NAME>``."""
+        Fresnel form (``FRESNEL_SCHLICK`` or ``FRESNEL_DIELECTRIC``, none for ``fresnel=None``;
+        ``FRESNEL_RUNTIME`` in the ``uber``-shader, whatever the instance's) and `defines`.  The key
+        emits each as ``<MODEL>_<NAME>``."""
         out = [c.define(getattr(self, c.name)) for c in self.choices]
-        if self.fresnel_slot is not None and self.fresnel is not None:
+        if self.fresnel_slot is not None and uber:
+            out.append(("FRESNEL_RUNTIME", "1"))
+        elif self.fresnel_slot is not None and self.fresnel is not None:
             out.append((f"FRESNEL_{self.fresnel.form.upper()}", "1"))
         return tuple(out) + tuple(self.defines())
 
-    def library_uses(self):
+    def library_uses(self, uber=False):
         """Library chunks this instance's program needs: `uses`, and ``'fresnel'`` where it has a
-        Fresnel factor (tuple)."""
-        extra = ("fresnel",) if self.fresnel_slot is not None and self.fresnel is not None else ()
+        Fresnel factor, or a slot in the ``uber``-shader (tuple)."""
+        extra = ("fresnel",) if self.fresnel_slot is not None and (self.fresnel is not None or uber) else ()
         return tuple(dict.fromkeys(tuple(self.uses) + extra))
 
     @property
@@ -809,6 +812,11 @@ class MaterialModel(Material):
                       f"    return fresnel_schlick(u_{name}_fresnel_f0, c);",
                       f"#elif defined({upper}_FRESNEL_DIELECTRIC)",
                       f"    return vec3(fresnel_dielectric(u_{name}_fresnel_ior, c));",
+                      f"#elif defined({upper}_FRESNEL_RUNTIME)  // the uber-shader: the form is a uniform",
+                      f"    vec3 schlick = fresnel_schlick(u_{name}_fresnel_f0, c);",
+                      f"    float dielectric = fresnel_dielectric(u_{name}_fresnel_ior, c);",
+                      f"    float form = u_{name}_fresnel_form;",
+                      "    return form == 1.0 ? schlick : (form == 2.0 ? vec3(dielectric) : vec3(1.0));",
                       "#else", "    return vec3(1.0);", "#endif", "}"]
         return "\n".join(lines)
 
@@ -912,7 +920,7 @@ class MaterialModel(Material):
             with np.errstate(all="ignore"):
                 add(self.response(f, wi, wo, moved, p))
         for param in self.uniform_params():
-            if param.kind != "scalar":
+            if param.kind != "scalar" or param.name == "fresnel_form":  # an index, not a measured value
                 continue
             for sign in (1.0, -1.0):
                 scaled = ParamValues({**p.__dict__, param.name: p.__dict__[param.name] * (1.0 + sign * constants.A * EPS)})
