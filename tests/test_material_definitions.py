@@ -19,7 +19,8 @@ import pytest
 
 import glphong
 from glphong import primitives
-from glphong.materials import MaterialDefinitionError, MaterialModel, MaterialSum, Param, PhongLobe, model_named
+from glphong.materials import (Choice, FresnelSlot, MaterialDefinitionError, MaterialModel, MaterialSum, Param, PhongLobe,
+                               SchlickFresnel, model_named)
 from glphong.programs import ShaderCompileError
 from glphong.testing import assert_render_matches, assert_twin_matches
 
@@ -104,6 +105,14 @@ def test_a_valid_definition_registers_under_its_name():
     ({"glsl": ...}, r"has no glsl"),
     ({"glsl": "no_such_file.glsl"}, r"names the file .*no_such_file\.glsl', which does not exist"),
     ({"params": (Param("k", "rgb", low=0.0), Param("k", "scalar", low=0.0))}, r"params repeats a name"),
+    ({"fresnel_slot": FresnelSlot("h.l")}, r"has a fresnel_slot, so its GLSL must call test_def_fresnel\(c\)"),
+    ({"glsl": "vec3 test_def_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)\n"
+              "{ return u_test_def_k * test_def_fresnel(n_dot_l) * n_dot_l; }"},
+     r"calls test_def_fresnel, which glphong generates only for a model with fresnel_slot"),
+    ({"fresnel_slot": 0.04}, r"fresnel_slot must be None or a glphong.materials.FresnelSlot"),
+    ({"choices": (Param("k2", "rgb", low=0.0),)}, r"choices must be a tuple of glphong.materials.Choice"),
+    ({"choices": (Choice("k", ("a", "b"), "a"),)}, r"params, choices and fresnel must have distinct names"),
+    ({"ambient_scale": 0.0}, r"ambient_scale must be a positive finite float"),
 ])
 def test_a_bad_definition_fails_when_the_class_is_defined(attrs, message):
     with pytest.raises(MaterialDefinitionError, match=message):
@@ -494,3 +503,64 @@ def test_stability_cases_of_a_tangent_model(session_gl):
 
     report = run_stability(context=session_gl, cases=cases_for(_Stripe))
     assert report.passed_count == len(report.rows) >= 8, report.format_table()
+
+
+# --------------------------------------------------------------------------- choices, Fresnel, ambient scale
+class Sheen(MaterialModel):
+    """A test glossy model with a structural choice and a Fresnel slot: f_r = k F(h.l) (n.v)^e, e = 1 or 2."""
+
+    name = "test_sheen"
+    params = (Param("k", "rgb", low=0.0, unit="1/sr"),)
+    needs = ("view",)
+    ambient = "k"
+    ambient_scale = 0.5
+    fresnel_slot = FresnelSlot(cosine="h.l", default=SchlickFresnel(0.1))
+    choices = (Choice("power", ("one", "two"), default="one", doc="the exponent of n.v"),)
+    glsl = """
+    vec3 test_sheen_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
+    {
+        vec3 h;
+        float h_len;
+        float c = safe_normalize(wi + wo, h, h_len) ? dot(h, wi) : 0.0;
+        float n_dot_v = max(dot(f.n, wo), 0.0);
+    #if TEST_SHEEN_POWER == 1
+        n_dot_v = n_dot_v * n_dot_v;
+    #endif
+        return u_test_sheen_k * test_sheen_fresnel(c) * (n_dot_v * n_dot_l);
+    }"""
+
+    def response(self, f, wi, wo, n_dot_l, p):
+        from glphong.materials.blinn import half_cosine
+        from glphong.materials.fresnel import fresnel_factor
+
+        n_dot_v = np.maximum(np.sum(f.n * wo, axis=-1), 0.0)
+        if p.power == "two":
+            n_dot_v = n_dot_v * n_dot_v
+        return p.k * fresnel_factor(p, half_cosine(wi, wo)) * (n_dot_v * n_dot_l)[..., None]
+
+
+def test_a_user_model_takes_choices_and_fresnel_like_the_built_ins(glphong_backend):
+    from glphong.key import program_key
+    from glphong.materials import DielectricFresnel
+
+    default = Sheen(0.5)
+    assert default.fresnel == SchlickFresnel(0.1) and default.power == "one"
+    assert repr(Sheen(0.5, None, "two")) == "Sheen(k=0.5, fresnel=None, power='two')"
+    assert repr(default) == "Sheen(k=0.5)"  # arguments at their defaults are not shown
+    with pytest.raises(ValueError, match=r"power must be 'one' or 'two' \(got 'three'\)"):
+        Sheen(0.5, power="three")
+    for material in (default, Sheen(0.5, fresnel=DielectricFresnel(1.4), power="two"), Sheen(0.5, fresnel=None)):
+        figures = assert_twin_matches(material, n=500, backend=glphong_backend)
+        assert figures["nonzero"] > 200 and figures["max_relative_error"] < 1e-5
+    key = program_key(Sheen(0.5, fresnel=DielectricFresnel(1.4), power="two"), {"point": 1}, (0.1, 0.1, 0.1))
+    assert ("TEST_SHEEN_POWER", "1") in key.defines() and ("TEST_SHEEN_FRESNEL_DIELECTRIC", "1") in key.defines()
+    assert "u_test_sheen_k * (0.5 * u_ambient)" in key.generated_chunks()["generated:material"]
+    scene = _scene(Sheen(0.5, power="two"), Sheen(0.4, fresnel=DielectricFresnel(1.4)), ambient=glphong.AmbientLight(0.1))
+    with glphong.Renderer(96, 64, backend=glphong_backend) as renderer:
+        report = assert_render_matches(scene, renderer)
+    assert report.max_relative_error < 1e-5
+    with glphong.Renderer(96, 64, backend=glphong_backend, specialise=False) as uber:
+        with pytest.raises(ValueError, match="holds one variant of each model, but the scene has two of 'test_sheen'"):
+            uber.render(scene)  # a choice is structural: two of them need two programs (specialise=True)
+        one_choice = _scene(Sheen(0.5), Sheen(0.4, fresnel=DielectricFresnel(1.4)))  # Fresnel is a runtime switch there
+        assert glphong.verify(one_choice, uber).passed

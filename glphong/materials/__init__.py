@@ -15,10 +15,10 @@ constant radiance [W/(m^2 sr)]; ``q`` is dimensionless.  Define your own with `M
 import importlib as _importlib
 import pkgutil as _pkgutil
 
-from .model import (GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues,
+from .model import (Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues,
                     Properties, ShadingFrame, model_named, registered_models)
 
-__all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "ParamValues", "Properties", "ShadingFrame",
+__all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "ParamValues", "Properties", "ShadingFrame",
            "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
 
 # every module of this package but the mechanism is one model: importing it registers the model, and

@@ -596,7 +596,8 @@ class Material:
 
     def __repr__(self):
         values = self.parameter_values()
-        hidden = {"fresnel"} if values.get("fresnel", 0) is None else set()  # fresnel=None: F = 1, the default
+        arguments = type(self).arguments() if hasattr(type(self), "arguments") else ()
+        hidden = {a.name for a in arguments if not isinstance(a, Param) and values.get(a.name) == a.default}
         shown = [f"{k}={_short(v)}" for k, v in values.items() if k not in MATERIAL_KEYWORDS and k not in hidden]
         if any(values["ka"]):
             shown.append(f"ka={_short(values['ka'])}")
