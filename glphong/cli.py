@@ -34,6 +34,24 @@ def _render(args):
     return 0
 
 
+def _gallery(args):
+    from .gallery import render_gallery
+    from .renderer import Renderer
+
+    with Renderer(args.tile, args.tile, backend=args.backend) as renderer:
+        start = time.perf_counter()
+        figure = render_gallery(renderer, tile=args.tile, columns=args.columns, verify=args.verify)
+        seconds = time.perf_counter() - start
+        figure.save_png(args.out, exposure=args.exposure)
+        print(f"wrote {args.out}: {len(figure.labels)} models, tiles of {args.tile}x{args.tile} on {renderer.backend} "
+              f"in {seconds:.2f} s")
+        if args.verify:
+            for label, report in zip(figure.labels, figure.reports):
+                print(f"  {label:30s} {report}")
+            return 0 if all(r.passed for r in figure.reports) else 1
+    return 0
+
+
 def _import_models(names):
     """Import modules (dotted names or .py paths) that define material models; returns the new models."""
     import importlib
@@ -164,7 +182,7 @@ def _tile_size(text):
 
 
 def build_parser():
-    """The argument parser (subcommands: render, stability, describe, bench)."""
+    """The argument parser (subcommands: render, stability, gallery, describe, bench)."""
     from . import __version__
 
     parser = argparse.ArgumentParser(
@@ -193,6 +211,15 @@ def build_parser():
                            help="import a module (dotted name or .py path) defining material models and add "
                                 "their stability cases (repeatable)")
     stability.set_defaults(func=_stability)
+    gallery = sub.add_parser("gallery", help="render one sphere per reflectance model under the same lights")
+    gallery.add_argument("--out", default="gallery.png", type=_png_path, help="PNG path (default: gallery.png)")
+    gallery.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
+    gallery.add_argument("--tile", type=_tile_size, default=160, help="tile size in pixels, 1 to 1024 (default 160)")
+    gallery.add_argument("--columns", type=_positive_int, default=4, help="tiles per row (default 4)")
+    gallery.add_argument("--exposure", type=_positive_float, default=1.0,
+                         help="linear exposure before sRGB encoding, > 0 (default 1.0)")
+    gallery.add_argument("--verify", action="store_true", help="cross-check every tile against the float64 twin")
+    gallery.set_defaults(func=_gallery)
     describe = sub.add_parser("describe", help="list the default scene's programs: keys, chunks, what each leaves out")
     describe.add_argument("--source", action="store_true", help="print each program's effective fragment source")
     describe.add_argument("--gbuffer", action="store_true", help="include the G-buffer programs")
