@@ -86,6 +86,19 @@ def describe(scenes, renderer=None, gbuffer=False):
     return out
 
 
+def _term_lines(key):
+    """One line per term of ``key``: the model, where its GLSL comes from, the library chunks it calls and its
+    structural defines."""
+    from .key import model_chunk_label
+
+    out = []
+    for t in key.terms:
+        extra = [f"calls {', '.join(c + '.glsl' for c in t.uses)}"] if t.uses else []
+        extra += [f"{t.name.upper()}_{n}={v}" for n, v in t.defines]
+        out.append(f"{t.name}: {model_chunk_label(t.name)} ({t.chunk})" + (f"; {'; '.join(extra)}" if extra else ""))
+    return out
+
+
 def format_descriptions(descriptions, source=False):
     """Readable text of `describe`'s result; ``source=True`` adds each effective fragment source."""
     lines = [f"{len(descriptions)} distinct program(s)"]
@@ -94,7 +107,11 @@ def format_descriptions(descriptions, source=False):
         lines += [f"\n[{i}] {d.key.describe()}", f"    drawn objects: {users}",
                   f"    vertex chunks:   {' '.join(d.vertex_chunks)}",
                   f"    fragment chunks: {' '.join(d.fragment_chunks)}",
-                  "    defines:         " + " ".join(f"{n}={v}" for n, v in d.defines),
+                  "    defines:         " + " ".join(f"{n}={v}" for n, v in d.defines)]
+        if d.key.terms:
+            lines.append("    model chunks:")
+            lines += [f"      - {line}" for line in _term_lines(d.key)]
+        lines += [
                   "    left out:"]
         lines += [f"      - {item}" for item in d.left_out]
         if source and d.fragment_source:
