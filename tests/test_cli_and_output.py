@@ -101,3 +101,22 @@ def test_setup_cfg_ships_every_subpackage():
     listed = set(config["options"]["packages"].split())
     found = {".".join(p.parent.relative_to(root).parts) for p in (root / "glphong").rglob("__init__.py")}
     assert found | {"glphong.glsl"} == listed
+
+
+def test_cli_gallery_renders_every_model_and_cross_checks_each_tile(tmp_path, capsys):
+    from PIL import Image
+
+    from glphong.cli import main
+    from glphong.gallery import GALLERY
+    from glphong.materials import registered_models
+
+    out = tmp_path / "gallery.png"
+    code = main(["gallery", "--tile", "40", "--columns", "4", "--verify", "--out", str(out)])
+    text = capsys.readouterr().out
+    assert code == 0, text
+    shown = [line for line in text.splitlines() if line.startswith("  ")]
+    assert len(shown) == len(GALLERY) and all("PASS" in line for line in shown), text  # every entry defined here
+    assert Image.open(out).size == (4 * 40, -(-len(GALLERY) // 4) * (40 + 16))
+    drawn = {type(t).name for _, factory in GALLERY for t in factory().components}
+    builtin = {m.name for m in registered_models() if m.__module__.startswith("glphong.")}
+    assert drawn == builtin  # one tile at least per built-in model
