@@ -56,7 +56,7 @@ class Signature:
 _FUNCTION = re.compile(r"^(float|vec2|vec3|vec4|bool|void)\s+([A-Za-z_]\w*)\s*\(([^)]*)\)\s*\{", re.M)
 
 
-def _parse(text, chunks, twin_module):
+def _parse(text, chunks, twin_module, uniforms=None):
     """Pure functions of a chunk's text (those of float/vec/bool parameters that read no uniform)."""
     from .materials.model import _strip_comments
 
@@ -77,7 +77,8 @@ def _parse(text, chunks, twin_module):
                 ok = False
                 break
             (outputs if qualifier == "out" else inputs).append((words[1], words[0]))
-        if ok and not re.search(r"\bu_\w+", body):
+        reads = set(re.findall(r"\bu_\w+", body))  # a local named u_x is not a uniform where the names are known
+        if ok and not (reads & uniforms if uniforms is not None else reads):
             out[m.group(2)] = Signature(tuple(chunks), tuple(inputs), tuple(outputs), m.group(1), twin_module)
     return out
 
@@ -97,7 +98,8 @@ def signatures():
         out.update(_parse(chunk_source(chunk), LIBRARY, "glphong.reference"))
     for model in registered_models():
         chunks = LIBRARY + (f"model:{model.name}@{model.source_hash()}",)
-        out.update(_parse(model.source(), chunks, model.__module__))
+        names = {model.uniform_name(p.name) for p in model.uniform_params()}
+        out.update(_parse(model.source(), chunks, model.__module__, names))
     return out
 
 

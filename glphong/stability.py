@@ -481,7 +481,9 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
             if case.in_range:
                 # judged against the oracle, with the band's widths as the tolerance: the twin and the
                 # band read the uniforms, the oracle the constructors, so a wrongly wired input shows
-                low = np.where(low > 0, expected - (twin - low), 0.0)
+                # (a band reaching 0 stays at 0, or follows the oracle below it where the model may be negative)
+                shifted = expected - (twin - low)
+                low = np.where(low > 0, shifted, np.where(low < 0, np.minimum(0.0, shifted), 0.0))
                 high = expected + (high - twin)
             # outside the valid range: the documented float32 behaviour (flush, saturation), which the
             # twin mirrors, within the band around it
