@@ -34,8 +34,10 @@ def test_float64_twin_agrees_with_the_mpmath_oracle():
         key, uniforms = case.inputs()
         u64 = {k: v.astype(np.float64) for k, v in uniforms.items()}
         n_valid, n, _ = ref.safe_normalize(np.asarray([case.normal], dtype=np.float32).astype(np.float64))
-        twin = ref.shade_point(np.zeros((1, 3)), n, n_valid, u64.get("u_eye"), key, u64, case.material)[0]
-        expected = oracle(case.scene(), case.normal)
+        frame = ref.shading_frame(n, np.asarray([case.tangent], dtype=np.float32).astype(np.float64),
+                                  np.asarray([case.uv], dtype=np.float32).astype(np.float64), key)
+        twin = ref.shade_point(np.zeros((1, 3)), frame, n_valid, u64.get("u_eye"), key, u64, case.material)[0]
+        expected = oracle(case.scene(), case.normal, tangent=case.tangent, uv=case.uv)
         if case.in_range:
             # the oracle rounds the constructors' values to float32; the uniforms are derived in float64
             # first (I = Phi / (4 pi), a unit direction) and then rounded: one float32 rounding apart,
