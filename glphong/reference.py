@@ -177,11 +177,12 @@ def log_one_minus(delta):
 def lobe_from_delta(delta, q):
     """``(1 - delta)^q``, stable for q up to FLT_MAX (lobe.glsl).
 
-    Returns 1 for q == 0, 0 for delta >= 1, else ``exp(max(q ln(1 - delta), -104))``.
+    Returns 1 for q == 0, 0 for delta >= 1, else ``exp(max(q ln(1 - delta), -104))``; ``q`` a scalar or
+    an array broadcasting with ``delta`` (a per-point exponent).
     """
     delta = np.asarray(delta)
     dtype = delta.dtype if delta.dtype.kind == "f" else np.float64
-    q = dtype.type(q)
+    q = np.asarray(q, dtype=dtype)
     inside = delta < 1
     with np.errstate(over="ignore", invalid="ignore"):
         value = np.exp(np.maximum(q * log_one_minus(np.where(inside, delta, 0)), dtype.type(-104)))

@@ -159,17 +159,11 @@ def ashikhmin_shirley_lobe(f, h, nu, nv):
 
     1 where ``e = 0``, 0 where ``delta >= 1``, else ``exp(max(e ln(1 - delta), -104))``.
     """
-    from ..reference import log_one_minus
+    from ..reference import lobe_from_delta
 
     d = h - f.n
     delta = 0.5 * _dot(d, d)
-    dtype = delta.dtype
-    e = np.asarray(ashikhmin_shirley_exponent(_dot(h, f.t), _dot(h, f.b), nu, nv), dtype=dtype)
-    inside = delta < 1
-    with np.errstate(over="ignore", invalid="ignore"):
-        value = np.exp(np.maximum(e * log_one_minus(np.where(inside, delta, 0).astype(dtype)), dtype.type(-104)))
-    value = np.where(inside, value, 0)
-    return np.where(e == 0, 1, value).astype(dtype)
+    return lobe_from_delta(delta, ashikhmin_shirley_exponent(_dot(h, f.t), _dot(h, f.b), nu, nv))
 
 
 def ashikhmin_shirley_specular(f, wi, wo, n_dot_l, n_dot_v, rho_s, nu, nv):
