@@ -262,6 +262,8 @@ class Scene:
 def _check_mesh_serves(mesh, material, name):
     """A mesh must carry what the material's terms need (tangents or UVs)."""
     for term in material.components:
+        if term.vanishes():
+            continue  # left out of every program: it needs nothing
         if "tangent" in term.needs and not mesh.has_tangents:
             raise ValueError(f"object {name!r}: the material term {term.name!r} needs a tangent frame, but the mesh has "
                              "neither tangents nor UVs: give MeshData tangents= or uvs=, a trimesh with UVs, or use "
