@@ -73,7 +73,7 @@ def describe(scenes, renderer=None, gbuffer=False):
                 for term in obj.material.components:
                     if term.name not in present and output != "gbuffer":
                         zero = [p for p in term.vanishes_with if not np.any(getattr(term, p))]
-                        reason = (", ".join(f"{p} = 0" for p in zero) if term.vanishes()
+                        reason = ((", ".join(f"{p} = 0" for p in zero) or "every scale parameter is 0") if term.vanishes()
                                   else "no light reaches it and it does not answer L_a")
                         absent.setdefault(key, {}).setdefault(type(term), reason)
     out = []
