@@ -16,7 +16,9 @@ from .camera import PerspectiveCamera
 from .contexts import BackendUnavailableError, available_backends, create_context
 from .describe import describe, format_descriptions
 from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
-from .materials import BlinnPhong, Lambert, Material, MaterialModel, MaterialSum, Param, Phong
+from .materials import (AshikhminShirley, BlinnPhong, CookTorrance, DielectricFresnel, Diffuse, Lafortune, Lambert,
+                        Material, MaterialModel, MaterialSum, NormalizedBlinnPhong, NormalizedPhong, OrenNayar, Param,
+                        Phong, SchlickFresnel, Ward)
 from .renderer import Frame, GBuffer, Renderer
 from .scene import Scene, SceneObject
 from .verify import VerifyReport, verify
@@ -25,7 +27,9 @@ __version__ = "0.1.0"
 
 __all__ = [
     "PerspectiveCamera", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
-    "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
+    "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
+    "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "SchlickFresnel",
+    "DielectricFresnel", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
     "imaging", "materials", "primitives", "radiometry", "reference",
 ]

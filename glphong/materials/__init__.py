@@ -4,13 +4,27 @@ Every material is a sum of terms; each term is a `MaterialModel` (a reflectance 
 parameters, GLSL response, numpy twin, band, properties and stability cases).  The built-ins use
 the same public mechanism a user's model does:
 
+The lecture's models (``kd``, ``ks`` are BRDF values [1/sr]):
+
 - `Lambert` (model ``lambert``): ``k_d (n.l)``;
 - `PhongLobe` (``phong_lobe``) and `Phong` = ``Lambert + PhongLobe``: ``k_d (n.l) + k_s (v.r)^q``;
 - `BlinnLobe` (``blinn_lobe``) and `BlinnPhong` = ``Lambert + BlinnLobe``: ``k_d (n.l) + k_s (n.h)^q``.
 
-Units: ``kd`` and ``ks`` are BRDF values [1/sr] (an albedo rho gives kd = rho/pi); ``ka`` is a
-constant radiance [W/(m^2 sr)]; ``q`` is dimensionless.  Define your own with `MaterialModel` and
-`Param` (see README, "Write your own material").
+The physically based models of DESIGN section 9 (``rho_*`` are albedos, dimensionless in [0, 1]):
+
+- `Diffuse` (``diffuse``): ``rho_d / pi``, the diffuse term of the sums below;
+- `NormalizedPhong` = ``Diffuse + NormalizedPhongLobe`` (Lafortune and Willems 1994) and
+  `NormalizedBlinnPhong` = ``Diffuse + NormalizedBlinnLobe`` (exact normalisation);
+- `CookTorrance` = ``Diffuse + CookTorranceLobe`` (Beckmann, Torrance-Sparrow; microfacet or 1982 form);
+- `Lafortune` = ``Diffuse + LafortuneLobes`` (1 to 4 generalised cosine lobes, Lafortune et al. 1997);
+- `OrenNayar` (``oren_nayar``): rough diffuse, full (with inter-reflection) or qualitative (1994);
+- `Ward` = ``Diffuse + WardLobe`` (anisotropic; Walter's, Duer's or the bounded normalisation);
+- `AshikhminShirley` (``ashikhmin_shirley``): anisotropic Phong with Schlick Fresnel and coupled diffuse (2000).
+
+Fresnel factors `SchlickFresnel(f0)` and `DielectricFresnel(ior)` are the ``fresnel=`` of the glossy
+models (`Phong`, `BlinnPhong`, the normalised ones, `CookTorrance`); each model states its cosine.
+``ka`` is a constant radiance [W/(m^2 sr)].  Define your own with `MaterialModel`, `Param`, `Choice`
+and `FresnelSlot` (see README, "Write your own material").
 """
 import importlib as _importlib
 import pkgutil as _pkgutil
