@@ -19,6 +19,7 @@ import numpy as np
 
 __all__ = [
     "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus", "lobe_from_delta",
+    "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
     "fresnel_schlick", "fresnel_dielectric", "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
     "shade_inputs", "shade",
 ]
@@ -188,6 +189,50 @@ def lobe_from_delta(delta, q):
         value = np.exp(np.maximum(q * log_one_minus(np.where(inside, delta, 0)), dtype.type(-104)))
     value = np.where(inside, value, 0)
     return np.where(q == 0, 1, value).astype(dtype)
+
+
+def phong_delta(n, wi, wo):
+    """``|r - v|^2 / 2`` with ``r = 2 (n.l) n - l`` (lobe.glsl); unit (..., 3) inputs -> (...)."""
+    r = 2 * _dot(n, wi)[..., None] * n - wi
+    e = r - wo
+    return 0.5 * _dot(e, e)
+
+
+def phong_lobe(n, wi, wo, q):
+    """``max(v.r, 0)^q`` = `lobe_from_delta` of `phong_delta` (lobe.glsl); (...)."""
+    return lobe_from_delta(phong_delta(n, wi, wo), q)
+
+
+#: lobe.glsl BLINN_HALF_FLOOR = 2^-20: |l + v| at or below it gives a zero Blinn lobe
+BLINN_HALF_FLOOR = 2.0 ** -20
+
+
+def blinn_delta(n, wi, wo):
+    """Blinn's ``delta = |h - n|^2 / 2`` (lobe.glsl).
+
+    Returns
+    -------
+    valid : (...) bool ndarray
+        ``n.v > 0`` and ``|l + v| > BLINN_HALF_FLOOR``.
+    delta : (...) ndarray
+        ``|h - n|^2 / 2``; 2 where not valid.
+    """
+    ok_h, h, h_len = safe_normalize(wi + wo)
+    valid = (_dot(n, wo) > 0) & ok_h & (h_len > BLINN_HALF_FLOOR)
+    e = h - n
+    return valid, np.where(valid, 0.5 * _dot(e, e), 2).astype(e.dtype)
+
+
+def blinn_lobe(n, wi, wo, q):
+    """``max(n.h, 0)^q``, 0 where `blinn_delta` is not valid (lobe.glsl); (...)."""
+    valid, delta = blinn_delta(n, wi, wo)
+    return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype)
+
+
+def half_cosine(wi, wo):
+    """``h.l`` with ``h = (l + v)/|l + v|``, 0 where ``l + v`` does not normalise (lobe.glsl); (...)."""
+    ok, h, _ = safe_normalize(wi + wo)
+    return np.where(ok, _dot(h, wi), 0).astype(h.dtype)
 
 
 # --------------------------------------------------------------------------- fresnel.glsl

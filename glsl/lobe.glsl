@@ -11,6 +11,22 @@
 //   delta = 1 - cos, the distance from the lobe peak (0 at the peak);  q >= 0 the exponent.
 //   q == 0: 1 (0^0 := 1);  delta >= 1 (cos <= 0): 0, the max(cos, 0) clamp;
 //   else exp(max(q ln(1 - delta), -104)).  Never NaN, never above 1.
+//
+// The two cosine-power lobes of the lecture, shared by every model built on them (phong_lobe,
+// blinn_lobe, the normalised lobes).  n, wi (= l), wo (= v): unit vectors pointing away from the
+// surface; q >= 0.  Dimensionless.  NAIVE (the textbook formulation, for the stability report only)
+// replaces each lobe by its pow() form.
+// phong_delta(n, wi, wo) -> delta = |r - v|^2 / 2,   r = 2 (n.l) n - l
+//   equals 1 - v.r for unit vectors, without the cancellation of 1 - dot(v, r) near the peak.
+// phong_lobe(n, wi, wo, q) -> max(v.r, 0)^q = lobe_from_delta(phong_delta(n, wi, wo), q)
+//   NAIVE: pow(max(dot(v, r), 0), q).
+// blinn_delta(n, wi, wo, out delta) -> valid
+//   h = (l + v) / |l + v| by scaled normalisation;  delta = |h - n|^2 / 2  (= 1 - n.h).
+//   valid is false (delta 2, the lobe 0) where n.v <= 0 or |l + v| <= BLINN_HALF_FLOOR = 2^-20:
+//   there h is undefined (l = -v) or dominated by rounding.
+// blinn_lobe(n, wi, wo, q) -> max(n.h, 0)^q, 0 where blinn_delta is not valid.
+//   NAIVE: pow(max(dot(n, normalize(l + v)), 0), q).
+// half_cosine(wi, wo) -> h.l, 0 where l + v does not normalise (the cosine of a half-vector Fresnel factor).
 
 float log_one_minus(float delta)
 {
@@ -33,4 +49,59 @@ float lobe_from_delta(float delta, float q)
         return 0.0;
     }
     return exp(max(q * log_one_minus(delta), -104.0));
+}
+
+float phong_delta(vec3 n, vec3 wi, vec3 wo)
+{
+    vec3 r = 2.0 * dot(n, wi) * n - wi;
+    vec3 e = r - wo;
+    return 0.5 * dot(e, e);
+}
+
+#if NAIVE
+float phong_lobe(vec3 n, vec3 wi, vec3 wo, float q)
+{
+    return pow(max(dot(wo, 2.0 * dot(n, wi) * n - wi), 0.0), q);
+}
+#else
+float phong_lobe(vec3 n, vec3 wi, vec3 wo, float q)
+{
+    return lobe_from_delta(phong_delta(n, wi, wo), q);
+}
+#endif
+
+const float BLINN_HALF_FLOOR = 9.5367431640625e-07;  // 2^-20
+
+bool blinn_delta(vec3 n, vec3 wi, vec3 wo, out float delta)
+{
+    vec3 h;
+    float h_len;
+    bool defined = safe_normalize(wi + wo, h, h_len);
+    bool valid = (dot(n, wo) > 0.0) && defined && (h_len > BLINN_HALF_FLOOR);
+    vec3 e = h - n;
+    delta = valid ? 0.5 * dot(e, e) : 2.0;
+    return valid;
+}
+
+#if NAIVE
+float blinn_lobe(vec3 n, vec3 wi, vec3 wo, float q)
+{
+    return pow(max(dot(n, normalize(wi + wo)), 0.0), q);
+}
+#else
+float blinn_lobe(vec3 n, vec3 wi, vec3 wo, float q)
+{
+    float delta;
+    bool valid = blinn_delta(n, wi, wo, delta);
+    float lobe = lobe_from_delta(delta, q);
+    return valid ? lobe : 0.0;
+}
+#endif
+
+float half_cosine(vec3 wi, vec3 wo)
+{
+    vec3 h;
+    float h_len;
+    bool defined = safe_normalize(wi + wo, h, h_len);
+    return defined ? dot(h, wi) : 0.0;
 }

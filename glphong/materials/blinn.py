@@ -14,50 +14,45 @@ q          scalar  >= 0        1       exponent (q = 0: lobe 1 where h is define
 """
 import numpy as np
 
+from ..reference import BLINN_HALF_FLOOR, blinn_delta, blinn_lobe, half_cosine
 from .fresnel import FresnelSlot, fresnel_band, fresnel_factor
 from .lambert import Lambert
 from .model import GlslFile, MaterialModel, MaterialSum, Properties
 from .phong import _KS, _Q, _dot, lobe_oracle
 
-__all__ = ["BlinnLobe", "BlinnPhong", "blinn_delta", "blinn_lobe", "half_cosine", "BLINN_HALF_FLOOR"]
-
-#: blinn_lobe.glsl BLINN_HALF_FLOOR = 2^-20: |l + v| at or below it gives a zero Blinn lobe
-BLINN_HALF_FLOOR = 2.0 ** -20
+__all__ = ["BlinnLobe", "BlinnPhong", "blinn_delta", "blinn_lobe", "half_cosine", "BLINN_HALF_FLOOR", "blinn_lobe_band"]
 
 
-def blinn_delta(n, wi, wo):
-    """Blinn's ``delta = |h - n|^2 / 2`` (blinn_lobe.glsl).
+def blinn_lobe_band(f, wi, wo, p, constants):
+    """Band of the Blinn lobe ``max(n.h, 0)^q`` and of its Fresnel factor ``F(h.l)``.
+
+    The lobe band of the Blinn delta (`glphong.tolerances.lobe_band`), its chord widening scaled by the
+    half vector's conditioning ``max(1, 2/|l + v|)``; near the gates (``|n.v| <= D eps``, ``|l + v|``
+    within a factor 4 of its floor) either outcome is accepted; the Fresnel band at ``h.l`` known to
+    ``4 D eps max(1, 2/|l + v|)``.
 
     Returns
     -------
-    valid : (...) bool ndarray
-        ``n.v > 0`` and ``|l + v| > BLINN_HALF_FLOOR``.
-    delta : (...) ndarray
-        ``|h - n|^2 / 2``; 2 where not valid.
+    low, high : (N,) ndarray
+        The lobe's interval.
+    f_low, f_high : (N, 3) ndarray
+        The Fresnel factor's interval.
     """
     from ..reference import safe_normalize
+    from ..tolerances import EPS, lobe_band
 
-    ok_h, h, h_len = safe_normalize(wi + wo)
-    valid = (_dot(n, wo) > 0) & ok_h & (h_len > BLINN_HALF_FLOOR)
-    e = h - n
-    return valid, np.where(valid, 0.5 * _dot(e, e), 2).astype(e.dtype)
-
-
-def blinn_lobe(n, wi, wo, q):
-    """``max(n.h, 0)^q``, 0 where `blinn_delta` is not valid (blinn_lobe.glsl)."""
-    from ..reference import lobe_from_delta
-
-    valid, delta = blinn_delta(n, wi, wo)
-    return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype)
-
-
-def half_cosine(wi, wo):
-    """``h.l`` with ``h = (l + v)/|l + v|``, 0 where ``l + v`` does not normalise (blinn_lobe.glsl's response)."""
-    from ..reference import safe_normalize
-
-    ok, h, _ = safe_normalize(wi + wo)
-    return np.where(ok, _dot(h, wi), 0).astype(h.dtype)
-
+    tol = constants.D * EPS
+    ok_h, h_dir, h_len = safe_normalize(wi + wo)
+    delta = 0.5 * _dot(h_dir - f.n, h_dir - f.n)
+    scale = np.maximum(1.0, 2.0 / np.maximum(h_len, BLINN_HALF_FLOOR))
+    low, high = lobe_band(delta, p.q, scale, constants)
+    n_dot_v = _dot(f.n, wo)
+    certain = ok_h & (n_dot_v > tol) & (h_len > 4 * BLINN_HALF_FLOOR)
+    possible = ok_h & (n_dot_v > -tol) & (h_len > BLINN_HALF_FLOOR / 4)
+    low = np.where(certain, low, 0.0)
+    high = np.where(possible, np.where(certain, high, 1.0), 0.0)
+    f_low, f_high = fresnel_band(p, half_cosine(wi, wo), 4 * tol * scale)
+    return low, high, f_low, f_high
 
 class BlinnLobe(MaterialModel):
     """The Blinn-Torrance lobe alone: response ``k_s max(n.h, 0)^q``.
@@ -80,23 +75,8 @@ class BlinnLobe(MaterialModel):
         return p.ks * fresnel_factor(p, half_cosine(wi, wo)) * blinn_lobe(f.n, wi, wo, p.q)[..., None]
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
-        """``k_s`` times the lobe band of the Blinn delta, its chord widening scaled by the half vector's
-        conditioning ``max(1, 2/|l + v|)``; near the gates (``|n.v| <= D eps``, ``|l + v|`` within a
-        factor 4 of its floor) either outcome is accepted."""
-        from ..reference import safe_normalize
-        from ..tolerances import EPS, lobe_band
-
-        tol = constants.D * EPS
-        ok_h, h_dir, h_len = safe_normalize(wi + wo)
-        delta = 0.5 * _dot(h_dir - f.n, h_dir - f.n)
-        scale = np.maximum(1.0, 2.0 / np.maximum(h_len, BLINN_HALF_FLOOR))
-        low, high = lobe_band(delta, p.q, scale, constants)
-        n_dot_v = _dot(f.n, wo)
-        certain = ok_h & (n_dot_v > tol) & (h_len > 4 * BLINN_HALF_FLOOR)
-        possible = ok_h & (n_dot_v > -tol) & (h_len > BLINN_HALF_FLOOR / 4)
-        low = np.where(certain, low, 0.0)
-        high = np.where(possible, np.where(certain, high, 1.0), 0.0)
-        f_low, f_high = fresnel_band(p, half_cosine(wi, wo), 4 * tol * scale)
+        """``k_s`` times `blinn_lobe_band` (the lobe's and the Fresnel factor's intervals)."""
+        low, high, f_low, f_high = blinn_lobe_band(f, wi, wo, p, constants)
         return p.ks * f_low * low[..., None], p.ks * f_high * high[..., None]
 
     def oracle(self, f, wi, wo, n_dot_l, p):

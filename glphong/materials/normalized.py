@@ -82,21 +82,18 @@ and accepted by the bands.
 """
 import numpy as np
 
-from .blinn import blinn_delta, half_cosine
+from ..reference import blinn_lobe, half_cosine, phong_delta, phong_lobe
+from .blinn import blinn_lobe_band
 from .diffuse import Diffuse
 from .fresnel import FresnelSlot, fresnel_band, fresnel_factor
 from .model import GlslFile, MaterialModel, MaterialSum, Param, Properties
-from .phong import _dot, lobe_oracle, phong_delta
+from .phong import lobe_oracle
 
 __all__ = ["NormalizedPhongLobe", "NormalizedPhong", "NormalizedBlinnLobe", "NormalizedBlinnPhong",
-           "normalized_phong_lobe_delta", "normalized_phong_lobe_cosine_power", "normalized_phong_lobe_norm",
-           "normalized_blinn_lobe_delta", "normalized_blinn_lobe_cosine_power", "normalized_blinn_lobe_half_cosine",
-           "normalized_blinn_lobe_norm", "NORMALIZED_BLINN_LOBE_HALF_FLOOR", "Q_MAX"]
+           "normalized_phong_lobe_norm", "normalized_blinn_lobe_norm", "Q_MAX"]
 
 #: the largest exponent accepted (the stability suite checks q up to this at and around the peak)
 Q_MAX = 1e7
-#: normalized_blinn_lobe.glsl NORMALIZED_BLINN_LOBE_HALF_FLOOR = 2^-20 (blinn_lobe.glsl's BLINN_HALF_FLOOR)
-NORMALIZED_BLINN_LOBE_HALF_FLOOR = 2.0 ** -20
 #: normalized_phong_lobe.glsl NORMALIZED_PHONG_LOBE_INV_2PI
 _INV_2PI = 1.0 / (2.0 * np.pi)
 #: normalized_blinn_lobe.glsl NORMALIZED_BLINN_LOBE_INV_8PI
@@ -118,21 +115,6 @@ def _float_dtype(x):
 
 
 # --------------------------------------------------------------------------- normalized_phong_lobe.glsl
-def normalized_phong_lobe_delta(n, wi, wo):
-    """``|r - v|^2 / 2``, ``r = 2 (n.l) n - l`` (normalized_phong_lobe.glsl): unit (..., 3) inputs -> (...).
-
-    The arithmetic of `glphong.materials.phong.phong_delta` (its GLSL is the same), which it calls.
-    """
-    return phong_delta(n, wi, wo)
-
-
-def normalized_phong_lobe_cosine_power(n, wi, wo, q):
-    """``max(v.r, 0)^q`` by `lobe_from_delta` of `normalized_phong_lobe_delta` (normalized_phong_lobe.glsl)."""
-    from ..reference import lobe_from_delta
-
-    return lobe_from_delta(normalized_phong_lobe_delta(n, wi, wo), q)
-
-
 def normalized_phong_lobe_norm(q):
     """``(q + 2) / (2 pi)`` [1/sr] (normalized_phong_lobe.glsl), in the dtype of ``q``."""
     dtype = _float_dtype(q)
@@ -141,33 +123,6 @@ def normalized_phong_lobe_norm(q):
 
 
 # --------------------------------------------------------------------------- normalized_blinn_lobe.glsl
-def normalized_blinn_lobe_delta(n, wi, wo):
-    """Blinn's ``delta = |h - n|^2 / 2`` (normalized_blinn_lobe.glsl; the arithmetic of
-    `glphong.materials.blinn.blinn_delta`, which it calls).
-
-    Returns
-    -------
-    valid : (...) bool ndarray
-        ``n.v > 0`` and ``|l + v| > NORMALIZED_BLINN_LOBE_HALF_FLOOR``.
-    delta : (...) ndarray
-        ``|h - n|^2 / 2``; 2 where not valid.
-    """
-    return blinn_delta(n, wi, wo)
-
-
-def normalized_blinn_lobe_cosine_power(n, wi, wo, q):
-    """``max(n.h, 0)^q``, 0 where `normalized_blinn_lobe_delta` is not valid (normalized_blinn_lobe.glsl)."""
-    from ..reference import lobe_from_delta
-
-    valid, delta = normalized_blinn_lobe_delta(n, wi, wo)
-    return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype)
-
-
-def normalized_blinn_lobe_half_cosine(wi, wo):
-    """``h.l``, 0 where ``l + v`` does not normalise (normalized_blinn_lobe.glsl; `blinn.half_cosine`)."""
-    return half_cosine(wi, wo)
-
-
 def normalized_blinn_lobe_norm(q):
     """``c(q) = ((q + 2) / (8 pi)) ((q + 4) / (q + 2^(-q/2)))`` [1/sr] (normalized_blinn_lobe.glsl), in the
     dtype of ``q``: the exact normalisation ``(q + 2)(q + 4) / (8 pi (q + 2^(-q/2)))``."""
@@ -218,7 +173,7 @@ class NormalizedPhongLobe(MaterialModel):
                             condition="rho_s <= 1 (its range): the albedo is rho_s at normal incidence, less elsewhere")
 
     def response(self, f, wi, wo, n_dot_l, p):
-        s = (normalized_phong_lobe_norm(p.q) * normalized_phong_lobe_cosine_power(f.n, wi, wo, p.q)) * n_dot_l
+        s = (normalized_phong_lobe_norm(p.q) * phong_lobe(f.n, wi, wo, p.q)) * n_dot_l
         return p.rho_s * fresnel_factor(p, n_dot_l) * s[..., None]
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
@@ -230,7 +185,7 @@ class NormalizedPhongLobe(MaterialModel):
         the peak of a 1e7 lobe the way `lobe_band` does, nor accepts the flush to 0 of a lobe below FLT_MIN."""
         from ..tolerances import EPS, lobe_band
 
-        low, high = lobe_band(normalized_phong_lobe_delta(f.n, wi, wo), p.q, 1.0, constants)
+        low, high = lobe_band(phong_delta(f.n, wi, wo), p.q, 1.0, constants)
         f_low, f_high = fresnel_band(p, n_dot_l, constants.D * EPS)
         return _scaled_band(p, normalized_phong_lobe_norm(np.float64(p.q)), low, high, n_dot_l, f_low, f_high,
                             constants)
@@ -310,8 +265,8 @@ class NormalizedBlinnLobe(MaterialModel):
                             condition="rho_s <= 1 (its range): the albedo is rho_s at normal incidence, less elsewhere")
 
     def response(self, f, wi, wo, n_dot_l, p):
-        s = (normalized_blinn_lobe_norm(p.q) * normalized_blinn_lobe_cosine_power(f.n, wi, wo, p.q)) * n_dot_l
-        return p.rho_s * fresnel_factor(p, normalized_blinn_lobe_half_cosine(wi, wo)) * s[..., None]
+        s = (normalized_blinn_lobe_norm(p.q) * blinn_lobe(f.n, wi, wo, p.q)) * n_dot_l
+        return p.rho_s * fresnel_factor(p, half_cosine(wi, wo)) * s[..., None]
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
         """The Blinn lobe band (as `BlinnLobe.band`: the chord widening scaled by the half vector's
@@ -319,21 +274,7 @@ class NormalizedBlinnLobe(MaterialModel):
         ``|l + v|`` within a factor 4 of its floor) times the normalisation, ``n.l +- D eps`` and the
         Fresnel band; 0 where the lower end is below FLT_MIN.  Model-specific for the reasons given in
         `NormalizedPhongLobe.band`."""
-        from ..reference import safe_normalize
-        from ..tolerances import EPS, lobe_band
-
-        floor = NORMALIZED_BLINN_LOBE_HALF_FLOOR
-        tol = constants.D * EPS
-        ok_h, h_dir, h_len = safe_normalize(wi + wo)
-        delta = 0.5 * _dot(h_dir - f.n, h_dir - f.n)
-        scale = np.maximum(1.0, 2.0 / np.maximum(h_len, floor))
-        low, high = lobe_band(delta, p.q, scale, constants)
-        n_dot_v = _dot(f.n, wo)
-        certain = ok_h & (n_dot_v > tol) & (h_len > 4 * floor)
-        possible = ok_h & (n_dot_v > -tol) & (h_len > floor / 4)
-        low = np.where(certain, low, 0.0)
-        high = np.where(possible, np.where(certain, high, 1.0), 0.0)
-        f_low, f_high = fresnel_band(p, normalized_blinn_lobe_half_cosine(wi, wo), 4 * tol * scale)
+        low, high, f_low, f_high = blinn_lobe_band(f, wi, wo, p, constants)
         return _scaled_band(p, normalized_blinn_lobe_norm(np.float64(p.q)), low, high, n_dot_l, f_low, f_high,
                             constants)
 

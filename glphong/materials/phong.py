@@ -16,6 +16,7 @@ q          scalar  >= 0        1       exponent (q = 0: lobe 1, the 0^0 := 1 con
 """
 import numpy as np
 
+from ..reference import phong_delta, phong_lobe
 from .fresnel import FresnelSlot, fresnel_band, fresnel_factor
 from .lambert import Lambert
 from .model import GlslFile, MaterialModel, MaterialSum, Param, Properties
@@ -28,20 +29,6 @@ _Q = Param("q", "scalar", low=0.0, doc="specular exponent; q = 0 gives a constan
 
 def _dot(a, b):
     return np.sum(a * b, axis=-1)
-
-
-def phong_delta(n, wi, wo):
-    """``|r - v|^2 / 2`` with ``r = 2 (n.l) n - l`` (phong_lobe.glsl); unit (..., 3) inputs -> (...)."""
-    r = 2 * _dot(n, wi)[..., None] * n - wi
-    e = r - wo
-    return 0.5 * _dot(e, e)
-
-
-def phong_lobe(n, wi, wo, q):
-    """``max(v.r, 0)^q`` (phong_lobe.glsl)."""
-    from ..reference import lobe_from_delta
-
-    return lobe_from_delta(phong_delta(n, wi, wo), q)
 
 
 def lobe_oracle(cosine, q):

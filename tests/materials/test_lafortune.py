@@ -624,22 +624,3 @@ def test_stability_cases_pass(glphong_backend):
     assert not any(r.passed for r in naive.values())  # pow(dot, 1e6): 1.7e-2 off near the peak; 2^1e6 = Inf
 
 
-def test_twin_agrees_with_the_mpmath_oracle():
-    """The float64 twin (shading the uniforms, with the case's tangent frame) against the oracle (the paper's
-    formula in mpmath, from the constructors) on every in-range stability case: to one float32 rounding."""
-    from glphong import reference as ref
-    from glphong.stability import cases_for, oracle
-
-    checked = 0
-    for case in cases_for(LafortuneLobes):
-        key, uniforms = case.inputs()
-        u64 = {k: v.astype(np.float64) for k, v in uniforms.items()}
-        n_valid, n, _ = ref.safe_normalize(np.asarray([case.normal], dtype=np.float32).astype(np.float64))
-        frame = ref.shading_frame(n, np.asarray([case.tangent], dtype=np.float32).astype(np.float64),
-                                  np.asarray([case.uv], dtype=np.float32).astype(np.float64), key)
-        twin = ref.shade_point(np.zeros((1, 3)), frame, n_valid, u64.get("u_eye"), key, u64, case.material)[0]
-        expected = oracle(case.scene(), case.normal, tangent=case.tangent, uv=case.uv)
-        if case.in_range:
-            np.testing.assert_allclose(twin, expected, rtol=1e-7, atol=0, err_msg=case.name)  # measured 3.5e-8
-            checked += 1
-    assert checked == 24
