@@ -416,14 +416,17 @@ _UBER_BUILTINS = {}
 
 
 def _uber_builtins():
-    """Example instances of the built-in models the uber-shader always holds (those that need no more
-    than the view and have no structural defines), computed once per state of the registry."""
+    """Example instances of the models the uber-shader always holds (those that declare ``in_uber = True``:
+    the lecture's Lambert, Phong and Blinn lobes; they need no more than the view and have no structural
+    defines), computed once per state of the registry.  Every other model joins it only where a scene has it:
+    each term costs every fragment its switch (measured: Lambert alone 2.25x the specialised program with
+    the lecture's three terms, 4.2x with the normalised lobes and the albedo diffuse term too)."""
     from .materials.model import registered_models
 
     models = registered_models()
     cached = _UBER_BUILTINS.get(models)
     if cached is None:
-        examples = [m.example() for m in models if m.__module__.startswith("glphong.") and set(m.needs) <= {"view"}]
+        examples = [m.example() for m in models if m.in_uber and set(m.needs) <= {"view"}]
         cached = _UBER_BUILTINS[models] = [e for e in examples if not e.structural_defines()]  # the uber-shader's
         # Fresnel is a runtime choice, so a glossy model whose only define is its Fresnel form is in
     return cached
@@ -439,8 +442,12 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
         The materials drawn with it (a scene's); their terms are all compiled in.
     """
     terms = {}
-    for term in _uber_builtins() + [term for material in materials for term in material.components]:
-        key = _term_key(term, lit=True, ambient=term.ambient is not None, uber=True)
+    drawn = [term for material in materials for term in material.components]
+    # a model's Fresnel form is a run-time switch, compiled only where one of the scene's terms has one
+    # (computing F for every fragment and light would cost the lecture's models whatever the scene)
+    with_fresnel = {t.name for t in drawn if getattr(t, "fresnel", None) is not None}
+    for term in _uber_builtins() + drawn:
+        key = _term_key(term, lit=True, ambient=term.ambient is not None, uber=term.name in with_fresnel)
         known = terms.setdefault(term.name, key)
         if known != key:
             raise ValueError(f"the uber-shader holds one variant of each model, but the scene has two of "

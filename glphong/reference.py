@@ -25,7 +25,7 @@ __all__ = [
 ]
 
 def __getattr__(name):
-    """A model's twin function by name (``reference.phong_lobe``): each lives with its model in
+    """A model's twin function by name (``reference.lambert``): each lives with its model in
     ``glphong.materials.<module>``; this finds it in the modules of the registered models."""
     import sys
 

@@ -27,6 +27,7 @@
 // blinn_lobe(n, wi, wo, q) -> max(n.h, 0)^q, 0 where blinn_delta is not valid.
 //   NAIVE: pow(max(dot(n, normalize(l + v)), 0), q).
 // half_cosine(wi, wo) -> h.l, 0 where l + v does not normalise (the cosine of a half-vector Fresnel factor).
+// Key defines read here: NAIVE (phong_lobe, blinn_lobe).
 
 float log_one_minus(float delta)
 {

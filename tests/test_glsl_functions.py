@@ -154,6 +154,18 @@ def test_blinn_delta(session_gl):
     assert valid[[-6, -3]].all() and not valid[[-4, -2, -1]].any()
 
 
+def test_half_cosine(session_gl):
+    _, wi, wo = _direction_sets(np.random.default_rng(RNG_SEED + 8), 400)
+    gpu = probe.evaluate(session_gl, "half_cosine", wi=wi, wo=wo)["return"]
+    want = ref.half_cosine(f64(wi), f64(wo))
+    _, _, h_len = ref.safe_normalize(f64(wi) + f64(wo))
+    # h is known to the half vector's conditioning max(1, 2/|l + v|) (measured at most 2.3 eps times it)
+    scale = np.maximum(1, 2 / np.maximum(h_len, ref.BLINN_HALF_FLOOR))
+    assert np.all(np.abs(gpu - want) <= 4 * EPS * scale)
+    # edges [-4], [-2], [-1]: l = -v gives 0 (h undefined); [-3], the mirror peak: h = n, h.l = n.l = 0.8
+    assert np.all(gpu[[-4, -2, -1]] == 0) and abs(gpu[-3] - 0.8) <= 4 * EPS
+
+
 @pytest.mark.parametrize("name", ["phong_lobe", "blinn_lobe"])
 @pytest.mark.parametrize("q", [0.0, 1.0, 1e3, 1e5, 1e7])
 def test_lobes(session_gl, name, q):

@@ -60,11 +60,9 @@ def test_uber_renderer_compiles_one_radiance_program(renderers):
     new = [k for k in uber.programs.keys() if k.output == "radiance" and k not in before]
     drawn = {uber.program_key(scene, o) for o in scene.objects}
     assert drawn == {uber_key([o.material for o in scene.objects])} and len(new) <= 1
-    # every built-in model that needs no more than the view and has no structural define, in name order
-    builtins = sorted(m.name for m in registered_models() if m.__module__.startswith("glphong.")
-                      and set(m.needs) <= {"view"} and not m.example().structural_defines())
-    assert {"blinn_lobe", "lambert", "phong_lobe"} <= set(builtins)
-    assert [t.name for t in drawn.pop().terms] == builtins
+    # the models that declare in_uber (the lecture's three), plus the scene's own terms (here the same)
+    assert sorted(m.name for m in registered_models() if m.in_uber) == ["blinn_lobe", "lambert", "phong_lobe"]
+    assert [t.name for t in drawn.pop().terms] == ["blinn_lobe", "lambert", "phong_lobe"]
 
 
 def test_mixed_scene_compiles_one_program_per_distinct_key(renderers):

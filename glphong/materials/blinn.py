@@ -3,7 +3,9 @@
 The lobe's response is ``k_s max(n.h, 0)^q`` with ``h = (l + v)/|l + v|`` (0 where ``n.v <= 0``
 or ``l + v`` is below a floor), so its BRDF is ``k_s (n.h)^q / (n.l)``: non-negative, not
 reciprocal, isotropic, not energy-conserving.  `BlinnPhong` is ``Lambert + BlinnLobe``.  Evaluated
-in the chord form of DESIGN section 3: ``delta = |h - n|^2 / 2``.
+in the chord form of DESIGN section 3: ``delta = |h - n|^2 / 2``.  `blinn_delta`, `blinn_lobe`,
+`half_cosine` and `BLINN_HALF_FLOOR` are library functions (GLSL in ``glsl/lobe.glsl``, twins in
+`glphong.reference`), shared with `glphong.materials.NormalizedBlinnLobe`; re-exported here.
 
 =========  ======  ==========  ======  =============================================
 parameter  kind    range       unit    meaning
@@ -54,6 +56,7 @@ def blinn_lobe_band(f, wi, wo, p, constants):
     f_low, f_high = fresnel_band(p, half_cosine(wi, wo), 4 * tol * scale)
     return low, high, f_low, f_high
 
+
 class BlinnLobe(MaterialModel):
     """The Blinn-Torrance lobe alone: response ``k_s max(n.h, 0)^q``.
 
@@ -67,6 +70,7 @@ class BlinnLobe(MaterialModel):
     glsl = GlslFile("materials/blinn_lobe.glsl")
     uses = ("lobe",)
     vanishes_with = ("ks",)
+    in_uber = True  # the lecture's models: every uber-shader holds them
     fresnel_slot = FresnelSlot(cosine="h.l")
     properties = Properties(reciprocal=False, isotropic=True, energy_conserving=False,
                             condition="never: the albedo grows without bound at grazing incidence")

@@ -13,8 +13,9 @@ the model states (``n.l`` for Phong-type lobes, ``h.l`` for half-vector lobes an
 The choice is structural (a ``#define`` of the term's program: ``<MODEL>_FRESNEL_SCHLICK`` or
 ``<MODEL>_FRESNEL_DIELECTRIC``); ``f0`` and ``ior`` are uniforms ``u_<model>_fresnel_f0`` and
 ``u_<model>_fresnel_ior``.  The uber-shader, which holds one variant of each model for every
-material of a scene, compiles both forms and selects by the uniform ``u_<model>_fresnel_form``
-(``<MODEL>_FRESNEL_RUNTIME``).  A user's model takes ``fresnel=`` by declaring ``fresnel_slot =
+material of a scene, compiles both forms for a model where one of the scene's terms has a Fresnel
+factor and selects by the uniform ``u_<model>_fresnel_form`` (``<MODEL>_FRESNEL_RUNTIME``); without
+one it compiles none.  A user's model takes ``fresnel=`` by declaring ``fresnel_slot =
 FresnelSlot(cosine='h.l')`` and calling ``<name>_fresnel(c)`` in its GLSL and `fresnel_factor` in its twin.
 """
 from dataclasses import dataclass

@@ -40,6 +40,7 @@ class Lambert(MaterialModel):
     glsl = GlslFile("materials/lambert.glsl")
     ambient = "kd"
     vanishes_with = ("kd",)
+    in_uber = True  # the lecture's models: every uber-shader holds them
     properties = Properties(reciprocal=True, isotropic=True, energy_conserving=True, condition="pi kd <= 1")
 
     def response(self, f, wi, wo, n_dot_l, p):

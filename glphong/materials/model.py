@@ -667,6 +667,15 @@ class MaterialModel(Material):
         Parameters that scale the whole term: where any of them is zero in every channel the term
         is left out of the program.
     properties : Properties
+    choices : tuple of Choice
+        Structural options (``form=``): each a ``#define <MODEL>_<NAME> <index>`` of the program.
+    fresnel_slot : FresnelSlot or None
+        Declares the ``fresnel=`` argument; the GLSL calls the generated ``<name>_fresnel(c)``.
+    ambient_scale : float
+        The answer to ``L_a`` is ``ambient_scale * <ambient param> * L_a`` (``1/pi`` for an albedo).
+    in_uber : bool
+        Compiled into every uber-shader, whether or not a scene has it (the lecture's models only;
+        default False: a model joins the uber-shader of the scenes that draw it).
 
     Methods a definition provides
     -----------------------------
@@ -695,6 +704,7 @@ class MaterialModel(Material):
     choices = ()
     fresnel_slot = None
     ambient_scale = 1.0
+    in_uber = False
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)
@@ -813,11 +823,11 @@ class MaterialModel(Material):
                       f"    return fresnel_schlick(u_{name}_fresnel_f0, c);",
                       f"#elif defined({upper}_FRESNEL_DIELECTRIC)",
                       f"    return vec3(fresnel_dielectric(u_{name}_fresnel_ior, c));",
-                      f"#elif defined({upper}_FRESNEL_RUNTIME)  // the uber-shader: the form is a uniform",
-                      f"    vec3 schlick = fresnel_schlick(u_{name}_fresnel_f0, c);",
-                      f"    float dielectric = fresnel_dielectric(u_{name}_fresnel_ior, c);",
-                      f"    float form = u_{name}_fresnel_form;",
-                      "    return form == 1.0 ? schlick : (form == 2.0 ? vec3(dielectric) : vec3(1.0));",
+                      f"#elif defined({upper}_FRESNEL_RUNTIME)  // the uber-shader: the form is a uniform, so",
+                      "    // the branches are uniform too: llvmpipe skips a branch no fragment takes",
+                      f"    if (u_{name}_fresnel_form == 1.0) return fresnel_schlick(u_{name}_fresnel_f0, c);",
+                      f"    if (u_{name}_fresnel_form == 2.0) return vec3(fresnel_dielectric(u_{name}_fresnel_ior, c));",
+                      "    return vec3(1.0);",
                       "#else", "    return vec3(1.0);", "#endif", "}"]
         return "\n".join(lines)
 

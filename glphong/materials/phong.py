@@ -5,7 +5,8 @@ is ``k_s (v.r)^q / (n.l)``: non-negative with the clamp, not reciprocal, isotrop
 energy-conserving (its albedo grows without bound at grazing incidence).  `Phong` is the sum
 ``Lambert + PhongLobe``: ``k_d (n.l) + k_s (v.r)^q`` per light.  Evaluated in the chord form of
 DESIGN section 3: ``delta = |r - v|^2 / 2``, ``lobe = (1 - delta)^q`` by `lobe_from_delta`, stable
-for q up to FLT_MAX.
+for q up to FLT_MAX.  `phong_delta` and `phong_lobe` are library functions (GLSL in ``glsl/lobe.glsl``,
+twins in `glphong.reference`), shared with `glphong.materials.NormalizedPhongLobe`; re-exported here.
 
 =========  ======  ==========  ======  =============================================
 parameter  kind    range       unit    meaning
@@ -57,6 +58,7 @@ class PhongLobe(MaterialModel):
     glsl = GlslFile("materials/phong_lobe.glsl")
     uses = ("lobe",)
     vanishes_with = ("ks",)
+    in_uber = True  # the lecture's models: every uber-shader holds them
     fresnel_slot = FresnelSlot(cosine="n.l")
     properties = Properties(reciprocal=False, isotropic=True, energy_conserving=False,
                             condition="never: the albedo grows without bound at grazing incidence")
