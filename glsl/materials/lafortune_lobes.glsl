@@ -15,7 +15,7 @@
 //   w.v = 1 - delta,       delta = |w - v|^2 / 2              (the chord: no cancellation at the peak)
 //   x^n = exp(n (ln m + ln(1 - u) / 2 + ln(1 - delta)))
 // every logarithm accurate to a few ulp relative (log_one_minus of lobe.glsl; ln m by lafortune_log).
-// For C = (-1, -1, 1) this is the chord form of phong_lobe.glsl (m = 1, u = 0 exactly), so the lobe is
+// For C = (-1, -1, 1) this is the chord form of phong_lobe of lobe.glsl (m = 1, u = 0 exactly), so the lobe is
 // exact at its peak for any n; for |Cx| = |Cy| = |Cz| (Phong-type, retro-reflective) u = 0 exactly too.
 // Accuracy (float32, eps = 2^-24), relative, near the peak:
 //   eps (16 + 4 lambda + 6 s sqrt(2 n lambda)) + 4 eps n (|ln m| + |ln(1 - u)| / 2) + 8 eps n sqrt(u / (1 - u))
