@@ -127,6 +127,27 @@ def _bench(args):
     return 0
 
 
+def _brdf(args):
+    from . import materials
+    from .analysis import format_properties, properties
+
+    namespace = {"__builtins__": {}}
+    namespace.update({name: getattr(materials, name) for name in materials.__all__
+                      if isinstance(getattr(materials, name), type) and not name.startswith("_")})
+    try:
+        material = eval(args.material, namespace)  # noqa: S307 - no builtins, only the material classes
+    except Exception as error:  # noqa: BLE001 - any failure of the expression is the user's to fix
+        print(f"glphong brdf: cannot build a material from {args.material!r}: {type(error).__name__}: {error} "
+              f"(write a call such as \"Phong(kd=0.2, ks=0.5, q=20)\" of a glphong.materials class)", file=sys.stderr)
+        return 2
+    if not isinstance(material, materials.Material):
+        print(f"glphong brdf: {args.material!r} is not a material (got {type(material).__name__})", file=sys.stderr)
+        return 2
+    record = properties(material, gpu=args.gpu, backend=args.backend, directions=args.directions)
+    print(record.to_json() if args.json else format_properties(record))
+    return 0
+
+
 def _writable(text):
     """An output path whose folder exists (checked before any work)."""
     import os
@@ -182,7 +203,7 @@ def _tile_size(text):
 
 
 def build_parser():
-    """The argument parser (subcommands: render, stability, gallery, describe, bench)."""
+    """The argument parser (subcommands: render, stability, gallery, describe, bench, brdf)."""
     from . import __version__
 
     parser = argparse.ArgumentParser(
@@ -233,6 +254,14 @@ def build_parser():
                        help="output prefix: PREFIX.csv, PREFIX.json, PREFIX.png")
     bench.add_argument("--no-progress", action="store_true", help="no progress bar")
     bench.set_defaults(func=_bench)
+    brdf = sub.add_parser("brdf", help="is a material's BRDF non-negative, energy-conserving, reciprocal, isotropic?")
+    brdf.add_argument("material", help='a material expression, e.g. "Phong(kd=0.2, ks=0.5, q=20)"')
+    brdf.add_argument("--json", action="store_true", help="print the record as JSON")
+    brdf.add_argument("--gpu", action="store_true", help="evaluate the GLSL on the GPU instead of the float64 twin")
+    brdf.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
+    brdf.add_argument("--directions", type=_positive_int, default=300,
+                      help="Fibonacci directions per side: their square is the number of pairs (default 300)")
+    brdf.set_defaults(func=_brdf)
     return parser
 
 
