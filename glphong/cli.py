@@ -127,25 +127,74 @@ def _bench(args):
     return 0
 
 
-def _brdf(args):
+def _material(command, text):
+    """The material an expression such as ``"Phong(kd=0.2, ks=0.5, q=20)"`` builds, or None (the error printed)."""
     from . import materials
-    from .analysis import format_properties, properties
 
     namespace = {"__builtins__": {}}
     namespace.update({name: getattr(materials, name) for name in materials.__all__
                       if isinstance(getattr(materials, name), type) and not name.startswith("_")})
     try:
-        material = eval(args.material, namespace)  # noqa: S307 - no builtins, only the material classes
+        material = eval(text, namespace)  # noqa: S307 - no builtins, only the material classes
     except Exception as error:  # noqa: BLE001 - any failure of the expression is the user's to fix
-        print(f"glphong brdf: cannot build a material from {args.material!r}: {type(error).__name__}: {error} "
+        print(f"glphong {command}: cannot build a material from {text!r}: {type(error).__name__}: {error} "
               f"(write a call such as \"Phong(kd=0.2, ks=0.5, q=20)\" of a glphong.materials class)", file=sys.stderr)
-        return 2
+        return None
     if not isinstance(material, materials.Material):
-        print(f"glphong brdf: {args.material!r} is not a material (got {type(material).__name__})", file=sys.stderr)
+        print(f"glphong {command}: {text!r} is not a material (got {type(material).__name__})", file=sys.stderr)
+        return None
+    return material
+
+
+def _brdf(args):
+    from .analysis import format_properties, properties
+
+    material = _material("brdf", args.material)
+    if material is None:
         return 2
     record = properties(material, gpu=args.gpu, backend=args.backend, directions=args.directions)
     print(record.to_json() if args.json else format_properties(record))
     return 0
+
+
+def _plot(args):
+    import importlib.util
+
+    import numpy as np
+
+    if importlib.util.find_spec("matplotlib") is None:
+        print("glphong plot needs matplotlib: pip install 'glphong[bench]'", file=sys.stderr)
+        return 2
+
+    from . import plots
+
+    if args.kind == "gallery":
+        curves = plots.plot_gallery(args.out, theta_i=np.radians(args.theta_i))
+        print(f"wrote {args.out}: the lobes of {len(curves)} models at theta_i = {args.theta_i:g} deg")
+        return 0
+    if not args.materials:
+        print(f"glphong plot {args.kind}: give one or more material expressions, e.g. \"Phong(kd=0, ks=0.5, q=20)\"",
+              file=sys.stderr)
+        return 2
+    chosen = {}
+    for text in args.materials:
+        material = _material("plot", text)
+        if material is None:
+            return 2
+        chosen[text] = material
+    if args.kind == "lobe":
+        plots.plot_lobes(chosen, np.radians(args.theta_i), args.out)
+    else:
+        plots.plot_albedo(chosen, args.out)
+    print(f"wrote {args.out}: {args.kind} of {len(chosen)} material(s)")
+    return 0
+
+
+def _incident_angle(text):
+    value = float(text)
+    if not 0.0 <= value < 90.0:
+        raise argparse.ArgumentTypeError(f"--theta-i must be in [0, 90) degrees (got {text})")
+    return value
 
 
 def _writable(text):
@@ -262,6 +311,14 @@ def build_parser():
     brdf.add_argument("--directions", type=_positive_int, default=300,
                       help="Fibonacci directions per side: their square is the number of pairs (default 300)")
     brdf.set_defaults(func=_brdf)
+    plot = sub.add_parser("plot", help="lobe and albedo plots of materials (PNG; matplotlib, in the [test] and [bench] extras)")
+    plot.add_argument("kind", choices=("lobe", "albedo", "gallery"),
+                      help="lobe: polar plot in the plane of incidence; albedo: against the incident angle; "
+                           "gallery: the lobe of every built-in model")
+    plot.add_argument("materials", nargs="*", help='material expressions, e.g. "Phong(kd=0, ks=0.5, q=20)"')
+    plot.add_argument("--theta-i", type=_incident_angle, default=45.0, help="incident angle [deg], 0 to 90 (default 45)")
+    plot.add_argument("--out", default="plot.png", type=_png_path, help="PNG path (default: plot.png)")
+    plot.set_defaults(func=_plot)
     return parser
 
 
