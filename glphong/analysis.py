@@ -52,7 +52,7 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-__all__ = ["albedo", "properties", "format_properties", "BrdfProperties", "brdf", "hemisphere_directions",
+__all__ = ["f_r", "albedo", "properties", "format_properties", "BrdfProperties", "hemisphere_directions",
            "DEFAULT_THETA_I"]
 
 #: incident angles [rad] of the white-furnace test in `properties`: cos(theta_i) from 1 to 1e-3
@@ -62,27 +62,46 @@ _CHUNK = 250_000
 
 
 # --------------------------------------------------------------------------- evaluation
+def f_r(material, wi, wo, tangent=(1.0, 0.0, 0.0), gpu=False, backend="auto"):
+    """The BRDF of ``material`` at direction pairs (normal +z): its response over ``n.wi``.
+
+    Parameters
+    ----------
+    material : glphong.materials.Material
+    wi, wo : (N, 3) array_like
+        Directions toward the light and the viewer (normalised and rounded to float32, as
+        `glphong.testing.evaluate` does).
+    tangent : (3,) array_like
+        The surface tangent, for anisotropic terms.
+    gpu : bool
+        The GLSL on the GPU (float32) instead of the float64 twin.
+    backend : {'auto', 'egl', 'osmesa'}
+
+    Returns
+    -------
+    (N, 3) float64 ndarray
+        ``f_r`` [1/sr]; 0 where ``n.wi <= 0``.  Evaluated in chunks of 250000 pairs.
+    """
+    from .testing import evaluate, float32_units
+
+    wi = np.asarray(wi, dtype=np.float64)
+    wo = np.asarray(wo, dtype=np.float64)
+    out = np.empty((len(wi), 3))
+    for s in range(0, len(wi), _CHUNK):
+        a, b = wi[s:s + _CHUNK], wo[s:s + _CHUNK]
+        if gpu:
+            r = evaluate(material, a, b, tangent=tangent, backend=backend).astype(np.float64)
+        else:
+            r = evaluate(material, a, b, tangent=tangent, twin=True)
+        nz = float32_units(a)[:, 2]  # n.wi exactly as evaluate forms it
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out[s:s + _CHUNK] = np.where((nz > 0)[:, None], r / np.where(nz > 0, nz, 1.0)[:, None], 0.0)
+    return out
+
+
 def _evaluator(material, gpu=False, backend="auto"):
-    """A function ``f(wi, wo) -> f_r`` (N, 3) float64 [1/sr], 0 where n.wi <= 0 (chunked)."""
-    from .testing import evaluate
-
-    def f(wi, wo, tangent=(1.0, 0.0, 0.0)):
-        wi = np.asarray(wi, dtype=np.float64)
-        wo = np.asarray(wo, dtype=np.float64)
-        out = np.empty((len(wi), 3))
-        for s in range(0, len(wi), _CHUNK):
-            a, b = wi[s:s + _CHUNK], wo[s:s + _CHUNK]
-            if gpu:
-                r = evaluate(material, a, b, tangent=tangent, backend=backend).astype(np.float64)
-            else:
-                r = evaluate(material, a, b, tangent=tangent, twin=True)
-            # n.wi exactly as evaluate forms it: the z of the float32-rounded unit vector
-            nz = (a / np.linalg.norm(a, axis=1, keepdims=True)).astype(np.float32).astype(np.float64)[:, 2]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                out[s:s + _CHUNK] = np.where((nz > 0)[:, None], r / np.where(nz > 0, nz, 1.0)[:, None], 0.0)
-        return out
-
-    return f
+    """``f(wi, wo, tangent) -> f_r``: `f_r` with the material and the evaluator fixed."""
+    return lambda wi, wo, tangent=(1.0, 0.0, 0.0): f_r(material, wi, wo, tangent, gpu, backend)
 
 
 # --------------------------------------------------------------------------- quadrature
@@ -268,10 +287,6 @@ def _pairs(count, seed=0):
     return np.concatenate([wi, ewi[up]]), np.concatenate([wo, ewo[up]])
 
 
-def _f32(v):
-    return (v / np.linalg.norm(v, axis=1, keepdims=True)).astype(np.float32).astype(np.float64)
-
-
 # --------------------------------------------------------------------------- the record
 @dataclass
 class BrdfProperties:
@@ -359,10 +374,12 @@ def properties(material, gpu=False, backend="auto", directions=300, theta_i=None
         for a model that reads only the frame) and by 90, 180 and 270 degrees applied to the
         directions (exact in float32, for a model that reads world axes).
     """
+    from .testing import float32_units
+
     tol = tolerance if tolerance is not None else (1e-2 if gpu else 1e-9)
     f = _evaluator(material, gpu, backend)
     wi, wo = _pairs(directions, seed)
-    wi, wo = _f32(wi), _f32(wo)  # exactly what evaluate sees: swaps and 90-degree turns stay exact
+    wi, wo = float32_units(wi), float32_units(wo)  # exactly what evaluate sees: swaps and 90-degree turns stay exact
     value = f(wi, wo)
     finite = np.isfinite(value)
     non_finite = int(np.count_nonzero(~finite.all(axis=1)))
@@ -436,9 +453,6 @@ def properties(material, gpu=False, backend="auto", directions=300, theta_i=None
             if said is not None and bool(said) != getattr(record, name):
                 record.disagreements.append(name)
     return record
-
-
-brdf = properties
 
 
 def format_properties(record):

@@ -27,21 +27,17 @@ def _m(name):
     return getattr(materials, name)
 
 
-def _fresnel(kind, value):
-    return _m(kind)(value)
-
-
 #: (label, factory) per tile, in reading order
 GALLERY = (
     ("Lambert", lambda: _m("Lambert")(KD)),
     ("Phong q=60", lambda: _m("Phong")(KD, 0.25, 60.0)),
     ("Blinn-Phong q=240", lambda: _m("BlinnPhong")(KD, 0.25, 240.0)),
-    ("Phong + Schlick 0.04", lambda: _m("Phong")(KD, 2.0, 60.0, fresnel=_fresnel("SchlickFresnel", 0.04))),
+    ("Phong + Schlick 0.04", lambda: _m("Phong")(KD, 2.0, 60.0, fresnel=_m("SchlickFresnel")(0.04))),
     ("Normalized Phong", lambda: _m("NormalizedPhong")(ALBEDO, 0.3, 60.0)),
     ("Normalized Blinn-Phong", lambda: _m("NormalizedBlinnPhong")(ALBEDO, 0.3, 240.0)),
     ("Cook-Torrance m=0.25", lambda: _m("CookTorrance")(ALBEDO, 0.25)),
     ("Cook-Torrance 1982", lambda: _m("CookTorrance")(ALBEDO, 0.25, form="1982")),
-    ("Cook-Torrance dielectric", lambda: _m("CookTorrance")(ALBEDO, 0.15, fresnel=_fresnel("DielectricFresnel", 1.5))),
+    ("Cook-Torrance dielectric", lambda: _m("CookTorrance")(ALBEDO, 0.15, fresnel=_m("DielectricFresnel")(1.5))),
     ("Lafortune off-specular", lambda: _m("Lafortune")(ALBEDO, [(2.5, -1.0, -1.0, 0.8, 30.0)])),
     ("Lafortune retro-reflective", lambda: _m("Lafortune")(ALBEDO, [(0.5, 1.0, 1.0, 1.0, 6.0)])),
     ("Oren-Nayar sigma=1", lambda: _m("OrenNayar")(ALBEDO, 1.0)),

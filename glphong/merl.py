@@ -162,7 +162,7 @@ def tabulate(material, chunk=200_000):
     -------
     (90, 90, 180, 3) float64 ndarray
     """
-    from .testing import evaluate
+    from .analysis import f_r
 
     wi, wo = bin_directions()
     wi, wo = wi.reshape(-1, 3), wo.reshape(-1, 3)
@@ -171,6 +171,5 @@ def tabulate(material, chunk=200_000):
     idx = np.flatnonzero(above)
     for start in range(0, len(idx), chunk):
         rows = idx[start:start + chunk]
-        response = evaluate(material, wi[rows], wo[rows], twin=True)
-        out[rows] = response / wi[rows, 2:3]
+        out[rows] = f_r(material, wi[rows], wo[rows])
     return out.reshape(SHAPE + (3,))

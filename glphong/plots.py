@@ -32,16 +32,14 @@ def lobe_curves(material, theta_i, count=721, tangent=(1.0, 0.0, 0.0)):
     value : (count, 3) ndarray
         ``f_r cos(theta_o)`` [1/sr] from the float64 twin (0 where ``n.l <= 0``).
     """
-    from .testing import evaluate
+    from .analysis import f_r
 
     if not 0.0 <= theta_i < np.pi / 2:
         raise ValueError(f"theta_i must be in [0, pi/2) rad (got {theta_i!r})")
     theta_o = np.linspace(-np.pi / 2, np.pi / 2, count + 2)[1:-1]
     wi = np.repeat([[-np.sin(theta_i), 0.0, np.cos(theta_i)]], count, axis=0)
     wo = np.stack([np.sin(theta_o), np.zeros(count), np.cos(theta_o)], axis=-1)
-    n_dot_l = wi[:, 2].astype(np.float32).astype(np.float64)
-    response = evaluate(material, wi, wo, tangent=tangent, twin=True)
-    return theta_o, response / n_dot_l[:, None] * np.cos(theta_o)[:, None]
+    return theta_o, f_r(material, wi, wo, tangent) * np.cos(theta_o)[:, None]
 
 
 def _pyplot():

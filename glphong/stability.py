@@ -300,10 +300,8 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
         return [x / length for x in a]
 
     def mp_values(term):
-        structure = term.values().__dict__
         return ParamValues({p.name: (vec(term.uniform_value(p.name)) if p.kind == "rgb" else f(term.uniform_value(p.name)))
-                            for p in term.uniform_params()}
-                           | {k: v for k, v in structure.items() if k not in {p.name for p in term.uniform_params()}})
+                            for p in term.uniform_params()} | term.structure())
 
     material = scene.objects[0].material
     terms = [t for t in material.components if not t.vanishes()]

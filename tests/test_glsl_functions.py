@@ -28,8 +28,9 @@ def test_every_chunk_function_has_a_twin():
     for name in ("safe_normalize", "frame_from_tangent", "point_irradiance", "log_one_minus", "lobe_from_delta",
                  "lambert", "phong_delta", "phong_lobe", "blinn_delta", "blinn_lobe"):
         assert name in signatures, name  # found by parsing the chunks, not listed by hand
-    for name in signatures:
-        assert callable(probe.twin_of(name)), name
+    for name, signature in signatures.items():
+        if signature.twin_module.startswith("glphong."):  # glphong's chunks (not models other tests define)
+            assert callable(probe.twin_of(name)), name
 
 
 def test_probe_rejects_wrong_inputs(session_gl):

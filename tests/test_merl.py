@@ -106,7 +106,7 @@ def test_tabulated_lambert_looks_up_exactly():
     measured = ~np.isnan(found[:, 0])
     assert measured.mean() > 0.97 and np.all(np.minimum(wi[~measured, 2], wo[~measured, 2]) < 0.2)
     np.testing.assert_allclose(found[measured], np.float32([0.1, 0.2, 0.3]) * np.ones((measured.sum(), 3)),
-                               rtol=1e-7)  # the twin's n.l from float32 directions, divided by the exact one
+                               rtol=1e-7)  # kd rounded to float32, as the GPU is given it
 
 
 def test_tabulated_lobe_round_trip():

@@ -25,9 +25,9 @@ import numpy as np
 from .model import Param
 
 __all__ = ["Fresnel", "SchlickFresnel", "DielectricFresnel", "FresnelSlot", "fresnel_factor", "FRESNEL_PARAMS",
-           "fresnel_oracle", "fresnel_band"]
+           "fresnel_oracle", "fresnel_band", "fresnel_uniform_values"]
 
-#: the uniforms a Fresnel slot adds to its model (``u_<model>_fresnel_f0``, ``u_<model>_fresnel_ior``)
+#: the uniforms a Fresnel slot adds to its model (``u_<model>_fresnel_f0``, ``_ior`` and ``_form``)
 FRESNEL_PARAMS = (Param("fresnel_f0", "rgb", low=0.0, high=1.0, default=0.0, doc="Schlick's f0 (fresnel=SchlickFresnel)"),
                   Param("fresnel_ior", "scalar", low=0.0, high=1e6, low_inclusive=False, default=1.5,
                         doc="relative index of refraction (fresnel=DielectricFresnel)"),
@@ -37,14 +37,34 @@ FRESNEL_PARAMS = (Param("fresnel_f0", "rgb", low=0.0, high=1.0, default=0.0, doc
 FORMS = ("none", "schlick", "dielectric")
 
 
+def fresnel_uniform_values(fresnel):
+    """``{'fresnel_f0': (3,) tuple, 'fresnel_ior': float, 'fresnel_form': float}`` of a factor: its own value,
+    its form's index and the neutral defaults of `FRESNEL_PARAMS` for the rest (all defaults for None)."""
+    values = {p.name: p.default for p in FRESNEL_PARAMS}
+    if fresnel is not None:
+        values["fresnel_form"] = float(fresnel.index)
+        values[fresnel.uniform] = getattr(fresnel, fresnel.field)
+    return values
+
+
 class Fresnel:
-    """Base of the Fresnel factors (`SchlickFresnel`, `DielectricFresnel`)."""
+    """Base of the Fresnel factors (`SchlickFresnel`, `DielectricFresnel`): a frozen dataclass of one
+    ``field`` held in the uniform ``u_<model>_<uniform>`` and validated by that uniform's `Param`."""
 
     form = None
+    field = None
+    uniform = None
+
+    def __post_init__(self):
+        param = {p.name: p for p in FRESNEL_PARAMS}[self.uniform]
+        try:
+            object.__setattr__(self, self.field, param.validate(getattr(self, self.field)))
+        except (TypeError, ValueError) as exc:
+            raise type(exc)(f"{type(self).__name__}: {str(exc).replace(self.uniform, self.field)}") from None
 
     def uniform_values(self):
-        """``{'fresnel_f0': (3,) tuple, 'fresnel_ior': float}``: this factor's value and a neutral other."""
-        raise NotImplementedError
+        """This factor's uniforms (`fresnel_uniform_values`)."""
+        return fresnel_uniform_values(self)
 
     @property
     def index(self):
@@ -63,23 +83,12 @@ class SchlickFresnel(Fresnel):
 
     f0: tuple = 0.04
     form = "schlick"
-
-    def __post_init__(self):
-        object.__setattr__(self, "f0", _f0(self.f0))
-
-    def uniform_values(self):
-        return {"fresnel_f0": self.f0, "fresnel_ior": 1.5, "fresnel_form": 1.0}
+    field = "f0"
+    uniform = "fresnel_f0"
 
     def __repr__(self):
         f0 = f"{self.f0[0]:g}" if len(set(self.f0)) == 1 else "(" + ", ".join(f"{c:g}" for c in self.f0) + ")"
         return f"SchlickFresnel(f0={f0})"
-
-
-def _f0(value):
-    try:
-        return FRESNEL_PARAMS[0].validate(value)
-    except (TypeError, ValueError) as exc:
-        raise type(exc)(f"SchlickFresnel: {str(exc).replace('fresnel_f0', 'f0')}") from None
 
 
 @dataclass(frozen=True, repr=False)
@@ -95,15 +104,8 @@ class DielectricFresnel(Fresnel):
 
     ior: float = 1.5
     form = "dielectric"
-
-    def __post_init__(self):
-        try:
-            object.__setattr__(self, "ior", FRESNEL_PARAMS[1].validate(self.ior))
-        except (TypeError, ValueError) as exc:
-            raise type(exc)(f"DielectricFresnel: {str(exc).replace('fresnel_ior', 'ior')}") from None
-
-    def uniform_values(self):
-        return {"fresnel_f0": (0.0, 0.0, 0.0), "fresnel_ior": self.ior, "fresnel_form": 2.0}
+    field = "ior"
+    uniform = "fresnel_ior"
 
     def __repr__(self):
         return f"DielectricFresnel(ior={self.ior:g})"

@@ -456,8 +456,6 @@ class Lafortune(MaterialSum):
                                       "for every lobe: where rho_d + sum_i rho_s,i <= 1 per channel")
 
     def __init__(self, rho_d, lobes=None, *, ka=0.0, two_sided=True, **per_lobe):
-        if not isinstance(two_sided, (bool, np.bool_)):
-            raise TypeError(f"two_sided must be a bool, True or False (got {two_sided!r})")
         count, values = _resolve_lobes(type(self).__name__, lobes, per_lobe)
         used = {k: v for k, v in values.items() if _lobe_index(k) <= count}
         parts = (Diffuse(rho_d, two_sided=two_sided), LafortuneLobes(**used, two_sided=two_sided))

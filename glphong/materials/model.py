@@ -18,6 +18,7 @@ models use exactly this mechanism; a definition is checked when its class is cre
 missing twin, a GLSL function of the wrong name or signature, a parameter without a range or a
 name that clashes fails there, with a message saying what is wrong.
 """
+import functools
 import hashlib
 import inspect
 import keyword
@@ -400,9 +401,10 @@ def _check_glsl(cls, text):
         raise MaterialDefinitionError(
             f"{cls.__qualname__}.glsl reads {', '.join(f'u_{name}_{x}' for x in sorted(read - declared))}, "
             f"which no Param declares (params: {', '.join(sorted(declared)) or 'none'})")
-    if declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]}:
+    unread = declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]}  # the Fresnel slot's: generated
+    if unread:
         raise MaterialDefinitionError(
-            f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(declared - read - {'fresnel_f0', 'fresnel_ior'}))}: "
+            f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(unread))}: "
             "every Param is a uniform the response must use (or remove the Param)")
     if re.search(rf"\buniform\s+\w+\s+u_{name}_", code):
         raise MaterialDefinitionError(f"{cls.__qualname__}.glsl declares its own u_{name}_* uniforms: glphong "
@@ -468,12 +470,26 @@ def _generated_names(cls):
     return names | ({f"{cls.name}_fresnel"} if cls.fresnel_slot is not None else set())
 
 
+@functools.lru_cache(maxsize=1)
 def _library_names():
+    """What the library chunks define at file scope (read once: the shader folder is fixed at import)."""
     from ..programs import chunk_source
 
     names = {"material_emission", "material_response", "shade_point"}
-    for chunk in ("common", "lights", "lobe", "fresnel", "shade", "srgb"):
+    for chunk in ("common", "lights") + LIBRARY_CHUNKS + ("shade", "srgb"):
         names |= _top_level_names(_strip_comments(chunk_source(chunk)))
+    return frozenset(names)
+
+
+_MODEL_NAMES = {}
+
+
+def _model_names(cls):
+    """What a registered model's GLSL defines at file scope, once per definition (name and source hash)."""
+    key = (cls.name, cls.source_hash())
+    names = _MODEL_NAMES.get(key)
+    if names is None:
+        names = _MODEL_NAMES[key] = frozenset(_top_level_names(_strip_comments(cls.source())))
     return names
 
 
@@ -487,7 +503,7 @@ def _check_namespace(cls, code):
     for other in registered_models():
         if other.name == cls.name:
             continue
-        theirs = _top_level_names(_strip_comments(other.source()))
+        theirs = _model_names(other)
         both = own & theirs
         if both:
             raise MaterialDefinitionError(
@@ -762,13 +778,12 @@ class MaterialModel(Material):
         return self.params if getattr(self, "fresnel", None) is None else self.uniform_params()
 
     def uniform_value(self, name):
-        """The value of the uniform ``u_<model>_<name>`` (a param, or the Fresnel factor's)."""
-        if name.startswith("fresnel_") and self.fresnel_slot is not None and name not in {p.name for p in self.params}:
-            from .fresnel import FRESNEL_PARAMS
+        """The value of the uniform ``u_<model>_<name>`` (a param, or the Fresnel factor's: no param may
+        start with ``fresnel_``)."""
+        if self.fresnel_slot is not None and name.startswith("fresnel_"):
+            from .fresnel import fresnel_uniform_values
 
-            if self.fresnel is None:
-                return {p.name: p.default for p in FRESNEL_PARAMS}[name]
-            return self.fresnel.uniform_values()[name]
+            return fresnel_uniform_values(self.fresnel)[name]
         return getattr(self, name)
 
     def structural_defines(self, uber=False):
@@ -856,15 +871,17 @@ class MaterialModel(Material):
         params = [p for p in self.uniform_params() if names is None or p.name in names]
         values = {p.name: np.asarray(uniforms[self.uniform_name(p.name)] if p in self.active_params() else
                                      _validate.float32_uniform(self.uniform_value(p.name)), dtype=dtype) for p in params}
-        return ParamValues(values | self._structure())
+        return ParamValues(values | self.structure())
 
     def values(self, dtype=np.float64):
         """`ParamValues` of this instance: its values as the GPU receives them (float32, subnormals
         flushed), in ``dtype``, with its structure as in `values_from_uniforms`."""
         return ParamValues({p.name: np.asarray(_validate.float32_uniform(self.uniform_value(p.name)), dtype=dtype)
-                            for p in self.uniform_params()} | self._structure())
+                            for p in self.uniform_params()} | self.structure())
 
-    def _structure(self):
+    def structure(self):
+        """What the twin reads beside the uniforms (dict): each choice's value by name, and ``fresnel_form``
+        (0 none, 1 Schlick, 2 dielectric) where the model has a Fresnel slot."""
         out = {c.name: getattr(self, c.name) for c in self.choices}
         if self.fresnel_slot is not None:
             out["fresnel_form"] = 0 if self.fresnel is None else self.fresnel.index
