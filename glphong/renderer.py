@@ -454,8 +454,10 @@ class Renderer:
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self._mgl.enable(moderngl.DEPTH_TEST)
         self._mgl.disable(moderngl.CULL_FACE)
+        # the uber-shader's key is the scene's, the same for every object: made once per frame, not per object
+        shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
         for index, obj in enumerate(scene.objects):
-            key = self.program_key(scene, obj, output)
+            key = shared or self.program_key(scene, obj, output)
             program = self.programs.get(key)
             program.bind(scene.uniform_values(index, key, aspect), drop_unused=key.formulation == "naive")
             # a mirroring pose (det < 0) reverses the winding: its counter-clockwise faces become clockwise
