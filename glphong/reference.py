@@ -20,7 +20,7 @@ import numpy as np
 __all__ = [
     "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus", "lobe_from_delta",
     "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
-    "fresnel_schlick", "fresnel_dielectric", "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
+    "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
     "shade_inputs", "shade",
 ]
 
@@ -267,6 +267,14 @@ def fresnel_dielectric(ior, c):
         q = (c * g_plus_c - 1) / (c * g_minus_c + 1)
         f = 0.5 * (ratio * ratio) * (1 + q * q)
     return np.where((g2 < 0) | (g_plus_c <= 0), 1, np.minimum(f, 1)).astype(dtype)
+
+
+# --------------------------------------------------------------------------- angle.glsl
+def atan2_first_quadrant(y, x):
+    """``atan(y / x)`` [rad] in [0, pi/2] for ``y, x >= 0``, 0 where both are 0 (angle.glsl): exact here
+    (``numpy.arctan2``); the GLSL evaluates Cephes' atanf polynomial, good to 3 ulp (GLSL's own atan
+    is not: 2e-5 relative measured on llvmpipe).  (...) -> (...)."""
+    return np.arctan2(y, x)
 
 
 # --------------------------------------------------------------------------- shade.glsl

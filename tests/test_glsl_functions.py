@@ -185,3 +185,18 @@ def test_lobes(session_gl, name, q):
     assert not bad.any(), np.c_[gpu, want, low, high][bad][:5]
     # the lobe is really exercised: some values near the peak, some far below it
     assert (want > 0.5).sum() >= 20 and (want < 0.5).sum() >= 20 or q == 0
+
+
+def test_atan2_first_quadrant(session_gl):
+    """angle.glsl's Cephes atan against numpy's arctan2: within 4 ulp of pi/2 absolute over the quadrant,
+    relative 4 ulp of the result, and 0 at (0, 0) (no NaN)."""
+    rng = np.random.default_rng(RNG_SEED + 7)
+    angle = rng.uniform(0, np.pi / 2, size=2000)
+    scale = 10.0 ** rng.uniform(-20, 20, size=2000)
+    y = np.concatenate([np.sin(angle) * scale, [0, 0, 1, 1e-30, 1, 3e38]]).astype(np.float32)
+    x = np.concatenate([np.cos(angle) * scale, [0, 1, 0, 1, 1e-30, 3e38]]).astype(np.float32)
+    gpu = probe.evaluate(session_gl, "atan2_first_quadrant", y=y, x=x)["return"].astype(np.float64)
+    want = ref.atan2_first_quadrant(f64(y), f64(x))
+    assert not np.isnan(gpu).any() and gpu[-6] == 0.0
+    err = np.abs(gpu - want)
+    assert np.all(err <= 4 * EPS * np.maximum(want, 2 ** -20)), float(np.max(err / np.maximum(want, 2 ** -20)) / EPS)

@@ -99,7 +99,7 @@ def test_a_valid_definition_registers_under_its_name():
     ({"name": "material"}, r"name 'material' is reserved"),
     ({"name": "Minnaert"}, r"name must be a lowercase GLSL identifier"),
     ({"needs": ("normal",)}, r"needs must be a tuple of 'view', 'tangent', 'uv'"),
-    ({"uses": ("srgb",)}, r"uses must be a tuple of library chunks 'lobe', 'fresnel'"),
+    ({"uses": ("srgb",)}, r"uses must be a tuple of library chunks 'lobe', 'fresnel', 'angle'"),
     ({"ambient": "q"}, r"ambient must be None or the name of an rgb Param \(k\)"),
     ({"vanishes_with": ("ks",)}, r"vanishes_with names \['ks'\]"),
     ({"glsl": ...}, r"has no glsl"),

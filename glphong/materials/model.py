@@ -39,7 +39,7 @@ KINDS = {"scalar": "float", "rgb": "vec3"}
 #: what a model may ask for beyond the normal and the light direction
 NEEDS = ("view", "tangent", "uv")
 #: library chunks (glsl/<name>.glsl) a model may use besides common.glsl, which is always there
-LIBRARY_CHUNKS = ("lobe", "fresnel")
+LIBRARY_CHUNKS = ("lobe", "fresnel", "angle")
 #: names a model may not take: GLSL prefixes and uniforms of the shading loop and the library
 RESERVED_NAMES = frozenset({
     "material", "shade", "common", "lights", "light", "point", "unattenuated", "directional", "ambient",

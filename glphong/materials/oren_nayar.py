@@ -83,9 +83,10 @@ Where common implementations differ from the paper (glphong follows the paper, D
 """
 import numpy as np
 
+from ..reference import atan2_first_quadrant
 from .model import Choice, GlslFile, MaterialModel, Param, Properties
 
-__all__ = ["OrenNayar", "oren_nayar_atan2", "oren_nayar_tangential", "oren_nayar_cos_phi", "oren_nayar_tan_beta",
+__all__ = ["OrenNayar", "oren_nayar_tangential", "oren_nayar_cos_phi", "oren_nayar_tan_beta",
            "oren_nayar_full", "oren_nayar_qualitative", "RHO", "SIGMA"]
 
 #: the facets' albedo
@@ -102,13 +103,6 @@ _TWO_OVER_PI = 2.0 / np.pi
 
 def _dot(a, b):
     return np.sum(a * b, axis=-1)
-
-
-def oren_nayar_atan2(y, x):
-    """``atan(y / x)`` for ``y, x >= 0`` (oren_nayar.glsl): exact here (``numpy.arctan2``); the GLSL
-    evaluates Cephes' atanf polynomial, good to a few ulp (GLSL's own atan is not: 2e-5 relative
-    measured on llvmpipe)."""
-    return np.arctan2(y, x)
 
 
 def oren_nayar_tangential(n, w):
@@ -160,8 +154,8 @@ def _full_parts(cos_i, sin_i, cos_o, sin_o, c, one_minus_c, one_minus_abs_c, s2)
     tan((alpha + beta)/2) cos_i`` and the inter-reflection part; all but the second are non-negative."""
     tan_beta, sin_alpha, cos_alpha = oren_nayar_tan_beta(cos_i, sin_i, cos_o, sin_o)
     tan_half = (sin_i + sin_o) * (cos_i / (cos_i + cos_o))
-    g_i = _TWO_OVER_PI * oren_nayar_atan2(cos_i, sin_i)
-    g_o = _TWO_OVER_PI * oren_nayar_atan2(cos_o, sin_o)
+    g_i = _TWO_OVER_PI * atan2_first_quadrant(cos_i, sin_i)
+    g_o = _TWO_OVER_PI * atan2_first_quadrant(cos_o, sin_o)
     g_b = np.maximum(g_i, g_o)
     g_a = np.minimum(g_i, g_o)
     k = s2 / (s2 + 0.09)
@@ -212,6 +206,7 @@ class OrenNayar(MaterialModel):
     choices = (FORM,)
     needs = ("view",)
     glsl = GlslFile("materials/oren_nayar.glsl")
+    uses = ("angle",)
     ambient = "rho"
     ambient_scale = 1.0 / np.pi
     vanishes_with = ("rho",)

@@ -33,12 +33,10 @@
 //   tan((alpha + beta)/2) (n.l) = (sin_i + sin_o) (n.l / (n.l + n.v)) (half-angle identity): at most 2.
 //   So the response f_r (n.l) stays bounded where f_r itself diverges (both grazing, c > 0: the
 //   paper's model is meant for theta < pi/2 and diverges as 1/(n.l) there).
-// oren_nayar_atan2(y, x) -> atan(y / x) for y, x >= 0 (not both 0), to 3 ulp (measured): Cephes'
-//   atanf polynomial (S. L. Moshier, Cephes Math Library) after reduction to |t| <= tan(pi/8), by
-//   selects.  GLSL's atan(y, x) may err by 4096 ulp (GLSL 4.50, 4.7.1); llvmpipe's measured 3.3e-6
-//   absolute, 2e-5 relative, which the full form's cancelling sums (C1 against c C2 tan(beta),
-//   c < 0) turned into 1e-4 relative error of the response.
-// The angles enter through g = 1 - 2 theta/pi = (2/pi) oren_nayar_atan2(cos(theta), sin(theta)),
+// The polar angles come from atan2_first_quadrant (angle.glsl: Cephes' atanf, 3 ulp; GLSL's own atan
+//   errs 2e-5 relative on llvmpipe, which the full form's cancelling sums (C1 against c C2 tan(beta),
+//   c < 0) turned into 1e-4 relative error of the response).
+// The angles enter through g = 1 - 2 theta/pi = (2/pi) atan2_first_quadrant(cos(theta), sin(theta)),
 //   relatively accurate at grazing, where the textbook sin(alpha) - (2 beta/pi)^3 and
 //   1 - (2 beta/pi)^2 cancel (g_b = max(g_i, g_o) is beta's, g_a = min(g_i, g_o) alpha's):
 //   sin(alpha) - (2 beta/pi)^3 = g_b (3 - 3 g_b + g_b^2) - cos(alpha)^2 / (1 + sin(alpha)),
@@ -57,19 +55,6 @@
 
 const float OREN_NAYAR_INV_PI = 0.3183098861837907;
 const float OREN_NAYAR_TWO_OVER_PI = 0.6366197723675814;
-
-float oren_nayar_atan2(float y, float x)
-{
-    float lo = min(y, x);
-    float hi = max(y, x);
-    float r = lo / hi;                                    // in [0, 1]
-    bool mid = r > 0.41421356237309503;                   // tan(pi/8)
-    float t = mid ? (r - 1.0) / (r + 1.0) : r;            // |t| <= tan(pi/8)
-    float z = t * t;
-    float p = (((8.05374449538e-2 * z - 1.38776856032e-1) * z + 1.99777106478e-1) * z - 3.33329491539e-1) * z * t + t;
-    float a = (mid ? 0.78539816339744831 : 0.0) + p;      // atan(r) in [0, pi/4]
-    return y > x ? 1.5707963267948966 - a : a;
-}
 
 float oren_nayar_tangential(vec3 n, vec3 w, out vec3 dir)
 {
@@ -105,8 +90,8 @@ vec2 oren_nayar_full(float cos_i, float sin_i, float cos_o, float sin_o, float c
     float sin_alpha, cos_alpha;
     float tan_beta = oren_nayar_tan_beta(cos_i, sin_i, cos_o, sin_o, sin_alpha, cos_alpha);
     float tan_half = (sin_i + sin_o) * (cos_i / (cos_i + cos_o));
-    float g_i = OREN_NAYAR_TWO_OVER_PI * oren_nayar_atan2(cos_i, sin_i);
-    float g_o = OREN_NAYAR_TWO_OVER_PI * oren_nayar_atan2(cos_o, sin_o);
+    float g_i = OREN_NAYAR_TWO_OVER_PI * atan2_first_quadrant(cos_i, sin_i);
+    float g_o = OREN_NAYAR_TWO_OVER_PI * atan2_first_quadrant(cos_o, sin_o);
     float g_b = max(g_i, g_o);
     float g_a = min(g_i, g_o);
     float k = s2 / (s2 + 0.09);

@@ -368,7 +368,7 @@ def test_definition():
     assert sigma.high == np.pi / 2
     (form,) = OrenNayar.choices
     assert (form.name, form.values, form.default) == ("form", ("full", "qualitative"), "full")
-    assert OrenNayar.needs == ("view",) and OrenNayar.uses == () and OrenNayar.fresnel_slot is None
+    assert OrenNayar.needs == ("view",) and OrenNayar.uses == ("angle",) and OrenNayar.fresnel_slot is None
     assert OrenNayar.ambient == "rho" and OrenNayar.ambient_scale == 1.0 / np.pi
     assert OrenNayar.vanishes_with == ("rho",)
     assert OrenNayar.properties == Properties(reciprocal=True, isotropic=True, energy_conserving=False,
