@@ -17,8 +17,8 @@ from .contexts import BackendUnavailableError, available_backends, create_contex
 from .describe import describe, format_descriptions
 from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
 from .materials import (AshikhminShirley, BlinnPhong, CookTorrance, DielectricFresnel, Diffuse, Lafortune, Lambert,
-                        Material, MaterialModel, MaterialSum, NormalizedBlinnPhong, NormalizedPhong, OrenNayar, Param,
-                        Phong, SchlickFresnel, Ward)
+                        Material, MaterialModel, MaterialSum, MeasuredBRDF, NormalizedBlinnPhong, NormalizedPhong,
+                        OrenNayar, Param, Phong, SchlickFresnel, Ward)
 from .renderer import Frame, GBuffer, Renderer
 from .scene import Scene, SceneObject
 from .verify import VerifyReport, verify
@@ -28,7 +28,7 @@ __version__ = "0.1.0"
 __all__ = [
     "PerspectiveCamera", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
-    "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "SchlickFresnel",
+    "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "SchlickFresnel",
     "DielectricFresnel", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
     "imaging", "materials", "primitives", "radiometry", "reference",

@@ -10,6 +10,7 @@ so the anisotropic models stretch their highlights around the sphere.
 `GALLERY` lists ``(label, factory)`` pairs; a model that is not defined in this installation is
 skipped.  `render_gallery` returns the mosaic and, with ``verify=True``, one cross-check report per tile.
 """
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -45,7 +46,16 @@ GALLERY = (
     ("Ward 0.3 x 0.06", lambda: _m("Ward")(ALBEDO, 0.2, 0.3, 0.06)),
     ("Ward bounded", lambda: _m("Ward")(ALBEDO, 0.2, 0.3, 0.06, normalization="bounded")),
     ("Ashikhmin-Shirley 1000 x 20", lambda: _m("AshikhminShirley")(ALBEDO, 0.1, 1000.0, 20.0)),
+    ("Measured: Cook-Torrance table", lambda: _measured_cook_torrance()),
 )
+
+
+@functools.lru_cache(maxsize=1)
+def _measured_cook_torrance():
+    """The "Cook-Torrance m=0.25" tile's material tabulated in the MERL layout (1.6 s), read trilinearly."""
+    from .merl import tabulate
+
+    return _m("MeasuredBRDF")(tabulate(_m("CookTorrance")(ALBEDO, 0.25)), "trilinear")
 
 
 def gallery_scene(material):

@@ -99,7 +99,7 @@ def signatures():
         out.update(_parse(chunk_source(chunk), LIBRARY, "glphong.reference"))
     for model in registered_models():
         chunks = LIBRARY + (f"model:{model.name}@{model.source_hash()}",)
-        names = {model.uniform_name(p.name) for p in model.uniform_params()}
+        names = {model.uniform_name(p.name) for p in model.uniform_params() + model.tables}
         out.update(_parse(model.source(), chunks, model.__module__, names))
     return out
 

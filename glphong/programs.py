@@ -234,10 +234,13 @@ class Program:
     ----------
     mgl : moderngl.Context
     key : glphong.key.ProgramKey
+    textures : glphong.textures.TextureStore, optional
+        Where the textures of `TableData` uniform values are uploaded (the cache's store).
     """
 
-    def __init__(self, mgl, key):
+    def __init__(self, mgl, key, textures=None):
         self.key = key
+        self.textures = textures
         defines, generated = key.defines(), key.generated_chunks()
         self.vertex_source = assemble(key.vertex_chunks(), defines, generated)
         self.fragment_source = assemble(key.fragment_chunks(), defines, generated) if key.fragment_chunks() else None
@@ -255,6 +258,9 @@ class Program:
 
         self.optional = {model_for_key(t.name, t.source_hash).uniform_name(p.name)
                          for t in getattr(key, "terms", ()) for p in model_for_key(t.name, t.source_hash).uniform_params()}
+        #: sampler uniforms in texture-unit order
+        self.samplers = tuple(name for name, u in self.active.items() if u.fmt.endswith("i") and "sampler" in
+                              _uniform_type(self.vertex_source, self.fragment_source, name))
 
     def bind(self, values, drop_unused=False):
         """Set every active uniform from ``values``; anything else is an error.
@@ -263,7 +269,9 @@ class Program:
         ----------
         values : dict of str to array_like
             float32 data per uniform name: shape ``()``, ``(k,)``, ``(k, k)`` (row-major
-            matrices, transposed here to GL's column-major) or ``(N, 3)`` for arrays.
+            matrices, transposed here to GL's column-major) or ``(N, 3)`` for arrays; for a
+            sampler, a `glphong.materials.TableData` (its texture is uploaded once per context
+            and bound to the sampler's unit) or a texture unit the caller bound.
         drop_unused : bool
             Ignore given uniforms that are not active instead of raising: only for the
             naive formulation, whose never-failing ``safe_normalize`` lets the compiler
@@ -283,9 +291,18 @@ class Program:
         unknown = sorted(set(values) - set(self.active))
         if missing or unknown:
             raise UniformError(f"program {self.key.describe()!r}: missing uniforms {missing}, unknown uniforms {unknown}")
+        from .materials.table import TableData
+
         for name, uniform in self.active.items():
+            value = values[name]
+            if isinstance(value, TableData):
+                if name not in self.samplers or self.textures is None:
+                    raise UniformError(f"uniform {name} of program {self.key.describe()!r} is not a sampler of a "
+                                       "program with a texture store: it cannot take a table")
+                value = self.samplers.index(name)
+                self.textures.bind(values[name], value)
             # float uniforms take float32; samplers and int uniforms ('1i' formats) take int32
-            data = np.asarray(values[name], dtype=np.int32 if uniform.fmt.endswith("i") else np.float32)
+            data = np.asarray(value, dtype=np.int32 if uniform.fmt.endswith("i") else np.float32)
             if data.ndim == 2 and data.shape[0] == data.shape[1] and uniform.dimension == data.size:
                 data = data.T
             expected = uniform.array_length * uniform.dimension
@@ -298,11 +315,22 @@ class Program:
         self.gl_program.release()
 
 
+def _uniform_type(vertex_source, fragment_source, name):
+    """The declared GLSL type of uniform ``name`` in a program's sources ('' where not found)."""
+    for source in (vertex_source, fragment_source or ""):
+        m = re.search(rf"^\s*uniform\s+(\w+)\s+{re.escape(name)}\s*[;\[]", source, re.M)
+        if m:
+            return m.group(1)
+    return ""
+
+
 class ProgramCache:
-    """Programs of one GL context, compiled once per `ProgramKey`.
+    """Programs of one GL context, compiled once per `ProgramKey`, and the textures they sample.
 
     Attributes
     ----------
+    textures : glphong.textures.TextureStore
+        The tables the programs' samplers have read, uploaded once each.
     hits, misses : int
         Cache statistics since creation.
     compile_seconds : float
@@ -310,8 +338,11 @@ class ProgramCache:
     """
 
     def __init__(self, mgl):
+        from .textures import TextureStore
+
         self._mgl = mgl
         self._programs = {}
+        self.textures = TextureStore(mgl)
         self.hits = 0
         self.misses = 0
         self.compile_seconds = 0.0
@@ -324,7 +355,7 @@ class ProgramCache:
             return program
         self.misses += 1
         start = time.perf_counter()
-        program = self._programs[key] = Program(self._mgl, key)
+        program = self._programs[key] = Program(self._mgl, key, self.textures)
         self.compile_seconds += time.perf_counter() - start
         return program
 
@@ -336,7 +367,8 @@ class ProgramCache:
         return len(self._programs)
 
     def release(self):
-        """Release every program."""
+        """Release every program and texture."""
         for program in self._programs.values():
             program.release()
         self._programs.clear()
+        self.textures.release()

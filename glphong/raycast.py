@@ -39,6 +39,7 @@ from .camera import PerspectiveCamera
 from .geometry import MeshData
 from .lights import AmbientLight
 from .materials import Material
+from .materials.table import uniform_as
 from .reference import safe_normalize, shade_point
 from .scene import Scene
 
@@ -317,7 +318,7 @@ def render_reference(camera, objects, lights=(), ambient=None, width=256, height
     for index, obj in enumerate(objects):
         scene_obj = scene.add(dummy, obj.material)
         key = scene.program_key(scene_obj)
-        u = {k: np.asarray(v, dtype=np.float64) for k, v in scene.uniform_values(index, key, width / height).items()}
+        u = {k: uniform_as(v, np.float64) for k, v in scene.uniform_values(index, key, width / height).items()}
         shading.append((key, u))
 
     offsets = stratified_offsets(n)

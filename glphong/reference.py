@@ -17,6 +17,8 @@ Conventions of the mirror:
 """
 import numpy as np
 
+from .materials.table import uniform_as
+
 __all__ = [
     "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus", "lobe_from_delta",
     "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
@@ -425,7 +427,7 @@ def shade_inputs(scene, gbuffer, dtype=np.float64):
         if not selection.any():
             continue
         key = scene.program_key(obj)
-        uniforms = {k: v.astype(dtype) for k, v in scene.uniform_values(index, key, width / height).items()}
+        uniforms = {k: uniform_as(v, dtype) for k, v in scene.uniform_values(index, key, width / height).items()}
         position = gbuffer.position[selection].astype(dtype)
         n_valid, n, _ = safe_normalize(gbuffer.normal[selection].astype(dtype))
         tangent = gbuffer.tangent[selection].astype(dtype) if key.has_tangent else None

@@ -523,12 +523,12 @@ class Renderer:
         _release_targets(self.context, self._targets)
 
     def gl_object_count(self):
-        """Number of GL objects this renderer holds (programs, buffers, vertex arrays, targets)."""
+        """Number of GL objects this renderer holds (programs, textures, buffers, vertex arrays, targets)."""
         meshes = sum(1 + len(e.buffers) + len(e.vertex_arrays) for e in self._meshes.values())
         targets = sum(1 if name[0] == "fullscreen" else
                       1 + len(f.color_attachments) + (f.depth_attachment is not None)
                       for name, f in self._targets.items())
-        return len(self.programs) + meshes + targets
+        return len(self.programs) + len(self.programs.textures) + meshes + targets
 
     @_one_call_at_a_time
     def release(self):

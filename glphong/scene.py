@@ -13,6 +13,7 @@ from .geometry import MeshData
 from .key import program_key
 from .lights import LIGHT_KINDS, AmbientLight
 from .materials import Material
+from .materials.table import TableData
 
 __all__ = ["Scene", "SceneObject"]
 
@@ -216,7 +217,7 @@ class Scene:
                 values["u_eye"] = self.camera.position
             values.update(obj.material.uniform_values(key))
             values.update(self.light_uniform_values(key))
-        return {name: _validate.float32_uniform(v) for name, v in values.items()}
+        return {name: v if isinstance(v, TableData) else _validate.float32_uniform(v) for name, v in values.items()}
 
     def _uber_uniform_values(self, index, key, aspect):
         """The uber-shader's uniforms: the specialised key's values, zeros for the terms the object's
@@ -239,9 +240,11 @@ class Scene:
         from .materials import model_named
 
         for term in key.terms:
-            for p in model_named(term.name).uniform_params():
-                name = f"u_{term.name}_{p.name}"
-                values.setdefault(name, np.zeros(3 if p.kind == "rgb" else (), np.float32))
+            model = model_named(term.name)
+            for p in model.uniform_params():
+                values.setdefault(model.uniform_name(p.name), np.zeros(3 if p.kind == "rgb" else (), np.float32))
+            for t in model.tables:
+                values.setdefault(model.uniform_name(t.name), TableData.zeros(t.shape, t.channels))
         for kind, (_, where_name, value_name) in LIGHT_KINDS.items():
             for name in (where_name, value_name):
                 padded = np.zeros((UBER_MAX_LIGHTS, 3), np.float32)

@@ -301,7 +301,8 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
 
     def mp_values(term):
         return ParamValues({p.name: (vec(term.uniform_value(p.name)) if p.kind == "rgb" else f(term.uniform_value(p.name)))
-                            for p in term.uniform_params()} | term.structure())
+                            for p in term.uniform_params()} | {t.name: getattr(term, t.name) for t in term.tables}
+                           | term.structure())
 
     material = scene.objects[0].material
     terms = [t for t in material.components if not t.vanishes()]

@@ -28,6 +28,7 @@ import numpy as np
 from .contexts import BACKENDS, BackendUnavailableError, create_context
 from .key import response_key
 from .materials.model import Material
+from .materials.table import uniform_as
 from .programs import ProgramCache
 from .tolerances import BAND, EPS, response_band
 
@@ -100,7 +101,7 @@ def _inputs(material, wi, wo, normal, tangent, uv):
 def _twin(material, key, uniforms, wi, wo, normal, tangent, uv):
     from . import reference as ref
 
-    u = {k: np.asarray(v, dtype=np.float64) for k, v in uniforms.items()}
+    u = {k: uniform_as(v, np.float64) for k, v in uniforms.items()}
     f = ref.shading_frame(normal.astype(np.float64), tangent.astype(np.float64), uv.astype(np.float64), key)
     wi64, wo64 = wi.astype(np.float64), wo.astype(np.float64)
     n_dot_l = np.sum(f.n * wi64, axis=-1)

@@ -90,7 +90,7 @@ def test_a_valid_definition_registers_under_its_name():
     ({"glsl": "vec3 test_def_response(vec3 n, vec3 wi, vec3 wo, float n_dot_l) { return u_test_def_k; }"},
      r"found `vec3 test_def_response\(vec3 n, vec3 wi, vec3 wo, float n_dot_l\)`"),
     ({"glsl": "vec3 test_def_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l) { return u_test_def_k * u_test_def_x; }"},
-     r"reads u_test_def_x, which no Param declares"),
+     r"reads u_test_def_x, which no Param or Table declares"),
     ({"glsl": "vec3 test_def_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l) { return vec3(n_dot_l); }"},
      r"never reads u_test_def_k"),
     ({"glsl": "uniform vec3 u_test_def_k;\nvec3 test_def_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l) "

@@ -21,9 +21,12 @@ The physically based models of DESIGN section 9 (``rho_*`` are albedos, dimensio
 - `Ward` = ``Diffuse + WardLobe`` (anisotropic; Walter's, Duer's or the bounded normalisation);
 - `AshikhminShirley` (``ashikhmin_shirley``): anisotropic Phong with Schlick Fresnel and coupled diffuse (2000).
 
+Measured: `MeasuredBRDF` (``measured_brdf``): a MERL table (Matusik et al. 2003) sampled from a 3D texture,
+nearest bin as the reference reader or trilinear; ``MeasuredBRDF.from_model`` tabulates any material.
+
 Fresnel factors `SchlickFresnel(f0)` and `DielectricFresnel(ior)` are the ``fresnel=`` of the glossy
 models (`Phong`, `BlinnPhong`, the normalised ones, `CookTorrance`); each model states its cosine.
-``ka`` is a constant radiance [W/(m^2 sr)].  Define your own with `MaterialModel`, `Param`, `Choice`
+``ka`` is a constant radiance [W/(m^2 sr)].  Define your own with `MaterialModel`, `Param`, `Table`, `Choice`
 and `FresnelSlot` (see README, "Write your own material").
 """
 import importlib as _importlib
@@ -31,15 +34,16 @@ import pkgutil as _pkgutil
 
 from .model import (Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues,
                     Properties, ShadingFrame, model_named, registered_models)
+from .table import Table, TableData
 
-__all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "ParamValues", "Properties", "ShadingFrame",
-           "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
+__all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "Table", "TableData", "ParamValues",
+           "Properties", "ShadingFrame", "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
 
 # every module of this package but the mechanism is one model: importing it registers the model, and
 # the material classes it exports are this package's, so a new model is one file here (with its GLSL
 # and its tests); its twin functions stay in its module (and are found by glphong.reference)
 for _info in sorted(_pkgutil.iter_modules(__path__), key=lambda info: info.name):
-    if _info.name != "model":
+    if _info.name not in ("model", "table"):  # the mechanism
         _module = _importlib.import_module(f"{__name__}.{_info.name}")
         for _name in _module.__all__:
             if isinstance(getattr(_module, _name), type):

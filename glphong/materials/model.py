@@ -30,8 +30,9 @@ from pathlib import Path
 import numpy as np
 
 from .. import _validate
+from .table import Table, TableData
 
-__all__ = ["Param", "Choice", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
+__all__ = ["Param", "Choice", "Table", "TableData", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
            "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
 
 #: parameter kinds and their GLSL types
@@ -61,6 +62,15 @@ class MaterialDefinitionError(TypeError):
 
 
 # --------------------------------------------------------------------------- parameters
+def _check_argument_name(kind, name):
+    """A `Param` or `Table` name: a lowercase identifier, not a GLSL or Python keyword, not a material keyword."""
+    if not isinstance(name, str) or not _IDENT.match(name) or name in _GLSL_KEYWORDS or keyword.iskeyword(name):
+        raise MaterialDefinitionError(f"{kind} name must be a lowercase identifier such as 'kd' (got {name!r})")
+    if name in MATERIAL_KEYWORDS:
+        raise MaterialDefinitionError(f"{kind} {name!r}: the name is a keyword every material takes "
+                                      f"({', '.join(MATERIAL_KEYWORDS)}); choose another")
+
+
 @dataclass(frozen=True)
 class Param:
     """One parameter of a material model.
@@ -95,13 +105,7 @@ class Param:
     high_inclusive: bool = True
 
     def __post_init__(self):
-        if not isinstance(self.name, str) or not _IDENT.match(self.name) or self.name in _GLSL_KEYWORDS \
-                or keyword.iskeyword(self.name):
-            raise MaterialDefinitionError(f"Param name must be a lowercase identifier such as 'kd' "
-                                          f"(got {self.name!r})")
-        if self.name in MATERIAL_KEYWORDS:
-            raise MaterialDefinitionError(f"Param {self.name!r}: the name is a keyword every material takes "
-                                          f"({', '.join(MATERIAL_KEYWORDS)}); choose another")
+        _check_argument_name("Param", self.name)
         if self.kind not in KINDS:
             raise MaterialDefinitionError(f"Param {self.name!r}: kind must be one of {', '.join(map(repr, KINDS))} "
                                           f"(got {self.kind!r})")
@@ -396,16 +400,16 @@ def _check_glsl(cls, text):
             + (f"found `{found.group(0)}`" if found else
                f"found no {name}_response (functions defined: {', '.join(functions) or 'none'})"))
     read = set(re.findall(rf"\bu_{name}_([A-Za-z_]\w*)", code))
-    declared = {p.name for p in cls.uniform_params()}
+    declared = {p.name for p in cls.uniform_params()} | {t.name for t in cls.tables}
     if read - declared:
         raise MaterialDefinitionError(
             f"{cls.__qualname__}.glsl reads {', '.join(f'u_{name}_{x}' for x in sorted(read - declared))}, "
-            f"which no Param declares (params: {', '.join(sorted(declared)) or 'none'})")
+            f"which no Param or Table declares (params and tables: {', '.join(sorted(declared)) or 'none'})")
     unread = declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]}  # the Fresnel slot's: generated
     if unread:
         raise MaterialDefinitionError(
             f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(unread))}: "
-            "every Param is a uniform the response must use (or remove the Param)")
+            "every Param and Table is a uniform the response must use (or remove it)")
     if re.search(rf"\buniform\s+\w+\s+u_{name}_", code):
         raise MaterialDefinitionError(f"{cls.__qualname__}.glsl declares its own u_{name}_* uniforms: glphong "
                                       "declares them from params; remove the declarations")
@@ -466,7 +470,8 @@ def _top_level_names(code):
 
 def _generated_names(cls):
     """The uniform and switch names glphong generates for a model."""
-    names = {cls.uniform_name(p.name) for p in cls.uniform_params()} | {f"u_use_{cls.name}", f"u_use_{cls.name}_ambient"}
+    names = {cls.uniform_name(p.name) for p in cls.uniform_params() + cls.tables}
+    names |= {f"u_use_{cls.name}", f"u_use_{cls.name}_ambient"}
     return names | ({f"{cls.name}_fresnel"} if cls.fresnel_slot is not None else set())
 
 
@@ -585,8 +590,8 @@ class Material:
         -------
         dict of str to numpy.ndarray
             ``u_ka`` where the key has it, and ``u_<model>_<param>`` of the key's terms: every
-            parameter of a term in the light loop, the ambient parameter of a term that only
-            answers ``L_a``.
+            parameter of a term in the light loop (its tables as `TableData`), the ambient
+            parameter of a term that only answers ``L_a``.
         """
         values = {}
         if key.has_ka:
@@ -599,6 +604,8 @@ class Material:
             params = term.active_params() if term_key.lit else [p for p in term.params if p.name == term.ambient]
             values.update({term.uniform_name(p.name): _validate.float32_uniform(term.uniform_value(p.name))
                            for p in params})
+            if term_key.lit:  # tables as `TableData`: the renderer binds their textures, the twin reads them
+                values.update({term.uniform_name(t.name): getattr(term, t.name) for t in term.tables})
         return values
 
     def __setattr__(self, name, value):
@@ -633,7 +640,7 @@ def _short(value):
 def _bind_arguments(cls, params, args, kwargs):
     """Map positional and keyword arguments onto ``params`` (validated values by name).
 
-    ``params`` are the constructor's arguments in positional order: `Param`, `Choice` and a
+    ``params`` are the constructor's arguments in positional order: `Table`, `Param`, `Choice` and a
     `FresnelSlot` (whose default may be None, a valid value)."""
     if len(args) > len(params):
         raise TypeError(f"{cls.__name__}() takes at most {len(params)} positional arguments "
@@ -651,7 +658,7 @@ def _bind_arguments(cls, params, args, kwargs):
     for p in params:
         if p.name in given:
             out[p.name] = p.validate(given[p.name])
-        elif p.default is not None or not isinstance(p, Param):
+        elif p.default is not None or not isinstance(p, (Param, Table)):
             out[p.name] = p.default
         else:
             raise TypeError(f"{cls.__name__}() missing parameter {p.name!r} ({p.kind} in {p.interval}"
@@ -668,6 +675,10 @@ class MaterialModel(Material):
         Lowercase GLSL prefix, unique: the GLSL defines ``<name>_response`` and reads uniforms
         ``u_<name>_<param>``; part of the program key.
     params : tuple of Param
+    tables : tuple of Table
+        Arrays the GLSL samples as textures (``sampler2D``/``sampler3D u_<name>_<table>``, declared by
+        glphong); the twin reads the same float32 values (``p.<table>.array``).  Uploaded only when
+        a drawn object's program reads them, once per content per context.
     needs : tuple of str
         Any of ``'view'`` (``wo`` is computed), ``'tangent'`` (``f.t``, ``f.b``), ``'uv'`` (``f.uv``).
         Nothing else is computed or uploaded.
@@ -711,6 +722,7 @@ class MaterialModel(Material):
     """
 
     params = ()
+    tables = ()
     needs = ()
     glsl = None
     uses = ()
@@ -726,7 +738,7 @@ class MaterialModel(Material):
         super().__init_subclass__(**kwargs)
         own = cls.__dict__
         if "name" not in own:
-            redefined = [a for a in ("glsl", "response", "params", "needs", "uses") if a in own]
+            redefined = [a for a in ("glsl", "response", "params", "tables", "needs", "uses") if a in own]
             if redefined and cls.name is not None:
                 raise MaterialDefinitionError(
                     f"{cls.__qualname__} redefines {', '.join(redefined)} but keeps the name {cls.name!r} of "
@@ -758,9 +770,9 @@ class MaterialModel(Material):
 
     @classmethod
     def arguments(cls):
-        """The constructor's arguments in positional order: `params`, then ``fresnel`` (where the model
-        has a `fresnel_slot`), then `choices` (tuple)."""
-        return cls.params + ((cls.fresnel_slot,) if cls.fresnel_slot is not None else ()) + cls.choices
+        """The constructor's arguments in positional order: `tables`, `params`, then ``fresnel`` (where the
+        model has a `fresnel_slot`), then `choices` (tuple)."""
+        return cls.tables + cls.params + ((cls.fresnel_slot,) if cls.fresnel_slot is not None else ()) + cls.choices
 
     @classmethod
     def uniform_params(cls):
@@ -826,10 +838,12 @@ class MaterialModel(Material):
 
     @classmethod
     def uniform_declarations(cls):
-        """The GLSL declarations of the model's uniforms, generated from `params`; where the model has
-        a `fresnel_slot`, also its Fresnel uniforms and ``vec3 <name>_fresnel(float c)``."""
+        """The GLSL declarations of the model's uniforms, generated from `params` and `tables`; where the
+        model has a `fresnel_slot`, also its Fresnel uniforms and ``vec3 <name>_fresnel(float c)``."""
         lines = [f"uniform {p.glsl_type} {cls.uniform_name(p.name)};  // {p.kind} in {p.interval}"
                  f"{' [' + p.unit + ']' if p.unit else ''}" for p in cls.uniform_params()]
+        lines += [f"uniform {t.glsl_type} {cls.uniform_name(t.name)};  // table {t.shape} x {t.channels}"
+                  f"{' [' + t.unit + ']' if t.unit else ''}" for t in cls.tables]
         if cls.fresnel_slot is not None:
             upper, name = cls.name.upper(), cls.name
             lines += [f"// the Fresnel factor F(c) of fresnel= (glphong/materials/fresnel.py), c = {cls.fresnel_slot.cosine}",
@@ -871,13 +885,15 @@ class MaterialModel(Material):
         params = [p for p in self.uniform_params() if names is None or p.name in names]
         values = {p.name: np.asarray(uniforms[self.uniform_name(p.name)] if p in self.active_params() else
                                      _validate.float32_uniform(self.uniform_value(p.name)), dtype=dtype) for p in params}
+        values |= {t.name: uniforms[self.uniform_name(t.name)] for t in self.tables if names is None or t.name in names}
         return ParamValues(values | self.structure())
 
     def values(self, dtype=np.float64):
         """`ParamValues` of this instance: its values as the GPU receives them (float32, subnormals
         flushed), in ``dtype``, with its structure as in `values_from_uniforms`."""
         return ParamValues({p.name: np.asarray(_validate.float32_uniform(self.uniform_value(p.name)), dtype=dtype)
-                            for p in self.uniform_params()} | self.structure())
+                            for p in self.uniform_params()} | {t.name: getattr(self, t.name) for t in self.tables}
+                           | self.structure())
 
     def structure(self):
         """What the twin reads beside the uniforms (dict): each choice's value by name, and ``fresnel_form``
@@ -970,7 +986,7 @@ class MaterialModel(Material):
     @classmethod
     def example(cls, **overrides):
         """An instance at representative values (`Param.example`), with ``overrides``."""
-        return cls(**{p.name: p.example() for p in cls.params} | overrides)
+        return cls(**{p.name: p.example() for p in cls.tables + cls.params} | overrides)
 
     @classmethod
     def stability_cases(cls):
@@ -1000,10 +1016,12 @@ def _check_definition(cls):
     params = cls.params
     if not isinstance(params, tuple) or not all(isinstance(p, Param) for p in params):
         raise MaterialDefinitionError(f"{cls.__qualname__}.params must be a tuple of glphong.materials.Param")
+    if not isinstance(cls.tables, tuple) or not all(isinstance(t, Table) for t in cls.tables):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.tables must be a tuple of glphong.materials.Table")
     names = [p.name for p in params]
     if len(set(names)) != len(names):
         raise MaterialDefinitionError(f"{cls.__qualname__}.params repeats a name ({names})")
-    shadowing = sorted(set(names) & set(dir(MaterialModel)))
+    shadowing = sorted(set(names + [t.name for t in cls.tables]) & set(dir(MaterialModel)))
     if shadowing:
         raise MaterialDefinitionError(f"{cls.__qualname__}.params: {', '.join(shadowing)} would shadow a "
                                       "MaterialModel attribute; choose other parameter names")
