@@ -184,6 +184,12 @@ def _plot(args):
         chosen[text] = material
     if args.kind == "lobe":
         plots.plot_lobes(chosen, np.radians(args.theta_i), args.out)
+    elif args.kind == "lobe3d":
+        if len(chosen) != 1:
+            print("glphong plot lobe3d: give exactly one material expression", file=sys.stderr)
+            return 2
+        text, material = next(iter(chosen.items()))
+        plots.plot_lobe_3d(material, np.radians(args.theta_i), args.out, title=f"{text}, theta_i = {args.theta_i:g} deg")
     else:
         plots.plot_albedo(chosen, args.out)
     print(f"wrote {args.out}: {args.kind} of {len(chosen)} material(s)")
@@ -312,8 +318,9 @@ def build_parser():
                       help="Fibonacci directions per side: their square is the number of pairs (default 300)")
     brdf.set_defaults(func=_brdf)
     plot = sub.add_parser("plot", help="lobe and albedo plots of materials (PNG; matplotlib, in the [test] and [bench] extras)")
-    plot.add_argument("kind", choices=("lobe", "albedo", "gallery"),
-                      help="lobe: polar plot in the plane of incidence; albedo: against the incident angle; "
+    plot.add_argument("kind", choices=("lobe", "lobe3d", "albedo", "gallery"),
+                      help="lobe: polar plot in the plane of incidence; lobe3d: one material's lobe over the "
+                           "hemisphere as a surface; albedo: against the incident angle; "
                            "gallery: the lobe of every built-in model")
     plot.add_argument("materials", nargs="*", help='material expressions, e.g. "Phong(kd=0, ks=0.5, q=20)"')
     plot.add_argument("--theta-i", type=_incident_angle, default=45.0, help="incident angle [deg], 0 to 90 (default 45)")

@@ -46,16 +46,17 @@ GALLERY = (
     ("Ward 0.3 x 0.06", lambda: _m("Ward")(ALBEDO, 0.2, 0.3, 0.06)),
     ("Ward bounded", lambda: _m("Ward")(ALBEDO, 0.2, 0.3, 0.06, normalization="bounded")),
     ("Ashikhmin-Shirley 1000 x 20", lambda: _m("AshikhminShirley")(ALBEDO, 0.1, 1000.0, 20.0)),
-    ("Measured: Cook-Torrance table", lambda: _measured_cook_torrance()),
+    ("Measured Cook-Torrance, trilinear", lambda: _m("MeasuredBRDF")(_cook_torrance_table(), "trilinear")),
+    ("Measured Cook-Torrance, nearest", lambda: _m("MeasuredBRDF")(_cook_torrance_table())),
 )
 
 
 @functools.lru_cache(maxsize=1)
-def _measured_cook_torrance():
-    """The "Cook-Torrance m=0.25" tile's material tabulated in the MERL layout (1.6 s), read trilinearly."""
+def _cook_torrance_table():
+    """The "Cook-Torrance m=0.25" tile's material tabulated in the MERL layout (1.6 s, once per process)."""
     from .merl import tabulate
 
-    return _m("MeasuredBRDF")(tabulate(_m("CookTorrance")(ALBEDO, 0.25)), "trilinear")
+    return _m("MeasuredBRDF")(tabulate(_m("CookTorrance")(ALBEDO, 0.25))).table
 
 
 def gallery_scene(material):

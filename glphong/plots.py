@@ -8,10 +8,13 @@ matplotlib is imported here only (and only when a plot is drawn), with the non-i
   irradiance [1/sr].
 - `plot_albedo`: the directional albedo `glphong.analysis.albedo` against the incident angle.
 - `plot_gallery`: the lobe of every built-in model of the gallery at one incident angle, one panel each.
+- `lobe_surface` / `plot_lobe_3d`: the whole lobe over the hemisphere as a 3D surface (radius ``f_r
+  cos(theta_o)`` in the direction ``wo``), where a plane of incidence hides what matters: anisotropic
+  lobes (Ward, Ashikhmin-Shirley) and off-plane structure of measured tables.
 """
 import numpy as np
 
-__all__ = ["lobe_curves", "plot_lobes", "plot_albedo", "plot_gallery"]
+__all__ = ["lobe_curves", "plot_lobes", "plot_albedo", "plot_gallery", "lobe_surface", "plot_lobe_3d"]
 
 
 def lobe_curves(material, theta_i, count=721, tangent=(1.0, 0.0, 0.0)):
@@ -133,3 +136,65 @@ def plot_gallery(path, theta_i=np.radians(45.0), columns=4):
     fig.savefig(path, dpi=110, bbox_inches="tight")
     plt.close(fig)
     return curves
+
+
+def lobe_surface(material, theta_i, rows=61, columns=121, tangent=(1.0, 0.0, 0.0)):
+    """The lobe of ``material`` over the whole upper hemisphere (normal +z, tangent +x, light from -x).
+
+    Parameters
+    ----------
+    material : glphong.materials.Material
+    theta_i : float
+        Incident angle [rad], in [0, pi/2).
+    rows, columns : int
+        Samples of ``theta_o`` in [0, pi/2) and of ``phi_o`` in [0, 2 pi].
+
+    Returns
+    -------
+    wo : (rows, columns, 3) ndarray
+        Unit viewing directions.
+    value : (rows, columns, 3) ndarray
+        ``f_r cos(theta_o)`` [1/sr] from the float64 twin.
+    """
+    from .analysis import f_r
+
+    if not 0.0 <= theta_i < np.pi / 2:
+        raise ValueError(f"theta_i must be in [0, pi/2) rad (got {theta_i!r})")
+    theta, phi = np.meshgrid(np.linspace(0.0, np.pi / 2, rows, endpoint=False), np.linspace(0.0, 2 * np.pi, columns),
+                             indexing="ij")
+    wo = np.stack([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)], axis=-1)
+    wi = np.broadcast_to([-np.sin(theta_i), 0.0, np.cos(theta_i)], wo.shape)
+    value = f_r(material, wi.reshape(-1, 3), wo.reshape(-1, 3), tangent).reshape(wo.shape) * np.cos(theta)[..., None]
+    return wo, value
+
+
+def plot_lobe_3d(material, theta_i, path, title=None):
+    """The lobe as a surface: radius ``f_r cos(theta_o)`` (mean over channels) in each direction ``wo``, the
+    light as a line; returns `lobe_surface`'s ``(wo, value)``."""
+    wo, value = lobe_surface(material, theta_i)
+    radius = value.mean(axis=-1)
+    points = wo * radius[..., None]
+    plt = _pyplot()
+    from matplotlib import cm
+
+    fig = plt.figure(figsize=(6.0, 5.0))
+    ax = fig.add_subplot(projection="3d")
+    top = radius.max() if radius.max() > 0 else 1.0
+    ax.plot_surface(points[..., 0], points[..., 1], points[..., 2], facecolors=cm.viridis(radius / top),
+                    rstride=1, cstride=1, linewidth=0, antialiased=False, shade=False)
+    light = np.array([-np.sin(theta_i), 0.0, np.cos(theta_i)]) * top
+    ax.plot([0, light[0]], [0, light[1]], [0, light[2]], color="0.3", lw=1.2, ls="--")
+    reach = max(np.abs(points).max(), top) * 1.05  # one scale on every axis: the lobe's true shape
+    ax.set_xlim(-reach, reach)
+    ax.set_ylim(-reach, reach)
+    ax.set_zlim(0, reach)
+    ax.set_box_aspect((2, 2, 1))
+    ax.set_xlabel("t (x)")
+    ax.set_ylabel("b (y)")
+    ax.set_zlabel("n (z)")
+    ax.tick_params(labelsize=6)
+    ax.set_title(title or f"{material!r}\nf_r cos(theta_o) [1/sr], theta_i = {np.degrees(theta_i):.0f} deg "
+                          "(dashed: the light)", fontsize=8)
+    fig.savefig(path, dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return wo, value

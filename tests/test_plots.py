@@ -49,3 +49,33 @@ def test_cli_plot(tmp_path, capsys):
         main(["plot", "lobe", "Lambert(0.2)", "--theta-i", "95"])
     with pytest.raises(ValueError, match=r"theta_i must be in \[0, pi/2\)"):
         plots.lobe_curves(glphong.Lambert(0.2), 2.0)
+
+
+def test_lobe_surface_is_the_brdf_and_shows_anisotropy(tmp_path):
+    """The 3D lobe's radius is f_r cos(theta_o) of the twin; Ward's lobe (alpha_x 0.3, alpha_y 0.06) is
+    wider along t than along b around the mirror direction, an isotropic Phong lobe is not."""
+    theta_i = np.radians(30.0)
+    ward = glphong.Ward(0.0, 0.5, 0.3, 0.06)
+    wo, value = plots.plot_lobe_3d(ward, theta_i, str(tmp_path / "w.png"))
+    wi = np.broadcast_to([-np.sin(theta_i), 0.0, np.cos(theta_i)], wo.shape)
+    expected = glphong.analysis.f_r(ward, wi.reshape(-1, 3), wo.reshape(-1, 3)).reshape(wo.shape) * wo[..., 2:]
+    np.testing.assert_allclose(value, expected, rtol=1e-12)
+    assert Image.open(tmp_path / "w.png").size[0] > 300
+
+    def spread(material):
+        """Half-widths (x, y) of the region above half the lobe's maximum, in direction cosines."""
+        directions, v = plots.lobe_surface(material, theta_i)
+        high = v.mean(axis=-1) > 0.5 * v.mean(axis=-1).max()
+        x, y = directions[high, 0], directions[high, 1]
+        return np.ptp(x), np.ptp(y)
+
+    wx, wy = spread(ward)
+    px, py = spread(glphong.Phong(0.0, 0.5, 60.0))
+    assert wx > 2.5 * wy and 0.7 < px / py < 1.3
+
+
+def test_cli_lobe3d(tmp_path, capsys):
+    assert main(["plot", "lobe3d", "AshikhminShirley(0.1, 0.1, 1000.0, 20.0)", "--out", str(tmp_path / "a.png")]) == 0
+    assert (tmp_path / "a.png").stat().st_size > 1000
+    assert main(["plot", "lobe3d", "Lambert(0.1)", "Lambert(0.2)", "--out", str(tmp_path / "b.png")]) == 2
+    assert "exactly one material" in capsys.readouterr().err

@@ -264,3 +264,20 @@ def test_twin_of_table_entries_is_exact_at_the_samples(tabulated):
         material = MeasuredBRDF(tabulated, lookup)
         got = material.response(frame, wi, wo, n_dot_l, material.values()) / n_dot_l[:, None]
         np.testing.assert_allclose(got, want, rtol=rtol + 1e-15)
+
+
+def test_cli_brdf_and_plots_of_a_measured_file(tmp_path, capsys):
+    """``glphong brdf`` and ``glphong plot`` take a measured material by its file, like any other."""
+    import json
+
+    from glphong.cli import main
+
+    path = tmp_path / "lambert.binary"
+    merl.write_merl(path, np.full(merl.SHAPE + (3,), 0.2))
+    assert main(["brdf", f"MeasuredBRDF({str(path)!r})", "--json", "--directions", "60"]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["non_negative"] and record["reciprocal"] and record["isotropic"]
+    assert abs(record["max_albedo"] - 0.2 * np.pi) < 1e-6  # a constant table is Lambert: albedo pi f_r
+    assert main(["plot", "lobe", f"MeasuredBRDF({str(path)!r})", "Lambert(0.2)", "--out", str(tmp_path / "l.png")]) == 0
+    assert main(["plot", "lobe3d", f"MeasuredBRDF({str(path)!r}, 'trilinear')", "--out", str(tmp_path / "s.png")]) == 0
+    assert (tmp_path / "l.png").exists() and (tmp_path / "s.png").exists()
