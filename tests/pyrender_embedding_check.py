@@ -28,6 +28,9 @@ def build_scene():
     for x, m in zip((-1.3, 0.0, 1.3), materials):
         mesh = pyrender.Mesh.from_trimesh(trimesh.creation.icosphere(4, radius=0.55), material=GlphongMaterial(m))
         scene.add(mesh, pose=translation(x, -0.2, 0.0), name=type(m).__name__)
+    measured = GlphongMaterial(glphong.MeasuredBRDF.example(lookup="trilinear"))  # a table: a 3D texture
+    scene.add(pyrender.Mesh.from_trimesh(trimesh.creation.icosphere(3, radius=0.3), material=measured),
+              pose=translation(-1.3, 0.85, 0.0), name="measured")
     pbr = pyrender.MetallicRoughnessMaterial(baseColorFactor=[0.2, 0.8, 0.2, 1.0], metallicFactor=0.0, roughnessFactor=0.5)
     scene.add(pyrender.Mesh.from_trimesh(trimesh.creation.icosphere(3, radius=0.3), material=pbr),
               pose=translation(0.0, 0.85, 0.0), name="pbr")
@@ -70,7 +73,8 @@ def main(platform):
         "pbr_pixels": int(pbr_region.sum()),
         "pbr_green": float(color[pbr_region][:, 1].mean()) if pbr_region.any() else 0.0,
         "second_frame_identical": bool(np.array_equal(color, color2)),
-        "programs": len(programs), "compiled": programs.misses,
+        "programs": len(programs), "compiled": programs.misses, "textures": len(programs.textures),
+        "texture_uploads": programs.textures.uploads,
         "keys": sorted(k.describe() for k in keys),
         "pyrender_chunks": sorted(set(k.fragment_chunks() for k in keys)),
         "glphong_chunks": sorted(set(own_chunks)),
