@@ -136,9 +136,11 @@ def bin_directions():
     """``(wi, wo)``, each (90, 90, 180, 3): a direction pair in every bin (normal +z, tangent +x).
 
     ``theta_h`` at its bin's lower edge ``(i / 90)^2 pi/2`` (exactly where the reference reader's index
-    is ``i``), nudged up by 1e-9 rad; ``theta_d`` and ``phi_d`` at their bins' centres; ``phi_h = 0``.
+    is ``i``), nudged up by 1e-9 rad past the first (its pairs have ``h = n`` exactly, so an isotropic
+    material's row 0 does not depend on ``phi_d``); ``theta_d`` and ``phi_d`` at their bins' centres;
+    ``phi_h = 0``.
     """
-    th = (np.arange(SHAPE[0]) / SHAPE[0]) ** 2 * (np.pi / 2) + 1e-9
+    th = (np.arange(SHAPE[0]) / SHAPE[0]) ** 2 * (np.pi / 2) + np.where(np.arange(SHAPE[0]) > 0, 1e-9, 0.0)
     td = (np.arange(SHAPE[1]) + 0.5) / SHAPE[1] * (np.pi / 2)
     pd = (np.arange(SHAPE[2]) + 0.5) / SHAPE[2] * np.pi
     th, td, pd = np.meshgrid(th, td, pd, indexing="ij")

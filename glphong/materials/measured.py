@@ -68,21 +68,23 @@ def measured_brdf_coordinates(n, wi, wo):
     """The continuous MERL bin coordinates ``(x_h, x_d, x_p)`` (measured_brdf.glsl), (..., 3) -> (..., 3).
 
     ``x_h = 90 sqrt(theta_h / (pi/2))``, ``x_d = 90 theta_d / (pi/2)``, ``x_p = 180 phi_d / pi`` with the
-    angles from `atan2_first_quadrant` of the parts across and along; ``u`` the tangent of Duff et al.'s
-    basis around h where ``n - (n.h) h`` vanishes.
+    angles from `atan2_first_quadrant`: ``theta_h`` of n's parts across and along h, ``theta_d`` of
+    ``|l - v|`` and ``|l + v|`` (half the angle between them), the azimuth of ``d = l - v`` about h from
+    ``u`` (the tangent of Duff et al.'s basis around h where ``n - (n.h) h`` vanishes).  Swapping l and v
+    negates d exactly: the folded coordinates are bit-identical.
     """
-    _, h, _ = safe_normalize(wi + wo)
+    _, h, length = safe_normalize(wi + wo)
     cos_h = _dot(n, h)
     tilted, u, sin_h = safe_normalize(cos_h[..., None] * h - n)
     fallback, _ = frame_from_tangent(h, np.zeros(h.shape[:-1] + (4,), h.dtype))
     u = np.where(tilted[..., None], u, fallback)
-    cos_d = _dot(h, wi)
-    y = _dot(wi, np.cross(h, u))
-    x = _dot(wi, u)
-    _, _, sin_d = safe_normalize(wi - cos_d[..., None] * h)
+    d = wi - wo  # 2 (l - (h.l) h): l's part across h, twice; -d for swapped l and v
+    y = _dot(d, np.cross(h, u))
+    x = _dot(d, u)
     theta_h = atan2_first_quadrant(np.minimum(sin_h, 1), np.maximum(cos_h, 0))
-    theta_d = atan2_first_quadrant(np.minimum(sin_d, 1), np.maximum(cos_d, 0))
-    ys, xs = np.where(y < 0, -y, y), np.where(y < 0, -x, x)
+    theta_d = atan2_first_quadrant(np.sqrt(_dot(d, d)), length)
+    flip = (y < 0) | ((y == 0) & (x < 0))  # folded into [0, pi): pi is 0
+    ys, xs = np.where(flip, -y, y), np.where(flip, -x, x)
     a = atan2_first_quadrant(ys, np.abs(xs))
     phi_d = np.where(xs < 0, np.pi - a, a)
     return np.stack([90.0 * np.sqrt(theta_h * (2.0 / np.pi)), theta_d * _DEG, phi_d * _DEG], axis=-1)
@@ -336,7 +338,7 @@ def _example_table(q=40.0):
     """``(rho_d/pi + rho_s c(q) cos(theta_h)^q) (1, 0.8, 0.6)`` (normalised Blinn-Phong, 0.3, 0.5) on the
     bins, as `glphong.merl.tabulate` places them; made once per process and exponent."""
     if q not in _EXAMPLE:
-        th = (np.arange(merl.SHAPE[0]) / merl.SHAPE[0]) ** 2 * (np.pi / 2) + 1e-9
+        th = (np.arange(merl.SHAPE[0]) / merl.SHAPE[0]) ** 2 * (np.pi / 2)
         c = (q + 2) * (q + 4) / (8 * np.pi * (q + 2.0 ** (-q / 2)))
         lobe = 0.3 / np.pi + 0.5 * c * np.cos(th) ** q
         table = np.broadcast_to(lobe[:, None, None, None], merl.SHAPE + (3,)) * np.array([1.0, 0.8, 0.6])

@@ -4,8 +4,9 @@
 //
 // f_r [1/sr] (rgb) = the table at the bin of (theta_h, theta_d, phi_d):
 //   h = (l + v)/|l + v|,  theta_h = angle(n, h),  theta_d = angle(h, l),
-//   phi_d = the azimuth of l about h from u = -normalize(n - (n.h) h), folded into [0, pi] by
-//   reciprocity (+ pi where negative); where h = n, u is the tangent of Duff et al.'s basis around h
+//   phi_d = the azimuth of l about h from u = -normalize(n - (n.h) h), folded into [0, pi) by
+//   reciprocity (+ pi where negative; pi itself is 0, the same azimuth after the fold, where the
+//   reference reader clamps it into the last bin); where h = n, u is the tangent of Duff et al.'s basis around h
 //   (frame_from_tangent's fallback; +x for h = +z, where glphong.merl.half_diff takes the tangent).
 // measured_brdf_coordinates(n, wi, wo) -> the continuous bin coordinates
 //   x_h = 90 sqrt(theta_h / (pi/2)),  x_d = 90 theta_d / (pi/2),  x_p = 180 phi_d / pi.
@@ -19,9 +20,11 @@
 //
 // Stable float32 formulation: every angle is atan2_first_quadrant(part across, part along) (angle.glsl),
 //   never acos of a dot product: near the peak acos resolves no angle below 3.5e-4 rad in float32,
-//   which is 1.3 bins of x_h there (the bins are finest at theta_h = 0).  The azimuth comes from
-//   l's components along u and h x u, at any scale.  No branch; indices clamped, so no fetch leaves
-//   the table.  NAIVE (the textbook formulation, for the stability report only): acos of the dots.
+//   which is 1.3 bins of x_h there (the bins are finest at theta_h = 0).  theta_d is half the angle
+//   between l and v, atan(|l - v| / |l + v|), and the azimuth comes from d = l - v (l's part across
+//   h, twice) along u and h x u: swapping l and v negates d exactly, so the folded coordinates are
+//   bit-identical (reciprocal in float32 too), at any scale.  No branch; indices clamped, so no fetch
+//   leaves the table.  NAIVE (the textbook formulation, for the stability report only): acos of the dots.
 // Valid range: the table's entries finite and >= 0 (unmeasured cells are 0: MeasuredBRDF replaces
 //   the file's negative markers when it reads a table).
 // Uniforms (declared by glphong from the model's table): u_measured_brdf_table, a sampler3D holding
@@ -44,23 +47,21 @@ vec3 measured_brdf_coordinates(vec3 n, vec3 wi, vec3 wo)
     bool tilted = safe_normalize(cos_h * h - n, u, sin_h);
     frame_from_tangent(h, vec4(0.0), fallback, unused);
     u = tilted ? u : fallback;
-    float cos_d = dot(h, wi);
-    float y = dot(wi, cross(h, u));
-    float x = dot(wi, u);
+    vec3 d = wi - wo;                                  // 2 (l - (h.l) h): l's part across h, twice
+    float y = dot(d, cross(h, u));
+    float x = dot(d, u);
 #if NAIVE
     float theta_h = acos(clamp(cos_h, -1.0, 1.0));
-    float theta_d = acos(clamp(cos_d, -1.0, 1.0));
+    float theta_d = acos(clamp(dot(h, wi), -1.0, 1.0));
     float phi = atan(y, x);
     float phi_d = phi < 0.0 ? phi + MEASURED_BRDF_PI : phi;
 #else
-    vec3 across;
-    float sin_d;
-    safe_normalize(wi - cos_d * h, across, sin_d);
     float theta_h = atan2_first_quadrant(min(sin_h, 1.0), max(cos_h, 0.0));
-    float theta_d = atan2_first_quadrant(min(sin_d, 1.0), max(cos_d, 0.0));
-    // atan2(y, x) folded into [0, pi]: (y, x) -> (-y, -x) where y < 0
-    float ys = y < 0.0 ? -y : y;
-    float xs = y < 0.0 ? -x : x;
+    float theta_d = atan2_first_quadrant(length(d), len);  // half the angle between l and v: |l - v|, |l + v|
+    // atan2(y, x) folded into [0, pi): (y, x) -> (-y, -x) where y < 0, or y = 0 and x < 0 (pi is 0)
+    bool flip = y < 0.0 || (y == 0.0 && x < 0.0);
+    float ys = flip ? -y : y;
+    float xs = flip ? -x : x;
     float a = atan2_first_quadrant(ys, abs(xs));
     float phi_d = xs < 0.0 ? MEASURED_BRDF_PI - a : a;
 #endif
