@@ -242,7 +242,7 @@ class ProgramKey:
             return ["nothing: the uber-shader compiles every built-in term and the scene's own and switches at run time"]
         out = []
         for model, reason in absent_terms:
-            params = ", ".join(model.uniform_name(p.name) for p in model.params)
+            params = ", ".join(model.uniform_name(p.name) for p in model.params + model.tables)
             out.append(f"term {model.name}: {model_chunk_label(model.name)}{', ' + params if params else ''} ({reason})")
         used = set(self.library_chunks())
         from .materials.model import LIBRARY_CHUNKS

@@ -687,7 +687,9 @@ class MaterialModel(Material):
         class).  It defines ``vec3 <name>_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)``.
         The common chunk (``safe_normalize``, ``ShadingFrame``, ``FLT_MAX``) is always available.
     uses : tuple of str
-        Library chunks the GLSL calls: ``'lobe'`` (``log_one_minus``, ``lobe_from_delta``).
+        Library chunks the GLSL calls: ``'lobe'`` (``log_one_minus``, ``lobe_from_delta``, the Phong and
+        Blinn lobes), ``'fresnel'`` (``fresnel_schlick``, ``fresnel_dielectric``), ``'angle'``
+        (``atan2_first_quadrant``).
     ambient : str or None
         The rgb parameter ``k`` of the model's answer ``k L_a`` to the ambient light, or None.
     vanishes_with : tuple of str

@@ -10,6 +10,7 @@ the float32 values the texture holds), so both sides look up identical numbers.
 The GLSL reads a table with ``texelFetch(u_<model>_<name>, ivec3(k, j, i), 0)`` for ``array[i, j, k]``:
 the array's last axis (before the channels) is the texture's x.
 """
+import functools
 import hashlib
 import threading
 import weakref
@@ -59,8 +60,9 @@ class TableData:
 
     @classmethod
     def zeros(cls, shape, channels):
-        """A table of zeros (the uber-shader's value for a model an object does not have)."""
-        return cls(np.zeros(tuple(shape) + (channels,), np.float32), source="zeros")
+        """A table of zeros (the uber-shader's value for a model an object does not have); made once per
+        shape and kept, so a frame neither allocates nor hashes it again."""
+        return _zeros(tuple(shape), channels)
 
     @property
     def shape(self):
@@ -88,6 +90,11 @@ class TableData:
 
     def __reduce__(self):  # pickled by value (a spawn-started worker rebuilds it, interned again there)
         return (TableData, (np.asarray(self.array), self.source))
+
+
+@functools.lru_cache(maxsize=None)
+def _zeros(shape, channels):
+    return TableData(np.zeros(shape + (channels,), np.float32), source="zeros")
 
 
 def uniform_as(value, dtype):
