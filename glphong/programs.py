@@ -258,6 +258,8 @@ class Program:
 
         self.optional = {model_for_key(t.name, t.source_hash).uniform_name(p.name)
                          for t in getattr(key, "terms", ()) for p in model_for_key(t.name, t.source_hash).uniform_params()}
+        #: the bytes last written to each uniform (`write` skips unchanged ones)
+        self._written = {}
         #: sampler uniforms in texture-unit order
         self.samplers = tuple(name for name, u in self.active.items() if u.fmt.endswith("i") and "sampler" in
                               _uniform_type(self.vertex_source, self.fragment_source, name))
@@ -284,23 +286,41 @@ class Program:
             program (the key leaves out every uniform it does not use), or the data size
             does not match.
         """
-        if drop_unused:
-            values = {k: v for k, v in values.items() if k in self.active}
-        values = {k: v for k, v in values.items() if k in self.active or k not in self.optional}
-        missing = sorted(set(self.active) - set(values))
-        unknown = sorted(set(values) - set(self.active))
-        if missing or unknown:
-            raise UniformError(f"program {self.key.describe()!r}: missing uniforms {missing}, unknown uniforms {unknown}")
+        pack = self.pack(values, drop_unused)
+        self.check_complete(pack)
+        self.write(pack)
+
+    def pack(self, values, drop_unused=False):
+        """``values`` (some of the active uniforms, as in `bind`) checked and packed for `write`.
+
+        Returns
+        -------
+        tuple of (name, moderngl.Uniform, bytes or TableData)
+            The bytes GL receives (matrices transposed), or a table for a sampler.
+
+        Raises
+        ------
+        UniformError
+            A name that is not an active uniform (unless ``drop_unused``, or a model uniform a
+            structural define compiled out), or a size that does not match.
+        """
         from .materials.table import TableData
 
-        for name, uniform in self.active.items():
-            value = values[name]
+        unknown = sorted(n for n in values if n not in self.active and not drop_unused and n not in self.optional)
+        if unknown:
+            missing = sorted(set(self.active) - set(values))
+            raise UniformError(f"program {self.key.describe()!r}: missing uniforms {missing}, unknown uniforms {unknown}")
+        out = []
+        for name, value in values.items():
+            uniform = self.active.get(name)
+            if uniform is None:
+                continue
             if isinstance(value, TableData):
                 if name not in self.samplers or self.textures is None:
                     raise UniformError(f"uniform {name} of program {self.key.describe()!r} is not a sampler of a "
                                        "program with a texture store: it cannot take a table")
-                value = self.samplers.index(name)
-                self.textures.bind(values[name], value)
+                out.append((name, uniform, value))
+                continue
             # float uniforms take float32; samplers and int uniforms ('1i' formats) take int32
             data = np.asarray(value, dtype=np.int32 if uniform.fmt.endswith("i") else np.float32)
             if data.ndim == 2 and data.shape[0] == data.shape[1] and uniform.dimension == data.size:
@@ -308,7 +328,31 @@ class Program:
             expected = uniform.array_length * uniform.dimension
             if data.size != expected:
                 raise UniformError(f"uniform {name} of program {self.key.describe()!r} takes {expected} floats (got shape {data.shape})")
-            uniform.write(np.ascontiguousarray(data).tobytes())
+            out.append((name, uniform, np.ascontiguousarray(data).tobytes()))
+        return tuple(out)
+
+    def check_complete(self, *packs):
+        """Raise `UniformError` unless ``packs`` together set every active uniform (each once at most)."""
+        names = [name for pack in packs for name, _, _ in pack]
+        missing = sorted(set(self.active) - set(names))
+        if missing or len(names) != len(set(names)):
+            repeated = sorted({n for n in names if names.count(n) > 1})
+            raise UniformError(f"program {self.key.describe()!r}: missing uniforms {missing}"
+                               f"{', given twice ' + str(repeated) if repeated else ''}, unknown uniforms []")
+
+    def write(self, pack):
+        """Write a `pack` to GL, skipping uniforms whose bytes this program already holds (GL keeps a
+        program's uniform values); a table's texture is bound to its sampler's unit every time (other
+        programs use the units too)."""
+        last = self._written
+        for name, uniform, data in pack:
+            if not isinstance(data, bytes):  # a table
+                unit = self.samplers.index(name)
+                self.textures.bind(data, unit)
+                data = np.int32(unit).tobytes()
+            if last.get(name) != data:
+                uniform.write(data)
+                last[name] = data
 
     def release(self):
         """Release the GL program."""

@@ -59,6 +59,20 @@ class Frame:
         save_npy(path, self.radiance)
 
 
+@dataclass(eq=False)
+class _ObjectEntry:
+    """What a renderer draws one scene object with (see `Renderer._draw_list`)."""
+
+    state: tuple
+    index: int
+    key: object
+    program: object
+    pack: tuple
+    vertex_array: object
+    mirrored: bool
+    checked: object = None
+
+
 @dataclass(frozen=True)
 class GBuffer:
     """The per-pixel inputs the shader used.
@@ -275,6 +289,7 @@ class Renderer:
         self.programs = ProgramCache(self._mgl)
         self._meshes = {}
         self._targets = {}
+        self._entries = weakref.WeakKeyDictionary()  # SceneObject -> {output: _ObjectEntry}
 
     def render_target_bytes(self, size=None):
         """Memory the render targets and one float32 readback need at ``size`` (default the current one) [bytes].
@@ -454,16 +469,52 @@ class Renderer:
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self._mgl.enable(moderngl.DEPTH_TEST)
         self._mgl.disable(moderngl.CULL_FACE)
-        # the uber-shader's key is the scene's, the same for every object: made once per frame, not per object
-        shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
-        for index, obj in enumerate(scene.objects):
-            key = shared or self.program_key(scene, obj, output)
-            program = self.programs.get(key)
-            program.bind(scene.uniform_values(index, key, aspect), drop_unused=key.formulation == "naive")
-            # a mirroring pose (det < 0) reverses the winding: its counter-clockwise faces become clockwise
-            self._mgl.front_face = "cw" if obj.mirrored else "ccw"
-            self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program).render(moderngl.TRIANGLES)
+        mirrored = False
+        for program, frame_pack, entry in self._draw_list(scene, output, aspect):
+            program.write(frame_pack)
+            program.write(entry.pack)
+            if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
+                mirrored = entry.mirrored
+                self._mgl.front_face = "cw" if mirrored else "ccw"
+            entry.vertex_array.render(moderngl.TRIANGLES)
         self._mgl.front_face = "ccw"
+
+    def _draw_list(self, scene, output, aspect):
+        """``(program, frame pack, object entry)`` per object, in order.
+
+        Per frame, the uniforms every object shares (camera, lights) are packed once per program key;
+        per object, its key, program, vertex array and packed uniforms (pose, normal matrix, material)
+        are made once and kept (`_ObjectEntry`) while the scene's lights, ambient light and the object's
+        index are what they were: objects, materials and poses are immutable.  The uber-shader's key is
+        the scene's, the same for every object (made once per frame)."""
+        drop = self.formulation == "naive"
+        state = (output, tuple(scene.light_counts().values()), scene.ambient_radiance, self.formulation,
+                 self.shading, self.specialise)
+        shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
+        frame_packs = {}
+        entries = self._entries
+        for index, obj in enumerate(scene.objects):
+            per_object = entries.get(obj)
+            if per_object is None:
+                per_object = entries[obj] = {}
+            entry = per_object.get(output)
+            if shared is not None or entry is None or entry.state != state or entry.index != index:
+                key = shared or self.program_key(scene, obj, output)
+                program = self.programs.get(key)
+                values = scene.uniform_values(index, key, aspect) if shared is not None else \
+                    scene.object_uniform_values(index, key)
+                vao = self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program)
+                entry = _ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored)
+                if shared is None:
+                    per_object[output] = entry
+            frame = frame_packs.get(entry.program)
+            if frame is None:
+                pack = () if shared is not None else entry.program.pack(scene.frame_uniform_values(entry.key, aspect), drop)
+                frame = frame_packs[entry.program] = (pack, tuple(name for name, _, _ in pack))
+            if entry.checked != frame[1]:  # strict: every active uniform set, checked once per entry
+                entry.program.check_complete(frame[0], entry.pack)
+                entry.checked = frame[1]
+            yield entry.program, frame[0], entry
 
     @staticmethod
     def _read(fbo, size, components, attachment=0, dtype="f4"):
@@ -535,6 +586,7 @@ class Renderer:
         """Release every GL object and the context; idempotent."""
         if self.context is None:
             return
+        self._entries.clear()
         _release_resources(self.context, self._meshes, self._targets, self.programs)
         self.context = None
 

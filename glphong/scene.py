@@ -29,7 +29,8 @@ class SceneObject:
     mesh : MeshData
     material : glphong.materials.Material
     pose : (4, 4) ndarray
-        Object-to-world affine transform, float64.
+        Object-to-world affine transform, float64, read-only (a renderer caches what it derives from it:
+        move an object by adding it again with another pose).
     name : str
     """
 
@@ -130,7 +131,8 @@ class Scene:
 
             if not isinstance(mesh, trimesh.Trimesh):
                 raise TypeError(f"mesh must be a trimesh.Trimesh or a glphong.geometry.MeshData (got {type(mesh).__name__})")
-        pose = _validate.affine_transform("pose", np.eye(4) if pose is None else pose)
+        pose = np.array(_validate.affine_transform("pose", np.eye(4) if pose is None else pose), dtype=np.float64)
+        pose.setflags(write=False)
         data = mesh if isinstance(mesh, MeshData) else MeshData.from_trimesh(mesh, smooth=bool(smooth))
         _check_mesh_serves(data, material, name or f"object{len(self._objects)}")
         obj = SceneObject(data, material, pose, name or f"object{len(self._objects)}")
@@ -189,7 +191,9 @@ class Scene:
         """Every uniform the program ``key`` declares for object ``index``, as float32.
 
         This is the single place where scene values become shader inputs; the numpy
-        twin reads the same dictionary, so both shade identical float32 inputs.
+        twin reads the same dictionary, so both shade identical float32 inputs.  It is the union
+        of `frame_uniform_values` (the same for every object of a frame) and
+        `object_uniform_values` (the object's own, which a renderer packs once per object).
 
         Parameters
         ----------
@@ -202,21 +206,33 @@ class Scene:
         Returns
         -------
         dict of str to ndarray
+            (a table parameter's value is its `glphong.materials.TableData`)
         """
-        obj = self._objects[index]
         if key.uber:
             return self._uber_uniform_values(index, key, aspect)
-        view_projection = self.camera.projection_matrix(aspect) @ self.camera.view_matrix()
-        values = {"u_model": obj.pose, "u_view_projection": view_projection}
+        return self.frame_uniform_values(key, aspect) | self.object_uniform_values(index, key)
+
+    def frame_uniform_values(self, key, aspect):
+        """The uniforms of program ``key`` that every object of a frame shares: the camera's view-projection
+        and eye, the lights and the ambient light (float32, dict of str to ndarray)."""
+        values = {"u_view_projection": self.camera.projection_matrix(aspect) @ self.camera.view_matrix()}
+        if key.output != "gbuffer":
+            if key.needs_view:
+                values["u_eye"] = self.camera.position
+            values.update(self.light_uniform_values(key))
+        return {name: _validate.float32_uniform(v) for name, v in values.items()}
+
+    def object_uniform_values(self, index, key):
+        """The uniforms of program ``key`` that belong to object ``index``: its pose, normal matrix, material
+        (or object id, in the G-buffer) (float32 arrays, and `TableData` for tables)."""
+        obj = self._objects[index]
+        values = {"u_model": obj.pose}
         if key.has_normal:
             values["u_normal_matrix"] = obj.normal_matrix
         if key.output == "gbuffer":
             values["u_object_id"] = float(index)
         else:
-            if key.needs_view:
-                values["u_eye"] = self.camera.position
             values.update(obj.material.uniform_values(key))
-            values.update(self.light_uniform_values(key))
         return {name: v if isinstance(v, TableData) else _validate.float32_uniform(v) for name, v in values.items()}
 
     def _uber_uniform_values(self, index, key, aspect):
