@@ -32,7 +32,9 @@ class Frame:
     radiance : (H, W, 3) float32 ndarray
         Linear radiance [W/(m^2 sr)], row 0 at the top, never clamped.  With multisampling
         or supersampling, pixels on silhouettes hold the coverage-weighted average (the
-        background counts as 0).
+        background counts as 0).  A writable view into the one RGBA readback (GL's bottom-up
+        rows flipped by a negative stride; no copy is made): ``numpy.ascontiguousarray`` gives
+        C order where a consumer needs it.
     mask : (H, W) bool ndarray
         Pixels covered by geometry (any sample).
     coverage : (H, W) float32 ndarray
@@ -373,8 +375,9 @@ class Renderer:
         s = self.supersample
         if s > 1:
             rgba = rgba.reshape(self.height, s, self.width, s, 4).mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
-        coverage = np.ascontiguousarray(rgba[..., 3])
-        return Frame(radiance=np.ascontiguousarray(rgba[..., :3]), mask=coverage > 0.0, coverage=coverage)
+        # views of the one readback (rows flipped by strides): no copy after the driver's
+        coverage = rgba[..., 3]
+        return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage)
 
     @_one_call_at_a_time
     def render_srgb8(self, scene, exposure=1.0):
@@ -518,9 +521,11 @@ class Renderer:
 
     @staticmethod
     def _read(fbo, size, components, attachment=0, dtype="f4"):
-        data = np.frombuffer(fbo.read(components=components, attachment=attachment, dtype=dtype),
-                             dtype=np.float32 if dtype == "f4" else np.uint8)
-        return data.reshape(size[1], size[0], components)[::-1]
+        """The attachment as a new writable (H, W, components) array, row 0 at the top (a view with a
+        negative row stride: GL's rows run bottom-up), read straight into it."""
+        data = np.empty((size[1], size[0], components), np.float32 if dtype == "f4" else np.uint8)
+        fbo.read_into(data, components=components, attachment=attachment, dtype=dtype)
+        return data[::-1]
 
     def _fullscreen(self, program):
         vao = self._targets.get(("fullscreen", program.key))

@@ -75,3 +75,13 @@ def test_unchanged_uniforms_are_not_written_again(glphong_backend, glphong_make_
     calls.clear()
     image = renderer.render(scene).radiance
     assert calls == ["u_eye"] and np.array_equal(image, glphong_make_renderer(32, 32, glphong_backend).render(scene).radiance)
+
+
+def test_readback_is_one_writable_array(glphong_backend, glphong_make_renderer):
+    """radiance and coverage are views of the one readback (no copy after the driver's), writable, row 0 at
+    the top: the sphere's lit top half is brighter than its bottom half."""
+    frame = glphong_make_renderer(64, 48, glphong_backend).render(_scene())
+    assert np.shares_memory(frame.radiance, frame.coverage)
+    frame.radiance[0, 0] = 1.0  # writable
+    light_side = frame.radiance[:24].sum()
+    assert light_side > frame.radiance[24:].sum() > 0
