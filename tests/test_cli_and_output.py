@@ -120,3 +120,33 @@ def test_cli_gallery_renders_every_model_and_cross_checks_each_tile(tmp_path, ca
     drawn = {type(t).name for _, factory in GALLERY for t in factory().components}
     builtin = {m.name for m in registered_models() if m.__module__.startswith("glphong.")}
     assert drawn == builtin  # one tile at least per built-in model
+
+
+@pytest.mark.parametrize("exposure", [1.0, 2.0, 0.37, 3.3e-7, 5e-324, 1e30])
+def test_fast_srgb8_is_the_formula_at_every_step(exposure):
+    """float32 radiance goes through the table of code steps: the same codes as the float64 formula on
+    random values, at each of the 255 steps and one float32 ulp either side, and at NaN, +-Inf, -0,
+    negative, subnormal and huge values."""
+    from glphong.imaging import _float32_code_table, encode_srgb8_reference
+
+    rng = np.random.default_rng(5)
+    values = [(rng.random(30000) ** 3 * 1.2).astype(np.float32)]
+    steps = _float32_code_table(float(exposure))[1][:-1]
+    steps = steps[np.isfinite(steps) & (steps > 0)]
+    values += [steps, np.nextafter(steps, np.float32(0)), np.nextafter(steps, np.float32(np.inf))]
+    values.append(np.array([np.nan, -np.nan, -1.0, -0.0, 0.0, np.inf, -np.inf, 1e-45, 3e38, 1.0, 0.5], np.float32))
+    flat = np.concatenate(values)
+    image = np.resize(flat, len(flat) + (-len(flat)) % 3).reshape(-1, 1, 3)[::-1]  # a strided view, as frames are
+    fast = encode_srgb8(image, exposure)
+    assert fast.dtype == np.uint8 and np.array_equal(fast, encode_srgb8_reference(image, exposure))
+    if exposure in (1.0, 2.0, 0.37):  # every step reachable: each of the 256 codes is met
+        assert len(np.unique(fast)) == 256
+
+
+def test_save_png_compress_level(tmp_path):
+    radiance = np.random.default_rng(1).random((16, 16, 3)).astype(np.float32)
+    for level in (0, 1, 9):
+        save_png(tmp_path / f"{level}.png", radiance, compress_level=level)
+        assert np.array_equal(np.asarray(Image.open(tmp_path / f"{level}.png")), encode_srgb8(radiance))
+    with pytest.raises(ValueError, match=r"compress_level must be in \[0, 9\]"):
+        save_png(tmp_path / "x.png", radiance, compress_level=10)
