@@ -17,6 +17,7 @@ import numpy as np
 
 from . import _validate
 from .contexts import check_not_forked, create_context
+from .culling import closed_outward, world_sphere
 from .key import FORMULATIONS, EncodeKey, uber_key
 from .programs import ProgramCache
 
@@ -72,7 +73,15 @@ class _ObjectEntry:
     pack: tuple
     vertex_array: object
     mirrored: bool
+    sphere: tuple = None  # (x, y, z, radius) in the world where the mesh's back faces may be culled
     checked: object = None
+
+
+def _between_clip_planes(sphere, eye, forward, near, far):
+    """`glphong.culling.view_allows_culling` on plain floats (once per object per frame)."""
+    x, y, z, radius = sphere
+    depth = (x - eye[0]) * forward[0] + (y - eye[1]) * forward[1] + (z - eye[2]) * forward[2]
+    return depth - radius > near and depth + radius < far
 
 
 @dataclass(frozen=True)
@@ -245,6 +254,11 @@ class Renderer:
     formulation : {'stable', 'naive'}
         'stable' (default): DESIGN section 3.  'naive': the textbook float32 formulation,
         for measuring what stability costs and buys; not for real use.
+    culling : {'auto', 'off'}
+        'auto' (default): cull the back faces of an object where they cannot be seen (a closed,
+        outward-wound mesh wholly between the near and far planes; `glphong.culling`), which
+        changes no pixel but a silhouette pixel where a back triangle ties with the front one in
+        depth (there the front face shows).  'off': draw every triangle.
     specialise : bool
         True (default): one program per distinct `ProgramKey`, containing only what the
         object needs.  False: every object drawn with the uber-shader (every built-in term,
@@ -258,12 +272,13 @@ class Renderer:
     """
 
     def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
-                 formulation="stable", specialise=True):
+                 formulation="stable", specialise=True, culling="auto"):
         self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
         self.samples = _validate.choice("samples", _validate.positive_int("samples", samples, 1, 8), (1, 2, 4, 8))
         self.supersample = _validate.positive_int("supersample", supersample, 1, 8)
         self._size = self._check_size(width, height)
         self.formulation = _validate.choice("formulation", formulation, FORMULATIONS)
+        self.culling = _validate.choice("culling", culling, ("auto", "off"))
         if not isinstance(specialise, (bool, np.bool_)):
             raise TypeError(f"specialise must be a bool, True or False (got {specialise!r})")
         self.specialise = bool(specialise)
@@ -472,15 +487,24 @@ class Renderer:
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self._mgl.enable(moderngl.DEPTH_TEST)
         self._mgl.disable(moderngl.CULL_FACE)
-        mirrored = False
+        camera = scene.camera
+        eye = tuple(camera.pose[:3, 3])
+        forward = tuple(-camera.pose[:3, 2])
+        near, far = camera.znear, camera.zfar
+        mirrored = culled = False
         for program, frame_pack, entry in self._draw_list(scene, output, aspect):
             program.write(frame_pack)
             program.write(entry.pack)
             if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
                 mirrored = entry.mirrored
                 self._mgl.front_face = "cw" if mirrored else "ccw"
+            cull = entry.sphere is not None and _between_clip_planes(entry.sphere, eye, forward, near, far)
+            if cull != culled:
+                culled = cull
+                (self._mgl.enable if cull else self._mgl.disable)(moderngl.CULL_FACE)
             entry.vertex_array.render(moderngl.TRIANGLES)
         self._mgl.front_face = "ccw"
+        self._mgl.disable(moderngl.CULL_FACE)
 
     def _draw_list(self, scene, output, aspect):
         """``(program, frame pack, object entry)`` per object, in order.
@@ -492,7 +516,7 @@ class Renderer:
         the scene's, the same for every object (made once per frame)."""
         drop = self.formulation == "naive"
         state = (output, tuple(scene.light_counts().values()), scene.ambient_radiance, self.formulation,
-                 self.shading, self.specialise)
+                 self.shading, self.specialise, self.culling)
         shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
         frame_packs = {}
         entries = self._entries
@@ -507,7 +531,9 @@ class Renderer:
                 values = scene.uniform_values(index, key, aspect) if shared is not None else \
                     scene.object_uniform_values(index, key)
                 vao = self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program)
-                entry = _ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored)
+                sphere = world_sphere(obj.mesh, obj.pose) if self.culling == "auto" and closed_outward(obj.mesh)[0] else None
+                entry = _ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
+                                     None if sphere is None else (*sphere[0], sphere[1]))
                 if shared is None:
                     per_object[output] = entry
             frame = frame_packs.get(entry.program)
