@@ -39,16 +39,12 @@ bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
 bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
 {
     float s = max(max(abs(x.x), abs(x.y)), abs(x.z));
-    if (isnan(x.x + x.y + x.z) || isinf(s) || !(s > 0.0)) {
-        x_hat = vec3(0.0);
-        len = 0.0;
-        return false;
-    }
-    vec3 y = x / s;
+    bool valid = !(isnan(x.x + x.y + x.z) || isinf(s) || !(s > 0.0));
+    vec3 y = x / (valid ? s : 1.0);
     float yy = dot(y, y);
-    len = s * sqrt(yy);
-    x_hat = y * inversesqrt(yy);
-    return true;
+    len = valid ? s * sqrt(yy) : 0.0;
+    x_hat = valid ? y * inversesqrt(yy) : vec3(0.0);
+    return valid;
 }
 #endif
 

@@ -31,25 +31,17 @@
 
 float log_one_minus(float delta)
 {
-    if (delta < 0.5) {
-        float two_sigma = (2.0 * delta) / (2.0 - delta);
-        float t = 0.25 * (two_sigma * two_sigma);
-        float series = 1.0 + t * (1.0 / 3.0 + t * (1.0 / 5.0 + t * (1.0 / 7.0 + t * (1.0 / 9.0
-                     + t * (1.0 / 11.0 + t * (1.0 / 13.0 + t * (1.0 / 15.0)))))));
-        return -two_sigma * series;
-    }
-    return log(1.0 - delta);
+    float two_sigma = (2.0 * delta) / (2.0 - delta);
+    float t = 0.25 * (two_sigma * two_sigma);
+    float series = 1.0 + t * (1.0 / 3.0 + t * (1.0 / 5.0 + t * (1.0 / 7.0 + t * (1.0 / 9.0
+                 + t * (1.0 / 11.0 + t * (1.0 / 13.0 + t * (1.0 / 15.0)))))));
+    return delta < 0.5 ? -two_sigma * series : log(1.0 - delta);
 }
 
 float lobe_from_delta(float delta, float q)
 {
-    if (q == 0.0) {
-        return 1.0;
-    }
-    if (!(delta < 1.0)) {
-        return 0.0;
-    }
-    return exp(max(q * log_one_minus(delta), -104.0));
+    float lobe = exp(max(q * log_one_minus(delta < 1.0 ? delta : 0.0), -104.0));
+    return q == 0.0 ? 1.0 : (delta < 1.0 ? lobe : 0.0);
 }
 
 float phong_delta(vec3 n, vec3 wi, vec3 wo)

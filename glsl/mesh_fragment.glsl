@@ -66,9 +66,7 @@ void main()
 #if HAS_NORMAL
     vec3 n_raw = v_normal;
 #if TWO_SIDED
-    if (SWITCH(u_two_sided) && !gl_FrontFacing) {
-        n_raw = -n_raw;
-    }
+    n_raw = (SWITCH(u_two_sided) && !gl_FrontFacing) ? -n_raw : n_raw;
 #endif
     float n_len;
     n_valid = safe_normalize(n_raw, n, n_len);

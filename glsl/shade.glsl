@@ -10,7 +10,12 @@
 // light_term(response, E) -> response * E, exactly 0 where E = 0 (a response that overflowed to Inf
 //   times an irradiance of 0 would be NaN): a select, no branch.
 // Each light kind is a loop of compile-time length; a kind the scene lacks has no loop at all.
-// Light j contributes nothing unless n.l_j > 0 (tested before anything else is evaluated).
+// Light j contributes nothing unless n.l_j > 0 (and its direction normalises): every light's term is
+// computed and the gate selects it, without a branch.  llvmpipe (and a GPU's SIMD group) runs both sides
+// of a branch under a mask, so an `if`/`continue` saves nothing and costs control flow; written as
+// selects the same arithmetic measured 0.59x to 0.70x the frame time of the branching version on the
+// gallery tiles at 1024x1024 (EGL), with bit-identical images.  A term's response may therefore be
+// computed where n.l <= 0 and discarded: it must not loop forever there, but NaN or Inf is harmless.
 // The view vector v is computed only where a term reads it (NEEDS_VIEW).
 // The uber-shader reads its light counts from uniforms (*_LIGHT_COUNT).
 //
@@ -39,42 +44,39 @@ vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec3 eye)
 {
     vec3 radiance = material_emission();
 #if NUM_POINT_LIGHTS > 0 || NUM_UNATTENUATED_LIGHTS > 0 || NUM_DIRECTIONAL_LIGHTS > 0
-    if (!n_valid) {
-        return radiance;
-    }
+    bool lit = n_valid;
     vec3 wo = vec3(0.0);
 #if NEEDS_VIEW
     float view_distance;
-    if (!safe_normalize(eye - position, wo, view_distance)) {
-        return radiance;
-    }
+    lit = lit && safe_normalize(eye - position, wo, view_distance);
 #endif
     vec3 wi;
     float d;
     float n_dot_l;
+    bool valid;
 #endif
 #if NUM_POINT_LIGHTS > 0
     for (int j = 0; j < POINT_LIGHT_COUNT; ++j) {
-        if (!safe_normalize(u_point_position[j] - position, wi, d)) continue;
+        valid = safe_normalize(u_point_position[j] - position, wi, d);
         n_dot_l = dot(f.n, wi);
-        if (!(n_dot_l > 0.0)) continue;
-        radiance += light_term(material_response(f, wi, wo, n_dot_l), point_irradiance(u_point_intensity[j], d));
+        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), point_irradiance(u_point_intensity[j], d));
+        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);
     }
 #endif
 #if NUM_UNATTENUATED_LIGHTS > 0
     for (int j = 0; j < UNATTENUATED_LIGHT_COUNT; ++j) {
-        if (!safe_normalize(u_unattenuated_position[j] - position, wi, d)) continue;
+        valid = safe_normalize(u_unattenuated_position[j] - position, wi, d);
         n_dot_l = dot(f.n, wi);
-        if (!(n_dot_l > 0.0)) continue;
-        radiance += light_term(material_response(f, wi, wo, n_dot_l), u_unattenuated_radiance[j]);
+        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), u_unattenuated_radiance[j]);
+        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);
     }
 #endif
 #if NUM_DIRECTIONAL_LIGHTS > 0
     for (int j = 0; j < DIRECTIONAL_LIGHT_COUNT; ++j) {
         wi = u_directional_direction[j];
         n_dot_l = dot(f.n, wi);
-        if (!(n_dot_l > 0.0)) continue;
-        radiance += light_term(material_response(f, wi, wo, n_dot_l), u_directional_irradiance[j]);
+        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), u_directional_irradiance[j]);
+        radiance += (lit && n_dot_l > 0.0) ? term : vec3(0.0);
     }
 #endif
     return radiance;

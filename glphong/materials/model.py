@@ -4,7 +4,8 @@ One reflectance model is one `MaterialModel` subclass: its parameters (`Param`),
 (the view vector, a tangent frame, UVs), its GLSL response ``<name>_response(f, wi, wo, n_dot_l)``
 and its numpy twin ``response(f, wi, wo, n_dot_l, p)``, both returning
 
-    f_r(wi, wo) (n.wi)    [1/sr], evaluated only where n.wi > 0.
+    f_r(wi, wo) (n.wi)    [1/sr], used only where n.wi > 0 (the shader may compute it elsewhere and
+                          discard it by a select: any value, NaN included, is harmless there).
 
 The radiance one light adds is ``response * E``.  A definition also states its answer to the
 ambient light ``L_a`` (``ambient``: the rgb parameter ``k`` of a ``k L_a`` term), which parameter
