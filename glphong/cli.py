@@ -112,6 +112,18 @@ def _describe(args):
 def _bench(args):
     import importlib.util
 
+    if args.speed:
+        from .speed import run_speed
+
+        report = run_speed(sizes=(64,) if args.quick else (512, 1024), repeats=3 if args.quick else max(args.repeats, 9),
+                           quick=args.quick, progress=not args.no_progress)
+        print(report.format())
+        path = f"{args.out}_speed.json"
+        with open(path, "w") as f:
+            f.write(report.to_json())
+        print(f"wrote {path}")
+        return 0
+
     missing = [m for m in ("matplotlib",) if importlib.util.find_spec(m) is None]
     if missing:  # say so at once, not after minutes of measuring
         print(f"glphong bench needs {', '.join(missing)} for its diagram: pip install 'glphong[bench]'", file=sys.stderr)
@@ -304,7 +316,10 @@ def build_parser():
     bench.add_argument("--width", type=_positive_int, default=256, help="image width in pixels (default 256)")
     bench.add_argument("--height", type=_positive_int, default=192, help="image height in pixels (default 192)")
     bench.add_argument("--repeats", type=_positive_int, default=5, help="timed repeats per point (median, >= 1)")
-    bench.add_argument("--quick", action="store_true", help="a tiny configuration (2 scenes, 2 knob values)")
+    bench.add_argument("--quick", action="store_true", help="a tiny configuration (2 scenes, 2 knob values; with "
+                       "--speed: small sizes and stand-in meshes)")
+    bench.add_argument("--speed", action="store_true", help="frame times on the scene family against the naive "
+                       "floor and pyrender (glphong.speed), instead of the work-precision report")
     bench.add_argument("--out", default="glphong_bench", type=_writable,
                        help="output prefix: PREFIX.csv, PREFIX.json, PREFIX.png")
     bench.add_argument("--no-progress", action="store_true", help="no progress bar")

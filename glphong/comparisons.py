@@ -33,7 +33,8 @@ metallic-roughness microfacet BRDF, not Phong or Blinn):
 - `UnattenuatedPointLight` has no pyrender equivalent (pyrender always divides by ``d^2``).
 - ambient ``L_a`` becomes ``ambient_light = L_a / pi``: pyrender adds
   ``baseColor * ambient_light = pi kd * ambient_light``, glphong adds ``kd L_a``.
-- every material is ``doubleSided`` because glphong never culls back faces.
+- ``doubleSided`` is False (pyrender's default: it culls back faces) unless ``double_sided=True``
+  (every triangle drawn, as glphong's ``culling='off'``).
 
 pyrender's output is not radiance: it is clamped to [0, 1], encoded with ``x ** (1/2.2)``
 and quantised to 8 bits.  On EGL it draws into a 4x multisampled framebuffer object (the
@@ -271,14 +272,14 @@ def pyrender_roughness(material):
     return min(values) if values else 1.0
 
 
-def _pyrender_material(pyrender, material):
+def _pyrender_material(pyrender, material, double_sided=False):
     ka = np.asarray(material.ka, dtype=np.float64)
     return pyrender.MetallicRoughnessMaterial(
         baseColorFactor=np.append(np.clip(pyrender_base_color(material), 0.0, 1.0), 1.0),
         metallicFactor=0.0,
         roughnessFactor=pyrender_roughness(material),
         emissiveFactor=np.sqrt(ka),  # pyrender 0.1.45 squares the emissive factor
-        doubleSided=True,
+        doubleSided=bool(double_sided),
     )
 
 
@@ -300,7 +301,7 @@ def _directional_pose(direction):
     return pose
 
 
-def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=None):
+def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=None, double_sided=False):
     """Convert a glphong `Scene` to a ``pyrender.Scene`` (see the module notes for the mapping).
 
     Parameters
@@ -314,6 +315,8 @@ def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=Non
     platform : {'egl', 'osmesa'}, optional
         Import pyrender on this platform (see `import_pyrender`); None imports it as is
         (PyOpenGL then picks its platform from the environment, GLX by default).
+    double_sided : bool
+        pyrender's ``doubleSided`` on every material: False (pyrender's default) culls back faces.
 
     Returns
     -------
@@ -342,7 +345,8 @@ def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=Non
     out = pyrender.Scene(bg_color=np.zeros(4), ambient_light=ambient)
     for obj in scene.objects:
         primitive = pyrender.Primitive(positions=obj.mesh.positions, normals=obj.mesh.normals,
-                                       indices=obj.mesh.indices, material=_pyrender_material(pyrender, obj.material))
+                                       indices=obj.mesh.indices,
+                                       material=_pyrender_material(pyrender, obj.material, double_sided))
         out.add(pyrender.Mesh([primitive], name=obj.name), pose=obj.pose, name=obj.name)
     camera = scene.camera
     out.add(pyrender.PerspectiveCamera(yfov=camera.yfov, znear=camera.znear, zfar=camera.zfar,
@@ -371,6 +375,9 @@ class PyrenderRenderer:
     platform : {'egl', 'osmesa'}
         ``PYOPENGL_PLATFORM``; set before pyrender is first imported.  Only one platform can
         be used per process.
+    double_sided : bool
+        Draw every triangle (pyrender's ``doubleSided``); False (default) is pyrender's default,
+        which culls back faces.
 
     Attributes
     ----------
@@ -385,8 +392,9 @@ class PyrenderRenderer:
         pyrender is not installed.
     """
 
-    def __init__(self, width, height, platform="egl"):
+    def __init__(self, width, height, platform="egl", double_sided=False):
         self._pyrender = import_pyrender(platform)
+        self.double_sided = bool(double_sided)
         self.width = int(width)
         self.height = int(height)
         self.platform = platform
@@ -397,7 +405,8 @@ class PyrenderRenderer:
 
     def prepare(self, scene):
         """Convert ``scene`` once (`to_pyrender`); returns self."""
-        self.scene = to_pyrender(scene, aspect_ratio=self.width / self.height, platform=self.platform)
+        self.scene = to_pyrender(scene, aspect_ratio=self.width / self.height, platform=self.platform,
+                                 double_sided=self.double_sided)
         return self
 
     def render(self):

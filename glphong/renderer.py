@@ -312,14 +312,16 @@ class Renderer:
         """Memory the render targets and one float32 readback need at ``size`` (default the current one) [bytes].
 
         Radiance target RGBA32F plus depth at the internal (supersampled) size, times the samples, a
-        resolve target when multisampling, the G-buffer (up to four RGBA32F planes and depth) at the
-        output size, and the float32 readback of the internal size.
+        resolve target when multisampling, the 8-bit display target and depth times the samples and
+        its resolve, the G-buffer (up to four RGBA32F planes and depth) at the output size, and the
+        float32 readback of the internal size.
         """
         w, h = size or self._size
         internal = w * h * self.supersample ** 2
         samples = self.samples
         radiance = internal * (16 + 4) * samples + (internal * 16 if samples > 1 else 0)
-        return radiance + w * h * (4 * 16 + 4) + internal * 16
+        display = w * h * (4 + 4) * samples + w * h * 4  # render_srgb8's 8-bit target and its resolve
+        return radiance + display + w * h * (4 * 16 + 4) + internal * 16
 
     def _check_limits(self, size, renderer_name):
         """The size against the context's limits and the memory it needs, before any work starts."""
@@ -395,17 +397,25 @@ class Renderer:
         return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage)
 
     @_one_call_at_a_time
-    def render_srgb8(self, scene, exposure=1.0):
-        """Render and encode on the GPU: box filter, exposure, exact sRGB curve, 8 bits.
-
-        The shading pass stays linear float; a separate pass (encode.glsl) encodes, and only
-        8-bit RGB is read back.
+    def render_srgb8(self, scene, exposure=1.0, resolve="display"):
+        """Render and encode on the GPU: exposure, exact sRGB curve, 8 bits; only 8-bit RGB is read back.
 
         Parameters
         ----------
         scene : Scene
         exposure : float
             Linear scale applied before encoding, > 0.
+        resolve : {'display', 'linear'}
+            'display' (default): each fragment is shaded, exposed and encoded in the shading pass
+            (OUTPUT_DISPLAY) into an 8-bit target, multisampled where ``samples > 1``, whose
+            silhouette samples are averaged as display values, as pyrender and most real-time
+            renderers do.  'linear': the linear float image is resolved (and box-filtered where
+            ``supersample > 1``, which always takes this path) first and encoded by a separate pass
+            (encode.glsl).  Interior pixels are the same either way; silhouette pixels of a
+            multisampled image differ (the average of encoded values against the encoded average).
+            'display' needs per-pixel shading, no supersampling and specialised programs; with any
+            other option the linear path runs.  Measured: 'display' saves the float target's clear,
+            resolve and readback (see README).
 
         Returns
         -------
@@ -414,7 +424,18 @@ class Renderer:
         """
         self._check_scene(scene)
         exposure = _validate.scalar("exposure", exposure, low=0.0, low_inclusive=False)
+        resolve = _validate.choice("resolve", resolve, ("display", "linear"))
         with self.context:
+            if resolve == "display" and self.supersample == 1 and self.shading == "pixel" and self.specialise:
+                target = self._target("display")
+                self._draw(scene, "display", target, {"u_exposure": exposure})
+                if self.samples > 1:
+                    resolved = self._target("srgb8")
+                    self._mgl.copy_framebuffer(resolved, target)
+                    target = resolved
+                rgb = self._read(target, self._size, components=3, dtype="f1")
+                self.context.check_error("rendering display values")
+                return rgb
             texture = self._draw_radiance(scene).color_attachments[0]
             out = self._target("srgb8")
             out.use()
@@ -480,7 +501,7 @@ class Renderer:
         self._mgl.copy_framebuffer(resolved, target)
         return resolved
 
-    def _draw(self, scene, output, fbo):
+    def _draw(self, scene, output, fbo, frame_values=None):
         aspect = self.width / self.height
         self._purge_dead_meshes()
         fbo.use()
@@ -492,7 +513,7 @@ class Renderer:
         forward = tuple(-camera.pose[:3, 2])
         near, far = camera.znear, camera.zfar
         mirrored = culled = False
-        for program, frame_pack, entry in self._draw_list(scene, output, aspect):
+        for program, frame_pack, entry in self._draw_list(scene, output, aspect, frame_values):
             program.write(frame_pack)
             program.write(entry.pack)
             if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
@@ -506,14 +527,15 @@ class Renderer:
         self._mgl.front_face = "ccw"
         self._mgl.disable(moderngl.CULL_FACE)
 
-    def _draw_list(self, scene, output, aspect):
+    def _draw_list(self, scene, output, aspect, frame_values=None):
         """``(program, frame pack, object entry)`` per object, in order.
 
         Per frame, the uniforms every object shares (camera, lights) are packed once per program key;
         per object, its key, program, vertex array and packed uniforms (pose, normal matrix, material)
         are made once and kept (`_ObjectEntry`) while the scene's lights, ambient light and the object's
         index are what they were: objects, materials and poses are immutable.  The uber-shader's key is
-        the scene's, the same for every object (made once per frame)."""
+        the scene's, the same for every object (made once per frame).  ``frame_values`` are uniforms the
+        call adds to every program's frame pack (the display programs' ``u_exposure``)."""
         drop = self.formulation == "naive"
         state = (output, tuple(scene.light_counts().values()), scene.ambient_radiance, self.formulation,
                  self.shading, self.specialise, self.culling)
@@ -538,7 +560,8 @@ class Renderer:
                     per_object[output] = entry
             frame = frame_packs.get(entry.program)
             if frame is None:
-                pack = () if shared is not None else entry.program.pack(scene.frame_uniform_values(entry.key, aspect), drop)
+                values = {} if shared is not None else scene.frame_uniform_values(entry.key, aspect)
+                pack = entry.program.pack(values | (frame_values or {}), drop)
                 frame = frame_packs[entry.program] = (pack, tuple(name for name, _, _ in pack))
             if entry.checked != frame[1]:  # strict: every active uniform set, checked once per entry
                 entry.program.check_complete(frame[0], entry.pack)
@@ -580,6 +603,9 @@ class Renderer:
         elif name == "radiance" and self.samples > 1:
             fbo = mgl.framebuffer([mgl.renderbuffer(self._internal_size, 4, samples=self.samples, dtype="f4")],
                                   mgl.depth_renderbuffer(self._internal_size, samples=self.samples))
+        elif name == "display":  # 8-bit display values, multisampled like the radiance target
+            fbo = mgl.framebuffer([mgl.renderbuffer(self._size, 4, samples=self.samples if self.samples > 1 else 0)],
+                                  mgl.depth_renderbuffer(self._size, samples=self.samples if self.samples > 1 else 0))
         elif name in ("radiance", "resolve"):
             texture = mgl.texture(self._internal_size, 4, dtype="f4")
             texture.filter = (moderngl.NEAREST, moderngl.NEAREST)

@@ -2,7 +2,7 @@
 import statistics
 import time
 
-__all__ = ["median_seconds", "alternating_medians"]
+__all__ = ["median_seconds", "alternating_medians", "alternating_times"]
 
 
 def median_seconds(run, repeats=7, warmup=2):
@@ -17,18 +17,14 @@ def median_seconds(run, repeats=7, warmup=2):
     return statistics.median(times)
 
 
-def alternating_medians(runs, repeats=7, warmup=2):
-    """Median wall time of each of several callables, timed in alternation so drift hits all alike.
-
-    Parameters
-    ----------
-    runs : dict of str to callable
-    repeats, warmup : int
+def alternating_times(runs, repeats=7, warmup=2):
+    """Wall times of several callables, timed in alternation (one round calls each once) so drift hits
+    all alike, after ``warmup`` untimed rounds.
 
     Returns
     -------
-    dict of str to float
-        Median seconds per name.
+    dict of str to list of float
+        ``repeats`` times [s] per name.
     """
     for run in runs.values():
         for _ in range(warmup):
@@ -39,4 +35,9 @@ def alternating_medians(runs, repeats=7, warmup=2):
             start = time.perf_counter()
             run()
             times[name].append(time.perf_counter() - start)
-    return {name: statistics.median(t) for name, t in times.items()}
+    return times
+
+
+def alternating_medians(runs, repeats=7, warmup=2):
+    """Median wall time [s] of each of several callables (`alternating_times`), dict of str to float."""
+    return {name: statistics.median(t) for name, t in alternating_times(runs, repeats, warmup).items()}

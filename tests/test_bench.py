@@ -1,5 +1,7 @@
 """The work-precision report's plumbing on a tiny configuration (the full sweep is a benchmark)."""
 import csv
+import subprocess
+import sys
 import json
 
 import numpy as np
@@ -62,3 +64,31 @@ def test_quick_cases_and_pyrender_reported_when_missing(monkeypatch):
     report = run_bench(32, 24, cases=quick_cases()[:1], method_list=only_pyrender, repeats=1, reference_samples=1,
                        scaling=False, targets=False, progress=False)
     assert report.points == [] and "pyrender is not installed" in report.skipped[0]
+
+
+def test_speed_report_in_process(tmp_path):
+    """The speed family's machinery on small stand-ins (no pyrender in this process: it fixes PyOpenGL's
+    platform): a row per scene with positive times and spreads, Python overhead, PNG cost and fits."""
+    import json
+
+    from glphong.speed import SCENES, run_speed
+
+    report = run_speed(sizes=(32,), repeats=3, quick=True, pyrender=False, progress=False)
+    assert [r["scene"] for r in report.rows] == list(SCENES)
+    for row in report.rows:
+        assert set(row["ms"]) == {"glphong float", "naive floor", "glphong 4x 8-bit"}
+        assert all(v > 0 for v in row["ms"].values()) and all(v >= 0 for v in row["spread"].values())
+    assert report.rows[SCENES.index("1000 objects")]["objects"] == 100  # the quick stand-in
+    assert report.python_per_object["objects"] == 100 and report.png["save_ms"] > report.png["encode_ms"] > 0
+    assert set(report.fits) == {"per object", "per pixel and light", "per triangle"}
+    text = report.format()
+    assert all(name in text for name in SCENES) and "Python per object" in text
+    assert json.loads(report.to_json())["rows"][0]["size"] == 32
+
+
+def test_cli_bench_speed_quick(tmp_path):
+    """``glphong bench --speed --quick`` in its own process (pyrender on EGL where installed)."""
+    out = subprocess.run([sys.executable, "-m", "glphong", "bench", "--speed", "--quick", "--no-progress",
+                          "--out", str(tmp_path / "s")], capture_output=True, text=True, timeout=600)
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert "float/floor" in out.stdout and (tmp_path / "s_speed.json").exists()

@@ -172,7 +172,9 @@ def test_pyrender_light_and_material_mapping(pyrender_egl):
     assert [n.name for n in mesh_nodes] == ["object0", "object1"]
     material = mesh_nodes[0].mesh.primitives[0].material
     np.testing.assert_allclose(material.baseColorFactor, [0.2 * np.pi, 0.1 * np.pi, 0.05 * np.pi, 1.0], rtol=1e-6)
-    assert material.metallicFactor == 0.0 and material.doubleSided
+    assert material.metallicFactor == 0.0 and not material.doubleSided  # pyrender's default: back faces culled
+    two_sided = to_pyrender(scene, double_sided=True)
+    assert all(p.material.doubleSided for n in two_sided.mesh_nodes for p in n.mesh.primitives)
     np.testing.assert_allclose(mesh_nodes[1].matrix, scene.objects[1].pose, atol=1e-12)
     np.testing.assert_allclose(converted.main_camera_node.matrix, scene.camera.pose, atol=1e-12)
 

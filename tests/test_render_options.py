@@ -91,7 +91,7 @@ def test_gpu_srgb8_matches_numpy_encoding(backend, options, make_renderer):
     scene = sphere_scene()
     r = make_renderer(96, 80, backend, **options)
     frame = r.render(scene)
-    gpu = r.render_srgb8(scene, exposure=2.0)
+    gpu = r.render_srgb8(scene, exposure=2.0, resolve="linear")
     cpu = encode_srgb8(frame.radiance, 2.0)
     assert gpu.dtype == np.uint8 and gpu.shape == (80, 96, 3)
     diff = np.abs(gpu.astype(int) - cpu.astype(int))
@@ -114,3 +114,27 @@ def test_options_survive_resize_without_leaks(backend, make_renderer):
     r.render_srgb8(scene)
     assert r.gl_object_count() == count
     r.context.check_error("resize")
+
+
+@pytest.mark.parametrize("samples", [1, 4])
+def test_srgb8_display_resolve(backend, samples, make_renderer):
+    """'display' (default) encodes in the shading pass: with one sample the very bytes of the linear path;
+    with 4x MSAA interior pixels within one step, silhouettes averaged as display values (darker than
+    the encoded linear average where a lit surface meets the black background); vertex shading and
+    supersampling take the linear path."""
+    scene = sphere_scene()
+    r = make_renderer(96, 80, backend, samples=samples)
+    display, linear = r.render_srgb8(scene, 2.0), r.render_srgb8(scene, 2.0, resolve="linear")
+    coverage = r.render(scene).coverage
+    if samples == 1:
+        assert np.array_equal(display, linear)
+    else:
+        diff = display.astype(int) - linear.astype(int)
+        assert np.abs(diff[coverage == 1.0]).max() <= 1
+        edge = (coverage > 0) & (coverage < 1) & (linear.max(axis=-1) > 20)
+        # the mean of encoded values lies below the encoded mean: x^(1/2.4) is concave
+        assert edge.sum() > 20 and (diff[edge].min(axis=-1) < -1).mean() > 0.5
+    vertex = make_renderer(96, 80, backend, samples=samples, shading="vertex")
+    assert np.array_equal(vertex.render_srgb8(scene), vertex.render_srgb8(scene, resolve="linear"))
+    with pytest.raises(ValueError, match="resolve must be"):
+        r.render_srgb8(scene, resolve="gamma")
