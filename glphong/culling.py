@@ -24,7 +24,7 @@ import weakref
 
 import numpy as np
 
-__all__ = ["closed_outward", "bounding_sphere", "view_allows_culling"]
+__all__ = ["closed_outward", "bounding_sphere", "world_sphere", "view_allows_culling", "culling_decision"]
 
 _CLOSURE = weakref.WeakKeyDictionary()
 
@@ -87,3 +87,15 @@ def view_allows_culling(centre, radius, eye, forward, znear, zfar):
     """True where a sphere lies wholly between a camera's near and far planes (see the module)."""
     depth = float(np.dot(np.subtract(centre, eye), forward))
     return depth - radius > znear and depth + radius < zfar
+
+
+def culling_decision(obj, camera):
+    """``(culled, reason)``: whether a renderer with ``culling='auto'`` culls the back faces of scene object
+    ``obj`` seen by ``camera``, and why (for `glphong.describe`)."""
+    closed, why = closed_outward(obj.mesh)
+    if not closed:
+        return False, f"drawn: the mesh is not closed and outward wound ({why})"
+    centre, radius = world_sphere(obj.mesh, obj.pose)
+    if not view_allows_culling(centre, radius, camera.pose[:3, 3], -camera.pose[:3, 2], camera.znear, camera.zfar):
+        return False, "drawn: the camera is inside its bounding sphere, or a clip plane cuts it"
+    return True, "culled: a closed, outward-wound mesh wholly between the near and far planes"

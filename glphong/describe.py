@@ -25,6 +25,8 @@ class ProgramDescription:
         What the program does not contain.
     vertex_source, fragment_source : str
         The generated sources, as compiled.
+    culling : tuple of str
+        Per drawn object, whether its back faces are culled and why (`glphong.culling`).
     """
 
     key: object
@@ -35,6 +37,7 @@ class ProgramDescription:
     left_out: list
     vertex_source: str
     fragment_source: str
+    culling: tuple = ()
 
     @property
     def effective_fragment_source(self):
@@ -63,12 +66,17 @@ def describe(scenes, renderer=None, gbuffer=False):
 
     scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
     outputs = ("radiance", "gbuffer") if gbuffer else ("radiance",)
-    users, absent = {}, {}
+    from .culling import culling_decision
+
+    users, absent, culling = {}, {}, {}
     for scene in scenes:
         for obj in scene.objects:
             for output in outputs:
                 key = renderer.program_key(scene, obj, output) if renderer else scene.program_key(obj, output)
                 users.setdefault(key, []).append(obj.name)
+                decision = "drawn: culling='off'" if renderer is not None and renderer.culling == "off" else \
+                    culling_decision(obj, scene.camera)[1]
+                culling.setdefault(key, []).append(f"{obj.name}: {decision}")
                 present = {t.name for t in key.terms}
                 for term in obj.material.components:
                     if term.name not in present and output != "gbuffer":
@@ -82,7 +90,8 @@ def describe(scenes, renderer=None, gbuffer=False):
         fragment = assemble(key.fragment_chunks(), defines, generated) if key.fragment_chunks() else ""
         out.append(ProgramDescription(key, tuple(dict.fromkeys(names)), key.vertex_chunks(), key.fragment_chunks(),
                                       defines, key.left_out(list(absent.get(key, {}).items())),
-                                      assemble(key.vertex_chunks(), defines, generated), fragment))
+                                      assemble(key.vertex_chunks(), defines, generated), fragment,
+                                      tuple(culling[key])))
     return out
 
 
@@ -114,6 +123,10 @@ def format_descriptions(descriptions, source=False):
         lines += [
                   "    left out:"]
         lines += [f"      - {item}" for item in d.left_out]
+        if d.culling:
+            lines.append("    back faces:")
+            lines += [f"      - {item}" for item in d.culling[:6]]
+            lines += [f"      - and {len(d.culling) - 6} more objects" for _ in (1,) if len(d.culling) > 6]
         if source and d.fragment_source:
             lines.append("    effective fragment source:")
             lines += [f"      | {line}" for line in d.effective_fragment_source.splitlines()]

@@ -81,3 +81,28 @@ def test_no_culling_where_back_faces_show(glphong_backend, glphong_make_renderer
     scene.add(primitives.sphere(3), glphong.Lambert(0.3), pose=pose)
     _, _, a, b = _pair(scene, glphong_backend, glphong_make_renderer)
     assert a.mask.mean() > 0.2 and np.array_equal(a.radiance, b.radiance)
+
+
+def test_describe_reports_each_objects_decision(glphong_make_renderer):
+    camera = glphong.PerspectiveCamera.look_at((0.0, 0.0, 3.0), (0.0, 0.0, 0.0))
+    scene = glphong.Scene(camera, [glphong.PointLight((1.0, 1.0, 2.0), 10.0)])
+    scene.add(primitives.sphere(2, 0.5), glphong.Lambert(0.2), name="ball")
+    scene.add(primitives.plane(), glphong.Lambert(0.2), name="floor")
+    scene.add(primitives.sphere(2, 5.0), glphong.Lambert(0.2), name="dome")  # the camera is inside it
+    lines = [line for d in glphong.describe(scene) for line in d.culling]
+    assert lines == ["ball: culled: a closed, outward-wound mesh wholly between the near and far planes",
+                     "floor: drawn: the mesh is not closed and outward wound (open: an edge has no opposite (a boundary))",
+                     "dome: drawn: the camera is inside its bounding sphere, or a clip plane cuts it"]
+    off = glphong_make_renderer(16, 16, "egl", culling="off")
+    assert all(line.endswith("culling='off'") for d in glphong.describe(scene, off) for line in d.culling)
+    assert "back faces:" in glphong.format_descriptions(glphong.describe(scene))
+    # the renderer decides alike: what it draws with culling enabled
+    auto = glphong_make_renderer(16, 16, "egl")
+    auto.render(scene)
+    from glphong.renderer import _between_clip_planes
+
+    eye, forward = tuple(camera.pose[:3, 3]), tuple(-camera.pose[:3, 2])
+    culled = [e["radiance"].sphere is not None and _between_clip_planes(e["radiance"].sphere, eye, forward,
+                                                                         camera.znear, camera.zfar)
+              for e in (auto._entries[o] for o in scene.objects)]
+    assert culled == [True, False, False]
