@@ -21,7 +21,7 @@ from .camera import PerspectiveCamera
 from .lights import AmbientLight, PointLight
 from .materials import BlinnPhong, Phong
 from .scene import Scene
-from .timing import median_seconds
+from .timing import median_seconds, progress_bar
 
 __all__ = ["BenchCase", "standard_cases", "quick_cases", "Method", "methods", "run_bench", "BenchReport"]
 
@@ -220,16 +220,6 @@ class BenchReport:
         return "\n".join(lines)
 
 
-def _progress(total, enabled):
-    if not enabled:
-        return None
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        return None
-    return tqdm(total=total, unit="point", leave=False)
-
-
 def _glphong_runner(method, width, height, value):
     from .renderer import Renderer
 
@@ -350,7 +340,7 @@ def run_bench(width=256, height=192, cases=None, method_list=None, repeats=5, re
             report.skipped.append(reason)
         else:
             runnable.append(m)
-    bar = _progress(len(cases) * sum(len(m.values) for m in runnable), progress)
+    bar = progress_bar(len(cases) * sum(len(m.values) for m in runnable), progress)
     for case in cases:
         reference = render_reference(case.camera(), case.analytic_objects(), case.light_list(), AmbientLight(0.02),
                                      width, height, samples_per_axis=reference_samples)

@@ -84,8 +84,10 @@ def world_sphere(mesh, pose):
 
 
 def view_allows_culling(centre, radius, eye, forward, znear, zfar):
-    """True where a sphere lies wholly between a camera's near and far planes (see the module)."""
-    depth = float(np.dot(np.subtract(centre, eye), forward))
+    """True where a sphere lies wholly between a camera's near and far planes (see the module).
+
+    Plain float arithmetic on 3-sequences (a renderer asks once per object and frame)."""
+    depth = (centre[0] - eye[0]) * forward[0] + (centre[1] - eye[1]) * forward[1] + (centre[2] - eye[2]) * forward[2]
     return depth - radius > znear and depth + radius < zfar
 
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from . import _validate
 from .contexts import check_not_forked, create_context
-from .culling import closed_outward, world_sphere
+from .culling import closed_outward, view_allows_culling, world_sphere
 from .key import FORMULATIONS, EncodeKey, uber_key
 from .programs import ProgramCache
 
@@ -73,15 +73,8 @@ class _ObjectEntry:
     pack: tuple
     vertex_array: object
     mirrored: bool
-    sphere: tuple = None  # (x, y, z, radius) in the world where the mesh's back faces may be culled
+    sphere: tuple = None  # ((x, y, z), radius) in the world where the mesh's back faces may be culled
     checked: object = None
-
-
-def _between_clip_planes(sphere, eye, forward, near, far):
-    """`glphong.culling.view_allows_culling` on plain floats (once per object per frame)."""
-    x, y, z, radius = sphere
-    depth = (x - eye[0]) * forward[0] + (y - eye[1]) * forward[1] + (z - eye[2]) * forward[2]
-    return depth - radius > near and depth + radius < far
 
 
 @dataclass(frozen=True)
@@ -519,7 +512,7 @@ class Renderer:
             if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
                 mirrored = entry.mirrored
                 self._mgl.front_face = "cw" if mirrored else "ccw"
-            cull = entry.sphere is not None and _between_clip_planes(entry.sphere, eye, forward, near, far)
+            cull = entry.sphere is not None and view_allows_culling(*entry.sphere, eye, forward, near, far)
             if cull != culled:
                 culled = cull
                 (self._mgl.enable if cull else self._mgl.disable)(moderngl.CULL_FACE)
@@ -555,7 +548,7 @@ class Renderer:
                 vao = self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program)
                 sphere = world_sphere(obj.mesh, obj.pose) if self.culling == "auto" and closed_outward(obj.mesh)[0] else None
                 entry = _ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
-                                     None if sphere is None else (*sphere[0], sphere[1]))
+                                     None if sphere is None else (tuple(sphere[0]), sphere[1]))
                 if shared is None:
                     per_object[output] = entry
             frame = frame_packs.get(entry.program)

@@ -37,7 +37,7 @@ from .camera import PerspectiveCamera
 from .lights import AmbientLight, PointLight
 from .materials import BlinnPhong, Lambert, Phong
 from .scene import Scene
-from .timing import alternating_times
+from .timing import alternating_times, progress_bar
 
 __all__ = ["SCENES", "speed_scenes", "SpeedReport", "run_speed", "python_per_object", "png_cost", "scaling_fits"]
 
@@ -188,7 +188,7 @@ def run_speed(sizes=(512, 1024), repeats=9, quick=False, pyrender=True, progress
             pyrender_class = PyrenderRenderer
         except (ImportError, RuntimeError) as exc:
             report.skipped.append(f"pyrender: {exc}")
-    bar = _bar(len(sizes) * len(scenes), progress)
+    bar = progress_bar(len(sizes) * len(scenes), progress, unit="scene")
     for size in sizes:
         float_renderer = Renderer(size, size, backend="egl")
         msaa = Renderer(size, size, backend="egl", samples=4)
@@ -227,16 +227,6 @@ def run_speed(sizes=(512, 1024), repeats=9, quick=False, pyrender=True, progress
     report.png = png_cost(repeats=repeats)
     report.fits = scaling_fits(quick=quick, repeats=max(5, repeats // 2))
     return report
-
-
-def _bar(total, enabled):
-    if not enabled:
-        return None
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        return None
-    return tqdm(total=total, unit="scene", leave=False)
 
 
 def python_per_object(scene, size=64, repeats=9):

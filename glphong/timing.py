@@ -2,7 +2,7 @@
 import statistics
 import time
 
-__all__ = ["median_seconds", "alternating_medians", "alternating_times"]
+__all__ = ["median_seconds", "alternating_medians", "alternating_times", "progress_bar"]
 
 
 def median_seconds(run, repeats=7, warmup=2):
@@ -41,3 +41,14 @@ def alternating_times(runs, repeats=7, warmup=2):
 def alternating_medians(runs, repeats=7, warmup=2):
     """Median wall time [s] of each of several callables (`alternating_times`), dict of str to float."""
     return {name: statistics.median(t) for name, t in alternating_times(runs, repeats, warmup).items()}
+
+
+def progress_bar(total, enabled=True, unit="point"):
+    """A tqdm progress bar of ``total`` steps, or None where disabled or tqdm is not installed."""
+    if not enabled:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        return None
+    return tqdm(total=total, unit=unit, leave=False)

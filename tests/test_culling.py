@@ -99,10 +99,10 @@ def test_describe_reports_each_objects_decision(glphong_make_renderer):
     # the renderer decides alike: what it draws with culling enabled
     auto = glphong_make_renderer(16, 16, "egl")
     auto.render(scene)
-    from glphong.renderer import _between_clip_planes
+    from glphong.culling import view_allows_culling
 
     eye, forward = tuple(camera.pose[:3, 3]), tuple(-camera.pose[:3, 2])
-    culled = [e["radiance"].sphere is not None and _between_clip_planes(e["radiance"].sphere, eye, forward,
-                                                                         camera.znear, camera.zfar)
+    culled = [e["radiance"].sphere is not None and view_allows_culling(*e["radiance"].sphere, eye, forward,
+                                                                        camera.znear, camera.zfar)
               for e in (auto._entries[o] for o in scene.objects)]
     assert culled == [True, False, False]
