@@ -40,11 +40,22 @@ class Frame:
         Pixels covered by geometry (any sample).
     coverage : (H, W) float32 ndarray
         Fraction of the pixel's samples covered by geometry (0 or 1 with one sample).
+    depth : (H, W) float32 ndarray or None
+        With ``render(scene, depth=True)``: linear depth [m], the distance of the surface point at
+        the pixel centre from the camera along its viewing axis (view-space ``-z``; not the distance
+        to the eye), 0 where no geometry covers the centre.  One sample per pixel at the output size,
+        whatever ``samples`` and ``supersample`` are.
+    normal : (H, W, 3) float32 ndarray or None
+        With ``render(scene, normals=True)``: the world-space unit shading normal at the pixel centre
+        (interpolated, renormalised, flipped toward the viewer on the back faces of two-sided
+        materials, as shaded), 0 where not covered or where the normal is zero or not finite.
     """
 
     radiance: np.ndarray
     mask: np.ndarray
     coverage: np.ndarray = None
+    depth: np.ndarray = None
+    normal: np.ndarray = None
 
     def to_srgb8(self, exposure=1.0):
         """8-bit sRGB image, (H, W, 3) uint8 (see `glphong.imaging.encode_srgb8`)."""
@@ -370,14 +381,25 @@ class Renderer:
             self._size = size
 
     @_one_call_at_a_time
-    def render(self, scene):
+    def render(self, scene, depth=False, normals=False):
         """Render the scene's shaded radiance (linear float32).
+
+        Parameters
+        ----------
+        scene : Scene
+        depth, normals : bool
+            Also return linear depth [m] and world-space normals (`Frame.depth`, `Frame.normal`), from
+            one G-buffer pass at the output size.
 
         Returns
         -------
         Frame
         """
         self._check_scene(scene)
+        for name, flag in (("depth", depth), ("normals", normals)):
+            if not isinstance(flag, (bool, np.bool_)):
+                raise TypeError(f"{name} must be a bool, True or False (got {flag!r})")
+        geometry = self.gbuffer(scene) if depth or normals else None  # the lock is re-entrant
         with self.context:
             fbo = self._draw_radiance(scene)
             rgba = self._read(fbo, self._internal_size, components=4)
@@ -387,7 +409,15 @@ class Renderer:
             rgba = rgba.reshape(self.height, s, self.width, s, 4).mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
         # views of the one readback (rows flipped by strides): no copy after the driver's
         coverage = rgba[..., 3]
-        return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage)
+        extra = {}
+        if depth:
+            camera = scene.camera
+            forward = -camera.pose[:3, 2]
+            along = np.einsum("ijk,k->ij", geometry.position - camera.pose[:3, 3], forward)
+            extra["depth"] = np.where(geometry.mask, along, 0.0).astype(np.float32)
+        if normals:
+            extra["normal"] = geometry.normal
+        return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, **extra)
 
     @_one_call_at_a_time
     def render_srgb8(self, scene, exposure=1.0, resolve="display"):
