@@ -7,7 +7,7 @@ import numpy as np
 
 from . import _validate
 
-__all__ = ["PerspectiveCamera"]
+__all__ = ["PerspectiveCamera", "IntrinsicsCamera", "opencv_pose"]
 
 
 class PerspectiveCamera:
@@ -80,13 +80,23 @@ class PerspectiveCamera:
     def projection_matrix(self, aspect):
         """OpenGL perspective projection for ``aspect = width / height``, (4, 4) float64."""
         f = 1.0 / np.tan(self.yfov / 2.0)
+        return self._frustum(f / aspect, f, 0.0, 0.0)
+
+    def _frustum(self, sx, sy, ox, oy):
+        """The projection ``x_ndc = sx x / -z + ox``, ``y_ndc = sy y / -z + oy`` with the depth rows of
+        `znear` and `zfar`, (4, 4) float64."""
         n, far = self.znear, self.zfar
         return np.array([
-            [f / aspect, 0.0, 0.0, 0.0],
-            [0.0, f, 0.0, 0.0],
+            [sx, 0.0, -ox, 0.0],
+            [0.0, sy, -oy, 0.0],
             [0.0, 0.0, (far + n) / (n - far), 2.0 * far * n / (n - far)],
             [0.0, 0.0, -1.0, 0.0],
         ])
+
+    def _image_plane(self, xp, yp, width, height):
+        """Camera-space ``(x, y)`` at ``z = -1`` of image positions ``(xp, yp)`` [px from the top-left corner]."""
+        t = np.tan(self.yfov / 2.0)
+        return (xp / width * 2.0 - 1.0) * t * (width / height), (1.0 - yp / height * 2.0) * t
 
     def sample_rays(self, width, height, offsets=None, rows=None):
         """World-space rays through sub-pixel positions.
@@ -112,12 +122,10 @@ class PerspectiveCamera:
         offsets = np.array([[0.5, 0.5]]) if offsets is None else np.asarray(offsets, dtype=np.float64)
         if offsets.ndim != 2 or offsets.shape[1] != 2:
             raise ValueError(f"offsets must have shape (S, 2) (got {offsets.shape})")
-        t = np.tan(self.yfov / 2.0)
-        aspect = width / height
         j = np.arange(height)[rows if rows is not None else slice(None)]
         i = np.arange(width)
-        x = ((i[None, :, None] + offsets[None, None, :, 0]) / width * 2.0 - 1.0) * t * aspect
-        y = (1.0 - (j[:, None, None] + offsets[None, None, :, 1]) / height * 2.0) * t
+        x, y = self._image_plane(i[None, :, None] + offsets[None, None, :, 0], j[:, None, None] + offsets[None, None, :, 1],
+                                 width, height)
         x, y = np.broadcast_arrays(x, y)
         d = np.stack([x, y, -np.ones_like(x)], axis=-1) @ self.pose[:3, :3].T
         return self.position, d / np.linalg.norm(d, axis=-1, keepdims=True)
@@ -137,3 +145,86 @@ class PerspectiveCamera:
 
     def __repr__(self):
         return f"PerspectiveCamera(yfov={self.yfov:.6g}, position={tuple(self.position)}, znear={self.znear:g}, zfar={self.zfar:g})"
+
+
+class IntrinsicsCamera(PerspectiveCamera):
+    """A pinhole camera from calibrated intrinsics, in OpenCV's convention.
+
+    A camera-space point ``(X, Y, Z)`` of OpenCV's frame (``+Z`` forward, ``+Y`` down, ``+X`` right) lands
+    at pixel ``u = fx X / Z + cx``, ``v = fy Y / Z + cy``, with integer ``(u, v)`` the centre of column
+    ``u`` and row ``v`` (row 0 at the top), as OpenCV's ``projectPoints`` and its calibration give them.
+    glphong's camera frame is OpenGL's (looking down ``-Z``, ``+Y`` up): ``X = x``, ``Y = -y``, ``Z = -z``;
+    `opencv_pose` turns OpenCV extrinsics ``[R | t]`` into the ``pose`` this class takes.
+
+    Parameters
+    ----------
+    fx, fy : float
+        Focal lengths [px], > 0.
+    cx, cy : float
+        Principal point [px], OpenCV's convention (pixel centres at integers).
+    width, height : int
+        The image size the intrinsics belong to.  Rendering at another size with the same aspect
+        scales them; another aspect is refused.
+    pose : (4, 4) array_like, optional
+        Camera-to-world rigid transform of glphong's (OpenGL) camera frame.
+    znear, zfar : float
+        Clip distances [m].
+
+    Notes
+    -----
+    pyrender's ``IntrinsicsCamera`` measures ``cx``, ``cy`` from the image's corner (its projection
+    has ``1 - 2 cx / width``): the same camera there has ``cx + 0.5``, ``cy + 0.5``.
+    """
+
+    def __init__(self, fx, fy, cx, cy, width, height, pose=None, znear=0.05, zfar=100.0):
+        self.fx = _validate.scalar("fx", fx, low=0.0, low_inclusive=False)
+        self.fy = _validate.scalar("fy", fy, low=0.0, low_inclusive=False)
+        self.cx = _validate.scalar("cx", cx, low=-np.inf)
+        self.cy = _validate.scalar("cy", cy, low=-np.inf)
+        self.width = _validate.positive_int("width", width, 1, 16384)
+        self.height = _validate.positive_int("height", height, 1, 16384)
+        # the vertical field of view of a centred image of this height (for reference and peers)
+        super().__init__(2.0 * np.arctan(self.height / (2.0 * self.fy)), pose=pose, znear=znear, zfar=zfar)
+
+    def projection_matrix(self, aspect):
+        """The off-axis projection of the intrinsics (``aspect`` must be ``width / height``), (4, 4) float64."""
+        expected = self.width / self.height
+        if abs(aspect - expected) > 1e-9 * expected:
+            raise ValueError(f"this IntrinsicsCamera belongs to {self.width}x{self.height} images (aspect "
+                             f"{expected:.6g}); render it at that aspect (got {aspect:.6g})")
+        w, h = self.width, self.height
+        return self._frustum(2.0 * self.fx / w, 2.0 * self.fy / h, 2.0 * (self.cx + 0.5) / w - 1.0,
+                             1.0 - 2.0 * (self.cy + 0.5) / h)
+
+    def _image_plane(self, xp, yp, width, height):
+        u = xp * (self.width / width) - 0.5  # OpenCV pixel coordinates: centres at integers
+        v = yp * (self.height / height) - 0.5
+        return (u - self.cx) / self.fx, -(v - self.cy) / self.fy
+
+    def __repr__(self):
+        return (f"IntrinsicsCamera(fx={self.fx:g}, fy={self.fy:g}, cx={self.cx:g}, cy={self.cy:g}, "
+                f"width={self.width}, height={self.height}, position={tuple(self.position)})")
+
+
+def opencv_pose(rotation, translation):
+    """glphong's camera pose from OpenCV extrinsics: ``x_cam = R x_world + t`` (OpenCV frame, +Z forward).
+
+    Parameters
+    ----------
+    rotation : (3, 3) array_like
+        ``R``, a rotation matrix (e.g. from ``cv2.Rodrigues(rvec)``).
+    translation : (3,) array_like
+        ``t`` [m].
+
+    Returns
+    -------
+    (4, 4) float64 ndarray
+        The camera-to-world pose of the OpenGL camera frame (``+Y`` up, looking down ``-Z``).
+    """
+    r = np.asarray(rotation, dtype=np.float64)
+    t = np.asarray(translation, dtype=np.float64).reshape(3)
+    if r.shape != (3, 3) or not np.allclose(r @ r.T, np.eye(3), atol=1e-6) or np.linalg.det(r) < 0:
+        raise ValueError(f"rotation must be a (3, 3) rotation matrix (got shape {r.shape})")
+    world_to_camera = np.eye(4)
+    world_to_camera[:3, :3], world_to_camera[:3, 3] = r, t
+    return np.linalg.inv(world_to_camera) @ np.diag([1.0, -1.0, -1.0, 1.0])

@@ -349,8 +349,14 @@ def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=Non
                                        material=_pyrender_material(pyrender, obj.material, double_sided))
         out.add(pyrender.Mesh([primitive], name=obj.name), pose=obj.pose, name=obj.name)
     camera = scene.camera
-    out.add(pyrender.PerspectiveCamera(yfov=camera.yfov, znear=camera.znear, zfar=camera.zfar,
-                                       aspectRatio=aspect_ratio), pose=camera.pose)
+    from .camera import IntrinsicsCamera
+
+    if isinstance(camera, IntrinsicsCamera):  # pyrender measures the principal point from the corner
+        out.add(pyrender.IntrinsicsCamera(camera.fx, camera.fy, camera.cx + 0.5, camera.cy + 0.5, znear=camera.znear,
+                                          zfar=camera.zfar), pose=camera.pose)
+    else:
+        out.add(pyrender.PerspectiveCamera(yfov=camera.yfov, znear=camera.znear, zfar=camera.zfar,
+                                           aspectRatio=aspect_ratio), pose=camera.pose)
     for light in scene.lights:
         if isinstance(light, PointLight):
             colour, peak = _colour_and_scale(light.power)

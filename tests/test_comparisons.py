@@ -244,3 +244,20 @@ def test_floor_with_shared_mesh_every_light_kind_and_unlit_objects(make_renderer
         image = floor.prepare(scene).render()
     assert frame.mask.sum() > 1000
     np.testing.assert_allclose(image, frame.radiance, rtol=1e-6, atol=1e-7 * float(frame.radiance.max()))
+
+
+def test_pyrender_intrinsics_camera_is_the_same_projection(pyrender_egl, make_renderer):
+    """An `IntrinsicsCamera` becomes pyrender's IntrinsicsCamera with the principal point moved by half a
+    pixel (pyrender measures it from the corner): the same projection matrix, and the same coverage."""
+    scene = sphere_scene(MATERIALS[sorted(MATERIALS)[0]], directional=True)
+    camera = glphong.IntrinsicsCamera(0.9 * WIDTH, 0.8 * WIDTH, WIDTH / 2 + 3.3, HEIGHT / 2 - 2.1, WIDTH, HEIGHT,
+                                      pose=scene.camera.pose)
+    scene.camera = camera
+    converted = to_pyrender(scene)
+    np.testing.assert_allclose(converted.main_camera_node.camera.get_projection_matrix(WIDTH, HEIGHT),
+                               camera.projection_matrix(WIDTH / HEIGHT), rtol=1e-12, atol=1e-12)
+    frame = make_renderer(WIDTH, HEIGHT, "egl").render(scene)
+    with PyrenderRenderer(WIDTH, HEIGHT, "egl") as pyr:
+        colour = pyr.prepare(scene).render()
+    agreement, on_silhouette = coverage_agreement(np.any(colour > 0, axis=-1), frame.mask)
+    assert agreement > 0.98 and on_silhouette, agreement
