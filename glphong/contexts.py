@@ -24,6 +24,7 @@ __all__ = [
     "BACKENDS",
     "SYSTEM_PACKAGES",
     "BackendUnavailableError",
+    "EGLDisplayTerminatedError",
     "GLContext",
     "available_backends",
     "create_context",
@@ -60,6 +61,34 @@ class BackendUnavailableError(RuntimeError):
 
 class ForkedProcessError(RuntimeError):
     """OpenGL used in a process forked from one that had already used OpenGL (it would hang)."""
+
+
+class EGLDisplayTerminatedError(RuntimeError):
+    """An EGL context can no longer be made current: its display was terminated (``eglTerminate``)."""
+
+
+_EGL_TERMINATED = (
+    "this EGL context can no longer be made current: the EGL display it lives on was terminated "
+    "(eglTerminate). Mesa gives every EGL context on a device one display, and pyrender's "
+    "OffscreenRenderer.delete() on EGL (also when the garbage collector drops one) terminates it, "
+    "taking the contexts of every other library in the process with it; glphong's drew nothing from "
+    "then on (moderngl says 'cannot create texture' or returns garbage). Make a new glphong.Renderer "
+    "(a fresh context re-initialises the display), keep pyrender's renderer alive while glphong's are "
+    "in use, or release it with glphong.comparisons.PyrenderRenderer.release, which does not terminate it")
+
+
+@functools.lru_cache(maxsize=1)
+def _egl_current_context():
+    """libEGL's ``eglGetCurrentContext`` (ctypes), or None where libEGL cannot be loaded."""
+    name = ctypes.util.find_library("EGL")
+    if name is None:
+        return None
+    try:
+        function = ctypes.CDLL(name).eglGetCurrentContext
+    except (OSError, AttributeError):
+        return None
+    function.restype = ctypes.c_void_p
+    return function
 
 
 #: the process that first tried to make a context (llvmpipe starts its rasterizer threads then)
@@ -186,6 +215,15 @@ class GLContext:
         # real switch.  Leaving an OSMesa context does nothing.
         self.mgl.__exit__(None, None, None)
         self.mgl.__enter__()
+        if self.backend == "egl" and self.alive is False:
+            raise EGLDisplayTerminatedError(_EGL_TERMINATED)
+
+    @property
+    def alive(self):
+        """For an EGL context just made current: whether EGL made it current (False once its display was
+        terminated, `EGLDisplayTerminatedError`); None where that cannot be asked (OSMesa, no libEGL)."""
+        current = _egl_current_context() if self.backend == "egl" else None
+        return None if current is None else bool(current())
 
     def detach(self):
         """Leave the context current on no thread, so that any thread may enter it next (EGL allows a
@@ -390,9 +428,13 @@ def _try_create(backend, require):
     """
     check_not_forked()
     reused = _reuse(backend, require)
-    if reused is not None:
-        reused._make_current()  # as a new context is: current (unless a with block restores another below)
-        return reused, None
+    while reused is not None:
+        try:
+            reused._make_current()  # as a new context is: current (unless a with block restores another below)
+            return reused, None
+        except EGLDisplayTerminatedError:  # a recycled context whose display was terminated since: drop it
+            reused._released = True
+            reused = _reuse(backend, require)
     try:
         context = _CREATORS[backend](require)
         _note_gl_use()

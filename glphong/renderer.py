@@ -16,7 +16,7 @@ import moderngl
 import numpy as np
 
 from . import _validate
-from .contexts import check_not_forked, create_context
+from .contexts import EGLDisplayTerminatedError, check_not_forked, create_context
 from .culling import closed_outward, view_allows_culling, world_sphere
 from .key import FORMULATIONS, EncodeKey, uber_key
 from .programs import ProgramCache
@@ -209,13 +209,18 @@ def _release_targets(context, targets):
 
 def _release_resources(context, meshes, targets, programs):
     """Release every GL object of a renderer, then recycle its context (`Renderer.release` and the
-    orphans of renderers dropped without it)."""
-    with context:
-        for entry in meshes.values():
-            entry.release()
-        meshes.clear()
-        _release_targets(context, targets)
-        programs.release()
+    orphans of renderers dropped without it).  A context whose EGL display was terminated has lost its
+    objects already: it is only marked released."""
+    try:
+        with context:
+            for entry in meshes.values():
+                entry.release()
+            meshes.clear()
+            _release_targets(context, targets)
+            programs.release()
+    except EGLDisplayTerminatedError:
+        context._released = True
+        return
     context.recycle()  # every GL object is released: the context may serve another renderer
 
 

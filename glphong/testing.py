@@ -42,8 +42,17 @@ _POOL_LOCK = threading.Lock()
 
 def _pooled(backend):
     """A context and its program cache per backend, created on first use and kept until exit."""
+    from .contexts import EGLDisplayTerminatedError
+
     with _POOL_LOCK:
         entry = _POOL.get(backend)
+        if entry is not None:
+            try:
+                with entry[2], entry[0]:
+                    pass
+            except EGLDisplayTerminatedError:  # its display was terminated (pyrender on EGL): start anew
+                entry[0]._released = True
+                entry = None
         if entry is None or entry[0].mgl is None:
             gl = create_context(backend)
             gl.detach()  # entered per call, from any thread

@@ -250,3 +250,50 @@ def test_available_backends_reports_reasons(broken):
         "egl": "simulated: eglQueryDevicesEXT failed (0x3001)",
         "osmesa": "simulated: libOSMesa.so not found",
     }
+
+
+_TERMINATE_SCRIPT = """
+import os, sys
+os.environ["PYOPENGL_PLATFORM"] = "egl"
+import numpy as np, glphong, pyrender
+from glphong import primitives
+from glphong.contexts import EGLDisplayTerminatedError
+scene = glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0)), [glphong.PointLight((2, 2, 2), 100.0)])
+scene.add(primitives.sphere(2), glphong.Lambert(0.3))
+old = glphong.Renderer(32, 32, backend="egl")
+before = old.render(scene).radiance.copy()
+spare = glphong.Renderer(8, 8, backend="egl")
+spare.release()                          # a recycled context waits in the pool
+p = pyrender.OffscreenRenderer(16, 16)
+p.delete()                               # eglTerminate on the display every EGL context shares
+try:
+    old.render(scene)
+    print("RENDERED")
+except EGLDisplayTerminatedError as exc:
+    print("REFUSED", "pyrender" in str(exc) and "new glphong.Renderer" in str(exc))
+old.release()                            # no error: the objects went with the display
+with glphong.Renderer(32, 32, backend="egl") as fresh:   # the dead pooled context is dropped, not reused
+    print("FRESH", np.array_equal(fresh.render(scene).radiance, before))
+from glphong.testing import evaluate
+first = evaluate(glphong.Lambert(0.3), [[0, 0, 1.0]], [[0, 0, 1.0]], backend="egl")
+q = pyrender.OffscreenRenderer(16, 16)
+q.delete()                               # again, under glphong.testing's pooled context
+print("EVALUATE", np.array_equal(evaluate(glphong.Lambert(0.3), [[0, 0, 1.0]], [[0, 0, 1.0]], backend="egl"), first))
+"""
+
+
+def test_a_terminated_egl_display_is_named_not_rendered_through(make_context):
+    """pyrender's OffscreenRenderer.delete() on EGL terminates the display glphong's EGL contexts share:
+    rendering with one of them raises EGLDisplayTerminatedError naming what happened (it returned NaN
+    images before), releasing it does not raise, a new Renderer draws the same image as before, and
+    glphong.testing's pooled context is replaced."""
+    import importlib.util
+    import subprocess
+    import sys
+
+    if importlib.util.find_spec("pyrender") is None:
+        pytest.skip("pyrender is not installed (pip install 'glphong[pyrender]')")
+    make_context("egl")  # skips (or fails where required) without EGL
+    out = subprocess.run([sys.executable, "-c", _TERMINATE_SCRIPT], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-3000:]
+    assert out.stdout.split() == ["REFUSED", "True", "FRESH", "True", "EVALUATE", "True"], out.stdout
