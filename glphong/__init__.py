@@ -12,7 +12,7 @@ Typical use::
         report = glphong.verify(scene, r)
 """
 from . import imaging, materials, primitives, radiometry, reference
-from .camera import IntrinsicsCamera, PerspectiveCamera, opencv_pose
+from .camera import Camera, IntrinsicsCamera, OrthographicCamera, PerspectiveCamera, opencv_pose
 from .contexts import BackendUnavailableError, available_backends, create_context
 from .describe import describe, format_descriptions
 from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
@@ -26,7 +26,7 @@ from .verify import VerifyReport, verify
 __version__ = "0.1.0"
 
 __all__ = [
-    "PerspectiveCamera", "IntrinsicsCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
+    "Camera", "PerspectiveCamera", "IntrinsicsCamera", "OrthographicCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
     "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "SchlickFresnel",
     "DielectricFresnel", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",

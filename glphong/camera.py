@@ -7,24 +7,42 @@ import numpy as np
 
 from . import _validate
 
-__all__ = ["PerspectiveCamera", "IntrinsicsCamera", "opencv_pose"]
+__all__ = ["Camera", "PerspectiveCamera", "OrthographicCamera", "IntrinsicsCamera", "opencv_pose"]
 
 
-class PerspectiveCamera:
-    """A pinhole camera.
+def _look_at_pose(eye, target, up):
+    """The camera-to-world pose of a camera at ``eye`` looking at ``target`` with ``up`` roughly up."""
+    eye = np.asarray(_validate.vec3("eye", eye))
+    target = np.asarray(_validate.vec3("target", target))
+    up = np.asarray(_validate.vec3("up", up, nonzero=True))
+    back = eye - target
+    if not np.any(back):
+        raise ValueError("target must differ from eye")
+    # scaled normalisation (DESIGN section 3): no underflow for tiny vectors
+    z = back / np.max(np.abs(back))
+    z /= np.linalg.norm(z)
+    x = np.cross(up / np.max(np.abs(up)), z)
+    if not np.linalg.norm(x) > 1e-12:
+        raise ValueError("up must not be parallel to the viewing direction target - eye")
+    x /= np.linalg.norm(x)
+    pose = np.eye(4)
+    pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = x, np.cross(z, x), z, eye
+    return pose
+
+
+class Camera:
+    """What every camera has: a rigid pose (OpenGL frame: looking down its -Z, +Y up), clip distances, and
+    rays through image positions.  Subclasses give the projection and the image-plane mapping.
 
     Parameters
     ----------
-    yfov : float
-        Vertical field of view [rad], in (0, pi).
     pose : (4, 4) array_like, optional
         Camera-to-world rigid transform (default identity: at the origin looking down -Z).
     znear, zfar : float, optional
         Clip distances [m], 0 < znear < zfar (defaults 0.05 and 100).
     """
 
-    def __init__(self, yfov, pose=None, znear=0.05, zfar=100.0):
-        self.yfov = _validate.scalar("yfov", yfov, low=0.0, high=np.pi, low_inclusive=False, high_inclusive=False)
+    def __init__(self, pose=None, znear=0.05, zfar=100.0):
         self.pose = _validate.rigid_pose("pose", np.eye(4) if pose is None else pose)
         self.znear = _validate.scalar("znear", znear, low=0.0, low_inclusive=False)
         self.zfar = _validate.scalar("zfar", zfar, low=0.0, low_inclusive=False)
@@ -32,42 +50,17 @@ class PerspectiveCamera:
             raise ValueError(f"zfar must be greater than znear, in ({self.znear!r}, {_validate.FLT_MAX:g}] "
                              f"(got zfar={self.zfar!r})")
 
-    @classmethod
-    def look_at(cls, eye, target, up=(0.0, 1.0, 0.0), yfov=np.pi / 4, znear=0.05, zfar=100.0):
-        """A camera at ``eye`` looking at ``target``.
-
-        Parameters
-        ----------
-        eye, target : (3,) array_like
-            Camera centre and the point it looks at [m]; must differ.
-        up : (3,) array_like
-            Approximate up direction; must not be parallel to ``target - eye``.
-        yfov : float
-            Vertical field of view [rad].
-        znear, zfar : float
-            Clip distances [m].
-        """
-        eye = np.asarray(_validate.vec3("eye", eye))
-        target = np.asarray(_validate.vec3("target", target))
-        up = np.asarray(_validate.vec3("up", up, nonzero=True))
-        back = eye - target
-        if not np.any(back):
-            raise ValueError("target must differ from eye")
-        # scaled normalisation (DESIGN section 3): no underflow for tiny vectors
-        z = back / np.max(np.abs(back))
-        z /= np.linalg.norm(z)
-        x = np.cross(up / np.max(np.abs(up)), z)
-        if not np.linalg.norm(x) > 1e-12:
-            raise ValueError("up must not be parallel to the viewing direction target - eye")
-        x /= np.linalg.norm(x)
-        pose = np.eye(4)
-        pose[:3, 0], pose[:3, 1], pose[:3, 2], pose[:3, 3] = x, np.cross(z, x), z, eye
-        return cls(yfov, pose=pose, znear=znear, zfar=zfar)
-
     @property
     def position(self):
         """Camera centre in world space [m], (3,) float64."""
         return self.pose[:3, 3].copy()
+
+    @property
+    def eye(self):
+        """The homogeneous eye ``(e, w)``, (4,) float64: the view vector at a point ``x`` is
+        ``normalize(e - w x)`` (``u_eye`` of the shaders).  A perspective camera's is its centre with
+        ``w = 1``; an orthographic camera's its backward axis with ``w = 0`` (parallel views)."""
+        return np.append(self.position, 1.0)
 
     def view_matrix(self):
         """World-to-camera transform, (4, 4) float64."""
@@ -78,25 +71,18 @@ class PerspectiveCamera:
         return view
 
     def projection_matrix(self, aspect):
-        """OpenGL perspective projection for ``aspect = width / height``, (4, 4) float64."""
-        f = 1.0 / np.tan(self.yfov / 2.0)
-        return self._frustum(f / aspect, f, 0.0, 0.0)
-
-    def _frustum(self, sx, sy, ox, oy):
-        """The projection ``x_ndc = sx x / -z + ox``, ``y_ndc = sy y / -z + oy`` with the depth rows of
-        `znear` and `zfar`, (4, 4) float64."""
-        n, far = self.znear, self.zfar
-        return np.array([
-            [sx, 0.0, -ox, 0.0],
-            [0.0, sy, -oy, 0.0],
-            [0.0, 0.0, (far + n) / (n - far), 2.0 * far * n / (n - far)],
-            [0.0, 0.0, -1.0, 0.0],
-        ])
+        """The OpenGL projection for ``aspect = width / height``, (4, 4) float64."""
+        raise NotImplementedError
 
     def _image_plane(self, xp, yp, width, height):
-        """Camera-space ``(x, y)`` at ``z = -1`` of image positions ``(xp, yp)`` [px from the top-left corner]."""
-        t = np.tan(self.yfov / 2.0)
-        return (xp / width * 2.0 - 1.0) * t * (width / height), (1.0 - yp / height * 2.0) * t
+        """Camera-space ``(x, y)`` of image positions ``(xp, yp)`` [px from the top-left corner]: on the
+        plane ``z = -1`` (perspective) or ``z = 0`` (orthographic)."""
+        raise NotImplementedError
+
+    def _camera_rays(self, x, y):
+        """Camera-space ``(origins, directions)`` of the rays through image-plane points: from the centre
+        through ``(x, y, -1)`` (the default, perspective)."""
+        return np.zeros(3), np.stack([x, y, -np.ones_like(x)], axis=-1)
 
     def sample_rays(self, width, height, offsets=None, rows=None):
         """World-space rays through sub-pixel positions.
@@ -114,8 +100,9 @@ class PerspectiveCamera:
 
         Returns
         -------
-        origin : (3,) float64 ndarray
-            The camera centre [m].
+        origins : (3,) or (R, width, S, 3) float64 ndarray
+            The camera centre [m] (perspective), or one origin per ray on the camera's plane
+            (orthographic).
         directions : (R, width, S, 3) float64 ndarray
             Unit ray directions; R is the number of rows selected.
         """
@@ -127,24 +114,133 @@ class PerspectiveCamera:
         x, y = self._image_plane(i[None, :, None] + offsets[None, None, :, 0], j[:, None, None] + offsets[None, None, :, 1],
                                  width, height)
         x, y = np.broadcast_arrays(x, y)
-        d = np.stack([x, y, -np.ones_like(x)], axis=-1) @ self.pose[:3, :3].T
-        return self.position, d / np.linalg.norm(d, axis=-1, keepdims=True)
+        origins, d = self._camera_rays(x, y)
+        d = d @ self.pose[:3, :3].T
+        return origins @ self.pose[:3, :3].T + self.pose[:3, 3], d / np.linalg.norm(d, axis=-1, keepdims=True)
 
     def pixel_rays(self, width, height):
         """World-space rays through the pixel centres, row 0 at the top of the image.
 
         Returns
         -------
-        origin : (3,) float64
-            The camera centre [m].
+        origins : (3,) or (height, width, 3) float64
+            The camera centre [m], or one origin per pixel (orthographic).
         directions : (height, width, 3) float64
             Unit ray directions.
         """
-        origin, directions = self.sample_rays(width, height)
-        return origin, directions[:, :, 0]
+        origins, directions = self.sample_rays(width, height)
+        return (origins if origins.ndim == 1 else origins[:, :, 0]), directions[:, :, 0]
+
+    def _frustum(self, sx, sy, ox, oy):
+        """The projection ``x_ndc = sx x / -z + ox``, ``y_ndc = sy y / -z + oy`` with the depth rows of
+        `znear` and `zfar`, (4, 4) float64."""
+        n, far = self.znear, self.zfar
+        return np.array([
+            [sx, 0.0, -ox, 0.0],
+            [0.0, sy, -oy, 0.0],
+            [0.0, 0.0, (far + n) / (n - far), 2.0 * far * n / (n - far)],
+            [0.0, 0.0, -1.0, 0.0],
+        ])
+
+
+class PerspectiveCamera(Camera):
+    """A pinhole camera.
+
+    Parameters
+    ----------
+    yfov : float
+        Vertical field of view [rad], in (0, pi).
+    pose : (4, 4) array_like, optional
+        Camera-to-world rigid transform (default identity: at the origin looking down -Z).
+    znear, zfar : float, optional
+        Clip distances [m], 0 < znear < zfar (defaults 0.05 and 100).
+    """
+
+    def __init__(self, yfov, pose=None, znear=0.05, zfar=100.0):
+        self.yfov = _validate.scalar("yfov", yfov, low=0.0, high=np.pi, low_inclusive=False, high_inclusive=False)
+        super().__init__(pose, znear, zfar)
+
+    @classmethod
+    def look_at(cls, eye, target, up=(0.0, 1.0, 0.0), yfov=np.pi / 4, znear=0.05, zfar=100.0):
+        """A camera at ``eye`` looking at ``target``.
+
+        Parameters
+        ----------
+        eye, target : (3,) array_like
+            Camera centre and the point it looks at [m]; must differ.
+        up : (3,) array_like
+            Approximate up direction; must not be parallel to ``target - eye``.
+        yfov : float
+            Vertical field of view [rad].
+        znear, zfar : float
+            Clip distances [m].
+        """
+        return cls(yfov, pose=_look_at_pose(eye, target, up), znear=znear, zfar=zfar)
+
+    def projection_matrix(self, aspect):
+        """OpenGL perspective projection for ``aspect = width / height``, (4, 4) float64."""
+        f = 1.0 / np.tan(self.yfov / 2.0)
+        return self._frustum(f / aspect, f, 0.0, 0.0)
+
+    def _image_plane(self, xp, yp, width, height):
+        t = np.tan(self.yfov / 2.0)
+        return (xp / width * 2.0 - 1.0) * t * (width / height), (1.0 - yp / height * 2.0) * t
 
     def __repr__(self):
         return f"PerspectiveCamera(yfov={self.yfov:.6g}, position={tuple(self.position)}, znear={self.znear:g}, zfar={self.zfar:g})"
+
+
+class OrthographicCamera(Camera):
+    """A parallel-projection camera: every view ray runs along the camera's -Z.
+
+    Parameters
+    ----------
+    ymag : float
+        Half the height of the view [m], > 0; the half width is ``ymag * width / height`` (glTF's and
+        pyrender's ``ymag``, with ``xmag`` from the image's aspect).
+    pose : (4, 4) array_like, optional
+        Camera-to-world rigid transform; the view is centred on its position.
+    znear, zfar : float, optional
+        Clip distances [m] along the viewing axis, 0 < znear < zfar.
+
+    Notes
+    -----
+    Shading sees one view direction everywhere: the shaders' homogeneous eye ``u_eye = (b, 0)`` with ``b``
+    the camera's backward axis (`Camera.eye`), so the view vector ``normalize(e - w x)`` is ``b``.
+    """
+
+    def __init__(self, ymag, pose=None, znear=0.05, zfar=100.0):
+        self.ymag = _validate.scalar("ymag", ymag, low=0.0, low_inclusive=False)
+        super().__init__(pose, znear, zfar)
+
+    @classmethod
+    def look_at(cls, eye, target, up=(0.0, 1.0, 0.0), ymag=1.0, znear=0.05, zfar=100.0):
+        """An orthographic camera at ``eye`` looking at ``target`` (see `PerspectiveCamera.look_at`)."""
+        return cls(ymag, pose=_look_at_pose(eye, target, up), znear=znear, zfar=zfar)
+
+    @property
+    def eye(self):
+        return np.append(self.pose[:3, 2], 0.0)
+
+    def projection_matrix(self, aspect):
+        """OpenGL orthographic projection for ``aspect = width / height``, (4, 4) float64."""
+        n, far = self.znear, self.zfar
+        return np.array([
+            [1.0 / (self.ymag * aspect), 0.0, 0.0, 0.0],
+            [0.0, 1.0 / self.ymag, 0.0, 0.0],
+            [0.0, 0.0, 2.0 / (n - far), (far + n) / (n - far)],
+            [0.0, 0.0, 0.0, 1.0],
+        ])
+
+    def _image_plane(self, xp, yp, width, height):
+        return (xp / width * 2.0 - 1.0) * self.ymag * (width / height), (1.0 - yp / height * 2.0) * self.ymag
+
+    def _camera_rays(self, x, y):
+        origins = np.stack([x, y, np.zeros_like(x)], axis=-1)
+        return origins, np.broadcast_to([0.0, 0.0, -1.0], origins.shape).copy()
+
+    def __repr__(self):
+        return f"OrthographicCamera(ymag={self.ymag:.6g}, position={tuple(self.position)}, znear={self.znear:g}, zfar={self.zfar:g})"
 
 
 class IntrinsicsCamera(PerspectiveCamera):

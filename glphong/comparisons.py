@@ -349,9 +349,14 @@ def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=Non
                                        material=_pyrender_material(pyrender, obj.material, double_sided))
         out.add(pyrender.Mesh([primitive], name=obj.name), pose=obj.pose, name=obj.name)
     camera = scene.camera
-    from .camera import IntrinsicsCamera
+    from .camera import IntrinsicsCamera, OrthographicCamera
 
-    if isinstance(camera, IntrinsicsCamera):  # pyrender measures the principal point from the corner
+    if isinstance(camera, OrthographicCamera):
+        if aspect_ratio is None:
+            raise ValueError("an OrthographicCamera needs aspect_ratio (its xmag is ymag * width / height)")
+        out.add(pyrender.OrthographicCamera(xmag=camera.ymag * aspect_ratio, ymag=camera.ymag, znear=camera.znear,
+                                            zfar=camera.zfar), pose=camera.pose)
+    elif isinstance(camera, IntrinsicsCamera):  # pyrender measures the principal point from the corner
         out.add(pyrender.IntrinsicsCamera(camera.fx, camera.fy, camera.cx + 0.5, camera.cy + 0.5, znear=camera.znear,
                                           zfar=camera.zfar), pose=camera.pose)
     else:

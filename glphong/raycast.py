@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _validate
-from .camera import PerspectiveCamera
+from .camera import Camera
 from .geometry import MeshData
 from .lights import AmbientLight
 from .materials import Material
@@ -298,8 +298,8 @@ def render_reference(camera, objects, lights=(), ambient=None, width=256, height
     point lights and an ambient light, Phong and Lambert: 0.86-1.34 s (1 sample: 0.065 s);
     128x128 px, one Phong sphere, one light: 0.20 s at 4x4, 0.74 s at 8x8.
     """
-    if not isinstance(camera, PerspectiveCamera):
-        raise TypeError(f"camera must be a glphong.PerspectiveCamera (got {type(camera).__name__})")
+    if not isinstance(camera, Camera):
+        raise TypeError(f"camera must be a glphong camera such as PerspectiveCamera (got {type(camera).__name__})")
     if ambient is not None and not isinstance(ambient, AmbientLight):
         raise TypeError(f"ambient must be a glphong.AmbientLight or None (got {type(ambient).__name__})")
     objects = list(objects)
@@ -323,7 +323,7 @@ def render_reference(camera, objects, lights=(), ambient=None, width=256, height
 
     offsets = stratified_offsets(n)
     s = len(offsets)
-    eye = camera.position
+    eye = camera.eye  # homogeneous: the view vector at p is e - w p
     forward = -camera.pose[:3, 2]
     radiance = np.zeros((height, width, 3))
     coverage = np.zeros((height, width))
@@ -332,12 +332,13 @@ def render_reference(camera, objects, lights=(), ambient=None, width=256, height
     rows_per_chunk = max(1, CHUNK_RAYS // (width * s))
     for r0 in range(0, height, rows_per_chunk):
         rows = slice(r0, min(r0 + rows_per_chunk, height))
-        _, d = camera.sample_rays(width, height, offsets, rows)
+        o, d = camera.sample_rays(width, height, offsets, rows)
         shape = d.shape[:-1]  # (R, W, S)
+        o = np.broadcast_to(o, d.shape).reshape(-1, 3)  # one origin (perspective) or one per ray (orthographic)
         d = d.reshape(-1, 3)
         # the rasteriser keeps depths (along the viewing axis) in [znear, zfar]
         cos = d @ forward
-        t = np.stack([obj.shape.intersect(eye, d, camera.znear / cos, camera.zfar / cos) for obj in objects])
+        t = np.stack([obj.shape.intersect(o, d, camera.znear / cos, camera.zfar / cos) for obj in objects])
         best = np.argmin(t, axis=0)
         t_best = t[best, np.arange(len(d))]
         hit = np.isfinite(t_best)
@@ -347,10 +348,10 @@ def render_reference(camera, objects, lights=(), ambient=None, width=256, height
             sel = np.flatnonzero(best == k)
             if not len(sel):
                 continue
-            p = eye + t_best[sel, None] * d[sel]
+            p = o[sel] + t_best[sel, None] * d[sel]
             nrm = obj.shape.normal_at(p)
             if key.two_sided:
-                back = np.einsum("ij,ij->i", nrm, eye - p) < 0
+                back = np.einsum("ij,ij->i", nrm, eye[:3] - p * eye[3]) < 0
                 nrm[back] = -nrm[back]
             sample[sel] = shade_point(p, nrm, np.ones(len(sel), bool), u.get("u_eye"), key, u, objects[k].material)
         radiance[rows] = sample.reshape(*shape, 3).sum(axis=2) / s

@@ -351,13 +351,18 @@ def view_direction(position, n_valid, eye, key):
     Returns
     -------
     wo : (N, 3) ndarray
-        Unit vectors toward the eye (0 where no lit term needs the view: not computed).
+        Unit vectors toward the viewer, ``normalize(e - w x)`` of the homogeneous eye ``(e, w)`` (0 where no
+        lit term needs the view: not computed).
     lit : (N,) bool ndarray
         Valid normal and, where the view is needed, a valid view direction.
     """
     if not key.needs_view:
         return np.zeros_like(position), n_valid
-    ok_v, wo, _ = safe_normalize(eye - position)
+    eye = np.asarray(eye)
+    if eye.shape[-1] == 3:  # a camera centre: the homogeneous eye (e, 1)
+        ok_v, wo, _ = safe_normalize(eye - position)
+    else:
+        ok_v, wo, _ = safe_normalize(eye[:3] - position * eye[3])
     return wo, n_valid & ok_v
 
 
@@ -372,8 +377,9 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
         Unit normals, or the whole shading frame (needed where a term reads t, b or uv).
     n_valid : (N,) bool ndarray
         False where the normal was zero or not finite: emission terms only.
-    eye : (3,) ndarray or None
-        Camera centre [m] (None where the key needs no view vector).
+    eye : (4,) or (3,) ndarray or None
+        The homogeneous eye ``(e, w)`` (`glphong.Camera.eye`), or a camera centre ``e`` (``w = 1``);
+        None where the key needs no view vector.
     key, uniforms
         As in `incident_light`.
     material : glphong.materials.Material

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import _validate
-from .camera import PerspectiveCamera
+from .camera import Camera
 from .geometry import MeshData
 from .key import program_key
 from .lights import LIGHT_KINDS, AmbientLight
@@ -56,15 +56,17 @@ class Scene:
 
     Parameters
     ----------
-    camera : PerspectiveCamera
+    camera : Camera
+        A `PerspectiveCamera`, `IntrinsicsCamera` or `OrthographicCamera`.
     lights : sequence of PointLight, UnattenuatedPointLight or DirectionalLight
     ambient : AmbientLight, optional
         The ambient ``L_a`` of the term ``k_d L_a``.
     """
 
     def __init__(self, camera, lights=(), ambient=None):
-        if not isinstance(camera, PerspectiveCamera):
-            raise TypeError(f"camera must be a glphong.PerspectiveCamera (got {type(camera).__name__})")
+        if not isinstance(camera, Camera):
+            raise TypeError(f"camera must be a glphong camera such as PerspectiveCamera or OrthographicCamera "
+                            f"(got {type(camera).__name__})")
         if ambient is not None and not isinstance(ambient, AmbientLight):
             raise TypeError(f"ambient must be a glphong.AmbientLight or None (got {type(ambient).__name__})")
         try:
@@ -218,7 +220,7 @@ class Scene:
         values = {"u_view_projection": self.camera.projection_matrix(aspect) @ self.camera.view_matrix()}
         if key.output != "gbuffer":
             if key.needs_view:
-                values["u_eye"] = self.camera.position
+                values["u_eye"] = self.camera.eye
             values.update(self.light_uniform_values(key))
         return {name: _validate.float32_uniform(v) for name, v in values.items()}
 
@@ -250,7 +252,7 @@ class Scene:
         values = self.uniform_values(index, spec, aspect)
         values["u_normal_matrix"] = np.asarray(obj.normal_matrix, dtype=np.float32)
         if key.needs_view:
-            values["u_eye"] = np.asarray(self.camera.position, dtype=np.float32)
+            values["u_eye"] = np.asarray(self.camera.eye, dtype=np.float32)
         values.setdefault("u_ka", np.asarray(obj.material.ka, dtype=np.float32))
         values.setdefault("u_ambient", np.asarray(self.ambient_radiance or (0.0, 0.0, 0.0), dtype=np.float32))
         from .materials import model_named

@@ -318,7 +318,8 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
         return np.array([float(o) for o in out])
     x = vec(point)
     n = unit(vec(raw_n))
-    v = unit([e - p for e, p in zip(vec(scene.camera.position), x)])
+    eye, w = vec(scene.camera.eye), f(scene.camera.eye[3])  # homogeneous: v = normalize(e - w x)
+    v = unit([e - w * p for e, p in zip(eye, x)])
     four_pi = 4 * mpmath.pi
     frame = _oracle_frame(n, vec(tangent[:3]), float(np.float32(tangent[3])), [f(c) for c in uv[:2]], unit, dot)
     for light in scene.lights:

@@ -49,9 +49,9 @@ layout(location = 2) out vec4 out_uv;  // the renderer packs the extra planes: u
 #endif
 #else
 #if NEEDS_VIEW
-uniform vec3 u_eye;
+uniform vec4 u_eye;  // homogeneous eye (e, w): the view vector at x is normalize(e - w x)
 #else
-const vec3 u_eye = vec3(0.0);  // no term reads the view: shade_point() never reads the eye
+const vec4 u_eye = vec4(0.0);  // no term reads the view: shade_point() never reads the eye
 #endif
 #if OUTPUT_DISPLAY
 uniform float u_exposure;

@@ -32,9 +32,9 @@ layout(location = 3) in vec2 in_uv;
 #if SHADE_PER_VERTEX
 out vec3 v_radiance;
 #if NEEDS_VIEW
-uniform vec3 u_eye;
+uniform vec4 u_eye;  // homogeneous eye (e, w): the view vector at x is normalize(e - w x)
 #else
-const vec3 u_eye = vec3(0.0);  // nothing reads the eye
+const vec4 u_eye = vec4(0.0);  // nothing reads the eye
 #endif
 #if TWO_SIDED && RUNTIME_SWITCHES
 uniform float u_two_sided;
@@ -70,7 +70,7 @@ void main()
     float n_len;
     n_valid = safe_normalize(u_normal_matrix * in_normal, n, n_len);
 #if TWO_SIDED
-    if (SWITCH(u_two_sided) && dot(n, u_eye - world.xyz) < 0.0) {
+    if (SWITCH(u_two_sided) && dot(n, u_eye.xyz - world.xyz * u_eye.w) < 0.0) {
         n = -n;
     }
 #endif

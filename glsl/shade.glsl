@@ -6,7 +6,9 @@
 // k_a plus each term's answer to L_a, and the sum of the terms' <model>_response() [1/sr, times cos].
 // shade_point(position, f, n_valid, eye) -> L [W/(m^2 sr)], RGB, linear, never clamped
 //   position: world-space surface point [m];  f: the ShadingFrame (n_valid false: emission only);
-//   eye: world-space camera centre [m].
+//   eye: the homogeneous eye (e, w): the view vector is v = normalize(e - w x); a perspective camera's
+//   centre [m] with w = 1, an orthographic camera's backward axis with w = 0 (x * 1.0 is exact: the
+//   perspective arithmetic is unchanged).
 // light_term(response, E) -> response * E, exactly 0 where E = 0 (a response that overflowed to Inf
 //   times an irradiance of 0 would be NaN): a select, no branch.
 // Each light kind is a loop of compile-time length; a kind the scene lacks has no loop at all.
@@ -40,7 +42,7 @@ vec3 light_term(vec3 response, vec3 irradiance)
     return mix(response * irradiance, vec3(0.0), equal(irradiance, vec3(0.0)));
 }
 
-vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec3 eye)
+vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec4 eye)
 {
     vec3 radiance = material_emission();
 #if NUM_POINT_LIGHTS > 0 || NUM_UNATTENUATED_LIGHTS > 0 || NUM_DIRECTIONAL_LIGHTS > 0
@@ -48,7 +50,7 @@ vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec3 eye)
     vec3 wo = vec3(0.0);
 #if NEEDS_VIEW
     float view_distance;
-    lit = lit && safe_normalize(eye - position, wo, view_distance);
+    lit = lit && safe_normalize(eye.xyz - position * eye.w, wo, view_distance);
 #endif
     vec3 wi;
     float d;

@@ -16,9 +16,9 @@ in vec4 in_tangent;
 in vec2 in_uv;
 #endif
 #if NEEDS_VIEW
-uniform vec3 u_eye;
+uniform vec4 u_eye;  // homogeneous eye (e, w): the view vector at x is normalize(e - w x)
 #else
-const vec3 u_eye = vec3(0.0);  // no term reads the view: shade_point() never reads the eye
+const vec4 u_eye = vec4(0.0);  // no term reads the view: shade_point() never reads the eye
 #endif
 out vec3 out_radiance;
 

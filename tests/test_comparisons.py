@@ -261,3 +261,18 @@ def test_pyrender_intrinsics_camera_is_the_same_projection(pyrender_egl, make_re
         colour = pyr.prepare(scene).render()
     agreement, on_silhouette = coverage_agreement(np.any(colour > 0, axis=-1), frame.mask)
     assert agreement > 0.98 and on_silhouette, agreement
+
+
+def test_pyrender_orthographic_camera_is_the_same_projection(pyrender_egl, make_renderer):
+    scene = sphere_scene(MATERIALS[sorted(MATERIALS)[0]], directional=True)
+    scene.camera = glphong.OrthographicCamera(1.3, pose=scene.camera.pose)
+    with pytest.raises(ValueError, match="needs aspect_ratio"):
+        to_pyrender(scene)
+    converted = to_pyrender(scene, aspect_ratio=WIDTH / HEIGHT)
+    np.testing.assert_allclose(converted.main_camera_node.camera.get_projection_matrix(WIDTH, HEIGHT),
+                               scene.camera.projection_matrix(WIDTH / HEIGHT), rtol=1e-12, atol=1e-12)
+    frame = make_renderer(WIDTH, HEIGHT, "egl").render(scene)
+    with PyrenderRenderer(WIDTH, HEIGHT, "egl") as pyr:
+        colour = pyr.prepare(scene).render()
+    agreement, on_silhouette = coverage_agreement(np.any(colour > 0, axis=-1), frame.mask)
+    assert agreement > 0.98 and on_silhouette, agreement

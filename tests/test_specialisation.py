@@ -112,7 +112,7 @@ def test_lambert_program_contains_no_lobe_and_describe_says_so():
                                "(ks = 0)") for item in only.left_out), only.left_out
     assert any("library chunk lobe.glsl" in item for item in only.left_out)
     src = only.effective_fragment_source
-    assert "lobe" not in src and "pow(" not in src and "uniform vec3 u_eye" not in src and "u_phong" not in src
+    assert "lobe" not in src and "pow(" not in src and "uniform vec4 u_eye" not in src and "u_phong" not in src
     text = format_descriptions(describe(scene, gbuffer=True), source=True)
     assert "2 distinct program(s)" in text and "effective fragment source:" in text
 

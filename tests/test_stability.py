@@ -152,7 +152,7 @@ def test_shade_is_in_band_and_finite(session_gl, lobe, log_q, q_zero, log_d, log
     uniforms = {"u_point_position": np.float32([light]), "u_point_intensity": np.float32([[power / (4 * np.pi)] * 3]),
                 **material.uniform_values(key)}
     if key.needs_view:  # only the lobes read the view vector
-        uniforms["u_eye"] = np.float32(eye)
+        uniforms["u_eye"] = np.float32(np.append(eye, 1.0))  # the homogeneous eye of a perspective view
     programs = ProgramCache(session_gl.mgl)
     try:
         gpu = shade_points(session_gl, programs, key, uniforms, positions, normals).astype(np.float64)

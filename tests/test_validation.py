@@ -447,7 +447,7 @@ def camera():
 
 @pytest.mark.parametrize("bad", [None, "camera", np.eye(4), glphong.PerspectiveCamera])
 def test_scene_camera_wrong_type(bad):
-    with pytest.raises(TypeError, match=m("camera must be a glphong.PerspectiveCamera", f"got {type(bad).__name__}")):
+    with pytest.raises(TypeError, match=m("camera must be a glphong camera such as PerspectiveCamera", f"got {type(bad).__name__}")):
         glphong.Scene(bad)
 
 

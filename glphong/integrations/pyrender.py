@@ -183,8 +183,10 @@ class _ProgramAdapter:
         values = {"u_model": model, "u_view_projection": self._camera["P"] @ self._camera["V"]}
         if key.has_normal:
             values["u_normal_matrix"] = np.linalg.inv(model[:3, :3]).T
-        if key.needs_view:
-            values["u_eye"] = self._camera["cam_pos"]
+        if key.needs_view:  # the homogeneous eye: pyrender's camera centre, or an orthographic view's axis
+            projection, view = self._camera["P"], self._camera["V"]
+            values["u_eye"] = np.append(view[2, :3], 0.0) if projection[3, 3] == 1.0 else \
+                np.append(self._camera["cam_pos"], 1.0)
         values["u_exposure"] = material.exposure
         values.update(material.glphong.uniform_values(key))
         values.update(self.lights.light_uniform_values(key))
