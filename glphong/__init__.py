@@ -16,9 +16,10 @@ from .camera import Camera, IntrinsicsCamera, OrthographicCamera, PerspectiveCam
 from .contexts import BackendUnavailableError, available_backends, create_context
 from .describe import describe, format_descriptions
 from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
+from .loaders import load_scene
 from .materials import (AshikhminShirley, BlinnPhong, CookTorrance, DielectricFresnel, Diffuse, Lafortune, Lambert,
-                        Material, MaterialModel, MaterialSum, MeasuredBRDF, NormalizedBlinnPhong, NormalizedPhong,
-                        OrenNayar, Param, Phong, SchlickFresnel, Ward)
+                        Material, MaterialModel, MaterialSum, MeasuredBRDF, MtlPhong, NormalizedBlinnPhong,
+                        NormalizedPhong, OrenNayar, Param, Phong, SchlickFresnel, Ward)
 from .renderer import Frame, GBuffer, Renderer
 from .scene import Scene, SceneObject
 from .verify import VerifyReport, verify
@@ -28,8 +29,8 @@ __version__ = "0.1.0"
 __all__ = [
     "Camera", "PerspectiveCamera", "IntrinsicsCamera", "OrthographicCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
-    "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "SchlickFresnel",
-    "DielectricFresnel", "Scene", "SceneObject", "Renderer", "Frame", "GBuffer",
+    "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
+    "DielectricFresnel", "Scene", "SceneObject", "load_scene", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
     "imaging", "materials", "primitives", "radiometry", "reference",
 ]

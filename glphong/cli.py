@@ -10,9 +10,48 @@ import time
 __all__ = ["main"]
 
 
+def _render_file(args):
+    """``glphong render FILE``: a scene file at the requested size (its camera and lights, or the defaults)."""
+    from pathlib import Path
+
+    from .loaders import load_scene
+    from .renderer import Renderer
+
+    try:
+        scene = load_scene(args.file)
+    except ValueError as exc:
+        print(f"glphong render: {exc}", file=sys.stderr)
+        return 2
+    out = args.out if args.out is not None else str(Path(args.file).with_suffix(".png").name)
+    exposure = 1.0 if args.exposure is None else args.exposure
+    with Renderer(args.width, args.height, backend=args.backend, samples=args.samples) as renderer:
+        start = time.perf_counter()
+        frame = renderer.render(scene)
+        seconds = time.perf_counter() - start
+        frame.save_png(out, exposure=exposure)
+        if args.npy:
+            frame.save_npy(args.npy)
+        print(f"wrote {out}: {args.file}, {len(scene.objects)} object(s), {args.width}x{args.height} on "
+              f"{renderer.backend} in {seconds:.2f} s")
+        if args.verify:
+            from .verify import verify
+
+            result = verify(scene, renderer)
+            print(f"cross-check against the float64 twin: {result}")
+            return 0 if result.passed else 1
+    return 0
+
+
 def _render(args):
     from .figures import phong_examples
     from .renderer import Renderer
+
+    if args.file is not None:
+        return _render_file(args)
+    if args.out is None:
+        args.out = "phong_examples.png"
+    if args.exposure is None:
+        args.exposure = 0.6
 
     with Renderer(args.tile, args.tile, backend=args.backend) as renderer:
         start = time.perf_counter()
@@ -256,6 +295,17 @@ def _positive_int(text):
     return value
 
 
+def _image_side(text):
+    """``--width``, ``--height``: an integer from 1 to 16384 (the renderer checks memory before work too)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"--width and --height must be integers from 1 to 16384 (got {text!r})") from None
+    if not 1 <= value <= 16384:
+        raise argparse.ArgumentTypeError(f"--width and --height must be from 1 to 16384 (got {value})")
+    return value
+
+
 def _tile_size(text):
     """``--tile``: an integer from 1 to 1024 (the figure is 8 x 5 tiles: 1024 makes 8192 x 5120 px, a
     0.5 GB float32 image in memory)."""
@@ -279,14 +329,19 @@ def build_parser():
         "twin. With no command: render the lecture's 'Phong Examples' figure to phong_examples.png.")
     parser.add_argument("--version", action="version", version=f"glphong {__version__}")
     sub = parser.add_subparsers(dest="command")
-    render = sub.add_parser("render", help="render the 'Phong Examples' figure (the default command)")
-    render.add_argument("--out", default="phong_examples.png", type=_png_path,
-                        help="PNG path (default: phong_examples.png)")
+    render = sub.add_parser("render", help="render the 'Phong Examples' figure (the default command), or a scene file")
+    render.add_argument("file", nargs="?", default=None,
+                        help="a scene file to render (.obj with its .mtl); without it, the default figure")
+    render.add_argument("--out", default=None, type=_png_path,
+                        help="PNG path (default: phong_examples.png, or the file's name with .png)")
+    render.add_argument("--width", type=_image_side, default=512, help="with FILE: image width, 1 to 16384 (default 512)")
+    render.add_argument("--height", type=_image_side, default=512, help="with FILE: image height, 1 to 16384 (default 512)")
+    render.add_argument("--samples", type=int, choices=(1, 2, 4), default=1, help="with FILE: MSAA samples (default 1)")
     render.add_argument("--npy", default=None, type=_writable, help="also write the raw float32 radiance to this .npy path")
     render.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
     render.add_argument("--tile", type=_tile_size, default=128, help="tile size in pixels, 1 to 1024 (default 128)")
-    render.add_argument("--exposure", type=_positive_float, default=0.6,
-                        help="linear exposure before sRGB encoding, > 0 (default 0.6)")
+    render.add_argument("--exposure", type=_positive_float, default=None,
+                        help="linear exposure before sRGB encoding, > 0 (default 0.6 for the figure, 1 for a file)")
     render.add_argument("--verify", action="store_true", help="cross-check every tile against the float64 twin")
     render.set_defaults(func=_render)
     stability = sub.add_parser("stability", help="run the extreme-case suite: GPU vs float64 vs tolerance band")

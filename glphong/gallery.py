@@ -46,6 +46,7 @@ GALLERY = (
     ("Ward 0.3 x 0.06", lambda: _m("Ward")(ALBEDO, 0.2, 0.3, 0.06)),
     ("Ward bounded", lambda: _m("Ward")(ALBEDO, 0.2, 0.3, 0.06, normalization="bounded")),
     ("Ashikhmin-Shirley 1000 x 20", lambda: _m("AshikhminShirley")(ALBEDO, 0.1, 1000.0, 20.0)),
+    ("MTL Phong (OBJ files)", lambda: _m("MtlPhong")(KD, 0.25, 60.0, 0.05)),
     ("Measured Cook-Torrance, trilinear", lambda: _m("MeasuredBRDF")(_cook_torrance_table(), "trilinear")),
     ("Measured Cook-Torrance, nearest", lambda: _m("MeasuredBRDF")(_cook_torrance_table())),
 )

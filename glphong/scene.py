@@ -141,6 +141,13 @@ class Scene:
         self._objects.append(obj)
         return obj
 
+    @classmethod
+    def from_trimesh(cls, trimesh_scene, camera=None, lights=None, ambient=None, materials=None):
+        """A scene of a ``trimesh.Scene``: its nodes' transforms and parts (`glphong.loaders.scene_from_trimesh`)."""
+        from .loaders import scene_from_trimesh
+
+        return scene_from_trimesh(trimesh_scene, camera, lights, ambient, materials)
+
     def light_counts(self):
         """Number of lights per kind, dict of str to int."""
         return {kind: sum(1 for light in self._lights if light.kind == kind) for kind in LIGHT_KINDS}

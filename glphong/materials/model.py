@@ -406,7 +406,8 @@ def _check_glsl(cls, text):
         raise MaterialDefinitionError(
             f"{cls.__qualname__}.glsl reads {', '.join(f'u_{name}_{x}' for x in sorted(read - declared))}, "
             f"which no Param or Table declares (params and tables: {', '.join(sorted(declared)) or 'none'})")
-    unread = declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]}  # the Fresnel slot's: generated
+    # the Fresnel slot's uniforms and the ambient parameter are read by generated code
+    unread = declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]} - {cls.ambient}
     if unread:
         raise MaterialDefinitionError(
             f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(unread))}: "

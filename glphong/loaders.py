@@ -1,0 +1,316 @@
+"""Scenes from the files users have: Wavefront OBJ with its MTL materials, and trimesh scenes.
+
+`load_scene(path)` reads an ``.obj`` file (`read_obj`: one object per material, ``usemtl``) and the MTL
+files it names (``mtllib``, `parse_mtl`) itself, so that ``Kd``, ``Ks``, ``Ka`` and ``Ns`` keep their
+decimal values (trimesh keeps 8-bit colours, and drops every material of a file whose MTL it cannot
+parse, e.g. one with a single-value ``Kd``).  Each part gets the material its MTL entry
+means (`glphong.materials.MtlPhong`):
+
+- ``illum 0``: colour ``Kd`` with no lighting: a constant radiance ``ka = Kd`` and nothing lit;
+- ``illum 1``: ``Kd (n.l) E + Ka L_a`` (no specular term);
+- ``illum 2``: ``Kd (n.l) E + Ks max(v.r, 0)^Ns E + Ka L_a``;
+- ``illum 3`` to ``10`` (reflections, refraction, ray tracing): rendered as ``illum 2``, with a warning.
+
+An OBJ file has no camera and no light.  Unless given, the camera looks at the centre of the geometry's
+bounding sphere (radius ``r``) from ``3 r`` along ``(0.3, 0.4, 1)`` (it fills 87% of a 45-degree view), a
+point light above and beside it delivers ``E = 1 W/m^2`` at the centre, and the ambient light is
+``L_a = 0.1`` (MTL's ``Ka`` multiplies it).
+
+`scene_from_trimesh` (also `glphong.Scene.from_trimesh`) keeps a ``trimesh.Scene``'s node transforms and
+parts; a part's material comes from ``materials`` (a mapping by part or material name, or a function of
+the name and the trimesh geometry), else from its trimesh material: a ``SimpleMaterial`` (OBJ) as
+`MtlPhong` from its 8-bit colours, a ``PBRMaterial`` (glTF) as ``Lambert(baseColor / pi)``, else
+``Lambert(0.5 / pi)``.
+"""
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+__all__ = ["load_scene", "read_obj", "scene_from_trimesh", "parse_mtl", "material_from_mtl", "default_view"]
+
+#: formats `load_scene` reads
+FORMATS = (".obj",)
+
+
+def parse_mtl(path):
+    """The materials of an MTL file, keyword values as written.
+
+    Returns
+    -------
+    dict of str to dict
+        Per ``newmtl`` name: ``Kd``, ``Ks``, ``Ka`` (tuples of 3 float, a single value repeated), ``Ns``
+        (float), ``illum`` (int), where the file gives them.
+
+    Raises
+    ------
+    ValueError
+        A keyword with values that are not numbers, naming the file and line.
+    """
+    out, current = {}, None
+    for number, raw in enumerate(Path(path).read_text(encoding="utf-8", errors="replace").splitlines(), start=1):
+        words = raw.split("#", 1)[0].split()
+        if not words:
+            continue
+        keyword, values = words[0], words[1:]
+        if keyword == "newmtl":
+            current = out.setdefault(" ".join(values), {})
+            continue
+        if current is None or keyword not in ("Kd", "Ks", "Ka", "Ns", "illum"):
+            continue
+        try:
+            if keyword in ("Kd", "Ks", "Ka"):
+                numbers = [float(v) for v in values[:3]]
+                current[keyword] = tuple(numbers * 3 if len(numbers) == 1 else numbers)
+                if len(current[keyword]) != 3:
+                    raise ValueError
+            elif keyword == "Ns":
+                current["Ns"] = float(values[0])
+            else:
+                current["illum"] = int(values[0])
+        except (ValueError, IndexError):
+            raise ValueError(f"{path}:{number}: {keyword} needs numbers (got {' '.join(values)!r})") from None
+    return out
+
+
+def material_from_mtl(entry, name="", source=""):
+    """The glphong material an MTL entry (`parse_mtl`) means (see the module)."""
+    from .materials import MtlPhong
+
+    kd = entry.get("Kd", (0.8, 0.8, 0.8))  # MTL's default diffuse colour
+    ks = entry.get("Ks", (0.0, 0.0, 0.0))
+    ka = entry.get("Ka", (0.0, 0.0, 0.0))
+    q = entry.get("Ns", 0.0)
+    illum = entry.get("illum", 2 if any(ks) else 1)
+    if illum == 0:
+        return MtlPhong(0.0, 0.0, 0.0, 0.0, ka=kd)
+    if illum == 1:
+        return MtlPhong(kd, 0.0, q, ka)
+    if illum != 2:
+        warnings.warn(f"{source}: material {name!r} has illum {illum} (reflection, refraction or ray tracing): "
+                      "glphong renders it as illum 2 (Kd, Ks, Ns and Ka)", stacklevel=3)
+    return MtlPhong(kd, ks, q, ka)
+
+
+def default_view(scene):
+    """A camera, a point light and an ambient light for a scene that has none (see the module):
+    ``(camera, [light], ambient)``."""
+    from .camera import PerspectiveCamera
+    from .lights import AmbientLight, PointLight
+
+    points = [(obj.pose[:3, :3] @ obj.mesh.positions.T).T + obj.pose[:3, 3] for obj in scene.objects]
+    points = np.concatenate(points) if points else np.zeros((1, 3))
+    centre = (points.min(axis=0) + points.max(axis=0)) / 2
+    radius = max(float(np.sqrt(np.max(np.sum((points - centre) ** 2, axis=1)))), 1e-6)
+    direction = np.array([0.3, 0.4, 1.0]) / np.linalg.norm([0.3, 0.4, 1.0])
+    distance = 3.0 * radius  # the bounding sphere fills 87% of a 45-degree view
+    camera = PerspectiveCamera.look_at(centre + distance * direction, centre, yfov=math.radians(45.0),
+                                       znear=0.01 * radius, zfar=distance + 4 * radius)
+    light = centre + distance * direction + radius * np.array([1.0, 1.5, 0.0])
+    d = np.linalg.norm(light - centre)
+    return camera, [PointLight(tuple(light), 4 * math.pi * d * d)], AmbientLight(0.1)
+
+
+def _trimesh_material(name, geometry):
+    from .materials import Lambert, MtlPhong
+
+    material = getattr(getattr(geometry, "visual", None), "material", None)
+    kind = type(material).__name__
+    if kind == "SimpleMaterial":
+        rgb = lambda c: tuple(np.asarray(c, dtype=np.float64)[:3] / 255.0)  # noqa: E731
+        return MtlPhong(rgb(material.diffuse), rgb(material.specular), float(material.glossiness or 0.0),
+                        rgb(material.ambient))
+    if kind == "PBRMaterial" and material.baseColorFactor is not None:
+        return Lambert(tuple(np.asarray(material.baseColorFactor, dtype=np.float64)[:3] / 255.0 / math.pi))
+    return Lambert(0.5 / math.pi)
+
+
+def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, materials=None):
+    """A `glphong.Scene` of a ``trimesh.Scene`` (or ``Trimesh``): every node's geometry with its world
+    transform, named after the node; materials as in the module notes.
+
+    Parameters
+    ----------
+    trimesh_scene : trimesh.Scene or trimesh.Trimesh
+    camera : glphong camera, optional
+        Default: `default_view`'s (also its light and ambient light when ``lights`` is None).
+    lights : sequence of lights, optional
+    ambient : glphong.AmbientLight, optional
+    materials : dict of str to Material, or callable, optional
+        By geometry name or material name; a callable gets ``(name, geometry)`` and returns a Material
+        (or None for the default).
+    """
+    import trimesh
+
+    from .materials import Material
+    from .scene import Scene
+
+    if isinstance(trimesh_scene, trimesh.Trimesh):
+        trimesh_scene = trimesh.Scene(trimesh_scene)
+    if not isinstance(trimesh_scene, trimesh.Scene):
+        raise TypeError(f"trimesh_scene must be a trimesh.Scene or trimesh.Trimesh (got {type(trimesh_scene).__name__})")
+    parts = []
+    for node in trimesh_scene.graph.nodes_geometry:
+        transform, geometry_name = trimesh_scene.graph[node]
+        geometry = trimesh_scene.geometry[geometry_name]
+        if not isinstance(geometry, trimesh.Trimesh) or len(geometry.faces) == 0:
+            continue  # point clouds and paths have no surface to shade
+        material = None
+        if callable(materials):
+            material = materials(geometry_name, geometry)
+        elif materials:
+            material_name = getattr(getattr(geometry.visual, "material", None), "name", None)
+            material = materials.get(geometry_name, materials.get(material_name))
+        if material is None:
+            material = _trimesh_material(geometry_name, geometry)
+        if not isinstance(material, Material):
+            raise TypeError(f"materials gave {type(material).__name__} for {geometry_name!r}: it must give a "
+                            "glphong material")
+        parts.append((geometry, material, np.asarray(transform, dtype=np.float64), str(node)))
+    from .camera import PerspectiveCamera
+
+    scene = Scene(camera if camera is not None else PerspectiveCamera(1.0), lights or (), ambient)
+    for geometry, material, transform, name in parts:
+        scene.add(geometry, material, pose=transform, name=name)
+    if camera is None:
+        view_camera, view_lights, view_ambient = default_view(scene)
+        scene.camera = view_camera
+        if lights is None:
+            for light in view_lights:
+                scene.add_light(light)
+            if ambient is None:
+                scene.ambient = view_ambient
+    return scene
+
+
+def read_obj(path):
+    """The triangles of a Wavefront OBJ file, one `MeshData` per material (``usemtl``) in order of first use.
+
+    ``v``, ``vn``, ``vt`` and ``f`` (polygons fanned into triangles, negative indices counted from the end)
+    are read; a part whose corners all carry a normal keeps the file's normals, the others get smooth
+    vertex normals (trimesh's, area-weighted).  Faces before any ``usemtl`` form the part ``""``.
+
+    Returns
+    -------
+    list of (str, MeshData)
+
+    Raises
+    ------
+    ValueError
+        Naming the file and line: a face index out of range, a value that is not a number.
+    """
+    from .geometry import MeshData
+
+    positions, normals, uvs, parts, current = [], [], [], {}, ""
+    text = Path(path).read_text(encoding="utf-8", errors="replace")
+    for number, raw in enumerate(text.splitlines(), start=1):
+        words = raw.split("#", 1)[0].split()
+        if not words:
+            continue
+        keyword = words[0]
+        try:
+            if keyword == "v":
+                positions.append([float(x) for x in words[1:4]])
+            elif keyword == "vn":
+                normals.append([float(x) for x in words[1:4]])
+            elif keyword == "vt":
+                uvs.append([float(x) for x in (words[1:3] + ["0"])[:2]])
+            elif keyword == "usemtl":
+                current = " ".join(words[1:])
+            elif keyword == "f":
+                corners = []
+                for word in words[1:]:
+                    fields = (word.split("/") + ["", ""])[:3]
+                    index = []
+                    for field, count in zip(fields, (len(positions), len(uvs), len(normals))):
+                        k = int(field) if field else 0
+                        k = k - 1 if k > 0 else (count + k if k < 0 else -1)
+                        if field and not 0 <= k < count:
+                            raise IndexError
+                        index.append(k)
+                    corners.append(tuple(index))
+                part = parts.setdefault(current, [])
+                part += [(corners[0], corners[i], corners[i + 1]) for i in range(1, len(corners) - 1)]
+        except (ValueError, IndexError):
+            raise ValueError(f"{path}:{number}: cannot read {raw.strip()!r} (a number or an index out of range)") from None
+    positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
+    out = []
+    for name, triangles in parts.items():
+        corners = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)  # (3T, [v, vt, vn])
+        unique, inverse = np.unique(corners, axis=0, return_inverse=True)
+        faces = inverse.reshape(-1, 3)
+        with_normals = bool(np.all(unique[:, 2] >= 0))
+        if with_normals:
+            vertex_normals = np.asarray(normals, dtype=np.float64)[unique[:, 2]]
+        else:
+            import trimesh
+
+            merged = trimesh.Trimesh(positions[unique[:, 0]], faces, process=False)
+            vertex_normals = merged.vertex_normals
+        vertex_uvs = np.asarray(uvs, dtype=np.float64)[unique[:, 1]] if len(uvs) and np.all(unique[:, 1] >= 0) else None
+        out.append((name, MeshData(positions[unique[:, 0]], vertex_normals, faces, uvs=vertex_uvs)))
+    return out
+
+
+def load_scene(path, camera=None, lights=None, ambient=None, materials=None):
+    """Load a scene file as a `glphong.Scene` (see the module for what each format keeps).
+
+    Parameters
+    ----------
+    path : str or path-like
+        A Wavefront ``.obj`` (with its ``.mtl`` files).
+    camera, lights, ambient
+        As in `scene_from_trimesh` (default: `default_view`'s).
+    materials : dict of str to Material, or callable, optional
+        Overrides the MTL materials by material name; a callable gets ``(name, MTL entry or None)``
+        and returns a Material (or None for the file's).
+
+    Raises
+    ------
+    ValueError
+        A format glphong does not read (naming those it does), a missing file, or a line of the OBJ or
+        MTL file that cannot be read (naming the file and line).
+    """
+    from .camera import PerspectiveCamera
+    from .materials import Material
+    from .scene import Scene
+
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise ValueError(f"{path}: glphong reads {', '.join(FORMATS)} scene files (got {suffix or 'no suffix'!r})")
+    if not path.is_file():
+        raise ValueError(f"{path}: no such file")
+    mtl = {}
+    for line in path.read_text(encoding="utf-8", errors="replace").splitlines():
+        words = line.split("#", 1)[0].split()
+        if words and words[0] == "mtllib":
+            for name in words[1:]:
+                library = path.parent / name
+                if library.is_file():
+                    mtl.update(parse_mtl(library))
+                else:
+                    warnings.warn(f"{path}: mtllib {name} not found next to it; its materials get defaults",
+                                  stacklevel=2)
+    scene = Scene(camera if camera is not None else PerspectiveCamera(1.0), lights or (), ambient)
+    for name, mesh in read_obj(path):
+        material = None
+        if callable(materials):
+            material = materials(name, mtl.get(name))
+        elif materials and name in materials:
+            material = materials[name]
+        if material is None:
+            material = material_from_mtl(mtl[name], name, str(path)) if name in mtl else material_from_mtl({}, name)
+        if not isinstance(material, Material):
+            raise TypeError(f"materials gave {type(material).__name__} for {name!r}: it must give a glphong material")
+        scene.add(mesh, material, name=name or path.stem)
+    if camera is None:
+        view_camera, view_lights, view_ambient = default_view(scene)
+        scene.camera = view_camera
+        if lights is None:
+            for light in view_lights:
+                scene.add_light(light)
+            if ambient is None:
+                scene.ambient = view_ambient
+    return scene
