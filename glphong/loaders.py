@@ -112,6 +112,28 @@ def default_view(scene):
     return camera, [PointLight(tuple(light), 4 * math.pi * d * d)], AmbientLight(0.1)
 
 
+def _scene(camera, lights, ambient):
+    """An empty scene with the given camera (a stand-in until `_with_view` places the default one)."""
+    from .camera import PerspectiveCamera
+    from .scene import Scene
+
+    return Scene(camera if camera is not None else PerspectiveCamera(1.0), lights or (), ambient)
+
+
+def _with_view(scene, camera, lights, ambient):
+    """``scene`` with `default_view`'s camera where none was given, and its lights and ambient light where
+    no lights were given either."""
+    if camera is None:
+        view_camera, view_lights, view_ambient = default_view(scene)
+        scene.camera = view_camera
+        if lights is None:
+            for light in view_lights:
+                scene.add_light(light)
+            if ambient is None:
+                scene.ambient = view_ambient
+    return scene
+
+
 def _trimesh_material(name, geometry):
     from .materials import Lambert, MtlPhong
 
@@ -144,7 +166,6 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
     import trimesh
 
     from .materials import Material
-    from .scene import Scene
 
     if isinstance(trimesh_scene, trimesh.Trimesh):
         trimesh_scene = trimesh.Scene(trimesh_scene)
@@ -168,20 +189,10 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
             raise TypeError(f"materials gave {type(material).__name__} for {geometry_name!r}: it must give a "
                             "glphong material")
         parts.append((geometry, material, np.asarray(transform, dtype=np.float64), str(node)))
-    from .camera import PerspectiveCamera
-
-    scene = Scene(camera if camera is not None else PerspectiveCamera(1.0), lights or (), ambient)
+    scene = _scene(camera, lights, ambient)
     for geometry, material, transform, name in parts:
         scene.add(geometry, material, pose=transform, name=name)
-    if camera is None:
-        view_camera, view_lights, view_ambient = default_view(scene)
-        scene.camera = view_camera
-        if lights is None:
-            for light in view_lights:
-                scene.add_light(light)
-            if ambient is None:
-                scene.ambient = view_ambient
-    return scene
+    return _with_view(scene, camera, lights, ambient)
 
 
 def read_obj(path):
@@ -272,9 +283,7 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None):
         A format glphong does not read (naming those it does), a missing file, or a line of the OBJ or
         MTL file that cannot be read (naming the file and line).
     """
-    from .camera import PerspectiveCamera
     from .materials import Material
-    from .scene import Scene
 
     path = Path(path)
     suffix = path.suffix.lower()
@@ -293,7 +302,7 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None):
                 else:
                     warnings.warn(f"{path}: mtllib {name} not found next to it; its materials get defaults",
                                   stacklevel=2)
-    scene = Scene(camera if camera is not None else PerspectiveCamera(1.0), lights or (), ambient)
+    scene = _scene(camera, lights, ambient)
     for name, mesh in read_obj(path):
         material = None
         if callable(materials):
@@ -305,12 +314,4 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None):
         if not isinstance(material, Material):
             raise TypeError(f"materials gave {type(material).__name__} for {name!r}: it must give a glphong material")
         scene.add(mesh, material, name=name or path.stem)
-    if camera is None:
-        view_camera, view_lights, view_ambient = default_view(scene)
-        scene.camera = view_camera
-        if lights is None:
-            for light in view_lights:
-                scene.add_light(light)
-            if ambient is None:
-                scene.ambient = view_ambient
-    return scene
+    return _with_view(scene, camera, lights, ambient)

@@ -20,8 +20,6 @@ kamb       rgb     >= 0                ambient coefficient ``Ka``: the answer ``
 
 Not reciprocal, not energy-conserving, isotropic (the lecture's Phong; `glphong.analysis` measures it).
 """
-import numpy as np
-
 from .model import GlslFile, MaterialModel, Param, Properties
 
 __all__ = ["MtlPhong"]
