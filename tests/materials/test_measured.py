@@ -24,7 +24,7 @@ import pytest
 
 import glphong
 from glphong import merl, primitives
-from glphong.materials import MeasuredBRDF, TableData
+from glphong.materials import MeasuredBRDF
 from glphong.materials.measured import measured_brdf_coordinates
 from glphong.testing import TwinMismatch, assert_twin_matches
 
