@@ -12,8 +12,10 @@ The default executor is a ``concurrent.futures.ProcessPoolExecutor`` started wit
 of a process that made a context would hang: `glphong.contexts.ForkedProcessError`), one renderer per
 worker made on first use and kept, and ``LP_NUM_THREADS`` set in each worker before its first context so
 that the workers do not oversubscribe the cores.  Any ``concurrent.futures.Executor`` works, a Dask
-client's included (``client.get_executor()``; see the README).  A worker that dies mid-batch costs no
-frame: the pool is made again and the frames not yet on disk are rendered again.
+client's included (``client.get_executor()``, for a real cluster ``Client("tcp://scheduler:8786")`` or
+dask-jobqueue's), and ``executor="dask"`` starts a local Dask cluster.  A worker that dies mid-batch costs
+no frame: the pool is made again and the frames not yet on disk are rendered again (Dask reschedules the
+task itself).
 """
 import hashlib
 import json
@@ -51,6 +53,19 @@ def _set_threads(threads):
     """Worker initialiser: llvmpipe's rasterizer threads per worker, before the worker's first context."""
     if threads:
         os.environ.setdefault("LP_NUM_THREADS", str(threads))
+
+
+def _local_dask(workers):
+    """``((client, cluster), executor)``: a local Dask cluster of ``workers`` single-threaded processes."""
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise ImportError("executor='dask' needs dask.distributed: pip install 'glphong[dask]'") from None
+    threads = max(1, (os.cpu_count() or 1) // workers)
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                           env={"LP_NUM_THREADS": str(threads)})
+    client = Client(cluster)
+    return (client, cluster), client.get_executor()
 
 
 def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options):
@@ -94,9 +109,11 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
     width, height : int
     out_dir : str or path-like
         Made if missing.  Holds the frames and ``manifest.json``.
-    executor : concurrent.futures.Executor, optional
+    executor : concurrent.futures.Executor or 'dask', optional
         Default: a 'spawn' process pool of ``workers`` processes (default: the CPU count), shut down at
-        the end; a given executor is used as it is and left running.
+        the end; a given executor is used as it is and left running (a Dask client's:
+        ``client.get_executor()``).  ``'dask'``: a local Dask cluster of ``workers`` single-threaded
+        worker processes (``dask.distributed.LocalCluster``, from the ``[dask]`` extra), closed at the end.
     fmt : {'npy', 'png'}
         float32 radiance ``.npy`` (default) or an 8-bit sRGB PNG at exposure 1.
     frames_per_task : int
@@ -140,8 +157,12 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
                              "batches in one folder; use another out_dir or remove it")
     paths = [str(out / _frame_name(i, fmt)) for i in range(len(specs))]
     missing = [i for i in range(len(specs)) if not os.path.exists(paths[i])]
-    own = executor is None
     workers = workers or os.cpu_count() or 1
+    cluster = None
+    if isinstance(executor, str):
+        _validate.choice("executor", executor, ("dask",))
+        cluster, executor = _local_dask(workers)
+    own = executor is None
     bar = progress_bar(len(missing), progress, unit="frame")
     renderer_name = None
     try:
@@ -176,6 +197,9 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
             bar.close()
         if own and executor is not None:
             executor.shutdown()
+        if cluster is not None:
+            for closing in cluster:
+                closing.close()
     if not manifest.exists():  # every frame was already there
         manifest.write_text(json.dumps(batch, indent=1))
     return paths

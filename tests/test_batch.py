@@ -87,3 +87,38 @@ def test_example_batch_turntable(tmp_path):
     spec.loader.exec_module(example)
     paths = example.main(frames=4, out_dir=str(tmp_path / "t"), size=24)
     assert len(paths) == 4 and all(np.load(p).shape == (24, 24, 3) for p in paths)
+
+
+def test_dask_cluster_with_a_killed_worker(tmp_path, serial):
+    """The same batch on a two-worker Dask LocalCluster (executor='dask'), one worker killed the first time
+    it meets spec 3: Dask reschedules it, every frame is present once and equal to the serial render."""
+    pytest.importorskip("distributed", reason="dask.distributed is not installed (pip install 'glphong[dask]')")
+    helper = tmp_path / "batch_helper_dask.py"
+    helper.write_text(textwrap.dedent(f"""
+        import os
+        from glphong.batch import turntable_scene
+
+        MARKER = {str(tmp_path / "died")!r}
+
+        def dying_scene(angle):
+            if angle == 90.0 and not os.path.exists(MARKER):
+                open(MARKER, "w").close()
+                os._exit(9)
+            return turntable_scene(angle)
+    """))
+    sys.path.insert(0, str(tmp_path))
+    os.environ["PYTHONPATH"] = os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])
+    try:
+        import batch_helper_dask
+
+        paths = render_many(batch_helper_dask.dying_scene, ANGLES, W, H, tmp_path / "frames", executor="dask",
+                            workers=2, progress=False)
+    finally:
+        sys.path.remove(str(tmp_path))
+        os.environ["PYTHONPATH"] = os.environ["PYTHONPATH"].split(os.pathsep, 1)[1]
+        if not os.environ["PYTHONPATH"]:
+            del os.environ["PYTHONPATH"]
+        sys.modules.pop("batch_helper_dask", None)
+    assert (tmp_path / "died").exists()
+    assert all(np.array_equal(a, b) for a, b in zip(_frames(paths), serial))
+    assert sorted(os.listdir(tmp_path / "frames")) == sorted([os.path.basename(p) for p in paths] + ["manifest.json"])
