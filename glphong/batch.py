@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["render_many", "turntable_scene", "BatchError"]
+__all__ = ["render_many", "turntable_scene", "orbit_scene", "BatchError"]
 
 _WORKER = {}
 
@@ -229,3 +229,28 @@ def turntable_scene(angle):
     floor[1, 3] = -0.6
     scene.add(primitives.plane(6.0, 4), Lambert(0.08), pose=floor)
     return scene
+
+
+def orbit_scene(spec):
+    """``spec = (path, angle)``: the scene file at ``path`` (`glphong.load_scene`, its default view) with the
+    camera turned by ``angle`` degrees about the vertical axis through the geometry's centre (a picklable
+    ``scene_fn`` for turntables of files: ``glphong render FILE --frames N``)."""
+    import math
+
+    from .camera import PerspectiveCamera
+    from .loaders import load_scene
+
+    path, angle = spec
+    scene = load_scene(path)
+    camera = scene.camera
+    target = camera.position - camera.pose[:3, 2] * np.linalg.norm(camera.position - _centre(scene))
+    a = math.radians(float(angle))
+    turn = np.array([[math.cos(a), 0.0, math.sin(a)], [0.0, 1.0, 0.0], [-math.sin(a), 0.0, math.cos(a)]])
+    eye = target + turn @ (camera.position - target)
+    scene.camera = PerspectiveCamera.look_at(eye, target, yfov=camera.yfov, znear=camera.znear, zfar=camera.zfar)
+    return scene
+
+
+def _centre(scene):
+    points = np.concatenate([(o.pose[:3, :3] @ o.mesh.positions.T).T + o.pose[:3, 3] for o in scene.objects])
+    return (points.min(axis=0) + points.max(axis=0)) / 2

@@ -22,8 +22,19 @@ def _render_file(args):
     except ValueError as exc:
         print(f"glphong render: {exc}", file=sys.stderr)
         return 2
-    out = args.out if args.out is not None else str(Path(args.file).with_suffix(".png").name)
     exposure = 1.0 if args.exposure is None else args.exposure
+    if args.frames:
+        from .batch import orbit_scene, render_many
+
+        folder = args.out if args.out is not None else f"{Path(args.file).stem}_frames"
+        start = time.perf_counter()
+        specs = [(str(Path(args.file).resolve()), 360.0 * k / args.frames) for k in range(args.frames)]
+        paths = render_many(orbit_scene, specs, args.width, args.height, folder, fmt="png", backend=args.backend,
+                            samples=args.samples)
+        print(f"wrote {len(paths)} frames of a turntable of {args.file} to {folder} in "
+              f"{time.perf_counter() - start:.1f} s")
+        return 0
+    out = args.out if args.out is not None else str(Path(args.file).with_suffix(".png").name)
     with Renderer(args.width, args.height, backend=args.backend, samples=args.samples) as renderer:
         start = time.perf_counter()
         frame = renderer.render(scene)
@@ -332,11 +343,15 @@ def build_parser():
     render = sub.add_parser("render", help="render the 'Phong Examples' figure (the default command), or a scene file")
     render.add_argument("file", nargs="?", default=None,
                         help="a scene file to render (.obj with its .mtl); without it, the default figure")
-    render.add_argument("--out", default=None, type=_png_path,
-                        help="PNG path (default: phong_examples.png, or the file's name with .png)")
+    render.add_argument("--out", default=None,
+                        help="PNG path (default: phong_examples.png, or the file's name with .png); with "
+                             "--frames, a folder")
     render.add_argument("--width", type=_image_side, default=512, help="with FILE: image width, 1 to 16384 (default 512)")
     render.add_argument("--height", type=_image_side, default=512, help="with FILE: image height, 1 to 16384 (default 512)")
     render.add_argument("--samples", type=int, choices=(1, 2, 4), default=1, help="with FILE: MSAA samples (default 1)")
+    render.add_argument("--frames", type=_positive_int, default=None,
+                        help="with FILE: a turntable of N PNG frames (worker processes) into --out, a folder "
+                             "(default FILE's name + _frames)")
     render.add_argument("--npy", default=None, type=_writable, help="also write the raw float32 radiance to this .npy path")
     render.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
     render.add_argument("--tile", type=_tile_size, default=128, help="tile size in pixels, 1 to 1024 (default 128)")
@@ -406,4 +421,14 @@ def main(argv=None):
     if not argv or argv[0].startswith("-") and argv[0] not in ("-h", "--help", "--version"):
         argv = ["render", *argv]
     args = parser.parse_args(argv)
+    if args.func is _render:  # --out is a PNG path, or a folder with FILE --frames: checked before any work
+        try:
+            if args.out is not None and not (args.file is not None and args.frames):
+                _png_path(args.out)
+            elif args.out is not None:
+                _writable(args.out)
+        except argparse.ArgumentTypeError as exc:
+            parser.error(f"argument --out: {exc}")
+        if args.frames and args.file is None:
+            parser.error("--frames needs a scene FILE (a turntable of it)")
     return args.func(args)

@@ -142,3 +142,23 @@ def test_cli_render_file(tmp_path, capsys):
     assert "glphong reads .obj scene files" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["render", str(path), "--width", "0"])
+
+
+def test_cli_turntable_frames(tmp_path, capsys):
+    from PIL import Image
+
+    from glphong.cli import main
+
+    folder = tmp_path / "spin"
+    assert main(["render", "examples/data/torus.obj", "--frames", "3", "--width", "40", "--height", "30",
+                 "--out", str(folder)]) == 0
+    frames = sorted(p.name for p in folder.glob("frame_*.png"))
+    assert frames == ["frame_000000.png", "frame_000001.png", "frame_000002.png"]
+    images = [np.asarray(Image.open(folder / f)) for f in frames]
+    assert images[0].shape == (30, 40, 3) and not np.array_equal(images[0], images[1])  # the view turned
+    with pytest.raises(SystemExit):
+        main(["render", "--frames", "3"])
+    assert "--frames needs a scene FILE" in capsys.readouterr().err
+    with pytest.raises(SystemExit):
+        main(["render", "examples/data/torus.obj", "--out", str(tmp_path / "x.jpg")])
+    assert "--out must end in .png" in capsys.readouterr().err
