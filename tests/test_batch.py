@@ -49,9 +49,10 @@ def test_pool_frames_equal_serial_and_resume(tmp_path, serial):
         render_many(turntable_scene, [lambda: 0], W, H, tmp_path / "other", workers=1, progress=False)
 
 
-def test_a_killed_worker_costs_no_frame(tmp_path, serial):
-    helper = tmp_path / "batch_helper_kill.py"
-    helper.write_text(textwrap.dedent(f"""
+def _dying_module(tmp_path, name):
+    """Write and import module ``name`` in ``tmp_path``: its ``dying_scene`` kills its process (``os._exit``)
+    the first time it meets the angle 90 (a marker file remembers), else builds the turntable scene."""
+    (tmp_path / f"{name}.py").write_text(textwrap.dedent(f"""
         import os
         from glphong.batch import turntable_scene
 
@@ -64,11 +65,14 @@ def test_a_killed_worker_costs_no_frame(tmp_path, serial):
             return turntable_scene(angle)
     """))
     sys.path.insert(0, str(tmp_path))
-    try:
-        import batch_helper_kill
+    return __import__(name)
 
+
+def test_a_killed_worker_costs_no_frame(tmp_path, serial):
+    try:
+        module = _dying_module(tmp_path, "batch_helper_kill")
         out = tmp_path / "frames"
-        paths = render_many(batch_helper_kill.dying_scene, ANGLES, W, H, out, workers=2, progress=False)
+        paths = render_many(module.dying_scene, ANGLES, W, H, out, workers=2, progress=False)
     finally:
         sys.path.remove(str(tmp_path))
         sys.modules.pop("batch_helper_kill", None)
@@ -93,25 +97,11 @@ def test_dask_cluster_with_a_killed_worker(tmp_path, serial):
     """The same batch on a two-worker Dask LocalCluster (executor='dask'), one worker killed the first time
     it meets spec 3: Dask reschedules it, every frame is present once and equal to the serial render."""
     pytest.importorskip("distributed", reason="dask.distributed is not installed (pip install 'glphong[dask]')")
-    helper = tmp_path / "batch_helper_dask.py"
-    helper.write_text(textwrap.dedent(f"""
-        import os
-        from glphong.batch import turntable_scene
-
-        MARKER = {str(tmp_path / "died")!r}
-
-        def dying_scene(angle):
-            if angle == 90.0 and not os.path.exists(MARKER):
-                open(MARKER, "w").close()
-                os._exit(9)
-            return turntable_scene(angle)
-    """))
-    sys.path.insert(0, str(tmp_path))
     os.environ["PYTHONPATH"] = os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])
     try:
-        import batch_helper_dask
+        module = _dying_module(tmp_path, "batch_helper_dask")
 
-        paths = render_many(batch_helper_dask.dying_scene, ANGLES, W, H, tmp_path / "frames", executor="dask",
+        paths = render_many(module.dying_scene, ANGLES, W, H, tmp_path / "frames", executor="dask",
                             workers=2, progress=False)
     finally:
         sys.path.remove(str(tmp_path))
