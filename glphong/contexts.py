@@ -28,6 +28,7 @@ __all__ = [
     "GLContext",
     "available_backends",
     "create_context",
+    "egl_device_count",
 ]
 
 BACKENDS = ("egl", "osmesa")
@@ -111,12 +112,12 @@ def _destroy_pool():
             pass
 
 
-def _reuse(backend, require):
-    """A recycled context of ``backend`` at least as new as ``require``, or None."""
+def _reuse(backend, require, device=0):
+    """A recycled context of ``backend`` (on EGL ``device``) at least as new as ``require``, or None."""
     with _POOL_LOCK:
         waiting = _POOL.get(backend, [])
         for i, ctx in enumerate(waiting):
-            if ctx.version_code >= require:
+            if ctx.version_code >= require and ctx.device == device:
                 return waiting.pop(i)
     return None
 
@@ -184,8 +185,9 @@ class GLContext:
         OpenGL version as reported by moderngl, e.g. ``450`` for 4.5.
     """
 
-    def __init__(self, backend, mgl, on_release=None):
+    def __init__(self, backend, mgl, on_release=None, device=0):
         self.backend = backend
+        self.device = device
         self.mgl = mgl
         self.renderer_name = mgl.info["GL_RENDERER"]
         self.version_code = mgl.version_code
@@ -380,10 +382,30 @@ def _osmesa_library():
     return lib
 
 
-def _create_egl(require):
+def _create_egl(require, device=0):
     # moderngl itself rejects a context older than ``require``.
-    mgl = moderngl.create_context(standalone=True, backend="egl", require=require)
-    return GLContext("egl", mgl)
+    mgl = moderngl.create_context(standalone=True, backend="egl", require=require, device_index=device)
+    return GLContext("egl", mgl, device=device)
+
+
+def egl_device_count():
+    """The number of EGL devices (``eglQueryDevicesEXT``), or None where libEGL or the extension is missing."""
+    name = ctypes.util.find_library("EGL")
+    if name is None:
+        return None
+    try:
+        egl = ctypes.CDLL(name)
+        egl.eglGetProcAddress.restype = ctypes.c_void_p
+        egl.eglGetProcAddress.argtypes = [ctypes.c_char_p]
+        address = egl.eglGetProcAddress(b"eglQueryDevicesEXT")
+    except (OSError, AttributeError):
+        return None
+    if not address:
+        return None
+    query = ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_int, ctypes.POINTER(ctypes.c_void_p),
+                             ctypes.POINTER(ctypes.c_int))(address)
+    count = ctypes.c_int(0)
+    return count.value if query(0, None, ctypes.byref(count)) else None
 
 
 def _create_osmesa(require):
@@ -421,22 +443,22 @@ def _create_osmesa(require):
 _CREATORS = {"egl": _create_egl, "osmesa": _create_osmesa}
 
 
-def _try_create(backend, require):
+def _try_create(backend, require, device=0):
     """Return ``(context, None)``, or ``(None, reason)`` if creation failed.
 
     The context current before the call stays current if it was entered.
     """
     check_not_forked()
-    reused = _reuse(backend, require)
+    reused = _reuse(backend, require, device)
     while reused is not None:
         try:
             reused._make_current()  # as a new context is: current (unless a with block restores another below)
             return reused, None
         except EGLDisplayTerminatedError:  # a recycled context whose display was terminated since: drop it
             reused._released = True
-            reused = _reuse(backend, require)
+            reused = _reuse(backend, require, device)
     try:
-        context = _CREATORS[backend](require)
+        context = _create_egl(require, device) if backend == "egl" else _CREATORS[backend](require)
         _note_gl_use()
         return context, None
     except Exception as exc:
@@ -451,7 +473,7 @@ def _install_hint(backend):
     return f"Debian/Ubuntu: apt-get install {SYSTEM_PACKAGES[backend]}"
 
 
-def create_context(backend="auto", require=330):
+def create_context(backend="auto", require=330, device=None):
     """Create an offscreen OpenGL core-profile context.
 
     A context a released `glphong.Renderer` recycled (`GLContext.recycle`) is reused when one of the
@@ -468,6 +490,8 @@ def create_context(backend="auto", require=330):
         empty, otherwise the first of `BACKENDS` that works.
     require : int, optional
         Minimum OpenGL version, as ``major * 100 + minor * 10``.
+    device : int, optional
+        The EGL device (GPU) index, as ``eglQueryDevicesEXT`` lists them (default 0); EGL only.
 
     Returns
     -------
@@ -477,7 +501,8 @@ def create_context(backend="auto", require=330):
     Raises
     ------
     ValueError
-        If ``backend`` or ``GLPHONG_BACKEND`` names no known backend.
+        If ``backend`` or ``GLPHONG_BACKEND`` names no known backend, or ``device`` is not an index of
+        this machine's EGL devices (the message gives their number).
     BackendUnavailableError
         If no context could be created; the message gives the reason for
         each backend tried and the system packages that provide it.
@@ -495,8 +520,19 @@ def create_context(backend="auto", require=330):
                 f"{', '.join(map(repr, BACKENDS))}; got {os.environ[_ENV_BACKEND]!r}"
             )
         origin = f" (chosen by {_ENV_BACKEND})"
+    if device is not None:
+        if backend == "auto":
+            backend = "egl"
+        if backend != "egl":
+            raise ValueError(f"device selects an EGL device: it needs backend 'egl' or 'auto' (got {backend!r})")
+        count = egl_device_count()
+        if isinstance(device, bool) or not isinstance(device, int) or device < 0 or (count is not None and device >= count):
+            raise ValueError(f"device must be an EGL device index from 0 to {'?' if count is None else count - 1} "
+                             f"(this machine has {'an unknown number of' if count is None else count} EGL device(s); "
+                             f"got {device!r})")
+    device = device or 0
     if backend != "auto":
-        ctx, reason = _try_create(backend, require)
+        ctx, reason = _try_create(backend, require, device)
         if ctx is None:
             raise BackendUnavailableError(
                 f"OpenGL backend {backend!r}{origin} is unavailable: {reason}. "

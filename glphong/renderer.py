@@ -268,6 +268,10 @@ class Renderer:
         outward-wound mesh wholly between the near and far planes; `glphong.culling`), which
         changes no pixel but a silhouette pixel where a back triangle ties with the front one in
         depth (there the front face shows).  'off': draw every triangle.
+    device : int, optional
+        The EGL device (GPU) to render on, an index of ``eglQueryDevicesEXT``'s list (default 0; EGL
+        only; `glphong.contexts.egl_device_count` says how many there are).  A batch passes it through
+        (``render_many(..., device=1)``).
     specialise : bool
         True (default): one program per distinct `ProgramKey`, containing only what the
         object needs.  False: every object drawn with the uber-shader (every built-in term,
@@ -281,7 +285,7 @@ class Renderer:
     """
 
     def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
-                 formulation="stable", specialise=True, culling="auto"):
+                 formulation="stable", specialise=True, culling="auto", device=None):
         self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
         self.samples = _validate.choice("samples", _validate.positive_int("samples", samples, 1, 8), (1, 2, 4, 8))
         self.supersample = _validate.positive_int("supersample", supersample, 1, 8)
@@ -295,7 +299,7 @@ class Renderer:
         self._lock = threading.RLock()
         check_not_forked()
         _release_orphans()
-        context = create_context(backend)
+        context = create_context(backend, device=device)
         try:
             with context:
                 info = context.mgl.info

@@ -297,3 +297,21 @@ def test_a_terminated_egl_display_is_named_not_rendered_through(make_context):
     out = subprocess.run([sys.executable, "-c", _TERMINATE_SCRIPT], capture_output=True, text=True, timeout=120)
     assert out.returncode == 0, out.stderr[-3000:]
     assert out.stdout.split() == ["REFUSED", "True", "FRESH", "True", "EVALUATE", "True"], out.stdout
+
+
+def test_egl_device_selection(make_context):
+    """``device`` selects an EGL device; an index this machine does not have is refused with how many it
+    has (it suggested installing packages before), and a non-EGL backend with a device is refused."""
+    import glphong
+    from glphong.contexts import egl_device_count
+
+    make_context("egl")  # skips (or fails where required) without EGL
+    count = egl_device_count()
+    assert count is not None and count >= 1
+    with glphong.Renderer(8, 8, backend="egl", device=0) as renderer:
+        assert renderer.context.device == 0
+    with pytest.raises(ValueError, match=rf"device must be an EGL device index from 0 to {count - 1} "
+                                         rf"\(this machine has {count} EGL device"):
+        glphong.Renderer(8, 8, device=count)
+    with pytest.raises(ValueError, match="needs backend 'egl' or 'auto'"):
+        glphong.Renderer(8, 8, backend="osmesa", device=0)
