@@ -68,6 +68,15 @@ def _local_dask(workers):
     return (client, cluster), client.get_executor()
 
 
+def _remove_partials(out):
+    """Remove the temporary files of writers that died (``.partial-*``; a frame is renamed when whole)."""
+    for leftover in Path(out).glob(".partial-*"):
+        try:
+            leftover.unlink()
+        except OSError:
+            pass
+
+
 def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options):
     """In a worker: render ``items`` (``(index, spec)`` pairs) with the worker's renderer, write each frame
     atomically; returns the written paths and the worker's GL renderer name."""
@@ -188,8 +197,9 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
                 manifest.write_text(json.dumps(batch | {"renderer": renderer_name}, indent=1))
             missing = [i for i in range(len(specs)) if not os.path.exists(paths[i])]
             if broken and own:
-                executor.shutdown(wait=False, cancel_futures=True)
+                executor.shutdown(wait=True, cancel_futures=True)  # every worker gone: none is writing now
                 executor = None
+                _remove_partials(out)  # a worker killed with its pool may have left a half-written file
             elif missing and not broken:
                 raise BatchError(f"{len(missing)} frame(s) were not written, e.g. {paths[missing[0]]}")
     finally:
@@ -200,6 +210,8 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
         if cluster is not None:
             for closing in cluster:
                 closing.close()
+    if own:
+        _remove_partials(out)
     if not manifest.exists():  # every frame was already there
         manifest.write_text(json.dumps(batch, indent=1))
     return paths
@@ -232,7 +244,7 @@ def turntable_scene(angle):
 
 
 def orbit_scene(spec):
-    """``spec = (path, angle)``: the scene file at ``path`` (`glphong.load_scene`, its default view) with the
+    """``spec = (path, angle[, load_scene keywords])``: the scene file at ``path`` (`glphong.load_scene`) with the
     camera turned by ``angle`` degrees about the vertical axis through the geometry's centre (a picklable
     ``scene_fn`` for turntables of files: ``glphong render FILE --frames N``)."""
     import math
@@ -240,8 +252,8 @@ def orbit_scene(spec):
     from .camera import PerspectiveCamera
     from .loaders import load_scene
 
-    path, angle = spec
-    scene = load_scene(path)
+    path, angle = spec[:2]
+    scene = load_scene(path, **(spec[2] if len(spec) > 2 else {}))
     camera = scene.camera
     target = camera.position - camera.pose[:3, 2] * np.linalg.norm(camera.position - _centre(scene))
     a = math.radians(float(angle))

@@ -18,7 +18,7 @@ def _render_file(args):
     from .renderer import Renderer
 
     try:
-        scene = load_scene(args.file)
+        scene = load_scene(args.file, light_units=args.light_units, camera_name=args.camera)
     except ValueError as exc:
         print(f"glphong render: {exc}", file=sys.stderr)
         return 2
@@ -28,7 +28,8 @@ def _render_file(args):
 
         folder = args.out if args.out is not None else f"{Path(args.file).stem}_frames"
         start = time.perf_counter()
-        specs = [(str(Path(args.file).resolve()), 360.0 * k / args.frames) for k in range(args.frames)]
+        keywords = {"light_units": args.light_units, "camera_name": args.camera}
+        specs = [(str(Path(args.file).resolve()), 360.0 * k / args.frames, keywords) for k in range(args.frames)]
         paths = render_many(orbit_scene, specs, args.width, args.height, folder, fmt="png", backend=args.backend,
                             samples=args.samples)
         print(f"wrote {len(paths)} frames of a turntable of {args.file} to {folder} in "
@@ -349,6 +350,10 @@ def build_parser():
     render.add_argument("--width", type=_image_side, default=512, help="with FILE: image width, 1 to 16384 (default 512)")
     render.add_argument("--height", type=_image_side, default=512, help="with FILE: image height, 1 to 16384 (default 512)")
     render.add_argument("--samples", type=int, choices=(1, 2, 4), default=1, help="with FILE: MSAA samples (default 1)")
+    render.add_argument("--light-units", choices=("photometric", "radiometric"), default=None,
+                        help="with a glTF FILE that has lights: candela and lux (the glTF specification) or W/sr "
+                             "and W/m^2")
+    render.add_argument("--camera", default=None, help="with a glTF FILE: the camera to look through (default the first)")
     render.add_argument("--frames", type=_positive_int, default=None,
                         help="with FILE: a turntable of N PNG frames (worker processes) into --out, a folder "
                              "(default FILE's name + _frames)")

@@ -22,16 +22,20 @@ the name and the trimesh geometry), else from its trimesh material: a ``SimpleMa
 `MtlPhong` from its 8-bit colours, a ``PBRMaterial`` (glTF) as ``Lambert(baseColor / pi)``, else
 ``Lambert(0.5 / pi)``.
 """
+import json
 import math
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-__all__ = ["load_scene", "read_obj", "scene_from_trimesh", "parse_mtl", "material_from_mtl", "default_view"]
+__all__ = ["load_scene", "read_obj", "read_gltf_json", "gltf_view", "gltf_material", "scene_from_trimesh", "parse_mtl",
+           "material_from_mtl", "default_view", "LUMENS_PER_WATT"]
 
 #: formats `load_scene` reads
-FORMATS = (".obj",)
+FORMATS = (".obj", ".gltf", ".glb")
+#: luminous efficacy of 555 nm light [lm/W]: photometric glTF intensities to watts (DESIGN section 2)
+LUMENS_PER_WATT = 683.0
 
 
 def parse_mtl(path):
@@ -264,18 +268,149 @@ def read_obj(path):
     return out
 
 
-def load_scene(path, camera=None, lights=None, ambient=None, materials=None):
+def read_gltf_json(path):
+    """The JSON document of a ``.gltf`` file, or of a ``.glb`` file's first chunk (dict)."""
+    import struct
+
+    data = Path(path).read_bytes()
+    if data[:4] == b"glTF":
+        if len(data) < 20:
+            raise ValueError(f"{path}: truncated glTF binary ({len(data)} bytes)")
+        length, kind = struct.unpack_from("<II", data, 12)
+        if kind != 0x4E4F534A:  # 'JSON'
+            raise ValueError(f"{path}: the first chunk of a glTF binary must be JSON")
+        data = data[20:20 + length]
+    try:
+        return json.loads(data.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError) as exc:
+        raise ValueError(f"{path}: not a glTF document ({exc})") from None
+
+
+def _node_matrices(document):
+    """World matrices of every node reachable from the default scene, by node index."""
+    nodes = document.get("nodes", [])
+
+    def local(node):
+        if "matrix" in node:
+            return np.asarray(node["matrix"], dtype=np.float64).reshape(4, 4).T  # column-major in glTF
+        t = np.asarray(node.get("translation", (0.0, 0.0, 0.0)), dtype=np.float64)
+        x, y, z, w = node.get("rotation", (0.0, 0.0, 0.0, 1.0))
+        r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                      [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+        m = np.eye(4)
+        m[:3, :3] = r * np.asarray(node.get("scale", (1.0, 1.0, 1.0)), dtype=np.float64)
+        m[:3, 3] = t
+        return m
+
+    out = {}
+
+    def walk(index, parent):
+        world = parent @ local(nodes[index])
+        out[index] = world
+        for child in nodes[index].get("children", []):
+            walk(child, world)
+
+    scenes = document.get("scenes", [{"nodes": list(range(len(nodes)))}])
+    for root in scenes[document.get("scene", 0)].get("nodes", []):
+        walk(root, np.eye(4))
+    return out
+
+
+def gltf_view(document, camera_name=None, light_units=None, source=""):
+    """The camera and lights of a glTF document: ``(camera or None, [lights])``.
+
+    The camera is the node camera named ``camera_name`` (by the camera's or its node's name) or the first
+    one; ``yfov``, ``znear`` and ``zfar`` are read as written (an infinite ``zfar``: ``1e6 znear``),
+    orthographic ``ymag`` too.  ``KHR_lights_punctual`` point and directional lights need ``light_units``:
+    ``'photometric'`` (the glTF specification: point intensity in candela, directional illuminance in lux;
+    ``Phi = 4 pi I color / 683``, ``E = lux color / 683``) or ``'radiometric'`` (intensity taken as W/sr and
+    W/m^2).  Spot lights are refused (glphong has point and directional lights).
+    """
+    from .camera import OrthographicCamera, PerspectiveCamera
+    from .lights import DirectionalLight, PointLight
+
+    nodes = document.get("nodes", [])
+    worlds = _node_matrices(document)
+    cameras = document.get("cameras", [])
+    camera = None
+    for index, node in enumerate(nodes):
+        if "camera" not in node or index not in worlds:
+            continue
+        spec = cameras[node["camera"]]
+        if camera_name is not None and camera_name not in (spec.get("name"), node.get("name")):
+            continue
+        pose = worlds[index].copy()
+        pose[:3, :3] /= np.linalg.norm(pose[:3, :3], axis=0)  # a camera node's scale does not apply
+        if spec.get("type") == "orthographic":
+            o = spec["orthographic"]
+            camera = OrthographicCamera(o["ymag"], pose=pose, znear=max(o.get("znear", 0.0), 1e-6), zfar=o["zfar"])
+        else:
+            p = spec["perspective"]
+            camera = PerspectiveCamera(p["yfov"], pose=pose, znear=p["znear"], zfar=p.get("zfar", 1e6 * p["znear"]))
+        break
+    if camera_name is not None and camera is None:
+        names = [c.get("name") for c in cameras]
+        raise ValueError(f"{source}: no camera named {camera_name!r} (cameras: {names})")
+    definitions = document.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
+    lights = []
+    for index, node in enumerate(nodes):
+        reference = node.get("extensions", {}).get("KHR_lights_punctual")
+        if reference is None or index not in worlds:
+            continue
+        light = definitions[reference["light"]]
+        kind = light.get("type")
+        if kind == "spot":
+            raise ValueError(f"{source}: light {light.get('name', reference['light'])!r} is a spot light: glphong has "
+                             "point and directional lights only")
+        if light_units not in ("photometric", "radiometric"):
+            raise ValueError(f"{source} has KHR_lights_punctual lights: say what their intensities are with "
+                             "light_units='photometric' (candela and lux, as the glTF specification says) or "
+                             "'radiometric' (W/sr and W/m^2)")
+        scale = (1.0 / LUMENS_PER_WATT if light_units == "photometric" else 1.0) * light.get("intensity", 1.0)
+        colour = np.asarray(light.get("color", (1.0, 1.0, 1.0)), dtype=np.float64) * scale
+        world = worlds[index]
+        if kind == "point":
+            lights.append(PointLight(tuple(world[:3, 3]), tuple(4 * math.pi * colour)))
+        elif kind == "directional":
+            lights.append(DirectionalLight(tuple(-world[:3, 2]), tuple(colour)))
+        else:
+            raise ValueError(f"{source}: light type {kind!r} is not one glphong knows")
+    return camera, lights
+
+
+def gltf_material(entry):
+    """glphong's approximation of a glTF metallic-roughness material (JSON ``materials`` entry): Cook-Torrance
+    with Beckmann slope ``m = roughness^2`` (glTF's GGX ``alpha``, at least 1e-3), diffuse albedo
+    ``baseColor (1 - metallic)`` and Schlick's Fresnel with ``f0 = 0.04 (1 - metallic) + baseColor metallic``.
+    The lobes differ (Beckmann against GGX, no coupling of diffuse and specular): an approximation."""
+    from .materials import CookTorrance, SchlickFresnel
+
+    pbr = entry.get("pbrMetallicRoughness", {})
+    base = np.asarray(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3], dtype=np.float64)
+    metallic = float(pbr.get("metallicFactor", 1.0))
+    roughness = float(pbr.get("roughnessFactor", 1.0))
+    f0 = 0.04 * (1 - metallic) + base * metallic
+    return CookTorrance(tuple(base * (1 - metallic)), max(roughness * roughness, 1e-3),
+                        fresnel=SchlickFresnel(tuple(np.clip(f0, 0.0, 1.0))))
+
+
+def load_scene(path, camera=None, lights=None, ambient=None, materials=None, light_units=None, camera_name=None):
     """Load a scene file as a `glphong.Scene` (see the module for what each format keeps).
 
     Parameters
     ----------
     path : str or path-like
-        A Wavefront ``.obj`` (with its ``.mtl`` files).
+        A Wavefront ``.obj`` (with its ``.mtl`` files), or a glTF 2.0 ``.gltf`` / ``.glb``.
     camera, lights, ambient
-        As in `scene_from_trimesh` (default: `default_view`'s).
+        As in `scene_from_trimesh`; default: the file's (glTF: `gltf_view`), else `default_view`'s.
     materials : dict of str to Material, or callable, optional
-        Overrides the MTL materials by material name; a callable gets ``(name, MTL entry or None)``
-        and returns a Material (or None for the file's).
+        Overrides the file's materials by material name; a callable gets ``(name, MTL or glTF entry or
+        None)`` and returns a Material (or None for the file's).
+    light_units : {'photometric', 'radiometric'}, optional
+        Required where a glTF file has lights (`gltf_view`).
+    camera_name : str, optional
+        The glTF camera to look through (default the first).
 
     Raises
     ------
@@ -291,6 +426,8 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None):
         raise ValueError(f"{path}: glphong reads {', '.join(FORMATS)} scene files (got {suffix or 'no suffix'!r})")
     if not path.is_file():
         raise ValueError(f"{path}: no such file")
+    if suffix in (".gltf", ".glb"):
+        return _load_gltf(path, camera, lights, ambient, materials, light_units, camera_name)
     mtl = {}
     for line in path.read_text(encoding="utf-8", errors="replace").splitlines():
         words = line.split("#", 1)[0].split()
@@ -315,3 +452,32 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None):
             raise TypeError(f"materials gave {type(material).__name__} for {name!r}: it must give a glphong material")
         scene.add(mesh, material, name=name or path.stem)
     return _with_view(scene, camera, lights, ambient)
+
+
+def _load_gltf(path, camera, lights, ambient, materials, light_units, camera_name):
+    import trimesh
+
+    document = read_gltf_json(path)
+    file_camera, file_lights = gltf_view(document, camera_name, light_units, str(path))
+    entries = {m.get("name", f"material{i}"): m for i, m in enumerate(document.get("materials", []))}
+    try:
+        loaded = trimesh.load(str(path), force="scene")
+    except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds; say which file
+        raise ValueError(f"{path}: trimesh could not read it ({type(exc).__name__}: {exc})") from None
+
+    def resolve(name, geometry):
+        material_name = getattr(getattr(geometry.visual, "material", None), "name", None)
+        entry = entries.get(material_name)
+        if callable(materials):
+            chosen = materials(material_name or name, entry)
+            if chosen is not None:
+                return chosen
+        elif materials:
+            for key in (material_name, name):
+                if key in materials:
+                    return materials[key]
+        return gltf_material(entry) if entry is not None else None
+
+    if lights is None and file_lights:
+        lights = file_lights
+    return scene_from_trimesh(loaded, camera if camera is not None else file_camera, lights, ambient, resolve)

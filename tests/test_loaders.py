@@ -117,7 +117,7 @@ def test_from_trimesh_keeps_transforms_names_and_materials():
 
 
 def test_errors_name_the_file(tmp_path):
-    with pytest.raises(ValueError, match=r"glphong reads \.obj scene files \(got '\.stl'\)"):
+    with pytest.raises(ValueError, match=r"glphong reads \.obj, \.gltf, \.glb scene files \(got '\.stl'\)"):
         glphong.load_scene(tmp_path / "a.stl")
     with pytest.raises(ValueError, match="no such file"):
         glphong.load_scene(tmp_path / "missing.obj")
@@ -139,7 +139,7 @@ def test_cli_render_file(tmp_path, capsys):
     assert code == 0 and "4 object(s), 64x48" in text and "PASS" in text
     assert Image.open(out).size == (64, 48)
     assert main(["render", str(tmp_path / "scene.stl")]) == 2
-    assert "glphong reads .obj scene files" in capsys.readouterr().err
+    assert "glphong reads .obj, .gltf, .glb scene files" in capsys.readouterr().err
     with pytest.raises(SystemExit):
         main(["render", str(path), "--width", "0"])
 

@@ -1,0 +1,113 @@
+"""glTF 2.0 scenes (`glphong.load_scene` on ``.gltf`` / ``.glb``): the file's camera, its KHR_lights_punctual
+lights in an explicit unit mode, node transforms and a documented approximation of its PBR materials.
+
+The files are made here: trimesh exports the geometry and material, and the test adds a camera, lights and
+their nodes to the JSON (nothing is downloaded).
+
+- The camera's ``yfov``, ``znear``, ``zfar`` are read as written and its node's transform is the pose;
+  a camera is found by name, an unknown name is refused naming the cameras.
+- Point light of 683 cd, colour (1, 0.5, 0.25): ``Phi = 4 pi colour`` photometric, ``4 pi 683 colour``
+  radiometric; a directional light of 683 lux travels along its node's -Z with ``E = colour`` (photometric).
+- Lights without ``light_units`` and spot lights are refused with what to do.
+- ``baseColorFactor`` 0.123457 (not an 8-bit colour) reaches the material exactly; the scene passes verify;
+  a ``.glb``'s JSON chunk is read; ``glphong render FILE.gltf --light-units --camera`` renders it.
+"""
+import json
+import math
+
+import numpy as np
+import pytest
+import trimesh
+
+import glphong
+from glphong.loaders import gltf_view, read_gltf_json
+
+BASE = [0.123457, 0.5, 0.75, 1.0]
+
+
+def _document(tmp_path, spot=False):
+    sphere = trimesh.creation.icosphere(3)
+    sphere.visual = trimesh.visual.TextureVisuals(material=trimesh.visual.material.PBRMaterial(
+        name="paint", baseColorFactor=BASE, metallicFactor=0.0, roughnessFactor=0.5))
+    scene = trimesh.Scene()
+    scene.add_geometry(sphere, node_name="ball", geom_name="ball")
+    files = scene.export(file_type="gltf")
+    document = json.loads(files["model.gltf"])
+    for name, data in files.items():
+        if name != "model.gltf":
+            (tmp_path / name).write_bytes(data)
+    document["materials"][0]["pbrMetallicRoughness"]["baseColorFactor"] = BASE  # floats as written
+    document["cameras"] = [{"name": "main", "type": "perspective",
+                            "perspective": {"yfov": 0.7, "znear": 0.125, "zfar": 37.5, "aspectRatio": 1.5}}]
+    lights = [{"type": "point", "color": [1.0, 0.5, 0.25], "intensity": 683.0, "name": "bulb"},
+              {"type": "directional", "color": [0.5, 0.5, 0.5], "intensity": 683.0, "name": "sun"}]
+    if spot:
+        lights.append({"type": "spot", "name": "torch", "spot": {}})
+    document["extensions"] = {"KHR_lights_punctual": {"lights": lights}}
+    document["extensionsUsed"] = ["KHR_lights_punctual"]
+    half = math.sqrt(0.5)
+    new_nodes = [{"name": "cam", "camera": 0, "translation": [0.0, 0.0, 5.0]},
+                 {"name": "bulb", "translation": [2.0, 3.0, 4.0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
+                 {"name": "sun", "rotation": [-half, 0.0, 0.0, half], "extensions": {"KHR_lights_punctual": {"light": 1}}}]
+    if spot:
+        new_nodes.append({"name": "torch", "extensions": {"KHR_lights_punctual": {"light": 2}}})
+    first = len(document["nodes"])
+    document["nodes"] += new_nodes
+    document["scenes"][document.get("scene", 0)]["nodes"] += list(range(first, first + len(new_nodes)))
+    path = tmp_path / "scene.gltf"
+    path.write_text(json.dumps(document))
+    return path
+
+
+def test_camera_lights_and_material(tmp_path, glphong_backend, glphong_make_renderer):
+    path = _document(tmp_path)
+    scene = glphong.load_scene(path, light_units="photometric")
+    camera = scene.camera
+    assert (camera.yfov, camera.znear, camera.zfar) == (0.7, 0.125, 37.5)
+    np.testing.assert_allclose(camera.pose[:3, 3], [0.0, 0.0, 5.0])
+    point, sun = sorted(scene.lights, key=lambda light: type(light).__name__ != "PointLight")
+    np.testing.assert_allclose(point.position, [2.0, 3.0, 4.0])
+    np.testing.assert_allclose(point.power, 4 * math.pi * np.array([1.0, 0.5, 0.25]), rtol=1e-15)
+    np.testing.assert_allclose(sun.irradiance, [0.5, 0.5, 0.5], rtol=1e-15)
+    np.testing.assert_allclose(sun.direction, [0.0, -1.0, 0.0], atol=1e-12)  # -Z turned by -90 degrees about x
+    (ball,) = scene.objects
+    assert ball.material.rho_d == tuple(BASE[:3]) and ball.material.m == 0.25
+    radiometric = glphong.load_scene(path, light_units="radiometric")
+    power = next(light.power for light in radiometric.lights if hasattr(light, "power"))
+    np.testing.assert_allclose(power, 4 * math.pi * 683.0 * np.array([1.0, 0.5, 0.25]), rtol=1e-15)
+    assert glphong.verify(scene, glphong_make_renderer(48, 32, glphong_backend)).passed
+
+
+def test_glb_and_named_camera(tmp_path):
+    path = _document(tmp_path)
+    loaded = trimesh.load(str(path), force="scene")
+    glb = tmp_path / "scene.glb"
+    glb.write_bytes(trimesh.exchange.gltf.export_glb(loaded))
+    assert read_gltf_json(glb)["asset"]["version"] == "2.0"
+    camera, lights = gltf_view(read_gltf_json(path), camera_name="main", light_units="photometric")
+    assert camera.yfov == 0.7 and len(lights) == 2
+    with pytest.raises(ValueError, match=r"no camera named 'side' \(cameras: \['main'\]\)"):
+        gltf_view(read_gltf_json(path), camera_name="side", light_units="photometric")
+
+
+def test_refusals(tmp_path):
+    with pytest.raises(ValueError, match="light_units='photometric'"):
+        glphong.load_scene(_document(tmp_path))
+    spot = tmp_path / "spot"
+    spot.mkdir()
+    with pytest.raises(ValueError, match="'torch' is a spot light"):
+        glphong.load_scene(_document(spot, spot=True), light_units="photometric")
+    (tmp_path / "bad.glb").write_bytes(b"glTF\x02\x00\x00\x00")
+    with pytest.raises(ValueError, match="truncated glTF binary"):
+        glphong.load_scene(tmp_path / "bad.glb")
+
+
+def test_cli_render_gltf(tmp_path, capsys):
+    from glphong.cli import main
+
+    path = _document(tmp_path)
+    assert main(["render", str(path), "--light-units", "photometric", "--camera", "main", "--width", "32",
+                 "--height", "24", "--verify", "--out", str(tmp_path / "g.png")]) == 0
+    assert "PASS" in capsys.readouterr().out
+    assert main(["render", str(path), "--out", str(tmp_path / "h.png")]) == 2
+    assert "light_units" in capsys.readouterr().err
