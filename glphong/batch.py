@@ -250,19 +250,15 @@ def orbit_scene(spec):
     import math
 
     from .camera import PerspectiveCamera
-    from .loaders import load_scene
+    from .loaders import load_scene, scene_bounds
 
     path, angle = spec[:2]
     scene = load_scene(path, **(spec[2] if len(spec) > 2 else {}))
     camera = scene.camera
-    target = camera.position - camera.pose[:3, 2] * np.linalg.norm(camera.position - _centre(scene))
+    target = camera.position - camera.pose[:3, 2] * np.linalg.norm(camera.position - scene_bounds(scene)[0])
     a = math.radians(float(angle))
     turn = np.array([[math.cos(a), 0.0, math.sin(a)], [0.0, 1.0, 0.0], [-math.sin(a), 0.0, math.cos(a)]])
     eye = target + turn @ (camera.position - target)
     scene.camera = PerspectiveCamera.look_at(eye, target, yfov=camera.yfov, znear=camera.znear, zfar=camera.zfar)
     return scene
 
-
-def _centre(scene):
-    points = np.concatenate([(o.pose[:3, :3] @ o.mesh.positions.T).T + o.pose[:3, 3] for o in scene.objects])
-    return (points.min(axis=0) + points.max(axis=0)) / 2

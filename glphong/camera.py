@@ -1,8 +1,10 @@
-"""Perspective camera with OpenGL conventions (DESIGN section 2).
+"""Cameras with OpenGL conventions (DESIGN section 2): perspective, from OpenCV intrinsics, orthographic.
 
-The camera looks down -Z of its own frame; +Y is up in the image; the world is
+A camera looks down -Z of its own frame; +Y is up in the image; the world is
 right-handed.  ``pose`` maps camera coordinates to world coordinates.
 """
+import abc
+
 import numpy as np
 
 from . import _validate
@@ -30,7 +32,7 @@ def _look_at_pose(eye, target, up):
     return pose
 
 
-class Camera:
+class Camera(abc.ABC):
     """What every camera has: a rigid pose (OpenGL frame: looking down its -Z, +Y up), clip distances, and
     rays through image positions.  Subclasses give the projection and the image-plane mapping.
 
@@ -70,14 +72,14 @@ class Camera:
         view[:3, 3] = -r.T @ t
         return view
 
+    @abc.abstractmethod
     def projection_matrix(self, aspect):
         """The OpenGL projection for ``aspect = width / height``, (4, 4) float64."""
-        raise NotImplementedError
 
+    @abc.abstractmethod
     def _image_plane(self, xp, yp, width, height):
         """Camera-space ``(x, y)`` of image positions ``(xp, yp)`` [px from the top-left corner]: on the
         plane ``z = -1`` (perspective) or ``z = 0`` (orthographic)."""
-        raise NotImplementedError
 
     def _camera_rays(self, x, y):
         """Camera-space ``(origins, directions)`` of the rays through image-plane points: from the centre

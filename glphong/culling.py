@@ -67,11 +67,16 @@ def _closure(positions, indices):
     return True, "closed, outward wound"
 
 
+def points_sphere(points):
+    """``(centre (3,), radius)``: the sphere about the centre of the points' bounding box holding them all."""
+    points = np.asarray(points, dtype=np.float64)
+    centre = (points.min(axis=0) + points.max(axis=0)) / 2
+    return centre, float(np.sqrt(np.max(np.sum((points - centre) ** 2, axis=1))))
+
+
 def bounding_sphere(mesh):
-    """``(centre (3,), radius)`` in object space enclosing every vertex of ``mesh`` (the box's centre)."""
-    positions = np.asarray(mesh.positions, dtype=np.float64)
-    centre = (positions.min(axis=0) + positions.max(axis=0)) / 2
-    return centre, float(np.sqrt(np.max(np.sum((positions - centre) ** 2, axis=1))))
+    """``(centre (3,), radius)`` in object space enclosing every vertex of ``mesh`` (`points_sphere`)."""
+    return points_sphere(mesh.positions)
 
 
 def world_sphere(mesh, pose):

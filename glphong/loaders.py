@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["load_scene", "read_obj", "read_gltf_json", "gltf_view", "gltf_material", "scene_from_trimesh", "parse_mtl",
-           "material_from_mtl", "default_view", "LUMENS_PER_WATT"]
+           "material_from_mtl", "default_view", "scene_bounds", "LUMENS_PER_WATT"]
 
 #: formats `load_scene` reads
 FORMATS = (".obj", ".gltf", ".glb")
@@ -97,16 +97,23 @@ def material_from_mtl(entry, name="", source=""):
     return MtlPhong(kd, ks, q, ka)
 
 
+def scene_bounds(scene):
+    """``(centre (3,), radius)``: a world-space sphere about the centre of the scene's bounding box holding
+    every vertex of every object (radius at least 1e-6 m)."""
+    from .culling import points_sphere
+
+    points = [(obj.pose[:3, :3] @ obj.mesh.positions.T).T + obj.pose[:3, 3] for obj in scene.objects]
+    centre, radius = points_sphere(np.concatenate(points) if points else np.zeros((1, 3)))
+    return centre, max(radius, 1e-6)
+
+
 def default_view(scene):
     """A camera, a point light and an ambient light for a scene that has none (see the module):
     ``(camera, [light], ambient)``."""
     from .camera import PerspectiveCamera
     from .lights import AmbientLight, PointLight
 
-    points = [(obj.pose[:3, :3] @ obj.mesh.positions.T).T + obj.pose[:3, 3] for obj in scene.objects]
-    points = np.concatenate(points) if points else np.zeros((1, 3))
-    centre = (points.min(axis=0) + points.max(axis=0)) / 2
-    radius = max(float(np.sqrt(np.max(np.sum((points - centre) ** 2, axis=1)))), 1e-6)
+    centre, radius = scene_bounds(scene)
     direction = np.array([0.3, 0.4, 1.0]) / np.linalg.norm([0.3, 0.4, 1.0])
     distance = 3.0 * radius  # the bounding sphere fills 87% of a 45-degree view
     camera = PerspectiveCamera.look_at(centre + distance * direction, centre, yfov=math.radians(45.0),
@@ -138,7 +145,7 @@ def _with_view(scene, camera, lights, ambient):
     return scene
 
 
-def _trimesh_material(name, geometry):
+def _trimesh_material(geometry):
     from .materials import Lambert, MtlPhong
 
     material = getattr(getattr(geometry, "visual", None), "material", None)
@@ -188,7 +195,7 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
             material_name = getattr(getattr(geometry.visual, "material", None), "name", None)
             material = materials.get(geometry_name, materials.get(material_name))
         if material is None:
-            material = _trimesh_material(geometry_name, geometry)
+            material = _trimesh_material(geometry)
         if not isinstance(material, Material):
             raise TypeError(f"materials gave {type(material).__name__} for {geometry_name!r}: it must give a "
                             "glphong material")
@@ -329,6 +336,7 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
     """
     from .camera import OrthographicCamera, PerspectiveCamera
     from .lights import DirectionalLight, PointLight
+    from .radiometry import power_from_intensity
 
     nodes = document.get("nodes", [])
     worlds = _node_matrices(document)
@@ -371,7 +379,7 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
         colour = np.asarray(light.get("color", (1.0, 1.0, 1.0)), dtype=np.float64) * scale
         world = worlds[index]
         if kind == "point":
-            lights.append(PointLight(tuple(world[:3, 3]), tuple(4 * math.pi * colour)))
+            lights.append(PointLight(tuple(world[:3, 3]), tuple(power_from_intensity(colour))))
         elif kind == "directional":
             lights.append(DirectionalLight(tuple(-world[:3, 2]), tuple(colour)))
         else:

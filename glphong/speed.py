@@ -37,7 +37,7 @@ from .camera import PerspectiveCamera
 from .lights import AmbientLight, PointLight
 from .materials import BlinnPhong, Lambert, Phong
 from .scene import Scene
-from .timing import alternating_times, progress_bar
+from .timing import alternating_times, median_seconds, progress_bar
 
 __all__ = ["SCENES", "speed_scenes", "SpeedReport", "run_speed", "python_per_object", "png_cost", "scaling_fits"]
 
@@ -314,7 +314,7 @@ def scaling_fits(quick=False, repeats=5):
             for i in range(n):
                 x, y = rng.uniform(-1.7, 1.7, 2)
                 s.add(tiny, (_PHONG, _BLINN)[i % 2], pose=_translate(x, y, 0.0, 0.05))
-            times.append(_median(lambda s=s: r.render(s), repeats))
+            times.append(median_seconds(lambda s=s: r.render(s), repeats, warmup=2))
     fits["per object"] = {"value": 1e6 * slope(counts, times), "unit": "us", "points": f"{counts} objects, 64x64"}
     sizes = (64, 128) if quick else (256, 512, 1024)
     lights = (1, 2) if quick else (1, 2, 4, 8)
@@ -325,7 +325,7 @@ def scaling_fits(quick=False, repeats=5):
                 s = Scene(base["plane"].camera, _lights(n), AmbientLight(0.03))
                 s.add(primitives.plane(4.0, 8), _BLINN)
                 x.append(size * size * n)
-                t.append(_median(lambda s=s: r.render(s), repeats))
+                t.append(median_seconds(lambda s=s: r.render(s), repeats, warmup=2))
     fits["per pixel and light"] = {"value": 1e9 * slope(x, t), "unit": "ns",
                                    "points": f"full-screen plane, {sizes} pixels squared x {lights} lights"}
     levels = (3, 4) if quick else (5, 6, 7, 8)
@@ -335,12 +335,6 @@ def scaling_fits(quick=False, repeats=5):
             s = Scene(base["sphere"].camera, _lights(2), AmbientLight(0.03))
             s.add(_big_mesh(level), _BLINN, pose=_translate(0.0, 0.0, 0.0, 0.95))
             x.append(s.objects[0].mesh.triangle_count)
-            t.append(_median(lambda s=s: r.render(s), repeats))
+            t.append(median_seconds(lambda s=s: r.render(s), repeats, warmup=2))
     fits["per triangle"] = {"value": 1e9 * slope(x, t), "unit": "ns", "points": f"icospheres of {x} triangles, 256x256"}
     return fits
-
-
-def _median(run, repeats):
-    from .timing import median_seconds
-
-    return median_seconds(run, repeats, warmup=2)

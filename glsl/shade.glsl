@@ -16,7 +16,7 @@
 // computed and the gate selects it, without a branch.  llvmpipe (and a GPU's SIMD group) runs both sides
 // of a branch under a mask, so an `if`/`continue` saves nothing and costs control flow; written as
 // selects the same arithmetic measured 0.59x to 0.70x the frame time of the branching version on the
-// gallery tiles at 1024x1024 (EGL), with bit-identical images.  A term's response may therefore be
+// six gallery tiles at 1024x1024 (EGL, one run), with bit-identical images on EGL and OSMesa.  A term's response may therefore be
 // computed where n.l <= 0 and discarded: it must not loop forever there, but NaN or Inf is harmless.
 // The view vector v is computed only where a term reads it (NEEDS_VIEW).
 // The uber-shader reads its light counts from uniforms (*_LIGHT_COUNT).

@@ -53,7 +53,8 @@ from ..reference import atan2_first_quadrant, frame_from_tangent, safe_normalize
 from .model import Choice, GlslFile, MaterialModel, Properties
 from .table import Table, TableData
 
-__all__ = ["MeasuredBRDF", "measured_brdf_coordinates", "measured_brdf_nearest", "measured_brdf_trilinear"]
+__all__ = ["MeasuredBRDF", "measured_brdf_coordinates", "measured_brdf_fetch", "measured_brdf_nearest",
+           "measured_brdf_trilinear"]
 
 #: the last bin of each axis (measured_brdf.glsl MEASURED_BRDF_LAST)
 LAST = np.array(merl.SHAPE) - 1
@@ -90,15 +91,15 @@ def measured_brdf_coordinates(n, wi, wo):
     return np.stack([90.0 * np.sqrt(theta_h * (2.0 / np.pi)), theta_d * _DEG, phi_d * _DEG], axis=-1)
 
 
-def _fetch(table, i):
-    """``table[i_h, i_d, i_p]`` as float64, (N, 3) integer indices -> (N, 3)."""
+def measured_brdf_fetch(i, table):
+    """``table[i_h, i_d, i_p]`` (measured_brdf.glsl, texel ``i.zyx``) as float64: (N, 3) integer indices -> (N, 3)."""
     return table[i[..., 0], i[..., 1], i[..., 2]].astype(np.float64)
 
 
 def measured_brdf_nearest(x, table):
     """The bin ``floor(x)``, clamped (measured_brdf.glsl): (N, 3) coordinates -> (N, 3) ``f_r``."""
     i = np.clip(np.floor(x), 0, LAST).astype(np.int64)
-    return _fetch(table, i)
+    return measured_brdf_fetch(i, table)
 
 
 def measured_brdf_trilinear(x, table):
@@ -115,8 +116,8 @@ def measured_brdf_trilinear(x, table):
         return p * (1 - t[:, None]) + q * t[:, None]
 
     def corner(ih, jd):
-        return mix(_fetch(table, np.stack([ih[:, 0], jd[:, 1], lo[:, 2]], -1)),
-                   _fetch(table, np.stack([ih[:, 0], jd[:, 1], hi[:, 2]], -1)), w[:, 2])
+        return mix(measured_brdf_fetch(np.stack([ih[:, 0], jd[:, 1], lo[:, 2]], -1), table),
+                   measured_brdf_fetch(np.stack([ih[:, 0], jd[:, 1], hi[:, 2]], -1), table), w[:, 2])
 
     c00, c01, c10, c11 = corner(lo, lo), corner(lo, hi), corner(hi, lo), corner(hi, hi)
     return mix(mix(c00, c01, w[:, 1]), mix(c10, c11, w[:, 1]), w[:, 0])

@@ -20,6 +20,7 @@ kamb       rgb     >= 0                ambient coefficient ``Ka``: the answer ``
 
 Not reciprocal, not energy-conserving, isotropic (the lecture's Phong; `glphong.analysis` measures it).
 """
+from ..reference import phong_lobe
 from .model import GlslFile, MaterialModel, Param, Properties
 
 __all__ = ["MtlPhong"]
@@ -51,8 +52,6 @@ class MtlPhong(MaterialModel):
 
     def response(self, f, wi, wo, n_dot_l, p):
         """Twin of ``mtl_phong_response``: ``kd (n.l) + ks phong_lobe`` (lobe.glsl's twin); (N, 3)."""
-        from ..reference import phong_lobe
-
         return p.kd * n_dot_l[:, None] + p.ks * phong_lobe(f.n, wi, wo, p.q)[:, None]
 
     def oracle(self, f, wi, wo, n_dot_l, p):
