@@ -19,7 +19,7 @@ from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPoin
 from .loaders import load_scene
 from .materials import (AshikhminShirley, BlinnPhong, CookTorrance, DielectricFresnel, Diffuse, Lafortune, Lambert,
                         Material, MaterialModel, MaterialSum, MeasuredBRDF, MtlPhong, NormalizedBlinnPhong,
-                        NormalizedPhong, OrenNayar, Param, Phong, SchlickFresnel, Ward)
+                        NormalizedPhong, OrenNayar, Param, Phong, SchlickFresnel, Texture, VertexColors, Ward)
 from .renderer import Frame, GBuffer, Renderer
 from .scene import Scene, SceneObject
 from .verify import VerifyReport, verify
@@ -30,7 +30,7 @@ __all__ = [
     "Camera", "PerspectiveCamera", "IntrinsicsCamera", "OrthographicCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
     "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
-    "DielectricFresnel", "Scene", "SceneObject", "load_scene", "Renderer", "Frame", "GBuffer",
+    "DielectricFresnel", "Texture", "VertexColors", "Scene", "SceneObject", "load_scene", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
     "imaging", "materials", "primitives", "radiometry", "reference",
 ]

@@ -3,7 +3,8 @@
 `MeshData` is an immutable float32 copy of a `trimesh.Trimesh`: positions, one
 normal per vertex (smooth: the mesh's vertex normals; flat: each face's normal on
 its own three vertices) and triangle indices; optionally texture coordinates and
-tangents, for materials whose terms need ``'uv'`` or ``'tangent'`` (DESIGN section 8).
+tangents, for materials whose terms need ``'uv'`` or ``'tangent'`` (DESIGN section 8), and linear
+vertex colours, for parameters that take them (`glphong.VertexColors`).
 
 Tangents, where a mesh does not supply them, come from its UVs by the standard method of
 Lengyel (2001, "Computing tangent space basis vectors for an arbitrary mesh"): per triangle
@@ -36,9 +37,12 @@ class MeshData:
     tangents : (V, 4) or (V, 3) array_like, optional
         Object-space tangents (any length; orthonormalised against the normal per fragment),
         handedness in the fourth column (+1 when omitted).  Default: from ``uvs`` (see the module).
+    colors : (V, 3) or (V, 4) array_like, optional
+        Linear vertex colours in [0, 1] (a fourth, alpha column is dropped); `from_trimesh` decodes a
+        trimesh's 8-bit sRGB vertex colours.
     """
 
-    def __init__(self, positions, normals, indices, uvs=None, tangents=None):
+    def __init__(self, positions, normals, indices, uvs=None, tangents=None, colors=None):
         positions = _validate.real_array("positions", positions, "a (V, 3) array of real numbers")
         normals = _validate.real_array("normals", normals, "a (V, 3) array of real numbers")
         indices = np.asarray(indices)
@@ -63,10 +67,16 @@ class MeshData:
         self.indices = np.ascontiguousarray(indices, dtype=np.uint32)
         self.uvs = None if uvs is None else _vertex_array("uvs", uvs, len(positions), (2,))
         self._tangents = None if tangents is None else _vertex_array("tangents", tangents, len(positions), (3, 4))
+        self.colors = None if colors is None else _vertex_array("colors", colors, len(positions), (3, 4))
+        if self.colors is not None:
+            self.colors = np.ascontiguousarray(self.colors[:, :3])
+            if self.colors.min() < 0.0 or self.colors.max() > 1.0:
+                raise ValueError(f"colors must be linear values in [0, 1] (got values from {self.colors.min():g} "
+                                 f"to {self.colors.max():g})")
         if self._tangents is not None and self._tangents.shape[1] == 3:
             self._tangents = np.ascontiguousarray(np.concatenate(
                 [self._tangents, np.ones((len(positions), 1), np.float32)], axis=1))
-        for a in (self.positions, self.normals, self.indices, self.uvs, self._tangents):
+        for a in (self.positions, self.normals, self.indices, self.uvs, self._tangents, self.colors):
             if a is not None:
                 a.setflags(write=False)
 
@@ -94,6 +104,9 @@ class MeshData:
         smooth : bool
             True: the mesh's vertex normals, interpolated across faces (Phong shading).
             False: flat shading, every face with its own face normal.
+
+        UVs come from a ``TextureVisuals`` with one uv per vertex; vertex colours from a
+        ``ColorVisuals`` of kind 'vertex' (8-bit sRGB, decoded to linear; face colours are not read).
         """
         import trimesh
 
@@ -110,13 +123,19 @@ class MeshData:
                              "the trimesh has a vertex that is not")
         uv = getattr(getattr(mesh, "visual", None), "uv", None)
         uv = None if uv is None or len(uv) != len(mesh.vertices) else np.asarray(uv, dtype=np.float64)
+        colors = None
+        if getattr(mesh.visual, "kind", None) == "vertex":
+            from .imaging import srgb_decode
+
+            colors = srgb_decode(np.asarray(mesh.visual.vertex_colors)[:, :3] / 255.0)
         if smooth:
-            return cls(mesh.vertices, mesh.vertex_normals, mesh.faces, uvs=uv)
+            return cls(mesh.vertices, mesh.vertex_normals, mesh.faces, uvs=uv, colors=colors)
         faces = np.asarray(mesh.faces)
         positions = np.asarray(mesh.vertices)[faces].reshape(-1, 3)
         normals = np.repeat(np.asarray(mesh.face_normals), 3, axis=0)
         return cls(positions, normals, np.arange(len(positions)).reshape(-1, 3),
-                   uvs=None if uv is None else uv[faces].reshape(-1, 2))
+                   uvs=None if uv is None else uv[faces].reshape(-1, 2),
+                   colors=None if colors is None else colors[faces].reshape(-1, 3))
 
     @property
     def triangle_count(self):
@@ -124,7 +143,8 @@ class MeshData:
         return len(self.indices)
 
     def __repr__(self):
-        extras = "".join([", uvs" if self.uvs is not None else "", ", tangents" if self._tangents is not None else ""])
+        extras = "".join([", uvs" if self.uvs is not None else "", ", tangents" if self._tangents is not None else "",
+                          ", colors" if self.colors is not None else ""])
         return f"MeshData({len(self.positions)} vertices, {self.triangle_count} triangles{extras})"
 
 

@@ -10,6 +10,8 @@ left out of the source.  Nothing here knows any model by name; the numpy twin re
 """
 from dataclasses import dataclass, fields
 
+from .materials.model import surface_define
+
 __all__ = ["ProgramKey", "TermKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "response_key", "UBER_MAX_LIGHTS",
            "material_chunk"]
 
@@ -21,6 +23,10 @@ FORMULATIONS = ("stable", "naive")
 LIGHT_KINDS = ("point", "unattenuated", "directional")
 #: label of the generated chunk that sums the terms
 MATERIAL_CHUNK = "generated:material"
+#: how a surface input is made (``<MODEL>_<PARAM>_INPUT`` is the mode's index plus 1)
+INPUT_MODES = ("texture", "vertex", "texture*vertex")
+#: textured parameters per material (one G-buffer plane of levels of detail)
+MAX_TEXTURED_INPUTS = 4
 
 
 @dataclass(frozen=True)
@@ -47,6 +53,9 @@ class TermKey:
         The rgb parameter of its ``k L_a`` answer.
     ambient_scale : float
         The answer is ``ambient_scale * k * L_a`` (``1/pi`` for an albedo ``rho``: ``rho/pi L_a``).
+    inputs : tuple of (str, str)
+        The parameters the program sets per fragment (surface inputs, glsl/surface.glsl) and how:
+        ``(param, mode)`` with mode ``'texture'``, ``'vertex'`` or ``'texture*vertex'``.
     """
 
     name: str
@@ -58,6 +67,7 @@ class TermKey:
     defines: tuple = ()
     ambient_param: str = None
     ambient_scale: float = 1.0
+    inputs: tuple = ()
 
     @property
     def chunk(self):
@@ -67,6 +77,7 @@ class TermKey:
 
     def describe(self):
         flags = [f for f, on in (("lit", self.lit), ("ambient", self.ambient)) if on]
+        flags += [f"{param}={mode}" for param, mode in self.inputs]
         return f"{self.name}[{','.join(flags)}]"
 
 
@@ -104,6 +115,15 @@ class ProgramKey:
         specialisation buys.
     shade_per_vertex : bool
         Gouraud shading: ``shade_point()`` runs in the vertex stage and its radiance is interpolated.
+    has_color : bool
+        Whether it reads the vertex-colour attribute (a surface input with vertex colours; for a
+        G-buffer program: whether it writes the interpolated colour).
+    has_lod : bool
+        G-buffer programs only: whether the G-buffer has the level-of-detail plane (the scene has a
+        textured parameter).
+    lod_textures : int
+        G-buffer programs only: how many textures' levels of detail it writes there (``textureQueryLOD``,
+        one per textured surface input of the object's material, at most 4; the rest are 0).
     """
 
     output: str = "radiance"
@@ -119,6 +139,9 @@ class ProgramKey:
     formulation: str = "stable"
     uber: bool = False
     shade_per_vertex: bool = False
+    has_color: bool = False
+    has_lod: bool = False
+    lod_textures: int = 0
 
     def __post_init__(self):
         if self.output not in OUTPUTS or self.formulation not in FORMULATIONS or \
@@ -143,6 +166,16 @@ class ProgramKey:
             (self.shade_per_vertex and self.two_sided and self.has_normal)
 
     @property
+    def inputs(self):
+        """``(term, param, mode)`` of every surface input the program computes (tuple)."""
+        return tuple((t.name, param, mode) for t in self.terms for param, mode in t.inputs)
+
+    @property
+    def textured_inputs(self):
+        """``(term, param)`` of the surface inputs that sample a texture, in sampler order (tuple)."""
+        return tuple((t, p) for t, p, mode in self.inputs if "texture" in mode)
+
+    @property
     def num_lights(self):
         """Total number of lights the program loops over."""
         return self.num_point_lights + self.num_unattenuated_lights + self.num_directional_lights
@@ -153,7 +186,17 @@ class ProgramKey:
         names += ["in_normal"] if self.has_normal else []
         names += ["in_tangent"] if self.has_tangent else []
         names += ["in_uv"] if self.has_uv else []
+        names += ["in_color"] if self.has_color else []
         return tuple(names)
+
+    def extensions(self):
+        """``#extension`` lines of the program: ``textureQueryLOD`` for a G-buffer that writes levels of detail."""
+        return ("GL_ARB_texture_query_lod : require",) if self.lod_textures else ()
+
+    def gbuffer_planes(self):
+        """The extra G-buffer planes a G-buffer program writes, in attachment order (tuple of str)."""
+        return tuple(name for name, on in (("tangent", self.has_tangent), ("uv", self.has_uv),
+                                           ("color", self.has_color), ("lod", self.has_lod)) if on)
 
     def defines(self):
         """The generated ``#define`` lines as (name, value) pairs."""
@@ -164,6 +207,10 @@ class ProgramKey:
             ("HAS_NORMAL", b(self.has_normal)),
             ("HAS_TANGENT", b(self.has_tangent)),
             ("HAS_UV", b(self.has_uv)),
+            ("HAS_COLOR", b(self.has_color)),
+            ("HAS_INPUTS", b(bool(self.inputs))),
+            ("HAS_LOD", b(self.has_lod)),
+            ("NUM_LOD_TEXTURES", str(self.lod_textures)),
             ("TWO_SIDED", b(self.two_sided)),
             ("RUNTIME_SWITCHES", b(self.uber)),
             ("SHADE_PER_VERTEX", b(self.shade_per_vertex)),
@@ -171,6 +218,10 @@ class ProgramKey:
             # SWITCH(u_flag): a float uniform flag in the uber-shader, the constant true otherwise
             ("SWITCH(flag)", "((flag) > 0.5)" if self.uber else "true"),
         ]
+        if self.output == "gbuffer":  # extra planes follow position and normal, packed in this order
+            planes = [name for name, on in (("TANGENT", self.has_tangent), ("UV", self.has_uv),
+                                            ("COLOR", self.has_color), ("LOD", self.has_lod)) if on]
+            out += [(f"GBUFFER_{name}_LOCATION", str(2 + i)) for i, name in enumerate(planes)]
         if self.output != "gbuffer":
             out.append(("NEEDS_VIEW", b(self.needs_view)))
             for kind in LIGHT_KINDS:
@@ -179,6 +230,7 @@ class ProgramKey:
                 out.append((f"{kind.upper()}_LIGHT_COUNT", f"int(u_{kind}_count)" if self.uber else str(size)))
             for term in self.terms:  # a model's structural defines, prefixed with its name
                 out += [(f"{term.name.upper()}_{name}", value) for name, value in term.defines]
+                out += [(surface_define(term.name, param), str(INPUT_MODES.index(mode) + 1)) for param, mode in term.inputs]
         return out
 
     def library_chunks(self):
@@ -191,6 +243,7 @@ class ProgramKey:
         if self.num_point_lights:
             chunks.append("lights")
         chunks += self.library_chunks()
+        chunks += ["surface"] if self.textured_inputs else []
         chunks += [t.chunk for t in self.terms]
         chunks += [MATERIAL_CHUNK, "shade"]
         return tuple(chunks)
@@ -211,7 +264,7 @@ class ProgramKey:
         if self.output in ("points", "response"):
             return ()
         if self.output == "gbuffer":
-            return ("common", "mesh_fragment")
+            return ("common", "surface", "mesh_fragment") if self.lod_textures else ("common", "mesh_fragment")
         if self.shade_per_vertex:
             return ("mesh_fragment",)
         if self.output == "display":
@@ -235,7 +288,9 @@ class ProgramKey:
             Terms of the drawn materials that the key leaves out, with the reason.
         """
         if self.output == "gbuffer":
-            extras = [name for name, on in (("tangent", self.has_tangent), ("uv", self.has_uv)) if not on]
+            extras = [name for name, on in (("tangent", self.has_tangent), ("uv", self.has_uv),
+                                            ("vertex colour", self.has_color), ("level-of-detail", self.lod_textures))
+                      if not on]
             return ["all shading code and lights (the G-buffer program writes the shading inputs only)",
                     "radiance output"] + [f"{name} output (no drawn term needs it)" for name in extras]
         if self.uber:
@@ -267,7 +322,11 @@ class ProgramKey:
         if not self.has_tangent:
             out.append("tangent attribute and the tangent frame (no lit term needs 'tangent')")
         if not self.has_uv:
-            out.append("uv attribute (no lit term needs 'uv')")
+            out.append("uv attribute (no lit term needs 'uv', no parameter is textured)")
+        if not self.has_color:
+            out.append("vertex-colour attribute (no parameter takes vertex colours)")
+        if not self.textured_inputs:
+            out.append("surface.glsl, texture samplers and material_inputs() (no parameter is textured)")
         out.append("G-buffer outputs (they exist only in the G-buffer program)")
         return out
 
@@ -339,6 +398,19 @@ def material_chunk(key):
         view = "wo" if "view" in t.needs else "vec3(0.0)"
         lines.append(_switch(key, f"u_use_{t.name}", f"response += {t.name}_response(f, wi, {view}, n_dot_l);"))
     lines += ["    return response;", "}"]
+    if key.inputs:
+        lines += ["", "// surface inputs (glsl/surface.glsl): u_<model>_<param> = scale * texture(uv) * vertex colour"]
+        for term, param, mode in key.inputs:
+            lines.append(f"uniform vec3 u_{term}_{param}_scale;")
+            if "texture" in mode:
+                lines.append(f"uniform sampler2D u_{term}_{param}_texture;")
+        lines += ["", "void material_inputs(vec2 uv, vec3 color)", "{"]
+        for term, param, mode in key.inputs:
+            factors = [f"u_{term}_{param}_scale"]
+            factors += [f"surface_texture(u_{term}_{param}_texture, uv)"] if "texture" in mode else []
+            factors += ["color"] if "vertex" in mode else []
+            lines.append(f"    u_{term}_{param} = {' * '.join(factors)};")
+        lines.append("}")
     return "\n".join(lines) + "\n"
 
 
@@ -347,9 +419,12 @@ def _ambient_present(ambient_radiance):
 
 
 def _term_key(term, lit, ambient, uber=False):
+    surface = term.surface_inputs()
+    inputs = tuple((p.name, surface[p.name].mode) for p in term.params
+                   if p.name in surface and (lit or (ambient and p.name == term.ambient)))
     return TermKey(term.name, term.source_hash(), tuple(term.needs), lit=lit, ambient=ambient,
                    uses=term.library_uses(uber), defines=term.structural_defines(uber), ambient_param=term.ambient,
-                   ambient_scale=float(term.ambient_scale))
+                   ambient_scale=float(term.ambient_scale), inputs=inputs)
 
 
 def term_keys(material, lit, ambient_present):
@@ -368,6 +443,8 @@ def response_key(material):
     """The key of a program that evaluates ``material``'s response at direction pairs (`glphong.testing`):
     every term that does not vanish, in the light loop's place, no light, no emission."""
     terms = tuple(t for t in term_keys(material, True, False))
+    _refuse_surface_inputs(terms, "glphong.testing evaluates a material's response at given directions, with "
+                                  "constant parameters")
     needs = {n for t in terms for n in t.needs}
     return ProgramKey(output="response", terms=terms, has_normal=True, has_tangent="tangent" in needs,
                       has_uv="uv" in needs, two_sided=False)
@@ -392,11 +469,18 @@ def program_key(material, light_counts, ambient_radiance, output="radiance", gbu
     ProgramKey
     """
     if output == "gbuffer":
-        return gbuffer_key(material, gbuffer_needs or ())
+        textured = program_key(material, light_counts, ambient_radiance).textured_inputs
+        if len(textured) > MAX_TEXTURED_INPUTS:
+            raise ValueError(f"a material may texture at most {MAX_TEXTURED_INPUTS} parameters (the G-buffer holds one "
+                             f"level of detail per texture); {type(material).__name__} textures {len(textured)}")
+        return gbuffer_key(material, gbuffer_needs or (), len(textured))
     # lights matter only to a material with a term that reflects them
     lit = sum(light_counts.values()) > 0 and any(not t.vanishes() for t in material.components)
     terms = term_keys(material, lit, _ambient_present(ambient_radiance))
     needs = {n for t in terms if t.lit for n in t.needs}
+    modes = [mode for t in terms for _, mode in t.inputs]
+    if output == "points":
+        _refuse_surface_inputs(terms, "shading at given points has no texture coordinates or vertex colours")
     count = lambda kind: light_counts.get(kind, 0) if lit else 0  # noqa: E731
     return ProgramKey(
         output=output,
@@ -407,9 +491,17 @@ def program_key(material, light_counts, ambient_radiance, output="radiance", gbu
         num_directional_lights=count("directional"),
         has_normal=lit,
         has_tangent="tangent" in needs,
-        has_uv="uv" in needs,
+        has_uv="uv" in needs or any("texture" in m for m in modes),
         two_sided=material.two_sided and lit,
+        has_color=any("vertex" in m for m in modes),
     )
+
+
+def _refuse_surface_inputs(terms, why):
+    inputs = [f"{t.name}.{param}" for t in terms for param, _ in t.inputs]
+    if inputs:
+        raise ValueError(f"{', '.join(inputs)} vary over the surface (a texture or vertex colours), but {why}: "
+                         "give the material constant parameters")
 
 
 _UBER_BUILTINS = {}
@@ -443,6 +535,10 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
     """
     terms = {}
     drawn = [term for material in materials for term in material.components]
+    textured = [f"{t.name}.{name}" for t in drawn for name in t.surface_inputs()]
+    if textured:
+        raise ValueError(f"the uber-shader holds constant parameters only, but {', '.join(textured)} vary over the "
+                         "surface (a texture or vertex colours): render it with specialise=True")
     # a model's Fresnel form is a run-time switch, compiled only where one of the scene's terms has one
     # (computing F for every fragment and light would cost the lecture's models whatever the scene)
     with_fresnel = {t.name for t in drawn if getattr(t, "fresnel", None) is not None}
@@ -490,9 +586,14 @@ class EncodeKey:
     def describe(self):
         return f"encode srgb8 supersample={self.supersample}"
 
+    def extensions(self):
+        return ()
 
-def gbuffer_key(material, needs=()):
-    """The G-buffer-program key of one material: its two-sided flag, and the scene's extra
-    G-buffer outputs ``needs`` ('tangent', 'uv')."""
+
+def gbuffer_key(material, needs=(), lod_textures=0):
+    """The G-buffer-program key of one material: its two-sided flag, the scene's extra G-buffer outputs
+    ``needs`` ('tangent', 'uv', 'color', 'lod') and the number of its textures whose level of detail it
+    writes."""
     return ProgramKey(output="gbuffer", has_normal=True, two_sided=material.two_sided,
-                      has_tangent="tangent" in needs, has_uv="uv" in needs)
+                      has_tangent="tangent" in needs, has_uv="uv" in needs, has_color="color" in needs,
+                      has_lod="lod" in needs, lod_textures=lod_textures)

@@ -100,7 +100,7 @@ def resolve_chunk(label, generated=None):
     return Chunk(label, "", chunk_source(label), f"{label}.glsl")
 
 
-def assemble(chunks, defines, generated=None):
+def assemble(chunks, defines, generated=None, extensions=()):
     """Assemble one stage's source.
 
     Parameters
@@ -111,6 +111,8 @@ def assemble(chunks, defines, generated=None):
         ``#define`` name and value pairs.
     generated : dict of str to str, optional
         Text of generated chunks by label.
+    extensions : sequence of str
+        ``#extension`` directives (``'GL_ARB_texture_query_lod : require'``), placed after ``#version``.
 
     Returns
     -------
@@ -121,6 +123,7 @@ def assemble(chunks, defines, generated=None):
         (Mesa gives 0 for some semantic errors).
     """
     lines = [GLSL_VERSION]
+    lines += [f"#extension {e}" for e in extensions]
     lines += [f"#define {name} {value}" for name, value in defines]
     for number, label in enumerate(chunks, start=1):
         chunk = resolve_chunk(label, generated)
@@ -243,7 +246,8 @@ class Program:
         self.textures = textures
         defines, generated = key.defines(), key.generated_chunks()
         self.vertex_source = assemble(key.vertex_chunks(), defines, generated)
-        self.fragment_source = assemble(key.fragment_chunks(), defines, generated) if key.fragment_chunks() else None
+        self.fragment_source = assemble(key.fragment_chunks(), defines, generated, key.extensions()) \
+            if key.fragment_chunks() else None
         try:
             self.gl_program = mgl.program(vertex_shader=self.vertex_source, fragment_shader=self.fragment_source,
                                           varyings=key.varyings())
@@ -304,6 +308,7 @@ class Program:
             A name that is not an active uniform (unless ``drop_unused``, or a model uniform a
             structural define compiled out), or a size that does not match.
         """
+        from .materials.surface import TextureImage
         from .materials.table import TableData
 
         unknown = sorted(n for n in values if n not in self.active and not drop_unused and n not in self.optional)
@@ -315,7 +320,7 @@ class Program:
             uniform = self.active.get(name)
             if uniform is None:
                 continue
-            if isinstance(value, TableData):
+            if isinstance(value, (TableData, TextureImage)):
                 if name not in self.samplers or self.textures is None:
                     raise UniformError(f"uniform {name} of program {self.key.describe()!r} is not a sampler of a "
                                        "program with a texture store: it cannot take a table")

@@ -315,16 +315,54 @@ def _terms(material):
     return {term.name: term for term in material.components}
 
 
-def material_emission(key, uniforms, shape, dtype, material=None):
-    """``k_a + sum_terms k L_a`` (the generated material chunk's ``material_emission``), broadcast to ``shape``."""
+def material_emission(key, uniforms, shape, dtype, material=None, inputs=None):
+    """``k_a + sum_terms k L_a`` (the generated material chunk's ``material_emission``), broadcast to ``shape``;
+    ``inputs`` the per-fragment values of surface inputs (`material_inputs`), where the key has them."""
     radiance = np.zeros(shape, dtype)
     if key.has_ka:
         radiance = radiance + uniforms["u_ka"]
     for term in key.terms:
         if term.ambient:
             scale = np.float32(term.ambient_scale).astype(dtype)
-            radiance = radiance + uniforms[f"u_{term.name}_{term.ambient_param}"] * (scale * uniforms["u_ambient"])
+            name = f"u_{term.name}_{term.ambient_param}"
+            k = inputs[name] if inputs is not None and name in inputs else uniforms[name]
+            radiance = radiance + k * (scale * uniforms["u_ambient"])
     return radiance
+
+
+def material_inputs(uv, color, lod, key, uniforms):
+    """The surface inputs of the generated material chunk's ``material_inputs(uv, color)``:
+    ``u_<model>_<param> = scale * surface_texture(texture, uv) * color``.
+
+    Parameters
+    ----------
+    uv : (N, 2) ndarray or None
+    color : (N, 3) ndarray or None
+        The interpolated vertex colour (the G-buffer's), where an input reads it.
+    lod : (N, 4) ndarray or None
+        The level of detail of each textured input, in `ProgramKey.textured_inputs` order.
+    key : glphong.key.ProgramKey
+    uniforms : dict
+        The program's uniforms (``u_<model>_<param>_scale`` and ``_texture``).
+
+    Returns
+    -------
+    dict of str to (N, 3) float64 ndarray
+        By uniform name; empty where the key has no surface input.
+    """
+    from .materials.surface import surface_texture
+
+    out = {}
+    textured = list(key.textured_inputs)
+    for term, param, mode in key.inputs:
+        name = f"u_{term}_{param}"
+        value = np.asarray(uniforms[f"{name}_scale"], dtype=np.float64)
+        if "texture" in mode:
+            value = value * surface_texture(uniforms[f"{name}_texture"], uv, lod[:, textured.index((term, param))])
+        if "vertex" in mode:
+            value = value * color
+        out[name] = np.broadcast_to(value, (len(uv) if uv is not None else len(color), 3))
+    return out
 
 
 def material_response(f, wi, wo, n_dot_l, key, uniforms, material):
@@ -333,7 +371,7 @@ def material_response(f, wi, wo, n_dot_l, key, uniforms, material):
     out = np.zeros(np.shape(wi), np.result_type(f.n, wi))
     for term_key in key.lit_terms:  # a term that does not need the view gets v = 0, as in the GLSL
         term = terms[term_key.name]
-        p = term.values_from_uniforms(uniforms, dtype=out.dtype)
+        p = term.values_from_uniforms(uniforms, dtype=out.dtype, inputs=f.inputs)
         view = wo if "view" in term.needs else np.zeros_like(wi)
         out = out + term.response(f, wi, view, n_dot_l, p)
     return out
@@ -391,7 +429,7 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
         Radiance [W/(m^2 sr)].
     """
     f = n if hasattr(n, "n") else shading_frame(np.asarray(n), key=key)
-    radiance = material_emission(key, uniforms, position.shape, position.dtype, material)
+    radiance = material_emission(key, uniforms, position.shape, position.dtype, material, f.inputs)
     if key.num_lights == 0:
         return radiance
     wo, lit = view_direction(position, n_valid, eye, key)
@@ -409,8 +447,11 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
 
 
 # --------------------------------------------------------------------------- mesh_fragment.glsl
-def shade_inputs(scene, gbuffer, dtype=np.float64):
+def shade_inputs(scene, gbuffer, dtype=np.float64, band=None):
     """Per object, the fragments it covers and the inputs its program shaded them with.
+
+    ``band`` (`glphong.tolerances.BandConstants`): also the intervals of the surface inputs
+    (``f.input_bounds``), for the tolerance band.
 
     Yields
     ------
@@ -424,7 +465,8 @@ def shade_inputs(scene, gbuffer, dtype=np.float64):
     position : (N, 3) ndarray
     f : ShadingFrame
         The G-buffer normal renormalised (mesh_fragment.glsl), and the frame built from the
-        G-buffer's tangent and uv where the key reads them (`shading_frame`).
+        G-buffer's tangent and uv where the key reads them (`shading_frame`), with the surface
+        inputs from the G-buffer's uv, vertex colour and levels of detail (`material_inputs`).
     n_valid : (N,) bool ndarray
     """
     height, width = gbuffer.mask.shape
@@ -438,7 +480,19 @@ def shade_inputs(scene, gbuffer, dtype=np.float64):
         n_valid, n, _ = safe_normalize(gbuffer.normal[selection].astype(dtype))
         tangent = gbuffer.tangent[selection].astype(dtype) if key.has_tangent else None
         uv = gbuffer.uv[selection].astype(dtype) if key.has_uv else None
-        yield selection, obj, key, uniforms, position, shading_frame(n, tangent, uv, key), n_valid
+        f = shading_frame(n, tangent, uv, key)
+        if key.inputs:
+            color = gbuffer.color[selection].astype(np.float64) if key.has_color else None
+            lod = gbuffer.lod[selection].astype(np.float64) if key.textured_inputs else None
+            uv64 = None if uv is None else gbuffer.uv[selection].astype(np.float64)
+            inputs = {k: v.astype(dtype) for k, v in material_inputs(uv64, color, lod, key, uniforms).items()}
+            bounds = None
+            if band is not None:
+                from .tolerances import input_bounds
+
+                bounds = input_bounds(uv64, color, lod, key, uniforms, band)
+            f = type(f)(f.n, f.t, f.b, f.uv, inputs, bounds)
+        yield selection, obj, key, uniforms, position, f, n_valid
 
 
 def shade(scene, gbuffer, dtype=np.float64):

@@ -107,7 +107,13 @@ class GBuffer:
         The interpolated world-space tangent (handedness in w) the frame was built from, where a
         drawn term needs ``'tangent'``; else None.
     uv : (H, W, 2) float32 ndarray or None
-        The interpolated texture coordinates, where a drawn term needs ``'uv'``; else None.
+        The interpolated texture coordinates, where a drawn term needs ``'uv'`` or a parameter is
+        textured; else None.
+    color : (H, W, 3) float32 ndarray or None
+        The interpolated linear vertex colour, where a parameter takes vertex colours; else None.
+    lod : (H, W, 4) float32 ndarray or None
+        Per pixel, the level of detail the GPU used for each texture of the object's material, in the
+        order of `glphong.key.ProgramKey.textured_inputs` (0 beyond), where a parameter is textured.
     """
 
     position: np.ndarray
@@ -116,6 +122,8 @@ class GBuffer:
     mask: np.ndarray
     tangent: np.ndarray = None
     uv: np.ndarray = None
+    color: np.ndarray = None
+    lod: np.ndarray = None
 
 
 class _MeshBuffers:
@@ -127,7 +135,7 @@ class _MeshBuffers:
 
     #: attribute -> (MeshData attribute, moderngl format)
     _SOURCES = {"in_position": ("positions", "3f"), "in_normal": ("normals", "3f"), "in_tangent": ("tangents", "4f"),
-                "in_uv": ("uvs", "2f")}
+                "in_uv": ("uvs", "2f"), "in_color": ("colors", "3f")}
 
     def __init__(self, mgl, mesh):
         self.owner = weakref.ref(mesh)
@@ -137,7 +145,7 @@ class _MeshBuffers:
 
     #: what a mesh without tangents or UVs supplies to a program that reads them for another object's
     #: sake (the G-buffer, the uber-shader): tangent 0 (the shader then uses the basis around n), uv 0
-    _DEFAULTS = {"in_tangent": (0.0, 0.0, 0.0, 1.0), "in_uv": (0.0, 0.0)}
+    _DEFAULTS = {"in_tangent": (0.0, 0.0, 0.0, 1.0), "in_uv": (0.0, 0.0), "in_color": (1.0, 1.0, 1.0)}
 
     def buffer(self, mgl, name):
         if name not in self.buffers:
@@ -490,7 +498,7 @@ class Renderer:
         """
         self._check_scene(scene)
         needs = scene.gbuffer_needs()
-        extras = [n for n in ("tangent", "uv") if n in needs]
+        extras = [n for n in ("tangent", "uv", "color", "lod") if n in needs]
         with self.context:
             fbo = self._target(("gbuffer", *extras))
             self._draw(scene, "gbuffer", fbo)
@@ -503,7 +511,9 @@ class Renderer:
         return GBuffer(position=np.ascontiguousarray(position[..., :3]), normal=np.ascontiguousarray(normal[..., :3]),
                        object_index=object_index, mask=mask,
                        tangent=np.ascontiguousarray(extra["tangent"]) if "tangent" in extra else None,
-                       uv=np.ascontiguousarray(extra["uv"][..., :2]) if "uv" in extra else None)
+                       uv=np.ascontiguousarray(extra["uv"][..., :2]) if "uv" in extra else None,
+                       color=np.ascontiguousarray(extra["color"][..., :3]) if "color" in extra else None,
+                       lod=np.ascontiguousarray(extra["lod"]) if "lod" in extra else None)
 
     def program_key(self, scene, obj, output="radiance"):
         """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading)."""
@@ -511,6 +521,10 @@ class Renderer:
         if output == "radiance" and not self.specialise:
             return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex)
         key = scene.program_key(obj, output)
+        if per_vertex and key.textured_inputs:
+            raise ValueError(f"object {obj.name!r}: {', '.join(f'{t}.{p}' for t, p in key.textured_inputs)} "
+                             "are textured, which needs per-pixel shading (a vertex has no texture footprint): "
+                             "use Renderer(shading='pixel')")
         if key.formulation != self.formulation or key.shade_per_vertex != per_vertex:
             key = replace(key, formulation=self.formulation, shade_per_vertex=per_vertex)
         return key

@@ -13,6 +13,7 @@ from .geometry import MeshData
 from .key import program_key
 from .lights import LIGHT_KINDS, AmbientLight
 from .materials import Material
+from .materials.surface import TextureImage
 from .materials.table import TableData
 
 __all__ = ["Scene", "SceneObject"]
@@ -163,7 +164,8 @@ class Scene:
         return program_key(obj.material, self.light_counts(), self.ambient_radiance, output, needs)
 
     def gbuffer_needs(self):
-        """Extra G-buffer outputs the scene's radiance programs read ('tangent', 'uv'), a frozenset.
+        """Extra G-buffer outputs the scene's radiance programs read ('tangent', 'uv', 'color'; 'lod' where a
+        parameter is textured), a frozenset.
 
         Computed once per state of the scene (objects and lights are only ever added; the ambient
         light may be replaced), not once per object drawn."""
@@ -172,7 +174,8 @@ class Scene:
         if cached is None or cached[0] != state:
             counts, ambient = self.light_counts(), self.ambient_radiance
             keys = [program_key(o.material, counts, ambient) for o in self._objects]
-            needs = frozenset(n for n in ("tangent", "uv") if any(getattr(k, f"has_{n}") for k in keys))
+            needs = {n for n in ("tangent", "uv", "color") if any(getattr(k, f"has_{n}") for k in keys)}
+            needs = frozenset(needs | ({"lod"} if any(k.textured_inputs for k in keys) else set()))
             cached = self._gbuffer_needs = (state, needs)
         return cached[1]
 
@@ -240,9 +243,15 @@ class Scene:
             values["u_normal_matrix"] = obj.normal_matrix
         if key.output == "gbuffer":
             values["u_object_id"] = float(index)
+            if key.lod_textures:  # the textures whose level of detail the G-buffer records, in sampler order
+                spec = self.program_key(obj)
+                surface = {(t.name, p): v for t in obj.material.components for p, v in t.surface_inputs().items()}
+                for i, (term, param) in enumerate(spec.textured_inputs):
+                    values[f"u_lod_texture{i}"] = surface[(term, param)].texture
         else:
             values.update(obj.material.uniform_values(key))
-        return {name: v if isinstance(v, TableData) else _validate.float32_uniform(v) for name, v in values.items()}
+        return {name: v if isinstance(v, (TableData, TextureImage)) else _validate.float32_uniform(v)
+                for name, v in values.items()}
 
     def _uber_uniform_values(self, index, key, aspect):
         """The uber-shader's uniforms: the specialised key's values, zeros for the terms the object's
@@ -299,3 +308,10 @@ def _check_mesh_serves(mesh, material, name):
         if "uv" in term.needs and mesh.uvs is None:
             raise ValueError(f"object {name!r}: the material term {term.name!r} needs UVs, but the mesh has none: "
                              "give MeshData uvs=, a trimesh with UVs, or use glphong.primitives")
+        for param, value in term.surface_inputs().items():
+            if value.texture is not None and mesh.uvs is None:
+                raise ValueError(f"object {name!r}: {term.name}.{param} is textured, but the mesh has no UVs: give "
+                                 "MeshData uvs=, a trimesh with UVs, or use glphong.primitives")
+            if value.vertex_colors and mesh.colors is None:
+                raise ValueError(f"object {name!r}: {term.name}.{param} takes vertex colours, but the mesh has none: "
+                                 "give MeshData colors= or a trimesh with vertex colours")

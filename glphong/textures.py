@@ -32,12 +32,34 @@ class TextureStore:
         self.uploads = 0
 
     def texture(self, table):
-        """The texture holding ``table`` (uploaded on first use): texel ``(k, j, i)`` is ``array[i, j, k]``,
-        nearest filtering, no mipmaps (the GLSL reads it with ``texelFetch``)."""
+        """The texture holding ``table`` (uploaded on first use).  A `TableData`: texel ``(k, j, i)`` is
+        ``array[i, j, k]``, nearest filtering, no mipmaps (the GLSL reads it with ``texelFetch``).  A
+        `glphong.materials.surface.TextureImage`: its levels as float16 or float32 rgb, its filter and wrap."""
         entry = self._entries.get(table.digest)
         if entry is not None and entry[0]() is not None:
             return entry[1]
         self._purge()
+        texture = self._upload_image(table) if hasattr(table, "levels") else self._upload_table(table)
+        self._entries[table.digest] = (weakref.ref(table), texture)
+        self.uploads += 1
+        return texture
+
+    def _upload_image(self, image):
+        levels = image.levels
+        dtype = "f2" if levels[0].dtype == np.float16 else "f4"
+        texture = self._mgl.texture(image.size, 3, levels[0].tobytes(), dtype=dtype, alignment=1)
+        if len(levels) > 1:
+            texture.build_mipmaps(0, len(levels) - 1)  # allocates the levels; glphong's own texels replace GL's
+            for k, level in enumerate(levels[1:], start=1):
+                texture.write(level.tobytes(), level=k, alignment=1)
+            texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+        else:
+            texture.filter = (moderngl.LINEAR, moderngl.LINEAR)
+        texture.repeat_x = texture.repeat_y = image.wrap == "repeat"  # else GL_CLAMP_TO_EDGE
+        texture.anisotropy = 1.0
+        return texture
+
+    def _upload_table(self, table):
         data = np.ascontiguousarray(table.array, dtype=np.float32)
         size = tuple(reversed(data.shape[:-1]))
         channels = data.shape[-1]
@@ -49,8 +71,6 @@ class TextureStore:
         texture.repeat_x = texture.repeat_y = False
         if len(size) == 3:
             texture.repeat_z = False
-        self._entries[table.digest] = (weakref.ref(table), texture)
-        self.uploads += 1
         return texture
 
     def bind(self, table, unit):
@@ -62,8 +82,8 @@ class TextureStore:
             self._entries.pop(digest)[1].release()
 
     def nbytes(self):
-        """Bytes of the textures held (float32 data)."""
-        return sum(t.width * t.height * getattr(t, "depth", 1) * t.components * 4 for _, t in self._entries.values())
+        """Bytes of the data of the textures held."""
+        return sum(ref().nbytes for ref, _ in self._entries.values() if ref() is not None)
 
     def __len__(self):
         return len(self._entries)

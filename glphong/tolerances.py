@@ -26,7 +26,7 @@ import numpy as np
 from . import reference as ref
 
 __all__ = ["EPS", "FLT_MIN", "FLT_MAX", "BandConstants", "BAND", "lobe_band", "response_band", "point_band",
-           "radiance_band"]
+           "radiance_band", "input_bounds"]
 
 EPS = 2.0 ** -24
 FLT_MIN = float(np.finfo(np.float32).tiny)
@@ -47,12 +47,18 @@ class BandConstants:
         Absolute error of the unit vectors' chord ``|r - v|`` (or ``|h - n|``).
     D : float
         Absolute error of ``n.l`` and ``n.v``.
+    T : float
+        Error of a filtered texture value as a fraction of the spread of the texels it weights
+        (`glphong.materials.surface.surface_texture_band`).  GL does not bound filter-weight precision;
+        2^-7 covers 8-bit weights (Direct3D's minimum).  llvmpipe measured 5.6e-5 (float16 and float32
+        texels, trilinear, lod 0 to 8: tests/test_surface_inputs.py).
     """
 
     A: float = 16.0
     B: float = 4.0
     C: float = 6.0
     D: float = 8.0
+    T: float = 2.0 ** -7
 
 
 BAND = BandConstants()
@@ -90,6 +96,45 @@ def lobe_band(delta, q, chord_scale=1.0, band=BAND):
     return np.where(low < FLT_MIN, 0.0, low), widen(high, +1.0)
 
 
+def input_bounds(uv, color, lod, key, u, band=BAND):
+    """Intervals of the GPU's surface inputs ``scale * T(uv) * C`` (`glphong.reference.material_inputs`).
+
+    The texture value's interval is `glphong.materials.surface.surface_texture_band`; scale and
+    colour are exact float32 inputs (>= 0), and the two float32 products add ``2 eps`` relative.
+
+    Returns
+    -------
+    dict of str to (low, high)
+        By uniform name, each (N, 3) float64.
+    """
+    from .materials.surface import surface_texture_band
+
+    out = {}
+    textured = list(key.textured_inputs)
+    for term, param, mode in key.inputs:
+        name = f"u_{term}_{param}"
+        scale = np.asarray(u[f"{name}_scale"], dtype=np.float64)
+        lo = hi = scale
+        if "texture" in mode:
+            t_lo, t_hi = surface_texture_band(u[f"{name}_texture"], uv, lod[:, textured.index((term, param))], band)
+            lo, hi = lo * t_lo, hi * t_hi
+        if "vertex" in mode:
+            lo, hi = lo * color, hi * color
+        n = len(uv) if uv is not None else len(color)
+        out[name] = (np.broadcast_to(lo * (1 - 2 * EPS), (n, 3)), np.broadcast_to(hi * (1 + 2 * EPS), (n, 3)))
+    return out
+
+
+def _input_ends(f):
+    """``(low, high)``: the surface inputs at the two ends of their intervals (None, None without inputs)."""
+    if not f.inputs:
+        return None, None
+    bounds = f.input_bounds
+    if bounds is None:  # no intervals asked for: the values themselves
+        return f.inputs, f.inputs
+    return {k: lo for k, (lo, _) in bounds.items()}, {k: hi for k, (_, hi) in bounds.items()}
+
+
 def point_band(key, u, position, n, n_valid, material, band=BAND):
     """Interval the GPU's ``shade_point()`` must return at given points.
 
@@ -116,8 +161,9 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
     low, high : (N, 3) float64 ndarray
     """
     f = n if hasattr(n, "n") else ref.shading_frame(np.asarray(n), key=key)
-    ambient = ref.material_emission(key, u, position.shape, np.float64)
-    lo, hi = ambient * (1 - band.A * EPS), ambient * (1 + band.A * EPS)
+    low_inputs, high_inputs = _input_ends(f)
+    lo = ref.material_emission(key, u, position.shape, np.float64, inputs=low_inputs) * (1 - band.A * EPS)
+    hi = ref.material_emission(key, u, position.shape, np.float64, inputs=high_inputs) * (1 + band.A * EPS)
     terms = int(key.has_ka) + sum(1 for t in key.terms if t.ambient)
     if key.num_lights:
         wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
@@ -170,7 +216,12 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
     for term_key in key.lit_terms:
         term = models[term_key.name]
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            t_lo, t_hi = term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u), band)
+            if term.surface_inputs():  # the band at both ends of the inputs' intervals (first order inside)
+                ends = [term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u, inputs=inputs), band)
+                        for inputs in _input_ends(f)]
+                t_lo, t_hi = np.minimum(ends[0][0], ends[1][0]), np.maximum(ends[0][1], ends[1][1])
+            else:
+                t_lo, t_hi = term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u), band)
         # a term's float32 result below FLT_MIN in magnitude may be flushed to 0 (e.g. ks * lobe with
         # the lobe just above FLT_MIN): the band then reaches 0
         t_lo = np.where((t_lo > 0) & (t_lo < FLT_MIN), 0.0, t_lo)
@@ -196,6 +247,6 @@ def radiance_band(scene, gbuffer, band=BAND):
     """
     low = np.zeros(gbuffer.position.shape)
     high = np.zeros(gbuffer.position.shape)
-    for selection, obj, key, u, position, f, n_valid in ref.shade_inputs(scene, gbuffer):
+    for selection, obj, key, u, position, f, n_valid in ref.shade_inputs(scene, gbuffer, band=band):
         low[selection], high[selection] = point_band(key, u, position, f, n_valid, obj.material, band)
     return low, high

@@ -9,9 +9,13 @@
 //   G-buffer outputs (OUTPUT_GBUFFER): position (world, [m]) with w = object id + 1, the
 //   normal exactly as shade_point() would use it (0 where it is invalid), w = 1; with HAS_TANGENT
 //   the interpolated tangent (xyz, handedness w), with HAS_UV the uv (xy): the inputs of shading_frame();
-//   locations 0 position, 1 normal, then tangent and uv in that order, packed (uv at 2 without a tangent).
-// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY,
-// SHADE_PER_VERTEX, NEEDS_VIEW, RUNTIME_SWITCHES, SWITCH(flag).
+//   with HAS_COLOR the interpolated vertex colour (rgb); with HAS_LOD the level of detail of each of the
+//   object's NUM_LOD_TEXTURES textures (surface_texture_lod(), 0 beyond): the inputs of material_inputs();
+//   locations 0 position, 1 normal, then the extra planes at GBUFFER_<PLANE>_LOCATION (key.py packs them).
+// HAS_INPUTS: material_inputs(uv, colour) sets the surface inputs (the generated material chunk) before shading.
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, NUM_LOD_TEXTURES,
+// GBUFFER_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW,
+// RUNTIME_SWITCHES, SWITCH(flag).
 
 invariant in vec3 v_position;
 #if SHADE_PER_VERTEX
@@ -32,6 +36,9 @@ invariant in vec4 v_tangent;
 #if HAS_UV
 invariant in vec2 v_uv;
 #endif
+#if HAS_COLOR
+invariant in vec3 v_color;
+#endif
 #if TWO_SIDED && RUNTIME_SWITCHES
 uniform float u_two_sided;
 #endif
@@ -40,12 +47,28 @@ uniform float u_object_id;
 layout(location = 0) out vec4 out_position;
 layout(location = 1) out vec4 out_normal;
 #if HAS_TANGENT
-layout(location = 2) out vec4 out_tangent;
+layout(location = GBUFFER_TANGENT_LOCATION) out vec4 out_tangent;
 #endif
-#if HAS_UV && HAS_TANGENT
-layout(location = 3) out vec4 out_uv;
-#elif HAS_UV
-layout(location = 2) out vec4 out_uv;  // the renderer packs the extra planes: uv follows the normal when there is no tangent
+#if HAS_UV
+layout(location = GBUFFER_UV_LOCATION) out vec4 out_uv;
+#endif
+#if HAS_COLOR
+layout(location = GBUFFER_COLOR_LOCATION) out vec4 out_color;
+#endif
+#if HAS_LOD
+layout(location = GBUFFER_LOD_LOCATION) out vec4 out_lod;
+#endif
+#if NUM_LOD_TEXTURES > 0
+uniform sampler2D u_lod_texture0;
+#endif
+#if NUM_LOD_TEXTURES > 1
+uniform sampler2D u_lod_texture1;
+#endif
+#if NUM_LOD_TEXTURES > 2
+uniform sampler2D u_lod_texture2;
+#endif
+#if NUM_LOD_TEXTURES > 3
+uniform sampler2D u_lod_texture3;
 #endif
 #else
 #if NEEDS_VIEW
@@ -79,6 +102,10 @@ void main()
 #if HAS_UV
     uv = v_uv;
 #endif
+    vec3 color = vec3(1.0);
+#if HAS_COLOR
+    color = v_color;
+#endif
 #if OUTPUT_GBUFFER
     out_position = vec4(v_position, u_object_id + 1.0);
     out_normal = vec4(n, 1.0);
@@ -88,10 +115,33 @@ void main()
 #if HAS_UV
     out_uv = vec4(uv, 0.0, 1.0);
 #endif
-#elif OUTPUT_DISPLAY
+#if HAS_COLOR
+    out_color = vec4(color, 1.0);
+#endif
+#if HAS_LOD
+    out_lod = vec4(0.0);
+#endif
+#if NUM_LOD_TEXTURES > 0
+    out_lod.x = surface_texture_lod(u_lod_texture0, uv);
+#endif
+#if NUM_LOD_TEXTURES > 1
+    out_lod.y = surface_texture_lod(u_lod_texture1, uv);
+#endif
+#if NUM_LOD_TEXTURES > 2
+    out_lod.z = surface_texture_lod(u_lod_texture2, uv);
+#endif
+#if NUM_LOD_TEXTURES > 3
+    out_lod.w = surface_texture_lod(u_lod_texture3, uv);
+#endif
+#else
+#if HAS_INPUTS
+    material_inputs(uv, color);
+#endif
+#if OUTPUT_DISPLAY
     out_radiance = vec4(srgb_encode(u_exposure * shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye)), 1.0);
 #else
     out_radiance = vec4(shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye), 1.0);
+#endif
 #endif
 }
 #endif

@@ -9,9 +9,11 @@
 //   no gl_FrontFacing); a vertex radiance beyond GOURAUD_MAX = 2^100 (about 1.3e30) saturates there, so
 //   the interpolation never meets Inf (Inf times a zero barycentric weight is NaN) nor overflows.
 //   Positions in metres, radiance in W/(m^2 sr).
-// Attribute locations are fixed and match pyrender's: 0 position, 1 normal, 2 tangent, 3 uv.
+// Attribute locations are fixed and match pyrender's: 0 position, 1 normal, 2 tangent, 3 uv; 4 the linear
+// vertex colour (HAS_COLOR: a surface input reads it; material_inputs() runs here when shading per vertex).
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
-// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, SHADE_PER_VERTEX, TWO_SIDED, NEEDS_VIEW, SWITCH(flag).
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, SHADE_PER_VERTEX, TWO_SIDED,
+// NEEDS_VIEW, SWITCH(flag).
 
 const float GOURAUD_MAX = 1.2676506002282294e30;  // 2^100: per-vertex radiance saturates here
 layout(location = 0) in vec3 in_position;
@@ -28,6 +30,9 @@ layout(location = 2) in vec4 in_tangent;
 #endif
 #if HAS_UV
 layout(location = 3) in vec2 in_uv;
+#endif
+#if HAS_COLOR
+layout(location = 4) in vec3 in_color;
 #endif
 #if SHADE_PER_VERTEX
 out vec3 v_radiance;
@@ -49,6 +54,9 @@ invariant out vec4 v_tangent;
 #if HAS_UV
 invariant out vec2 v_uv;
 #endif
+#if HAS_COLOR
+invariant out vec3 v_color;
+#endif
 #endif
 
 void main()
@@ -64,6 +72,13 @@ void main()
     uv = in_uv;
 #endif
 #if SHADE_PER_VERTEX
+#if HAS_INPUTS
+#if HAS_COLOR
+    material_inputs(uv, in_color);
+#else
+    material_inputs(uv, vec3(1.0));
+#endif
+#endif
     vec3 n = vec3(0.0);
     bool n_valid = false;
 #if HAS_NORMAL
@@ -87,6 +102,9 @@ void main()
 #endif
 #if HAS_UV
     v_uv = uv;
+#endif
+#if HAS_COLOR
+    v_color = in_color;
 #endif
 #endif
     gl_Position = u_view_projection * world;

@@ -34,16 +34,18 @@ import pkgutil as _pkgutil
 
 from .model import (Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues,
                     Properties, ShadingFrame, model_named, registered_models)
+from .surface import SurfaceInput, Texture, TextureImage, VertexColors
 from .table import Table, TableData
 
 __all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "Table", "TableData", "ParamValues",
-           "Properties", "ShadingFrame", "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
+           "Properties", "ShadingFrame", "MaterialDefinitionError", "GlslFile", "registered_models", "model_named",
+           "SurfaceInput", "Texture", "TextureImage", "VertexColors"]
 
 # every module of this package but the mechanism is one model: importing it registers the model, and
 # the material classes it exports are this package's, so a new model is one file here (with its GLSL
 # and its tests); its twin functions stay in its module (and are found by glphong.reference)
 for _info in sorted(_pkgutil.iter_modules(__path__), key=lambda info: info.name):
-    if _info.name not in ("model", "table"):  # the mechanism
+    if _info.name not in ("model", "table", "surface"):  # the mechanism
         _module = _importlib.import_module(f"{__name__}.{_info.name}")
         for _name in _module.__all__:
             if isinstance(getattr(_module, _name), type):

@@ -91,9 +91,9 @@ _INV_8PI = 1.0 / (8.0 * np.pi)
 _DIFFUSE_NORM = 28.0 / (23.0 * np.pi)
 _EXPONENT_MAX = 1e6
 
-_RHO_D = Param("rho_d", "rgb", low=0.0, high=1.0,
+_RHO_D = Param("rho_d", "rgb", low=0.0, high=1.0, textureable=True,
                doc="diffuse reflectance of the substrate, dimensionless (f_d = 28 rho_d/(23 pi) (1 - rho_s) ...)")
-_RHO_S = Param("rho_s", "rgb", low=0.0, high=1.0,
+_RHO_S = Param("rho_s", "rgb", low=0.0, high=1.0, textureable=True,
                doc="specular reflectance at normal incidence, dimensionless (Schlick's f0)")
 _NU = Param("nu", "scalar", low=0.0, high=_EXPONENT_MAX, doc="Phong exponent along the tangent t")
 _NV = Param("nv", "scalar", low=0.0, high=_EXPONENT_MAX, doc="Phong exponent along the bitangent b")

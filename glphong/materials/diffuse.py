@@ -19,7 +19,7 @@ from .model import GlslFile, MaterialModel, Param, Properties
 __all__ = ["Diffuse", "diffuse", "RHO_D"]
 
 #: the albedo parameter shared by the models with a diffuse term
-RHO_D = Param("rho_d", "rgb", low=0.0, high=1.0, doc="diffuse albedo, dimensionless (f_r = rho_d / pi)")
+RHO_D = Param("rho_d", "rgb", low=0.0, high=1.0, textureable=True, doc="diffuse albedo, dimensionless (f_r = rho_d / pi)")
 
 
 def diffuse(rho_d, n_dot_l):

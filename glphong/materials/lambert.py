@@ -36,7 +36,7 @@ class Lambert(MaterialModel):
     """
 
     name = "lambert"
-    params = (Param("kd", "rgb", low=0.0, unit="1/sr", doc="diffuse BRDF value; an albedo rho is kd = rho/pi"),)
+    params = (Param("kd", "rgb", low=0.0, unit="1/sr", textureable=True, doc="diffuse BRDF value; an albedo rho is kd = rho/pi"),)
     glsl = GlslFile("materials/lambert.glsl")
     ambient = "kd"
     vanishes_with = ("kd",)

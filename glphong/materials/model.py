@@ -93,6 +93,11 @@ class Param:
         One line of documentation.
     low_inclusive, high_inclusive : bool
         Whether the ends of the range are allowed values.
+    textureable : bool
+        The parameter also takes a `glphong.materials.surface.SurfaceInput` (a texture, vertex
+        colours or both, `glphong.Texture`, `glphong.VertexColors`): its value then varies over the
+        surface, and the model's GLSL reads ``u_<model>_<name>`` unchanged (glphong sets it per fragment
+        before the response is called).  rgb parameters only.
     """
 
     name: str
@@ -104,12 +109,16 @@ class Param:
     doc: str = ""
     low_inclusive: bool = True
     high_inclusive: bool = True
+    textureable: bool = False
 
     def __post_init__(self):
         _check_argument_name("Param", self.name)
         if self.kind not in KINDS:
             raise MaterialDefinitionError(f"Param {self.name!r}: kind must be one of {', '.join(map(repr, KINDS))} "
                                           f"(got {self.kind!r})")
+        if self.textureable and self.kind != "rgb":
+            raise MaterialDefinitionError(f"Param {self.name!r}: only rgb parameters can be textureable (a texture "
+                                          "gives rgb per fragment)")
         if self.low is None and self.high is None:
             raise MaterialDefinitionError(
                 f"Param {self.name!r} has no range: give low= and/or high= (for example low=0.0); "
@@ -145,6 +154,10 @@ class Param:
         TypeError, ValueError
             Naming the parameter and its valid range.
         """
+        from .surface import SurfaceInput
+
+        if isinstance(value, SurfaceInput):
+            return self._validate_surface_input(value)
         low = max(self.low, -_validate.FLT_MAX)
         high = min(self.high, _validate.FLT_MAX)
         low_inclusive = self.low_inclusive or self.low < -_validate.FLT_MAX
@@ -154,6 +167,21 @@ class Param:
                                  high_inclusive=high_inclusive)
         return _validate.scalar(self.name, value, low=low, high=high, low_inclusive=low_inclusive,
                                 high_inclusive=high_inclusive)
+
+    def _validate_surface_input(self, value):
+        """A `SurfaceInput` given to this parameter: allowed where textureable, its values over any surface
+        (texels times ``scale``; vertex colours in [0, 1]) within the range."""
+        if not self.textureable:
+            raise TypeError(f"{self.name} takes a constant ({self.kind} in {self.interval}), not a texture or vertex "
+                            "colours: the model does not declare it textureable")
+        low, high = value.value_range()
+        below = self.low > -np.inf and (np.any(low < self.low) or not self.low_inclusive and np.any(low == self.low))
+        above = self.high < np.inf and (np.any(high > self.high) or not self.high_inclusive and np.any(high == self.high))
+        if below or above:
+            raise ValueError(f"{self.name} must be in {self.interval} everywhere; {value!r} spans "
+                             f"[{float(np.min(low)):g}, {float(np.max(high)):g}] (texels times scale"
+                             f"{', vertex colours in [0, 1]' if value.vertex_colors else ''})")
+        return value
 
     def example(self):
         """A representative valid value: the default, else 0.5 moved into the range."""
@@ -257,18 +285,29 @@ class ShadingFrame:
         Unit tangent and bitangent, ``(t, b, n)`` right-handed up to the mesh's handedness sign;
         None unless a term needs ``'tangent'``.
     uv : (N, 2) ndarray or None
-        Texture coordinates; None unless a term needs ``'uv'``.
+        Texture coordinates; None unless a term needs ``'uv'`` or a parameter is textured.
+    inputs : dict of str to (N, 3) ndarray or None
+        The twin's per-fragment values of surface inputs by uniform name (``u_<model>_<param>``: in GLSL
+        the globals `material_inputs` sets); None where no parameter varies.
+    input_bounds : dict of str to ((N, 3), (N, 3)) or None
+        Their intervals for the tolerance band (`glphong.tolerances.input_bounds`).
     """
 
     n: np.ndarray
     t: np.ndarray = None
     b: np.ndarray = None
     uv: np.ndarray = None
+    inputs: dict = None
+    input_bounds: dict = None
 
     def select(self, mask):
         """The frame at the points where ``mask`` is true."""
         pick = lambda a: None if a is None else a[mask]  # noqa: E731
-        return ShadingFrame(self.n[mask], pick(self.t), pick(self.b), pick(self.uv))
+        inputs = None if self.inputs is None else {k: v[mask] for k, v in self.inputs.items()}
+        bounds = None if self.input_bounds is None else \
+            {k: (lo[mask], hi[mask]) for k, (lo, hi) in self.input_bounds.items()}
+        return ShadingFrame(self.n[mask], pick(self.t), pick(self.b), pick(self.uv), inputs, bounds)
+
 
 
 # --------------------------------------------------------------------------- GLSL sources
@@ -473,6 +512,7 @@ def _top_level_names(code):
 def _generated_names(cls):
     """The uniform and switch names glphong generates for a model."""
     names = {cls.uniform_name(p.name) for p in cls.uniform_params() + cls.tables}
+    names |= {cls.uniform_name(f"{p.name}_{suffix}") for p in cls.params if p.textureable for suffix in ("scale", "texture")}
     names |= {f"u_use_{cls.name}", f"u_use_{cls.name}_ambient"}
     return names | ({f"{cls.name}_fresnel"} if cls.fresnel_slot is not None else set())
 
@@ -604,8 +644,14 @@ class Material:
             if term is None:
                 continue  # the uber-shader's terms this material does not have: the caller fills zeros
             params = term.active_params() if term_key.lit else [p for p in term.params if p.name == term.ambient]
-            values.update({term.uniform_name(p.name): _validate.float32_uniform(term.uniform_value(p.name))
-                           for p in params})
+            surface = term.surface_inputs()
+            for p in params:
+                if p.name in surface:  # scale * texture * vertex colour, per fragment (material_inputs)
+                    values[term.uniform_name(f"{p.name}_scale")] = _validate.float32_uniform(surface[p.name].scale)
+                    if surface[p.name].texture is not None:
+                        values[term.uniform_name(f"{p.name}_texture")] = surface[p.name].texture
+                else:
+                    values[term.uniform_name(p.name)] = _validate.float32_uniform(term.uniform_value(p.name))
             if term_key.lit:  # tables as `TableData`: the renderer binds their textures, the twin reads them
                 values.update({term.uniform_name(t.name): getattr(term, t.name) for t in term.tables})
         return values
@@ -629,6 +675,16 @@ class Material:
         if not values["two_sided"]:
             shown.append("two_sided=False")
         return f"{type(self).__name__}({', '.join(shown)})"
+
+
+def _constant_part(value):
+    """A parameter's value, or a surface input's constant ``scale``."""
+    return getattr(value, "scale", value)
+
+
+def surface_define(model, param):
+    """``<MODEL>_<PARAM>_INPUT``: defined where a program sets the parameter per fragment."""
+    return f"{model.upper()}_{param.upper()}_INPUT"
 
 
 def _short(value):
@@ -844,8 +900,14 @@ class MaterialModel(Material):
     def uniform_declarations(cls):
         """The GLSL declarations of the model's uniforms, generated from `params` and `tables`; where the
         model has a `fresnel_slot`, also its Fresnel uniforms and ``vec3 <name>_fresnel(float c)``."""
-        lines = [f"uniform {p.glsl_type} {cls.uniform_name(p.name)};  // {p.kind} in {p.interval}"
-                 f"{' [' + p.unit + ']' if p.unit else ''}" for p in cls.uniform_params()]
+        lines = []
+        for p in cls.uniform_params():
+            line = f"{p.glsl_type} {cls.uniform_name(p.name)};  // {p.kind} in {p.interval}{' [' + p.unit + ']' if p.unit else ''}"
+            if p.textureable:  # a surface input: a global set per fragment by material_inputs() (key.py)
+                lines += [f"#if defined({surface_define(cls.name, p.name)})", f"{line}, per fragment: material_inputs()",
+                          "#else", f"uniform {line}", "#endif"]
+            else:
+                lines.append(f"uniform {line}")
         lines += [f"uniform {t.glsl_type} {cls.uniform_name(t.name)};  // table {t.shape} x {t.channels}"
                   f"{' [' + t.unit + ']' if t.unit else ''}" for t in cls.tables]
         if cls.fresnel_slot is not None:
@@ -874,27 +936,50 @@ class MaterialModel(Material):
         return ()
 
     def vanishes(self):
-        """True where a `vanishes_with` parameter is zero in every channel: the term is left out."""
-        return any(not np.any(getattr(self, name)) for name in self.vanishes_with)
+        """True where a `vanishes_with` parameter is zero in every channel (a surface input: its scale):
+        the term is left out."""
+        return any(not np.any(_constant_part(getattr(self, name))) for name in self.vanishes_with)
 
     def answers_ambient(self):
         """True where the model answers ``L_a`` with a non-zero ``k``."""
-        return self.ambient is not None and bool(np.any(getattr(self, self.ambient)))
+        return self.ambient is not None and bool(np.any(_constant_part(getattr(self, self.ambient))))
 
-    def values_from_uniforms(self, uniforms, dtype=np.float64, names=None):
+    def surface_inputs(self):
+        """The parameters given a `SurfaceInput` (a texture or vertex colours), by name (dict)."""
+        from .surface import SurfaceInput
+
+        return {p.name: getattr(self, p.name) for p in self.params if isinstance(getattr(self, p.name), SurfaceInput)}
+
+    def values_from_uniforms(self, uniforms, dtype=np.float64, names=None, inputs=None):
         """`ParamValues` from a program's uniforms (the float32 values the GPU was given), with this
         instance's structure: its choices (by value) and ``fresnel_form`` (0 none, 1 Schlick, 2 dielectric).
 
-        ``names`` limits them (an ambient-only term has only its ambient parameter)."""
+        ``names`` limits them (an ambient-only term has only its ambient parameter).  ``inputs`` maps
+        the uniform name of each surface input to its per-fragment values, (N, 3) (the twin's
+        `glphong.reference.material_inputs`); those parameters are (N, 3) arrays."""
         params = [p for p in self.uniform_params() if names is None or p.name in names]
-        values = {p.name: np.asarray(uniforms[self.uniform_name(p.name)] if p in self.active_params() else
-                                     _validate.float32_uniform(self.uniform_value(p.name)), dtype=dtype) for p in params}
+        surface = self.surface_inputs()
+        if surface and inputs is None:
+            raise ValueError(f"{type(self).__name__}: {', '.join(surface)} vary over the surface (a texture or vertex "
+                             "colours): their values per fragment are needed (inputs=)")
+
+        def value(p):
+            name = self.uniform_name(p.name)
+            if p.name in surface:
+                return inputs[name]
+            return uniforms[name] if p in self.active_params() else _validate.float32_uniform(self.uniform_value(p.name))
+
+        values = {p.name: np.asarray(value(p), dtype=dtype) for p in params}
         values |= {t.name: uniforms[self.uniform_name(t.name)] for t in self.tables if names is None or t.name in names}
         return ParamValues(values | self.structure())
 
     def values(self, dtype=np.float64):
         """`ParamValues` of this instance: its values as the GPU receives them (float32, subnormals
-        flushed), in ``dtype``, with its structure as in `values_from_uniforms`."""
+        flushed), in ``dtype``, with its structure as in `values_from_uniforms`.  An instance with a
+        surface input has no single value: ValueError."""
+        if self.surface_inputs():
+            raise ValueError(f"{type(self).__name__}: {', '.join(self.surface_inputs())} vary over the surface (a texture "
+                             "or vertex colours); this evaluates constant parameters: pass constants")
         return ParamValues({p.name: np.asarray(_validate.float32_uniform(self.uniform_value(p.name)), dtype=dtype)
                             for p in self.uniform_params()} | {t.name: getattr(self, t.name) for t in self.tables}
                            | self.structure())

@@ -103,7 +103,7 @@ _INV_8PI = 1.0 / (8.0 * np.pi)
 #: division and the three products, with margin
 _NORM_ULPS = 12
 
-RHO_S = Param("rho_s", "rgb", low=0.0, high=1.0,
+RHO_S = Param("rho_s", "rgb", low=0.0, high=1.0, textureable=True,
               doc="specular albedo, dimensionless: the lobe's directional albedo at normal incidence")
 _Q = Param("q", "scalar", low=0.0, high=Q_MAX,
            doc="specular exponent; q = 0 gives a constant (Lambertian) lobe")

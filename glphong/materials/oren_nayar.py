@@ -90,7 +90,7 @@ __all__ = ["OrenNayar", "oren_nayar_tangential", "oren_nayar_cos_phi", "oren_nay
            "oren_nayar_full", "oren_nayar_qualitative", "RHO", "SIGMA"]
 
 #: the facets' albedo
-RHO = Param("rho", "rgb", low=0.0, high=1.0,
+RHO = Param("rho", "rgb", low=0.0, high=1.0, textureable=True,
             doc="albedo of the Lambertian facets, dimensionless (sigma = 0: f_r = rho/pi)")
 #: the roughness
 SIGMA = Param("sigma", "scalar", low=0.0, high=np.pi / 2, unit="rad",

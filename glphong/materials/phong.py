@@ -24,7 +24,7 @@ from .model import GlslFile, MaterialModel, MaterialSum, Param, Properties
 
 __all__ = ["PhongLobe", "Phong", "phong_delta", "phong_lobe"]
 
-_KS = Param("ks", "rgb", low=0.0, unit="1/sr", doc="specular coefficient")
+_KS = Param("ks", "rgb", low=0.0, unit="1/sr", textureable=True, doc="specular coefficient")
 _Q = Param("q", "scalar", low=0.0, doc="specular exponent; q = 0 gives a constant lobe of 1")
 
 

@@ -98,8 +98,8 @@ def _zeros(shape, channels):
 
 
 def uniform_as(value, dtype):
-    """A uniform's value in ``dtype`` for the twin: arrays cast, tables passed through (`TableData.astype`)."""
-    return value if isinstance(value, TableData) else np.asarray(value, dtype=dtype)
+    """A uniform's value in ``dtype`` for the twin: arrays cast, tables and texture images passed through."""
+    return value if isinstance(value, TableData) or hasattr(value, "levels") else np.asarray(value, dtype=dtype)
 
 
 @dataclass(frozen=True)

@@ -92,7 +92,7 @@ WARD_NORMALIZATIONS = ("walter", "duer", "bounded")
 _FLT_MIN = 2.0 ** -126
 _INV_4PI = 1.0 / (4.0 * np.pi)
 
-_RHO_S = Param("rho_s", "rgb", low=0.0, high=1.0, doc="specular albedo, dimensionless (the lobe's scale)")
+_RHO_S = Param("rho_s", "rgb", low=0.0, high=1.0, textureable=True, doc="specular albedo, dimensionless (the lobe's scale)")
 _ALPHA_X = Param("alpha_x", "scalar", low=1e-3, high=1.0,
                  doc="RMS microfacet slope along the tangent t (dimensionless), 1e-3 to 1")
 _ALPHA_Y = Param("alpha_y", "scalar", low=1e-3, high=1.0,

@@ -1,0 +1,367 @@
+"""Surface inputs: values of a textureable parameter that vary over a mesh (textures, vertex colours).
+
+A parameter declared ``Param(..., textureable=True)`` (an rgb parameter) takes, besides a constant,
+a `SurfaceInput`, whose value at a fragment is
+
+    value = scale * T(uv) * C            (per channel; glsl/surface.glsl, `material_inputs`)
+
+    T(uv)  the texture's linear rgb filtered at the fragment's uv (GLSL ``texture()``: trilinear over
+           glphong's own mip pyramid, or bilinear), 1 without a texture;
+    C      the mesh's interpolated linear vertex colour (`glphong.geometry.MeshData` ``colors``), 1
+           unless ``vertex_colors=True``.
+
+`Texture` and `VertexColors` make the two common cases.  Images are decoded on the CPU: 8- and
+16-bit images are sRGB-decoded (``srgb=True``, the default for them) or scaled to [0, 1] (``srgb=False``,
+for data such as roughness maps) in float64; float arrays are taken as linear.  The mip pyramid is
+made here too (a box filter in linear float64, level ``k`` of size ``max(1, floor(size / 2^k))``), so
+the GPU and the twin hold the same texels on every driver (``glGenerateMipmap``'s filter is the
+driver's, and llvmpipe's sRGB texture decode is off by up to 2.5 % on dark texels: measured).
+Texels are stored as float16 for 8-bit sources (every decoded 8-bit value to 2^-12 relative) and as
+float32 otherwise; the twin reads those very values.
+
+UV convention: ``(0, 0)`` is the image's bottom-left corner and v points up (OpenGL, OBJ); the glTF
+loader flips glTF's v.  Alpha is ignored.  The twin's sampler is `surface_texture` (the GLSL
+``texture()`` call of surface.glsl) and its band `surface_texture_band`.
+"""
+import hashlib
+import threading
+import weakref
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .. import _validate
+
+__all__ = ["SurfaceInput", "Texture", "VertexColors", "TextureImage", "surface_texture", "surface_texture_band",
+           "WRAPS", "FILTERS", "MAX_TEXTURE_SIZE"]
+
+#: texture wrap modes: GL_REPEAT, GL_CLAMP_TO_EDGE (moderngl's textures offer no mirrored repeat)
+WRAPS = ("repeat", "clamp")
+#: filters: trilinear (GL_LINEAR_MIPMAP_LINEAR, mip pyramid) or bilinear (GL_LINEAR, level 0 only)
+FILTERS = ("trilinear", "bilinear")
+#: the largest side glphong uploads (GL 4.5 guarantees 16384)
+MAX_TEXTURE_SIZE = 16384
+
+
+def _decode(array, srgb):
+    """Linear float64 rgb (H, W, 3) of an image array (H, W), (H, W, 1..4)."""
+    from ..imaging import srgb_decode
+
+    a = np.asarray(array)
+    if a.ndim == 2:
+        a = a[..., None]
+    if a.ndim != 3 or a.shape[2] not in (1, 2, 3, 4):
+        raise ValueError(f"a texture image must have shape (H, W) or (H, W, 1 to 4) (got {np.shape(array)})")
+    a = a[..., :3] if a.shape[2] >= 3 else np.repeat(a[..., :1], 3, axis=2)  # grey (and alpha): grey rgb
+    if a.dtype.kind in "ui" and a.dtype.itemsize <= 2 and a.dtype != bool:
+        full = 255.0 if a.dtype.itemsize == 1 else 65535.0
+        if a.min() < 0:
+            raise ValueError("a texture image of integers must not be negative")
+        x = a.astype(np.float64) / full
+        return srgb_decode(x) if srgb else x
+    if a.dtype.kind != "f":
+        raise TypeError(f"a texture image must hold uint8, uint16 or float values (got {a.dtype})")
+    if srgb:
+        raise ValueError("srgb=True decodes 8- and 16-bit images; a float image is taken as linear: pass srgb=False")
+    x = a.astype(np.float64)
+    if not (np.all(np.isfinite(x)) and np.all(np.abs(x) <= _validate.FLT_MAX)):
+        raise ValueError("a float texture image must be finite in float32")
+    return x
+
+
+def _downsample_axis(a, axis):
+    """Box filter halving ``axis`` (size n -> max(1, n // 2)): output texel i averages the source interval
+    ``[i n/m, (i+1) n/m)`` with exact area weights (pairs for even n, three texels for odd n)."""
+    n = a.shape[axis]
+    if n == 1:
+        return a
+    m = n // 2
+    a = np.moveaxis(a, axis, 0)
+    if n % 2 == 0:
+        out = 0.5 * (a[0::2] + a[1::2])
+    else:
+        edges = np.arange(m + 1) * (n / m)
+        out = np.zeros((m,) + a.shape[1:])
+        for j in range(n):  # source texel j covers [j, j + 1): its overlap with each output interval
+            lo = np.clip(edges[:-1], j, j + 1)
+            hi = np.clip(edges[1:], j, j + 1)
+            w = (hi - lo) * (m / n)
+            for i in np.nonzero(w > 0)[0]:
+                out[i] += w[i] * a[j]
+    return np.moveaxis(out, 0, axis)
+
+
+class TextureImage:
+    """An immutable texture: linear rgb mip levels and how they are sampled (what the GPU holds).
+
+    Equal contents and sampling are one object (interned while anything holds it), so an image used
+    by several materials is uploaded once per context.
+
+    Parameters
+    ----------
+    image : (H, W) or (H, W, C) array_like, or str or pathlib.Path
+        Pixels, top row first (as Pillow and image files store them), or an image file Pillow reads.
+    srgb : bool or None
+        Decode 8/16-bit values with the sRGB curve (None: True for 8/16-bit images, False for float).
+    wrap : {'repeat', 'clamp'}
+    filter : {'trilinear', 'bilinear'}
+
+    Attributes
+    ----------
+    levels : tuple of (h_k, w_k, 3) ndarray
+        Linear rgb, float16 (8-bit sources) or float32, row 0 at the bottom (v = 0); one level for
+        'bilinear', the whole pyramid down to 1x1 for 'trilinear'.  Read-only.
+    low, high : float
+        Smallest and largest texel value (level 0 bounds every level).
+    digest : str
+    source : str or None
+    """
+
+    _interned = weakref.WeakValueDictionary()
+    _lock = threading.Lock()
+
+    def __new__(cls, image, srgb=None, wrap="repeat", filter="trilinear"):
+        source = None
+        if isinstance(image, (str, Path)):
+            source = str(image)
+            try:
+                from PIL import Image
+
+                with Image.open(image) as opened:
+                    pixels = np.asarray(opened.convert("RGB") if opened.mode not in ("L", "I;16", "RGB", "RGBA")
+                                        else opened)
+            except OSError as exc:
+                raise ValueError(f"cannot read a texture image from {source!r} ({exc})") from None
+        else:
+            pixels = np.asarray(image)
+        if wrap not in WRAPS:
+            raise ValueError(f"wrap must be one of {', '.join(map(repr, WRAPS))} (got {wrap!r})")
+        if filter not in FILTERS:
+            raise ValueError(f"filter must be one of {', '.join(map(repr, FILTERS))} (got {filter!r})")
+        if srgb is None:
+            srgb = pixels.dtype.kind in "ui"
+        if not isinstance(srgb, (bool, np.bool_)):
+            raise TypeError(f"srgb must be True, False or None (got {srgb!r})")
+        if pixels.ndim < 2 or not 1 <= pixels.shape[0] <= MAX_TEXTURE_SIZE or not 1 <= pixels.shape[1] <= MAX_TEXTURE_SIZE:
+            raise ValueError(f"a texture image must be from 1x1 to {MAX_TEXTURE_SIZE}x{MAX_TEXTURE_SIZE} pixels "
+                             f"(got shape {pixels.shape})")
+        linear = _decode(pixels, bool(srgb))[::-1]  # row 0 at the bottom: v = 0
+        store = np.float16 if pixels.dtype.itemsize == 1 and pixels.dtype.kind in "ui" else np.float32
+        levels = [linear]
+        if filter == "trilinear":
+            while levels[-1].shape[0] > 1 or levels[-1].shape[1] > 1:
+                levels.append(_downsample_axis(_downsample_axis(levels[-1], 0), 1))
+        return cls._from_levels(tuple(np.ascontiguousarray(lv, dtype=store) for lv in levels), wrap, filter, source)
+
+    @classmethod
+    def _from_levels(cls, levels, wrap, filter, source=None):
+        h = hashlib.sha256(f"{wrap} {filter}".encode())
+        for lv in levels:
+            h.update(repr((lv.shape, lv.dtype.str)).encode() + lv.tobytes())
+        digest = h.hexdigest()[:16]
+        with cls._lock:
+            known = cls._interned.get(digest)
+            if known is not None:
+                return known
+            self = object.__new__(cls)
+            for lv in levels:
+                lv.setflags(write=False)
+            self.levels, self.wrap, self.filter, self.digest = tuple(levels), wrap, filter, digest
+            self.source = source
+            base = levels[0].astype(np.float64)
+            self.low, self.high = float(base.min()), float(base.max())
+            cls._interned[digest] = self
+        return self
+
+    @property
+    def size(self):
+        """``(width, height)`` of level 0 [texels]."""
+        return self.levels[0].shape[1], self.levels[0].shape[0]
+
+    @property
+    def nbytes(self):
+        """Bytes of every level."""
+        return sum(lv.nbytes for lv in self.levels)
+
+    def __eq__(self, other):
+        return isinstance(other, TextureImage) and other.digest == self.digest
+
+    def __hash__(self):
+        return hash(self.digest)
+
+    def __repr__(self):
+        name = repr(self.source) if self.source else self.digest[:8]
+        return f"TextureImage({name}, {self.size[0]}x{self.size[1]}, {self.wrap}, {self.filter})"
+
+    def __reduce__(self):  # by value: a spawn-started worker rebuilds (and interns) it
+        return (TextureImage._from_levels, (tuple(np.asarray(lv) for lv in self.levels), self.wrap, self.filter,
+                                            self.source))
+
+
+@dataclass(frozen=True, eq=True)
+class SurfaceInput:
+    """The value of a textureable parameter over a surface: ``scale * T(uv) * C`` (see the module).
+
+    Parameters
+    ----------
+    scale : float or (3,) array_like
+        Constant factor per channel (>= 0); the parameter's range applies to the product.
+    texture : TextureImage or None
+    vertex_colors : bool
+        Multiply by the mesh's vertex colours (the mesh must have ``colors``).
+    """
+
+    scale: tuple = (1.0, 1.0, 1.0)
+    texture: TextureImage = None
+    vertex_colors: bool = False
+
+    def __post_init__(self):
+        object.__setattr__(self, "scale", _validate.rgb("scale", self.scale))
+        if self.texture is not None and not isinstance(self.texture, TextureImage):
+            raise TypeError(f"texture must be a glphong TextureImage or None (got {type(self.texture).__name__})")
+        if not isinstance(self.vertex_colors, (bool, np.bool_)):
+            raise TypeError(f"vertex_colors must be a bool (got {self.vertex_colors!r})")
+        if self.texture is None and not self.vertex_colors:
+            raise ValueError("a SurfaceInput needs a texture, vertex_colors=True or both (a constant is a plain value)")
+
+    @property
+    def mode(self):
+        """``'texture'``, ``'vertex'`` or ``'texture*vertex'``: what the program computes (part of its key)."""
+        return "texture*vertex" if self.texture is not None and self.vertex_colors else \
+            "texture" if self.texture is not None else "vertex"
+
+    def value_range(self):
+        """``(low, high)``, each (3,): the bounds of the value over any surface (vertex colours in [0, 1])."""
+        s = np.asarray(self.scale)
+        lo, hi = (self.texture.low, self.texture.high) if self.texture is not None else (1.0, 1.0)
+        if self.vertex_colors:
+            lo, hi = min(lo, 0.0), max(hi, 0.0)
+        return s * lo, s * hi
+
+    def __repr__(self):
+        parts = [] if self.scale == (1.0, 1.0, 1.0) else [f"scale={self.scale}"]
+        kind = "VertexColors" if self.texture is None else "Texture"
+        if self.texture is not None:
+            parts.insert(0, repr(self.texture))
+            parts += ["vertex_colors=True"] if self.vertex_colors else []
+        return f"{kind}({', '.join(parts)})"
+
+
+def Texture(image, scale=1.0, srgb=None, wrap="repeat", filter="trilinear", vertex_colors=False):
+    """A textureable parameter's value from an image: ``scale * T(uv)`` (times the vertex colours with
+    ``vertex_colors=True``).
+
+    Parameters
+    ----------
+    image : array_like, str, pathlib.Path or TextureImage
+        Pixels (top row first), an image file, or a `TextureImage` (its srgb, wrap and filter kept).
+    scale : float or (3,) array_like
+        Factor per channel, >= 0 (glTF's baseColorFactor, MTL's Kd under map_Kd).
+    srgb : bool or None
+        sRGB-decode 8/16-bit pixels (None: yes for them; float images are linear).
+    wrap : {'repeat', 'clamp'}
+    filter : {'trilinear', 'bilinear'}
+    vertex_colors : bool
+
+    Returns
+    -------
+    SurfaceInput
+
+    Examples
+    --------
+    >>> import numpy as np, glphong
+    >>> checker = (np.indices((8, 8)).sum(axis=0) % 2 * 255).astype(np.uint8)
+    >>> material = glphong.Lambert(kd=glphong.Texture(checker, scale=1 / np.pi))
+    """
+    texture = image if isinstance(image, TextureImage) else TextureImage(image, srgb, wrap, filter)
+    return SurfaceInput(scale=scale, texture=texture, vertex_colors=vertex_colors)
+
+
+def VertexColors(scale=1.0):
+    """A textureable parameter's value from the mesh's vertex colours: ``scale * C``.
+
+    Returns
+    -------
+    SurfaceInput
+    """
+    return SurfaceInput(scale=scale, vertex_colors=True)
+
+
+# --------------------------------------------------------------------------- the twin of surface.glsl
+def _wrap_index(i, n, wrap):
+    """Texel index ``i`` wrapped into ``[0, n)`` (GL 4.6 table 8.20)."""
+    return np.mod(i, n) if wrap == "repeat" else np.clip(i, 0, n - 1)
+
+
+def _bilinear(level, uv, wrap):
+    """``(value, texels)`` of GL_LINEAR at ``uv`` on one level: value (N, 3); texels (4, N, 3) the four
+    texels it weights."""
+    h, w = level.shape[:2]
+    x = uv[:, 0] * w - 0.5
+    y = uv[:, 1] * h - 0.5
+    i0, j0 = np.floor(x), np.floor(y)
+    a, b = (x - i0)[:, None], (y - j0)[:, None]
+    i0, j0 = i0.astype(np.int64), j0.astype(np.int64)
+    i1, j1 = _wrap_index(i0 + 1, w, wrap), _wrap_index(j0 + 1, h, wrap)
+    i0, j0 = _wrap_index(i0, w, wrap), _wrap_index(j0, h, wrap)
+    texels = np.stack([level[j0, i0], level[j0, i1], level[j1, i0], level[j1, i1]]).astype(np.float64)
+    value = (1 - a) * (1 - b) * texels[0] + a * (1 - b) * texels[1] + (1 - a) * b * texels[2] + a * b * texels[3]
+    return value, texels
+
+
+def _sample(image, uv, lod):
+    """``(value, low, high)``: the filtered value and the extremes of the texels it weights, each (N, 3)."""
+    uv = np.asarray(uv, dtype=np.float64)
+    if image.filter == "bilinear" or len(image.levels) == 1:
+        value, texels = _bilinear(image.levels[0], uv, image.wrap)
+        return value, texels.min(axis=0), texels.max(axis=0)
+    top = len(image.levels) - 1
+    lam = np.clip(np.asarray(lod, dtype=np.float64), 0.0, top)
+    d1 = np.minimum(np.floor(lam).astype(np.int64), top)
+    frac = (lam - d1)[:, None]
+    value, low, high = (np.zeros((len(uv), 3)) for _ in range(3))
+    for d in np.unique(d1):
+        sel = d1 == d
+        v1, t1 = _bilinear(image.levels[d], uv[sel], image.wrap)
+        if d < top:
+            v2, t2 = _bilinear(image.levels[d + 1], uv[sel], image.wrap)
+            t = np.concatenate([t1, t2])
+            value[sel] = (1 - frac[sel]) * v1 + frac[sel] * v2
+        else:
+            t = t1
+            value[sel] = v1
+        low[sel], high[sel] = t.min(axis=0), t.max(axis=0)
+    return value, low, high
+
+
+def surface_texture(image, uv, lod):
+    """The twin of surface.glsl's ``surface_texture(s, uv)`` (GLSL ``texture(s, uv).rgb``), (N, 3) float64.
+
+    Parameters
+    ----------
+    image : TextureImage
+    uv : (N, 2) array_like
+        Texture coordinates (the G-buffer's).
+    lod : (N,) array_like
+        The level of detail the GPU used (the G-buffer's ``textureQueryLOD(s, uv).x``): trilinear
+        filtering blends levels ``floor(lod)`` and ``floor(lod) + 1`` by its fraction, as GL 4.6 section
+        8.14 defines; ignored for 'bilinear'.
+    """
+    return _sample(image, uv, lod)[0]
+
+
+def surface_texture_band(image, uv, lod, constants):
+    """Interval ``(low, high)``, each (N, 3), of the GPU's filtered texture value.
+
+    GL leaves the precision of filter weights to the implementation (Direct3D requires 8 fractional
+    bits): the value may be off by ``T`` times the spread of the texels it weights, plus a few ulps of
+    their magnitude, and a filter's weights are non-negative and sum to 1, so it also lies between
+    the smallest and the largest of them.  ``T = constants.T``.
+    """
+    from ..tolerances import EPS
+
+    value, low, high = _sample(image, uv, lod)
+    ulps = constants.A * EPS * np.maximum(np.abs(low), np.abs(high))
+    width = constants.T * (high - low) + ulps
+    return np.maximum(value - width, low - ulps), np.minimum(value + width, high + ulps)
