@@ -16,6 +16,7 @@ from .camera import Camera, IntrinsicsCamera, OrthographicCamera, PerspectiveCam
 from .contexts import BackendUnavailableError, available_backends, create_context
 from .describe import describe, format_descriptions
 from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
+from .gltf_export import save_gltf
 from .loaders import load_scene
 from .materials import (AshikhminShirley, BlinnPhong, CookTorrance, DielectricFresnel, Diffuse, Lafortune, Lambert,
                         Material, MaterialModel, MaterialSum, MeasuredBRDF, MtlPhong, NormalizedBlinnPhong,
@@ -30,7 +31,7 @@ __all__ = [
     "Camera", "PerspectiveCamera", "IntrinsicsCamera", "OrthographicCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
     "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
-    "DielectricFresnel", "Texture", "VertexColors", "Scene", "SceneObject", "load_scene", "Renderer", "Frame", "GBuffer",
+    "DielectricFresnel", "Texture", "VertexColors", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
     "imaging", "materials", "primitives", "radiometry", "reference",
 ]

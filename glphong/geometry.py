@@ -95,7 +95,7 @@ class MeshData:
         return self._tangents
 
     @classmethod
-    def from_trimesh(cls, mesh, smooth=True):
+    def from_trimesh(cls, mesh, smooth=True, colors="srgb"):
         """Convert a `trimesh.Trimesh`.
 
         Parameters
@@ -105,8 +105,13 @@ class MeshData:
             True: the mesh's vertex normals, interpolated across faces (Phong shading).
             False: flat shading, every face with its own face normal.
 
+        colors : {'srgb', 'linear'}
+            How the mesh's vertex colours are encoded: 8-bit sRGB (PLY, OBJ and most tools: decoded to
+            linear) or linear (glTF's COLOR_0).
+
         UVs come from a ``TextureVisuals`` with one uv per vertex; vertex colours from a
-        ``ColorVisuals`` of kind 'vertex' (8-bit sRGB, decoded to linear; face colours are not read).
+        ``ColorVisuals`` of kind 'vertex', or a ``TextureVisuals``' ``vertex_attributes['color']``
+        (glTF COLOR_0 beside a texture; integers are normalised); face colours are not read.
         """
         import trimesh
 
@@ -123,11 +128,9 @@ class MeshData:
                              "the trimesh has a vertex that is not")
         uv = getattr(getattr(mesh, "visual", None), "uv", None)
         uv = None if uv is None or len(uv) != len(mesh.vertices) else np.asarray(uv, dtype=np.float64)
-        colors = None
-        if getattr(mesh.visual, "kind", None) == "vertex":
-            from .imaging import srgb_decode
-
-            colors = srgb_decode(np.asarray(mesh.visual.vertex_colors)[:, :3] / 255.0)
+        if colors not in ("srgb", "linear"):
+            raise ValueError(f"colors must be 'srgb' or 'linear' (got {colors!r})")
+        colors = _trimesh_vertex_colors(mesh, colors)
         if smooth:
             return cls(mesh.vertices, mesh.vertex_normals, mesh.faces, uvs=uv, colors=colors)
         faces = np.asarray(mesh.faces)
@@ -146,6 +149,26 @@ class MeshData:
         extras = "".join([", uvs" if self.uvs is not None else "", ", tangents" if self._tangents is not None else "",
                           ", colors" if self.colors is not None else ""])
         return f"MeshData({len(self.positions)} vertices, {self.triangle_count} triangles{extras})"
+
+
+def _trimesh_vertex_colors(mesh, encoding):
+    """Linear (V, 3) float64 vertex colours of a trimesh, or None (see `MeshData.from_trimesh`)."""
+    visual = getattr(mesh, "visual", None)
+    raw = None
+    if getattr(visual, "kind", None) == "vertex":
+        raw = np.asarray(visual.vertex_colors)
+    elif getattr(visual, "vertex_attributes", None) is not None and "color" in visual.vertex_attributes:
+        raw = np.asarray(visual.vertex_attributes["color"])
+    if raw is None or raw.ndim != 2 or len(raw) != len(mesh.vertices) or raw.shape[1] < 3:
+        return None
+    values = raw[:, :3].astype(np.float64)
+    if raw.dtype.kind in "ui":
+        values /= 255.0 if raw.dtype.itemsize == 1 else 65535.0
+    if encoding == "srgb":
+        from .imaging import srgb_decode
+
+        values = srgb_decode(values)
+    return np.clip(values, 0.0, 1.0)
 
 
 def _vertex_array(name, value, count, widths):

@@ -29,7 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["load_scene", "read_obj", "read_gltf_json", "gltf_view", "gltf_material", "scene_from_trimesh", "parse_mtl",
+__all__ = ["load_scene", "read_obj", "read_gltf_json", "gltf_view", "gltf_material", "material_from_extras",
+           "scene_from_trimesh", "parse_mtl",
            "material_from_mtl", "default_view", "scene_bounds", "LUMENS_PER_WATT"]
 
 #: formats `load_scene` reads
@@ -45,7 +46,8 @@ def parse_mtl(path):
     -------
     dict of str to dict
         Per ``newmtl`` name: ``Kd``, ``Ks``, ``Ka`` (tuples of 3 float, a single value repeated), ``Ns``
-        (float), ``illum`` (int), where the file gives them.
+        (float), ``illum`` (int), ``map_Kd`` and ``map_Ks`` (the image's path, resolved against the MTL
+        file's folder; options such as ``-s`` are ignored, with a warning), where the file gives them.
 
     Raises
     ------
@@ -61,7 +63,14 @@ def parse_mtl(path):
         if keyword == "newmtl":
             current = out.setdefault(" ".join(values), {})
             continue
-        if current is None or keyword not in ("Kd", "Ks", "Ka", "Ns", "illum"):
+        if current is None or keyword not in ("Kd", "Ks", "Ka", "Ns", "illum", "map_Kd", "map_Ks"):
+            continue
+        if keyword.startswith("map_"):
+            if not values:
+                raise ValueError(f"{path}:{number}: {keyword} needs an image file")
+            if values[0].startswith("-"):
+                warnings.warn(f"{path}:{number}: {keyword} options {' '.join(values[:-1])!r} are ignored", stacklevel=2)
+            current[keyword] = Path(path).parent / values[-1]
             continue
         try:
             if keyword in ("Kd", "Ks", "Ka"):
@@ -79,15 +88,29 @@ def parse_mtl(path):
 
 
 def material_from_mtl(entry, name="", source=""):
-    """The glphong material an MTL entry (`parse_mtl`) means (see the module)."""
-    from .materials import MtlPhong
+    """The glphong material an MTL entry (`parse_mtl`) means (see the module).  ``map_Kd`` and ``map_Ks``
+    are textures that ``Kd`` and ``Ks`` multiply (1 where the entry omits them)."""
+    from .materials import MtlPhong, Texture
 
-    kd = entry.get("Kd", (0.8, 0.8, 0.8))  # MTL's default diffuse colour
-    ks = entry.get("Ks", (0.0, 0.0, 0.0))
+    kd = entry.get("Kd", (1.0, 1.0, 1.0) if "map_Kd" in entry else (0.8, 0.8, 0.8))  # MTL's default diffuse colour
+    ks = entry.get("Ks", (1.0, 1.0, 1.0) if "map_Ks" in entry else (0.0, 0.0, 0.0))
+    for keyword, value in (("map_Kd", kd), ("map_Ks", ks)):
+        if keyword in entry:
+            image = entry[keyword]
+            if not Path(image).is_file():
+                warnings.warn(f"{source}: material {name!r}: {keyword} {image} not found; its constant is used",
+                              stacklevel=3)
+                continue
+            texture = Texture(image, scale=value)
+            kd, ks = (texture, ks) if keyword == "map_Kd" else (kd, texture)
     ka = entry.get("Ka", (0.0, 0.0, 0.0))
     q = entry.get("Ns", 0.0)
     illum = entry.get("illum", 2 if any(ks) else 1)
     if illum == 0:
+        if not isinstance(kd, tuple):
+            warnings.warn(f"{source}: material {name!r} has illum 0 and map_Kd: rendered with the constant Kd",
+                          stacklevel=3)
+            kd = entry.get("Kd", (1.0, 1.0, 1.0))
         return MtlPhong(0.0, 0.0, 0.0, 0.0, ka=kd)
     if illum == 1:
         return MtlPhong(kd, 0.0, q, ka)
@@ -159,7 +182,8 @@ def _trimesh_material(geometry):
     return Lambert(0.5 / math.pi)
 
 
-def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, materials=None):
+def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, materials=None, vertex_colors="srgb",
+                       order=None):
     """A `glphong.Scene` of a ``trimesh.Scene`` (or ``Trimesh``): every node's geometry with its world
     transform, named after the node; materials as in the module notes.
 
@@ -173,9 +197,14 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
     materials : dict of str to Material, or callable, optional
         By geometry name or material name; a callable gets ``(name, geometry)`` and returns a Material
         (or None for the default).
+    vertex_colors : {'srgb', 'linear'}
+        The encoding of the meshes' vertex colours (`glphong.geometry.MeshData.from_trimesh`).
+    order : sequence of str, optional
+        Node names in the order the objects are added (the file's); others follow, in trimesh's order.
     """
     import trimesh
 
+    from .geometry import MeshData
     from .materials import Material
 
     if isinstance(trimesh_scene, trimesh.Trimesh):
@@ -200,9 +229,12 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
             raise TypeError(f"materials gave {type(material).__name__} for {geometry_name!r}: it must give a "
                             "glphong material")
         parts.append((geometry, material, np.asarray(transform, dtype=np.float64), str(node)))
+    if order is not None:
+        rank = {name: i for i, name in enumerate(order)}
+        parts.sort(key=lambda part: rank.get(part[3], len(rank)))
     scene = _scene(camera, lights, ambient)
     for geometry, material, transform, name in parts:
-        scene.add(geometry, material, pose=transform, name=name)
+        scene.add(MeshData.from_trimesh(geometry, colors=vertex_colors), material, pose=transform, name=name)
     return _with_view(scene, camera, lights, ambient)
 
 
@@ -277,20 +309,86 @@ def read_obj(path):
 
 def read_gltf_json(path):
     """The JSON document of a ``.gltf`` file, or of a ``.glb`` file's first chunk (dict)."""
-    import struct
-
     data = Path(path).read_bytes()
     if data[:4] == b"glTF":
-        if len(data) < 20:
-            raise ValueError(f"{path}: truncated glTF binary ({len(data)} bytes)")
-        length, kind = struct.unpack_from("<II", data, 12)
-        if kind != 0x4E4F534A:  # 'JSON'
-            raise ValueError(f"{path}: the first chunk of a glTF binary must be JSON")
-        data = data[20:20 + length]
+        data = _glb_chunks(path, data)[0]
     try:
         return json.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, ValueError) as exc:
         raise ValueError(f"{path}: not a glTF document ({exc})") from None
+
+
+def _glb_chunks(path, data):
+    """``(json bytes, binary bytes or None)`` of a ``.glb`` file's contents."""
+    import struct
+
+    if len(data) < 20:
+        raise ValueError(f"{path}: truncated glTF binary ({len(data)} bytes)")
+    length, kind = struct.unpack_from("<II", data, 12)
+    if kind != 0x4E4F534A:  # 'JSON'
+        raise ValueError(f"{path}: the first chunk of a glTF binary must be JSON")
+    start = 20 + length
+    binary = None
+    if len(data) >= start + 8:
+        size, kind = struct.unpack_from("<II", data, start)
+        binary = data[start + 8:start + 8 + size] if kind == 0x004E4942 else None  # 'BIN'
+    return data[20:start], binary
+
+
+def _gltf_image(path, document, index):
+    """The pixels (H, W, C) of glTF texture ``index``: from a buffer view (a .glb's binary chunk or a data
+    URI buffer) or an image file beside the document."""
+    import base64
+    from io import BytesIO
+
+    from PIL import Image
+
+    image = document["images"][document["textures"][index]["source"]]
+    if "bufferView" in image:
+        view = document["bufferViews"][image["bufferView"]]
+        uri = document["buffers"][view["buffer"]].get("uri")
+        if uri is None:
+            blob = _glb_chunks(path, Path(path).read_bytes())[1]
+        elif uri.startswith("data:"):
+            blob = base64.b64decode(uri.split(",", 1)[1])
+        else:
+            blob = (Path(path).parent / uri).read_bytes()
+        start = view.get("byteOffset", 0)
+        payload = BytesIO(blob[start:start + view["byteLength"]])
+    elif image.get("uri", "").startswith("data:"):
+        payload = BytesIO(base64.b64decode(image["uri"].split(",", 1)[1]))
+    else:
+        payload = Path(path).parent / image["uri"]
+    with Image.open(payload) as opened:
+        return np.asarray(opened.convert("RGB"))
+
+
+def _glphong_extras(document):
+    """What glphong stored in the asset's ``extras`` (`glphong.gltf_export`), or {}."""
+    extras = document.get("asset", {}).get("extras", {})
+    stored = extras.get("glphong") if isinstance(extras, dict) else None
+    return stored if isinstance(stored, dict) else {}
+
+
+def material_from_extras(entry, path, document):
+    """The glphong material stored in a glTF material's ``extras: {"glphong": ...}``
+    (`glphong.materials.as_json`), or None where there is none."""
+    from .materials.as_json import material_from_json
+    from .materials.surface import TextureImage
+
+    extras = entry.get("extras", {})
+    stored = extras.get("glphong") if isinstance(extras, dict) else None
+    if stored is None:
+        return None
+
+    def textures(index, wrap, filter, srgb):
+        return TextureImage(_gltf_image(path, document, index), srgb=srgb, wrap=wrap, filter=filter)
+
+    try:
+        return material_from_json(stored, textures)
+    except (TypeError, ValueError, KeyError) as exc:
+        raise ValueError(f"{path}: material {entry.get('name', '')!r} stores a glphong material that cannot be "
+                         f"made: {exc}") from None
 
 
 def _node_matrices(document):
@@ -371,6 +469,8 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
         if kind == "spot":
             raise ValueError(f"{source}: light {light.get('name', reference['light'])!r} is a spot light: glphong has "
                              "point and directional lights only")
+        if light_units is None:  # a file may declare them (glphong.gltf_export writes radiometric lights)
+            light_units = _glphong_extras(document).get("light_units")
         if light_units not in ("photometric", "radiometric"):
             raise ValueError(f"{source} has KHR_lights_punctual lights: say what their intensities are with "
                              "light_units='photometric' (candela and lux, as the glTF specification says) or "
@@ -387,20 +487,28 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
     return camera, lights
 
 
-def gltf_material(entry):
+def gltf_material(entry, base_color_texture=None, vertex_colors=False):
     """glphong's approximation of a glTF metallic-roughness material (JSON ``materials`` entry): Cook-Torrance
     with Beckmann slope ``m = roughness^2`` (glTF's GGX ``alpha``, at least 1e-3), diffuse albedo
-    ``baseColor (1 - metallic)`` and Schlick's Fresnel with ``f0 = 0.04 (1 - metallic) + baseColor metallic``.
-    The lobes differ (Beckmann against GGX, no coupling of diffuse and specular): an approximation."""
-    from .materials import CookTorrance, SchlickFresnel
+    ``baseColor (1 - metallic)`` and Schlick's Fresnel with ``f0 = 0.04 (1 - metallic) + baseColorFactor metallic``.
+    The lobes differ (Beckmann against GGX, no coupling of diffuse and specular): an approximation.
+
+    ``baseColor`` is ``baseColorFactor`` times the base-colour texture (``base_color_texture``, an image
+    array, sRGB) times the mesh's ``COLOR_0`` (``vertex_colors``), as glTF defines it; the texture and the
+    colours vary the diffuse albedo only (the metallic-roughness texture is not read)."""
+    from .materials import CookTorrance, SchlickFresnel, SurfaceInput, Texture
 
     pbr = entry.get("pbrMetallicRoughness", {})
     base = np.asarray(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3], dtype=np.float64)
     metallic = float(pbr.get("metallicFactor", 1.0))
     roughness = float(pbr.get("roughnessFactor", 1.0))
     f0 = 0.04 * (1 - metallic) + base * metallic
-    return CookTorrance(tuple(base * (1 - metallic)), max(roughness * roughness, 1e-3),
-                        fresnel=SchlickFresnel(tuple(np.clip(f0, 0.0, 1.0))))
+    rho_d = tuple(base * (1 - metallic))
+    if base_color_texture is not None:
+        rho_d = Texture(base_color_texture, scale=rho_d, srgb=True, vertex_colors=vertex_colors)
+    elif vertex_colors:
+        rho_d = SurfaceInput(scale=rho_d, vertex_colors=True)
+    return CookTorrance(rho_d, max(roughness * roughness, 1e-3), fresnel=SchlickFresnel(tuple(np.clip(f0, 0.0, 1.0))))
 
 
 def load_scene(path, camera=None, lights=None, ambient=None, materials=None, light_units=None, camera_name=None):
@@ -474,7 +582,8 @@ def _load_gltf(path, camera, lights, ambient, materials, light_units, camera_nam
         raise ValueError(f"{path}: trimesh could not read it ({type(exc).__name__}: {exc})") from None
 
     def resolve(name, geometry):
-        material_name = getattr(getattr(geometry.visual, "material", None), "name", None)
+        trimesh_material = getattr(geometry.visual, "material", None)
+        material_name = getattr(trimesh_material, "name", None)
         entry = entries.get(material_name)
         if callable(materials):
             chosen = materials(material_name or name, entry)
@@ -484,8 +593,24 @@ def _load_gltf(path, camera, lights, ambient, materials, light_units, camera_nam
             for key in (material_name, name):
                 if key in materials:
                     return materials[key]
-        return gltf_material(entry) if entry is not None else None
+        if entry is None:
+            return None
+        stored = material_from_extras(entry, str(path), document)
+        if stored is not None:
+            return stored
+        image = getattr(trimesh_material, "baseColorTexture", None)
+        has_uv = getattr(geometry.visual, "uv", None) is not None
+        texture = np.asarray(image.convert("RGB")) if image is not None and has_uv else None
+        from .geometry import _trimesh_vertex_colors
 
-    if lights is None and file_lights:
+        return gltf_material(entry, texture, _trimesh_vertex_colors(geometry, "linear") is not None)
+
+    written = _glphong_extras(document)
+    if lights is None and (file_lights or written):
         lights = file_lights
-    return scene_from_trimesh(loaded, camera if camera is not None else file_camera, lights, ambient, resolve)
+    if ambient is None and written.get("ambient") is not None:
+        from .lights import AmbientLight
+
+        ambient = AmbientLight(tuple(written["ambient"]))
+    return scene_from_trimesh(loaded, camera if camera is not None else file_camera, lights, ambient, resolve,
+                              vertex_colors="linear", order=[n.get("name") for n in document.get("nodes", [])])

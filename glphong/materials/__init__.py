@@ -45,7 +45,7 @@ __all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "Table
 # the material classes it exports are this package's, so a new model is one file here (with its GLSL
 # and its tests); its twin functions stay in its module (and are found by glphong.reference)
 for _info in sorted(_pkgutil.iter_modules(__path__), key=lambda info: info.name):
-    if _info.name not in ("model", "table", "surface"):  # the mechanism
+    if _info.name not in ("model", "table", "surface", "as_json"):  # the mechanism
         _module = _importlib.import_module(f"{__name__}.{_info.name}")
         for _name in _module.__all__:
             if isinstance(getattr(_module, _name), type):

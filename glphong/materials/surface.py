@@ -114,6 +114,9 @@ class TextureImage:
         'bilinear', the whole pyramid down to 1x1 for 'trilinear'.  Read-only.
     low, high : float
         Smallest and largest texel value (level 0 bounds every level).
+    encoding : {'srgb8', 'linear8', 'srgb16', 'linear16', 'float'}
+        What the source pixels were (8-bit sources re-encode exactly from the float16 texels:
+        `pixels8`).
     digest : str
     source : str or None
     """
@@ -148,14 +151,17 @@ class TextureImage:
                              f"(got shape {pixels.shape})")
         linear = _decode(pixels, bool(srgb))[::-1]  # row 0 at the bottom: v = 0
         store = np.float16 if pixels.dtype.itemsize == 1 and pixels.dtype.kind in "ui" else np.float32
+        encoding = "float" if pixels.dtype.kind == "f" else \
+            f"{'srgb' if srgb else 'linear'}{8 * min(pixels.dtype.itemsize, 2)}"
         levels = [linear]
         if filter == "trilinear":
             while levels[-1].shape[0] > 1 or levels[-1].shape[1] > 1:
                 levels.append(_downsample_axis(_downsample_axis(levels[-1], 0), 1))
-        return cls._from_levels(tuple(np.ascontiguousarray(lv, dtype=store) for lv in levels), wrap, filter, source)
+        return cls._from_levels(tuple(np.ascontiguousarray(lv, dtype=store) for lv in levels), wrap, filter, source,
+                                encoding)
 
     @classmethod
-    def _from_levels(cls, levels, wrap, filter, source=None):
+    def _from_levels(cls, levels, wrap, filter, source=None, encoding="float"):
         h = hashlib.sha256(f"{wrap} {filter}".encode())
         for lv in levels:
             h.update(repr((lv.shape, lv.dtype.str)).encode() + lv.tobytes())
@@ -168,7 +174,7 @@ class TextureImage:
             for lv in levels:
                 lv.setflags(write=False)
             self.levels, self.wrap, self.filter, self.digest = tuple(levels), wrap, filter, digest
-            self.source = source
+            self.source, self.encoding = source, encoding
             base = levels[0].astype(np.float64)
             self.low, self.high = float(base.min()), float(base.max())
             cls._interned[digest] = self
@@ -184,6 +190,23 @@ class TextureImage:
         """Bytes of every level."""
         return sum(lv.nbytes for lv in self.levels)
 
+    def pixels8(self):
+        """The 8-bit source pixels, top row first, (H, W, 3) uint8 (rgb), recovered exactly from the texels.
+
+        Raises
+        ------
+        ValueError
+            The source was not 8-bit (16-bit and float images cannot be re-encoded losslessly in 8 bits).
+        """
+        from ..imaging import encode_srgb8
+
+        base = self.levels[0][::-1].astype(np.float64)
+        if self.encoding == "srgb8":
+            return encode_srgb8(base)
+        if self.encoding == "linear8":
+            return np.rint(np.clip(base, 0.0, 1.0) * 255.0).astype(np.uint8)
+        raise ValueError(f"{self!r} was made from a {self.encoding} image, which 8-bit pixels cannot hold exactly")
+
     def __eq__(self, other):
         return isinstance(other, TextureImage) and other.digest == self.digest
 
@@ -196,7 +219,7 @@ class TextureImage:
 
     def __reduce__(self):  # by value: a spawn-started worker rebuilds (and interns) it
         return (TextureImage._from_levels, (tuple(np.asarray(lv) for lv in self.levels), self.wrap, self.filter,
-                                            self.source))
+                                            self.source, self.encoding))
 
 
 @dataclass(frozen=True, eq=True)

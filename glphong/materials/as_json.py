@@ -1,0 +1,128 @@
+"""Materials as JSON: what glphong stores in a glTF material's ``extras`` (``{"glphong": ...}``).
+
+A material is written by its class and its constructor's arguments (`MaterialModel.arguments`), so
+every model, built-in or a user's, round-trips the same way::
+
+    {"class": "Phong", "module": "glphong.materials.phong",
+     "arguments": {"kd": [0.2, 0.2, 0.2], "ks": [0.3, 0.3, 0.3], "q": 20.0},
+     "ka": [0, 0, 0], "two_sided": true}
+
+Parameters are lists of 3 floats or floats (the validated values, which JSON keeps exactly: Python's
+float repr round-trips), choices strings, a Fresnel factor ``{"class": "SchlickFresnel", "f0": [...]}``
+and a surface input ``{"surface": {"scale": [...], "texture": <index>, "vertex_colors": false}}``, where
+the index names a texture of the file (the writer's ``texture_index``, the reader's ``textures``).
+Tables (`MeasuredBRDF`) are not stored: a file would hold megabytes of JSON.  On reading, the class is
+found among the defined materials by module and name (a user's module must have been imported).
+"""
+__all__ = ["material_to_json", "material_from_json"]
+
+#: the version of the layout above
+VERSION = 1
+
+
+def _plain(value):
+    return [float(c) for c in value] if isinstance(value, tuple) else float(value)
+
+
+def material_to_json(material, texture_index=None):
+    """The JSON-ready dict of ``material`` (see the module).
+
+    Parameters
+    ----------
+    material : glphong.materials.Material
+    texture_index : callable, optional
+        ``texture_index(TextureImage) -> int``: the file's index of a texture (the glTF writer adds it to
+        the file).  Without it a textured parameter raises ValueError.
+
+    Raises
+    ------
+    ValueError
+        A table argument, or a texture without ``texture_index``.
+    """
+    from .fresnel import Fresnel
+    from .model import Choice, Param
+    from .surface import SurfaceInput
+    from .table import Table
+
+    cls = type(material)
+    arguments = {}
+    for argument in cls.arguments():
+        value = getattr(material, argument.name)
+        if isinstance(argument, Table):
+            raise ValueError(f"{cls.__name__}.{argument.name} is a table, which glphong does not store as JSON")
+        if isinstance(value, SurfaceInput):
+            surface = {"scale": _plain(value.scale), "vertex_colors": bool(value.vertex_colors)}
+            if value.texture is not None:
+                if texture_index is None:
+                    raise ValueError(f"{cls.__name__}.{argument.name} is textured: give texture_index to store it")
+                surface.update(texture=int(texture_index(value.texture)), wrap=value.texture.wrap,
+                               filter=value.texture.filter, srgb=value.texture.encoding.startswith("srgb"))
+            arguments[argument.name] = {"surface": surface}
+        elif isinstance(value, Fresnel):
+            arguments[argument.name] = {"class": type(value).__name__, value.field: _plain(getattr(value, value.field))}
+        elif isinstance(argument, (Param, Choice)) or value is None:
+            arguments[argument.name] = value if isinstance(value, str) or value is None else _plain(value)
+    return {"version": VERSION, "class": cls.__name__, "module": cls.__module__, "arguments": arguments,
+            "ka": _plain(material.ka), "two_sided": bool(material.two_sided)}
+
+
+def _material_classes():
+    from .model import Material
+
+    out, stack = {}, [Material]
+    while stack:
+        cls = stack.pop()
+        for sub in cls.__subclasses__():
+            out.setdefault((sub.__module__, sub.__name__), sub)
+            stack.append(sub)
+    return out
+
+
+def material_from_json(data, textures=None):
+    """The material a `material_to_json` dict describes.
+
+    Parameters
+    ----------
+    data : dict
+    textures : callable, optional
+        ``textures(index, wrap, filter, srgb) -> TextureImage`` for textured parameters.
+
+    Raises
+    ------
+    ValueError
+        An unknown class (naming it and where it should come from), a newer layout, or a value the
+        class refuses (its own message).
+    """
+    from . import fresnel as fresnel_module
+    from .surface import SurfaceInput
+
+    if not isinstance(data, dict) or data.get("version", 0) > VERSION or "class" not in data:
+        raise ValueError(f"not a glphong material (layout version {VERSION}): {data!r}"[:300])
+    classes = _material_classes()
+    cls = classes.get((data.get("module"), data["class"]))
+    if cls is None:
+        named = [c for (module, name), c in classes.items() if name == data["class"]]
+        if len(named) != 1:
+            raise ValueError(f"no material class {data.get('module')}.{data['class']} is defined: import the module "
+                             "that defines it before loading")
+        cls = named[0]
+    arguments = {}
+    for name, value in data.get("arguments", {}).items():
+        if isinstance(value, dict) and "surface" in value:
+            s = value["surface"]
+            texture = None
+            if "texture" in s:
+                if textures is None:
+                    raise ValueError(f"{cls.__name__}.{name} is textured, but no textures were given")
+                texture = textures(s["texture"], s.get("wrap", "repeat"), s.get("filter", "trilinear"), s.get("srgb", True))
+            value = SurfaceInput(tuple(s["scale"]), texture, bool(s.get("vertex_colors", False)))
+        elif isinstance(value, dict) and "class" in value:
+            factor = getattr(fresnel_module, value["class"], None)
+            if factor is None:
+                raise ValueError(f"{cls.__name__}.{name}: unknown Fresnel factor {value['class']!r}")
+            value = factor(**{k: tuple(v) if isinstance(v, list) else v for k, v in value.items() if k != "class"})
+        elif isinstance(value, list):
+            value = tuple(value)
+        arguments[name] = value
+    ka = data.get("ka", 0.0)
+    return cls(**arguments, ka=tuple(ka) if isinstance(ka, list) else float(ka), two_sided=bool(data.get("two_sided", True)))
