@@ -1,4 +1,4 @@
-"""Scenes from the files users have: Wavefront OBJ with its MTL materials, and trimesh scenes.
+"""Scenes from the files users have: Wavefront OBJ with its MTL materials, glTF 2.0, and trimesh scenes.
 
 `load_scene(path)` reads an ``.obj`` file (`read_obj`: one object per material, ``usemtl``) and the MTL
 files it names (``mtllib``, `parse_mtl`) itself, so that ``Kd``, ``Ks``, ``Ka`` and ``Ns`` keep their
@@ -9,18 +9,25 @@ means (`glphong.materials.MtlPhong`):
 - ``illum 0``: colour ``Kd`` with no lighting: a constant radiance ``ka = Kd`` and nothing lit;
 - ``illum 1``: ``Kd (n.l) E + Ka L_a`` (no specular term);
 - ``illum 2``: ``Kd (n.l) E + Ks max(v.r, 0)^Ns E + Ka L_a``;
-- ``illum 3`` to ``10`` (reflections, refraction, ray tracing): rendered as ``illum 2``, with a warning.
+- ``illum 3`` to ``10`` (reflections, refraction, ray tracing): rendered as ``illum 2``, with a warning;
+- ``map_Kd`` / ``map_Ks``: textures (sRGB, trilinear, repeat) that ``Kd`` / ``Ks`` multiply.
 
 An OBJ file has no camera and no light.  Unless given, the camera looks at the centre of the geometry's
 bounding sphere (radius ``r``) from ``3 r`` along ``(0.3, 0.4, 1)`` (it fills 87% of a 45-degree view), a
 point light above and beside it delivers ``E = 1 W/m^2`` at the centre, and the ambient light is
 ``L_a = 0.1`` (MTL's ``Ka`` multiplies it).
 
+A glTF file (``.gltf``, ``.glb``) is read from its own arrays (`glphong.gltf_data`: positions, normals,
+uvs, tangents, ``COLOR_0``, indices, nodes in file order), its camera and ``KHR_lights_punctual`` lights
+(`gltf_view`), and its materials: a glphong material stored in the material's ``extras``
+(`material_from_extras`, written by `glphong.save_gltf`), else the metallic-roughness approximation
+`gltf_material` (with ``baseColorTexture`` and ``COLOR_0``).
+
 `scene_from_trimesh` (also `glphong.Scene.from_trimesh`) keeps a ``trimesh.Scene``'s node transforms and
 parts; a part's material comes from ``materials`` (a mapping by part or material name, or a function of
 the name and the trimesh geometry), else from its trimesh material: a ``SimpleMaterial`` (OBJ) as
 `MtlPhong` from its 8-bit colours, a ``PBRMaterial`` (glTF) as ``Lambert(baseColor / pi)``, else
-``Lambert(0.5 / pi)``.
+``Lambert(0.5 / pi)``; vertex colours are decoded as 8-bit sRGB unless ``vertex_colors='linear'``.
 """
 import json
 import math
@@ -182,8 +189,7 @@ def _trimesh_material(geometry):
     return Lambert(0.5 / math.pi)
 
 
-def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, materials=None, vertex_colors="srgb",
-                       order=None):
+def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, materials=None, vertex_colors="srgb"):
     """A `glphong.Scene` of a ``trimesh.Scene`` (or ``Trimesh``): every node's geometry with its world
     transform, named after the node; materials as in the module notes.
 
@@ -199,8 +205,6 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
         (or None for the default).
     vertex_colors : {'srgb', 'linear'}
         The encoding of the meshes' vertex colours (`glphong.geometry.MeshData.from_trimesh`).
-    order : sequence of str, optional
-        Node names in the order the objects are added (the file's); others follow, in trimesh's order.
     """
     import trimesh
 
@@ -229,9 +233,6 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
             raise TypeError(f"materials gave {type(material).__name__} for {geometry_name!r}: it must give a "
                             "glphong material")
         parts.append((geometry, material, np.asarray(transform, dtype=np.float64), str(node)))
-    if order is not None:
-        rank = {name: i for i, name in enumerate(order)}
-        parts.sort(key=lambda part: rank.get(part[3], len(rank)))
     scene = _scene(camera, lights, ambient)
     for geometry, material, transform, name in parts:
         scene.add(MeshData.from_trimesh(geometry, colors=vertex_colors), material, pose=transform, name=name)
@@ -309,58 +310,15 @@ def read_obj(path):
 
 def read_gltf_json(path):
     """The JSON document of a ``.gltf`` file, or of a ``.glb`` file's first chunk (dict)."""
+    from .gltf_data import glb_chunks
+
     data = Path(path).read_bytes()
     if data[:4] == b"glTF":
-        data = _glb_chunks(path, data)[0]
+        data = glb_chunks(path, data)[0]
     try:
         return json.loads(data.decode("utf-8"))
     except (UnicodeDecodeError, ValueError) as exc:
         raise ValueError(f"{path}: not a glTF document ({exc})") from None
-
-
-def _glb_chunks(path, data):
-    """``(json bytes, binary bytes or None)`` of a ``.glb`` file's contents."""
-    import struct
-
-    if len(data) < 20:
-        raise ValueError(f"{path}: truncated glTF binary ({len(data)} bytes)")
-    length, kind = struct.unpack_from("<II", data, 12)
-    if kind != 0x4E4F534A:  # 'JSON'
-        raise ValueError(f"{path}: the first chunk of a glTF binary must be JSON")
-    start = 20 + length
-    binary = None
-    if len(data) >= start + 8:
-        size, kind = struct.unpack_from("<II", data, start)
-        binary = data[start + 8:start + 8 + size] if kind == 0x004E4942 else None  # 'BIN'
-    return data[20:start], binary
-
-
-def _gltf_image(path, document, index):
-    """The pixels (H, W, C) of glTF texture ``index``: from a buffer view (a .glb's binary chunk or a data
-    URI buffer) or an image file beside the document."""
-    import base64
-    from io import BytesIO
-
-    from PIL import Image
-
-    image = document["images"][document["textures"][index]["source"]]
-    if "bufferView" in image:
-        view = document["bufferViews"][image["bufferView"]]
-        uri = document["buffers"][view["buffer"]].get("uri")
-        if uri is None:
-            blob = _glb_chunks(path, Path(path).read_bytes())[1]
-        elif uri.startswith("data:"):
-            blob = base64.b64decode(uri.split(",", 1)[1])
-        else:
-            blob = (Path(path).parent / uri).read_bytes()
-        start = view.get("byteOffset", 0)
-        payload = BytesIO(blob[start:start + view["byteLength"]])
-    elif image.get("uri", "").startswith("data:"):
-        payload = BytesIO(base64.b64decode(image["uri"].split(",", 1)[1]))
-    else:
-        payload = Path(path).parent / image["uri"]
-    with Image.open(payload) as opened:
-        return np.asarray(opened.convert("RGB"))
 
 
 def _glphong_extras(document):
@@ -373,6 +331,7 @@ def _glphong_extras(document):
 def material_from_extras(entry, path, document):
     """The glphong material stored in a glTF material's ``extras: {"glphong": ...}``
     (`glphong.materials.as_json`), or None where there is none."""
+    from .gltf_data import read_gltf_image
     from .materials.as_json import material_from_json
     from .materials.surface import TextureImage
 
@@ -382,7 +341,7 @@ def material_from_extras(entry, path, document):
         return None
 
     def textures(index, wrap, filter, srgb):
-        return TextureImage(_gltf_image(path, document, index), srgb=srgb, wrap=wrap, filter=filter)
+        return TextureImage(read_gltf_image(path, document, index), srgb=srgb, wrap=wrap, filter=filter)
 
     try:
         return material_from_json(stored, textures)
@@ -494,7 +453,7 @@ def gltf_material(entry, base_color_texture=None, vertex_colors=False):
     The lobes differ (Beckmann against GGX, no coupling of diffuse and specular): an approximation.
 
     ``baseColor`` is ``baseColorFactor`` times the base-colour texture (``base_color_texture``, an image
-    array, sRGB) times the mesh's ``COLOR_0`` (``vertex_colors``), as glTF defines it; the texture and the
+    array, sRGB, or a `glphong.materials.TextureImage`) times the mesh's ``COLOR_0`` (``vertex_colors``), as glTF defines it; the texture and the
     colours vary the diffuse albedo only (the metallic-roughness texture is not read)."""
     from .materials import CookTorrance, SchlickFresnel, SurfaceInput, Texture
 
@@ -571,39 +530,40 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None, lig
 
 
 def _load_gltf(path, camera, lights, ambient, materials, light_units, camera_name):
-    import trimesh
+    """A glTF file's scene: its own arrays (`glphong.gltf_data`), nodes in file order, materials from the
+    user's ``materials``, else the stored glphong material (``extras``), else `gltf_material`."""
+    from .gltf_data import read_gltf_image, read_gltf_primitives, texture_sampling
+    from .materials import Material, Texture
 
     document = read_gltf_json(path)
     file_camera, file_lights = gltf_view(document, camera_name, light_units, str(path))
-    entries = {m.get("name", f"material{i}"): m for i, m in enumerate(document.get("materials", []))}
-    try:
-        loaded = trimesh.load(str(path), force="scene")
-    except Exception as exc:  # noqa: BLE001 - trimesh raises many kinds; say which file
-        raise ValueError(f"{path}: trimesh could not read it ({type(exc).__name__}: {exc})") from None
+    entries = document.get("materials", [])
+    made = {}
 
-    def resolve(name, geometry):
-        trimesh_material = getattr(geometry.visual, "material", None)
-        material_name = getattr(trimesh_material, "name", None)
-        entry = entries.get(material_name)
+    def resolve(name, mesh, index):
+        entry = entries[index] if index is not None else None
+        material_name = entry.get("name") if entry is not None else None
+        chosen = None
         if callable(materials):
             chosen = materials(material_name or name, entry)
-            if chosen is not None:
-                return chosen
         elif materials:
-            for key in (material_name, name):
-                if key in materials:
-                    return materials[key]
-        if entry is None:
-            return None
-        stored = material_from_extras(entry, str(path), document)
-        if stored is not None:
-            return stored
-        image = getattr(trimesh_material, "baseColorTexture", None)
-        has_uv = getattr(geometry.visual, "uv", None) is not None
-        texture = np.asarray(image.convert("RGB")) if image is not None and has_uv else None
-        from .geometry import _trimesh_vertex_colors
-
-        return gltf_material(entry, texture, _trimesh_vertex_colors(geometry, "linear") is not None)
+            chosen = next((materials[k] for k in (material_name, name) if k is not None and k in materials), None)
+        if chosen is not None or entry is None:
+            return chosen
+        textured = "baseColorTexture" in entry.get("pbrMetallicRoughness", {}) and mesh.uvs is not None
+        key = (index, textured, mesh.colors is not None)
+        if key not in made:
+            stored = material_from_extras(entry, str(path), document)
+            if stored is None:
+                texture = None
+                if textured:
+                    reference = entry["pbrMetallicRoughness"]["baseColorTexture"]["index"]
+                    wrap, filter_ = texture_sampling(document, reference)
+                    texture = Texture(read_gltf_image(path, document, reference), srgb=True, wrap=wrap, filter=filter_)
+                    texture = texture.texture
+                stored = gltf_material(entry, texture, mesh.colors is not None)
+            made[key] = stored
+        return made[key]
 
     written = _glphong_extras(document)
     if lights is None and (file_lights or written):
@@ -612,5 +572,13 @@ def _load_gltf(path, camera, lights, ambient, materials, light_units, camera_nam
         from .lights import AmbientLight
 
         ambient = AmbientLight(tuple(written["ambient"]))
-    return scene_from_trimesh(loaded, camera if camera is not None else file_camera, lights, ambient, resolve,
-                              vertex_colors="linear", order=[n.get("name") for n in document.get("nodes", [])])
+    chosen_camera = camera if camera is not None else file_camera
+    scene = _scene(chosen_camera, lights, ambient)
+    for name, mesh, world, index in read_gltf_primitives(path, document):
+        material = resolve(name, mesh, index)
+        if material is None:
+            material = _trimesh_material(None)
+        if not isinstance(material, Material):
+            raise TypeError(f"materials gave {type(material).__name__} for {name!r}: it must give a glphong material")
+        scene.add(mesh, material, pose=world, name=name)
+    return _with_view(scene, chosen_camera, lights, ambient)
