@@ -124,6 +124,10 @@ class ProgramKey:
     lod_textures : int
         G-buffer programs only: how many textures' levels of detail it writes there (``textureQueryLOD``,
         one per textured surface input of the object's material, at most 4; the rest are 0).
+    attribute_locations : tuple of (str, int)
+        Where the tangent, uv and colour attributes are bound, where not at glphong's own locations
+        (tangent 2, uv 3, colour 5): pyrender packs a primitive's attributes in order, so its uv is at 2
+        when the primitive has no tangents (`glphong.integrations.pyrender`).
     """
 
     output: str = "radiance"
@@ -142,6 +146,7 @@ class ProgramKey:
     has_color: bool = False
     has_lod: bool = False
     lod_textures: int = 0
+    attribute_locations: tuple = ()
 
     def __post_init__(self):
         if self.output not in OUTPUTS or self.formulation not in FORMULATIONS or \
@@ -210,6 +215,8 @@ class ProgramKey:
             ("HAS_COLOR", b(self.has_color)),
             ("HAS_INPUTS", b(bool(self.inputs))),
             ("HAS_LOD", b(self.has_lod)),
+            *((f"{name.upper()}_LOCATION", str(where)) for name, where in
+              ({"tangent": 2, "uv": 3, "color": 5} | dict(self.attribute_locations)).items()),
             ("NUM_LOD_TEXTURES", str(self.lod_textures)),
             ("TWO_SIDED", b(self.two_sided)),
             ("RUNTIME_SWITCHES", b(self.uber)),

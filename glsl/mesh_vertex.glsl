@@ -9,11 +9,12 @@
 //   no gl_FrontFacing); a vertex radiance beyond GOURAUD_MAX = 2^100 (about 1.3e30) saturates there, so
 //   the interpolation never meets Inf (Inf times a zero barycentric weight is NaN) nor overflows.
 //   Positions in metres, radiance in W/(m^2 sr).
-// Attribute locations are fixed and match pyrender's: 0 position, 1 normal, 2 tangent, 3 uv; 4 the linear
-// vertex colour (HAS_COLOR: a surface input reads it; material_inputs() runs here when shading per vertex).
+// Attribute locations: 0 position, 1 normal, then TANGENT_LOCATION, UV_LOCATION, COLOR_LOCATION (the linear
+// vertex colour: HAS_COLOR, a surface input reads it; material_inputs() runs here when shading per vertex):
+// 2, 3 and 5 in glphong's own draws, pyrender's packed order inside pyrender (the key says which).
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
-// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, SHADE_PER_VERTEX, TWO_SIDED,
-// NEEDS_VIEW, SWITCH(flag).
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, *_LOCATION, SHADE_PER_VERTEX,
+// TWO_SIDED, NEEDS_VIEW, SWITCH(flag).
 
 const float GOURAUD_MAX = 1.2676506002282294e30;  // 2^100: per-vertex radiance saturates here
 layout(location = 0) in vec3 in_position;
@@ -26,13 +27,13 @@ layout(location = 1) in vec3 in_normal;
 uniform mat3 u_normal_matrix;
 #endif
 #if HAS_TANGENT
-layout(location = 2) in vec4 in_tangent;
+layout(location = TANGENT_LOCATION) in vec4 in_tangent;
 #endif
 #if HAS_UV
-layout(location = 3) in vec2 in_uv;
+layout(location = UV_LOCATION) in vec2 in_uv;
 #endif
 #if HAS_COLOR
-layout(location = 4) in vec3 in_color;
+layout(location = COLOR_LOCATION) in vec3 in_color;
 #endif
 #if SHADE_PER_VERTEX
 out vec3 v_radiance;

@@ -34,6 +34,17 @@ def build_scene():
     pbr = pyrender.MetallicRoughnessMaterial(baseColorFactor=[0.2, 0.8, 0.2, 1.0], metallicFactor=0.0, roughnessFactor=0.5)
     scene.add(pyrender.Mesh.from_trimesh(trimesh.creation.icosphere(3, radius=0.3), material=pbr),
               pose=translation(0.0, 0.85, 0.0), name="pbr")
+    # a textured plane and a vertex-coloured sphere: samplers and the colour attribute inside pyrender
+    plane = glphong.primitives.plane(1.0)
+    checker = (np.indices((8, 8)).sum(axis=0) % 2 * 200 + 30).astype(np.uint8)
+    textured = pyrender.Primitive(plane.positions, plane.normals, texcoord_0=plane.uvs * 2, indices=plane.indices,
+                                  material=GlphongMaterial(glphong.Lambert(kd=glphong.Texture(checker, 0.3))))
+    scene.add(pyrender.Mesh([textured]), pose=translation(1.3, 0.85, 0.0), name="textured")
+    ball = trimesh.creation.icosphere(2, radius=0.25)
+    colours = np.random.default_rng(3).random((len(ball.vertices), 4))
+    coloured = pyrender.Primitive(ball.vertices, ball.vertex_normals, color_0=colours, indices=ball.faces,
+                                  material=GlphongMaterial(glphong.Lambert(kd=glphong.VertexColors(0.3))))
+    scene.add(pyrender.Mesh([coloured]), pose=translation(0.0, -1.0, 0.5), name="coloured")
     scene.add(pyrender.PerspectiveCamera(yfov=0.8, znear=0.05, zfar=100.0), pose=translation(0.0, 0.0, 4.0))
     scene.add(pyrender.PointLight(color=[1.0, 0.9, 0.8], intensity=25.0), pose=translation(2.0, 2.0, 3.0))
     light_pose = np.eye(4)

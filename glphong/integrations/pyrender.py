@@ -31,6 +31,7 @@ pyrender 0.1.45's OSMesa platform needs PyOpenGL >= 3.1.5 (``pip install --no-de
 """
 import os
 import threading
+from dataclasses import replace
 
 import numpy as np
 import pyrender
@@ -130,8 +131,9 @@ def scene_from_pyrender(scene):
             if isinstance(primitive.material, GlphongMaterial):
                 # pyrender keeps indices as float32 (exact below 2^24 vertices)
                 indices = np.rint(np.asarray(primitive.indices, dtype=np.float64)).astype(np.int64).reshape(-1, 3)
+                colors = None if primitive.color_0 is None else np.asarray(primitive.color_0, dtype=np.float64)[:, :3]
                 data = MeshData(primitive.positions, primitive.normals, indices, uvs=primitive.texcoord_0,
-                                tangents=primitive.tangents)
+                                tangents=primitive.tangents, colors=colors)
                 out.add(data, primitive.material.glphong, pose=scene.get_pose(node), name=node.name)
     return out
 
@@ -221,12 +223,23 @@ class _GlphongRenderer(_PyrenderRenderer):
                              f"{len(primitive.poses)} poses); use one mesh node per instance")
         scene = self._glphong_scene
         key = program_key(material.glphong, scene.light_counts(), scene.ambient_radiance, output="display")
-        # pyrender binds tangents at location 2 and texcoord_0 at 3, the locations mesh_vertex.glsl reads
+        # pyrender packs the attributes a primitive has in this order, one location each
+        present = [name for name, value in (("position", primitive.positions), ("normal", primitive.normals),
+                                            ("tangent", primitive.tangents), ("uv", primitive.texcoord_0),
+                                            ("uv1", primitive.texcoord_1), ("color", primitive.color_0))
+                   if value is not None]
+        key = replace(key, attribute_locations=tuple((name, present.index(name)) for name in ("tangent", "uv", "color")
+                                                     if name in present and getattr(key, f"has_{name}")))
         if key.has_tangent and primitive.tangents is None:
             raise ValueError("a primitive with a GlphongMaterial whose terms need 'tangent' must have tangents "
                              "(pyrender.Primitive(tangents=...) or a glTF mesh with TANGENT)")
         if key.has_uv and primitive.texcoord_0 is None:
-            raise ValueError("a primitive with a GlphongMaterial whose terms need 'uv' must have texcoord_0")
+            raise ValueError("a primitive with a GlphongMaterial whose terms need 'uv' (or a textured parameter) "
+                             "must have texcoord_0")
+        # pyrender binds color_0 at location 5, where mesh_vertex.glsl reads the (linear) vertex colour
+        if key.has_color and primitive.color_0 is None:
+            raise ValueError("a primitive with a GlphongMaterial whose parameter takes vertex colours must have "
+                             "color_0 (linear, in [0, 1])")
         if not hasattr(self, "_glphong_programs"):
             self._glphong_programs = ProgramCache(attach_current(os.environ.get("PYOPENGL_PLATFORM", "egl")))
             self._glphong_adapters = {}
