@@ -147,3 +147,17 @@ def test_save_gltf_refuses_textures_it_cannot_store(tmp_path):
     with pytest.raises(ValueError, match="writes .glb or .gltf"):
         glphong.save_gltf(_rich_scene(), tmp_path / "scene.obj")
     assert TextureImage(NOISE).pixels8().tolist() == NOISE.tolist()
+
+
+def test_example_textured_scene(tmp_path):
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location(
+        "textured_scene", Path(__file__).resolve().parent.parent / "examples" / "textured_scene.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    report, difference = module.main(tmp_path)
+    assert report.passed and report.covered_pixels > 50000
+    assert difference < 3e-5
+    assert (tmp_path / "textured.png").stat().st_size > 10000 and (tmp_path / "textured.glb").is_file()
