@@ -26,8 +26,8 @@ uvs, tangents, ``COLOR_0``, indices, nodes in file order), its camera and ``KHR_
 `scene_from_trimesh` (also `glphong.Scene.from_trimesh`) keeps a ``trimesh.Scene``'s node transforms and
 parts; a part's material comes from ``materials`` (a mapping by part or material name, or a function of
 the name and the trimesh geometry), else from its trimesh material: a ``SimpleMaterial`` (OBJ) as
-`MtlPhong` from its 8-bit colours, a ``PBRMaterial`` (glTF) as ``Lambert(baseColor / pi)``, else
-``Lambert(0.5 / pi)``; vertex colours are decoded as 8-bit sRGB unless ``vertex_colors='linear'``.
+`MtlPhong` from its 8-bit colours, a ``PBRMaterial`` (glTF) as ``Lambert(baseColor / pi)`` (each with its
+image as a texture the colour multiplies, where the mesh has UVs), else ``Lambert(0.5 / pi)``; vertex colours are decoded as 8-bit sRGB unless ``vertex_colors='linear'``.
 """
 import json
 import math
@@ -176,16 +176,24 @@ def _with_view(scene, camera, lights, ambient):
 
 
 def _trimesh_material(geometry):
-    from .materials import Lambert, MtlPhong
+    from .materials import Lambert, MtlPhong, Texture
 
-    material = getattr(getattr(geometry, "visual", None), "material", None)
+    visual = getattr(geometry, "visual", None)
+    material = getattr(visual, "material", None)
     kind = type(material).__name__
+    has_uv = getattr(visual, "uv", None) is not None
+
+    def textured(scale, image):  # the material's image times its colour, where the mesh has UVs
+        return Texture(np.asarray(image.convert("RGB")), scale=scale) if image is not None and has_uv else scale
+
     if kind == "SimpleMaterial":
         rgb = lambda c: tuple(np.asarray(c, dtype=np.float64)[:3] / 255.0)  # noqa: E731
-        return MtlPhong(rgb(material.diffuse), rgb(material.specular), float(material.glossiness or 0.0),
-                        rgb(material.ambient))
-    if kind == "PBRMaterial" and material.baseColorFactor is not None:
-        return Lambert(tuple(np.asarray(material.baseColorFactor, dtype=np.float64)[:3] / 255.0 / math.pi))
+        return MtlPhong(textured(rgb(material.diffuse), getattr(material, "image", None)), rgb(material.specular),
+                        float(material.glossiness or 0.0), rgb(material.ambient))
+    if kind == "PBRMaterial":
+        factor = material.baseColorFactor if material.baseColorFactor is not None else (255, 255, 255, 255)
+        kd = tuple(np.asarray(factor, dtype=np.float64)[:3] / 255.0 / math.pi)
+        return Lambert(textured(kd, material.baseColorTexture))
     return Lambert(0.5 / math.pi)
 
 

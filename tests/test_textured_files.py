@@ -161,3 +161,16 @@ def test_example_textured_scene(tmp_path):
     assert report.passed and report.covered_pixels > 50000
     assert difference < 3e-5
     assert (tmp_path / "textured.png").stat().st_size > 10000 and (tmp_path / "textured.glb").is_file()
+
+
+def test_from_trimesh_keeps_material_images_as_textures():
+    box = trimesh.creation.box()
+    image = Image.fromarray(NOISE)
+    box.visual = trimesh.visual.TextureVisuals(uv=RNG.random((len(box.vertices), 2)), material=
+                                               trimesh.visual.material.PBRMaterial(baseColorTexture=image,
+                                                                                  baseColorFactor=[255, 128, 64, 255]))
+    kd = glphong.Scene.from_trimesh(trimesh.Scene(box)).objects[0].material.kd
+    assert kd.texture == TextureImage(NOISE)
+    np.testing.assert_allclose(kd.scale, np.array([255, 128, 64]) / 255 / np.pi)
+    box.visual = trimesh.visual.TextureVisuals(material=trimesh.visual.material.PBRMaterial(baseColorTexture=image))
+    assert isinstance(glphong.Scene.from_trimesh(trimesh.Scene(box)).objects[0].material.kd, tuple)  # no UVs: the colour
