@@ -252,3 +252,32 @@ def test_trimesh_vertex_colours_are_decoded_from_srgb():
     np.testing.assert_allclose(data.colors[0], _srgb_decode([255, 128, 0]).astype(np.float32))
     flat = MeshData.from_trimesh(box, smooth=False)
     assert flat.colors.shape == (len(flat.positions), 3)
+
+
+class FiveInputs(glphong.MaterialModel):
+    """A user's model with five textureable parameters: the mechanism the built-ins use, nothing else."""
+
+    name = "five_inputs"
+    params = tuple(glphong.Param(f"c{i}", "rgb", low=0.0, default=0.05, textureable=True) for i in range(5))
+    glsl = """
+vec3 five_inputs_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
+{
+    return (u_five_inputs_c0 + u_five_inputs_c1 + u_five_inputs_c2 + u_five_inputs_c3 + u_five_inputs_c4) * n_dot_l;
+}
+"""
+
+    def response(self, f, wi, wo, n_dot_l, p):
+        return (p.c0 + p.c1 + p.c2 + p.c3 + p.c4) * n_dot_l[:, None]
+
+
+def test_a_users_model_textures_four_parameters_and_is_refused_a_fifth(glphong_make_renderer):
+    images = [RNG.integers(0, 256, (8 + i, 12, 3), dtype=np.uint8) for i in range(5)]
+    four = FiveInputs(**{f"c{i}": glphong.Texture(images[i], 0.05) for i in range(4)}, c4=glphong.VertexColors(0.05))
+    scene = _oblique_scene(four, _plane(colors=RNG.random((len(_plane().positions), 3))))
+    renderer = glphong_make_renderer(120, 90, "egl")
+    report = glphong.verify(scene, renderer)
+    assert report.passed and report.covered_pixels > 3000
+    assert renderer.gbuffer(scene).lod.shape == (90, 120, 4)
+    five = FiveInputs(**{f"c{i}": glphong.Texture(images[i], 0.05) for i in range(5)})
+    with pytest.raises(ValueError, match="at most 4 parameters .* textures 5"):
+        renderer.gbuffer(_oblique_scene(five))
