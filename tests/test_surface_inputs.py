@@ -281,3 +281,12 @@ def test_a_users_model_textures_four_parameters_and_is_refused_a_fifth(glphong_m
     five = FiveInputs(**{f"c{i}": glphong.Texture(images[i], 0.05) for i in range(5)})
     with pytest.raises(ValueError, match="at most 4 parameters .* textures 5"):
         renderer.gbuffer(_oblique_scene(five))
+
+
+@pytest.mark.parametrize("scale", [1e-8, 1e8])
+def test_sixty_decades_of_texels_verify(scale, glphong_make_renderer):
+    """A float texture with texels from 1e-30 to 1e30 (times 1e-8 or 1e8: products down to 1e-38, up to 1e38)."""
+    hdr = (10.0 ** RNG.uniform(-30, 30, (32, 32, 3))).astype(np.float32)
+    scene = _oblique_scene(glphong.Lambert(kd=glphong.Texture(hdr, scale=scale)))
+    report = glphong.verify(scene, glphong_make_renderer(120, 90, "egl"))
+    assert report.passed and report.nonfinite_count == 0, report.summary()
