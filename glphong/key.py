@@ -23,6 +23,10 @@ FORMULATIONS = ("stable", "naive")
 LIGHT_KINDS = ("point", "unattenuated", "directional")
 #: label of the generated chunk that sums the terms
 MATERIAL_CHUNK = "generated:material"
+#: label of the generated chunk of a G-buffer program that records its textures' levels of detail
+LOD_CHUNK = "generated:levels_of_detail"
+#: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed)
+GBUFFER_PLANES = ("tangent", "uv", "color", "lod")
 #: how a surface input is made (``<MODEL>_<PARAM>_INPUT`` is the mode's index plus 1)
 INPUT_MODES = ("texture", "vertex", "texture*vertex")
 #: textured parameters per material (one G-buffer plane of levels of detail)
@@ -200,8 +204,7 @@ class ProgramKey:
 
     def gbuffer_planes(self):
         """The extra G-buffer planes a G-buffer program writes, in attachment order (tuple of str)."""
-        return tuple(name for name, on in (("tangent", self.has_tangent), ("uv", self.has_uv),
-                                           ("color", self.has_color), ("lod", self.has_lod)) if on)
+        return tuple(name for name in GBUFFER_PLANES if getattr(self, f"has_{name}"))
 
     def defines(self):
         """The generated ``#define`` lines as (name, value) pairs."""
@@ -226,9 +229,7 @@ class ProgramKey:
             ("SWITCH(flag)", "((flag) > 0.5)" if self.uber else "true"),
         ]
         if self.output == "gbuffer":  # extra planes follow position and normal, packed in this order
-            planes = [name for name, on in (("TANGENT", self.has_tangent), ("UV", self.has_uv),
-                                            ("COLOR", self.has_color), ("LOD", self.has_lod)) if on]
-            out += [(f"GBUFFER_{name}_LOCATION", str(2 + i)) for i, name in enumerate(planes)]
+            out += [(f"GBUFFER_{name.upper()}_LOCATION", str(2 + i)) for i, name in enumerate(self.gbuffer_planes())]
         if self.output != "gbuffer":
             out.append(("NEEDS_VIEW", b(self.needs_view)))
             for kind in LIGHT_KINDS:
@@ -271,7 +272,7 @@ class ProgramKey:
         if self.output in ("points", "response"):
             return ()
         if self.output == "gbuffer":
-            return ("common", "surface", "mesh_fragment") if self.lod_textures else ("common", "mesh_fragment")
+            return ("common", "surface", LOD_CHUNK, "mesh_fragment") if self.lod_textures else ("common", "mesh_fragment")
         if self.shade_per_vertex:
             return ("mesh_fragment",)
         if self.output == "display":
@@ -280,7 +281,9 @@ class ProgramKey:
 
     def generated_chunks(self):
         """Text of the chunks generated from the key (label -> GLSL)."""
-        return {} if self.output == "gbuffer" else {MATERIAL_CHUNK: material_chunk(self)}
+        if self.output == "gbuffer":
+            return {LOD_CHUNK: lod_chunk(self)} if self.lod_textures else {}
+        return {MATERIAL_CHUNK: material_chunk(self)}
 
     def varyings(self):
         """Transform-feedback outputs of a 'points' or 'response' program."""
@@ -295,11 +298,9 @@ class ProgramKey:
             Terms of the drawn materials that the key leaves out, with the reason.
         """
         if self.output == "gbuffer":
-            extras = [name for name, on in (("tangent", self.has_tangent), ("uv", self.has_uv),
-                                            ("vertex colour", self.has_color), ("level-of-detail", self.lod_textures))
-                      if not on]
             return ["all shading code and lights (the G-buffer program writes the shading inputs only)",
-                    "radiance output"] + [f"{name} output (no drawn term needs it)" for name in extras]
+                    "radiance output"] + [f"{name} output (no drawn term needs it)" for name in GBUFFER_PLANES
+                                          if name not in self.gbuffer_planes()]
         if self.uber:
             return ["nothing: the uber-shader compiles every built-in term and the scene's own and switches at run time"]
         out = []
@@ -418,6 +419,19 @@ def material_chunk(key):
             factors += ["color"] if "vertex" in mode else []
             lines.append(f"    u_{term}_{param} = {' * '.join(factors)};")
         lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def lod_chunk(key):
+    """The generated GLSL of a G-buffer program with textures (label ``generated:levels_of_detail``): one
+    sampler per textured input of the object's material, ``u_lod_texture<i>``, and
+    ``gbuffer_levels_of_detail(uv)``, their ``surface_texture_lod`` in x, y, z, w (0 beyond)."""
+    lines = ["// levels of detail (generated from the program key): what texture() used for each of the object's",
+             "// textures, in ProgramKey.textured_inputs order; the twin blends the same levels (surface.glsl)"]
+    lines += [f"uniform sampler2D u_lod_texture{i};" for i in range(key.lod_textures)]
+    lines += ["", "vec4 gbuffer_levels_of_detail(vec2 uv)", "{", "    vec4 lod = vec4(0.0);"]
+    lines += [f"    lod.{'xyzw'[i]} = surface_texture_lod(u_lod_texture{i}, uv);" for i in range(key.lod_textures)]
+    lines += ["    return lod;", "}"]
     return "\n".join(lines) + "\n"
 
 

@@ -18,7 +18,7 @@ import numpy as np
 from . import _validate
 from .contexts import EGLDisplayTerminatedError, check_not_forked, create_context
 from .culling import closed_outward, view_allows_culling, world_sphere
-from .key import FORMULATIONS, EncodeKey, uber_key
+from .key import FORMULATIONS, GBUFFER_PLANES, EncodeKey, uber_key
 from .programs import ProgramCache
 
 __all__ = ["Renderer", "Frame", "GBuffer"]
@@ -498,7 +498,7 @@ class Renderer:
         """
         self._check_scene(scene)
         needs = scene.gbuffer_needs()
-        extras = [n for n in ("tangent", "uv", "color", "lod") if n in needs]
+        extras = [n for n in GBUFFER_PLANES if n in needs]
         with self.context:
             fbo = self._target(("gbuffer", *extras))
             self._draw(scene, "gbuffer", fbo)

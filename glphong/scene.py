@@ -10,7 +10,7 @@ import numpy as np
 from . import _validate
 from .camera import Camera
 from .geometry import MeshData
-from .key import program_key
+from .key import GBUFFER_PLANES, program_key
 from .lights import LIGHT_KINDS, AmbientLight
 from .materials import Material
 from .materials.surface import TextureImage
@@ -174,8 +174,8 @@ class Scene:
         if cached is None or cached[0] != state:
             counts, ambient = self.light_counts(), self.ambient_radiance
             keys = [program_key(o.material, counts, ambient) for o in self._objects]
-            needs = {n for n in ("tangent", "uv", "color") if any(getattr(k, f"has_{n}") for k in keys)}
-            needs = frozenset(needs | ({"lod"} if any(k.textured_inputs for k in keys) else set()))
+            needs = frozenset(n for n in GBUFFER_PLANES if any(
+                k.textured_inputs if n == "lod" else getattr(k, f"has_{n}") for k in keys))
             cached = self._gbuffer_needs = (state, needs)
         return cached[1]
 
@@ -243,11 +243,11 @@ class Scene:
             values["u_normal_matrix"] = obj.normal_matrix
         if key.output == "gbuffer":
             values["u_object_id"] = float(index)
-            if key.lod_textures:  # the textures whose level of detail the G-buffer records, in sampler order
+            if key.lod_textures:  # the radiance program's textures, whose levels of detail the G-buffer records
                 spec = self.program_key(obj)
-                surface = {(t.name, p): v for t in obj.material.components for p, v in t.surface_inputs().items()}
+                textures = obj.material.uniform_values(spec)
                 for i, (term, param) in enumerate(spec.textured_inputs):
-                    values[f"u_lod_texture{i}"] = surface[(term, param)].texture
+                    values[f"u_lod_texture{i}"] = textures[f"u_{term}_{param}_texture"]
         else:
             values.update(obj.material.uniform_values(key))
         return {name: v if isinstance(v, (TableData, TextureImage)) else _validate.float32_uniform(v)

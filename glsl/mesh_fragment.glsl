@@ -10,7 +10,8 @@
 //   normal exactly as shade_point() would use it (0 where it is invalid), w = 1; with HAS_TANGENT
 //   the interpolated tangent (xyz, handedness w), with HAS_UV the uv (xy): the inputs of shading_frame();
 //   with HAS_COLOR the interpolated vertex colour (rgb); with HAS_LOD the level of detail of each of the
-//   object's NUM_LOD_TEXTURES textures (surface_texture_lod(), 0 beyond): the inputs of material_inputs();
+//   object's NUM_LOD_TEXTURES textures (gbuffer_levels_of_detail(), generated; 0 beyond): the inputs of
+//   material_inputs();
 //   locations 0 position, 1 normal, then the extra planes at GBUFFER_<PLANE>_LOCATION (key.py packs them).
 // HAS_INPUTS: material_inputs(uv, colour) sets the surface inputs (the generated material chunk) before shading.
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, NUM_LOD_TEXTURES,
@@ -57,18 +58,6 @@ layout(location = GBUFFER_COLOR_LOCATION) out vec4 out_color;
 #endif
 #if HAS_LOD
 layout(location = GBUFFER_LOD_LOCATION) out vec4 out_lod;
-#endif
-#if NUM_LOD_TEXTURES > 0
-uniform sampler2D u_lod_texture0;
-#endif
-#if NUM_LOD_TEXTURES > 1
-uniform sampler2D u_lod_texture1;
-#endif
-#if NUM_LOD_TEXTURES > 2
-uniform sampler2D u_lod_texture2;
-#endif
-#if NUM_LOD_TEXTURES > 3
-uniform sampler2D u_lod_texture3;
 #endif
 #else
 #if NEEDS_VIEW
@@ -118,20 +107,10 @@ void main()
 #if HAS_COLOR
     out_color = vec4(color, 1.0);
 #endif
-#if HAS_LOD
-    out_lod = vec4(0.0);
-#endif
-#if NUM_LOD_TEXTURES > 0
-    out_lod.x = surface_texture_lod(u_lod_texture0, uv);
-#endif
-#if NUM_LOD_TEXTURES > 1
-    out_lod.y = surface_texture_lod(u_lod_texture1, uv);
-#endif
-#if NUM_LOD_TEXTURES > 2
-    out_lod.z = surface_texture_lod(u_lod_texture2, uv);
-#endif
-#if NUM_LOD_TEXTURES > 3
-    out_lod.w = surface_texture_lod(u_lod_texture3, uv);
+#if HAS_LOD && NUM_LOD_TEXTURES > 0
+    out_lod = gbuffer_levels_of_detail(uv);  // the generated levels-of-detail chunk
+#elif HAS_LOD
+    out_lod = vec4(0.0);                     // another object of the scene has textures, this one none
 #endif
 #else
 #if HAS_INPUTS

@@ -5,7 +5,8 @@
 //           own mip pyramid (or GL_LINEAR); texels are linear (sRGB decoded on the CPU), float16/float32;
 //   C     = the interpolated linear vertex colour, dimensionless.
 // surface_texture_lod(s, uv) -> the level of detail texture() used at this fragment (textureQueryLOD(s, uv).x,
-//   GL_ARB_texture_query_lod), written to the G-buffer so the twin blends the same two levels.
+//   GL_ARB_texture_query_lod), written to the G-buffer so the twin blends the same two levels.  It has no
+//   numpy twin on purpose: it reports the GPU's own choice, which the twin reads instead of recomputing.
 // Called only from main(), in uniform control flow: the implicit derivatives are defined.
 
 vec3 surface_texture(sampler2D s, vec2 uv)
