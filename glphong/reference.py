@@ -330,7 +330,7 @@ def material_emission(key, uniforms, shape, dtype, material=None, inputs=None):
     return radiance
 
 
-def material_inputs(uv, color, lod, key, uniforms):
+def material_inputs(uv, color, lod, key, uniforms, sample=None):
     """The surface inputs of the generated material chunk's ``material_inputs(uv, color)``:
     ``u_<model>_<param> = scale * surface_texture(texture, uv) * color``.
 
@@ -344,24 +344,30 @@ def material_inputs(uv, color, lod, key, uniforms):
     key : glphong.key.ProgramKey
     uniforms : dict
         The program's uniforms (``u_<model>_<param>_scale`` and ``_texture``).
+    sample : callable, optional
+        ``sample(image, uv, lod)`` in place of `surface_texture`; it may return ``(k, N, 3)`` (several
+        arrays that the products broadcast over: `glphong.tolerances.input_bounds` passes the value and
+        its interval from one sampling).
 
     Returns
     -------
-    dict of str to (N, 3) float64 ndarray
+    dict of str to (N, 3) (or (k, N, 3)) float64 ndarray
         By uniform name; empty where the key has no surface input.
     """
     from .materials.surface import surface_texture
 
+    sample = surface_texture if sample is None else sample
     out = {}
     textured = list(key.textured_inputs)
     for term, param, mode in key.inputs:
         name = f"u_{term}_{param}"
         value = np.asarray(uniforms[f"{name}_scale"], dtype=np.float64)
         if "texture" in mode:
-            value = value * surface_texture(uniforms[f"{name}_texture"], uv, lod[:, textured.index((term, param))])
+            value = value * sample(uniforms[f"{name}_texture"], uv, lod[:, textured.index((term, param))])
         if "vertex" in mode:
             value = value * color
-        out[name] = np.broadcast_to(value, (len(uv) if uv is not None else len(color), 3))
+        n = len(uv) if uv is not None else len(color)
+        out[name] = np.broadcast_to(value, np.broadcast_shapes(np.shape(value), (n, 3)))
     return out
 
 
@@ -485,13 +491,14 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None):
             color = gbuffer.color[selection].astype(np.float64) if key.has_color else None
             lod = gbuffer.lod[selection].astype(np.float64) if key.textured_inputs else None
             uv64 = None if uv is None else gbuffer.uv[selection].astype(np.float64)
-            inputs = {k: v.astype(dtype) for k, v in material_inputs(uv64, color, lod, key, uniforms).items()}
             bounds = None
-            if band is not None:
+            if band is None:
+                inputs = material_inputs(uv64, color, lod, key, uniforms)
+            else:  # the values and their intervals from one sampling of each texture
                 from .tolerances import input_bounds
 
-                bounds = input_bounds(uv64, color, lod, key, uniforms, band)
-            f = type(f)(f.n, f.t, f.b, f.uv, inputs, bounds)
+                inputs, bounds = input_bounds(uv64, color, lod, key, uniforms, band)
+            f = type(f)(f.n, f.t, f.b, f.uv, {k: v.astype(dtype) for k, v in inputs.items()}, bounds)
         yield selection, obj, key, uniforms, position, f, n_valid
 
 

@@ -98,32 +98,28 @@ def lobe_band(delta, q, chord_scale=1.0, band=BAND):
 
 
 def input_bounds(uv, color, lod, key, u, band=BAND):
-    """Intervals of the GPU's surface inputs ``scale * T(uv) * C`` (`glphong.reference.material_inputs`).
+    """The surface inputs ``scale * T(uv) * C`` (`glphong.reference.material_inputs`) and the intervals the
+    GPU's values lie in, from one sampling of each texture.
 
     The texture value's interval is `glphong.materials.surface.surface_texture_band`; scale and
-    colour are exact float32 inputs (>= 0), and the two float32 products add ``2 eps`` relative.
+    colour are exact float32 inputs (>= 0), so the products carry the interval's ends, and the two
+    float32 products add ``2 eps`` relative.
 
     Returns
     -------
-    dict of str to (low, high)
-        By uniform name, each (N, 3) float64.
+    values : dict of str to (N, 3) float64 ndarray
+    bounds : dict of str to (low, high)
+        Both by uniform name.
     """
     from .materials.surface import surface_texture_band
 
-    out = {}
-    textured = list(key.textured_inputs)
-    for term, param, mode in key.inputs:
-        name = f"u_{term}_{param}"
-        scale = np.asarray(u[f"{name}_scale"], dtype=np.float64)
-        lo = hi = scale
-        if "texture" in mode:
-            t_lo, t_hi = surface_texture_band(u[f"{name}_texture"], uv, lod[:, textured.index((term, param))], band)
-            lo, hi = lo * t_lo, hi * t_hi
-        if "vertex" in mode:
-            lo, hi = lo * color, hi * color
-        n = len(uv) if uv is not None else len(color)
-        out[name] = (np.broadcast_to(lo * (1 - 2 * EPS), (n, 3)), np.broadcast_to(hi * (1 + 2 * EPS), (n, 3)))
-    return out
+    stacked = ref.material_inputs(uv, color, lod, key, u,
+                                  sample=lambda image, at, level: np.stack(surface_texture_band(image, at, level, band)))
+    values, bounds = {}, {}
+    for name, v in stacked.items():
+        value, low, high = v if v.ndim == 3 else (v, v, v)  # (value, low, high), or exact (no texture)
+        values[name], bounds[name] = value, (low * (1 - 2 * EPS), high * (1 + 2 * EPS))
+    return values, bounds
 
 
 def _input_ends(f):

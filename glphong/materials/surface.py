@@ -375,7 +375,8 @@ def surface_texture(image, uv, lod):
 
 
 def surface_texture_band(image, uv, lod, constants):
-    """Interval ``(low, high)``, each (N, 3), of the GPU's filtered texture value.
+    """``(value, low, high)``, each (N, 3): `surface_texture`'s value and the interval of the GPU's filtered
+    texture value around it, from one sampling.
 
     GL leaves the precision of filter weights to the implementation (Direct3D requires 8 fractional
     bits): the value may be off by ``T`` times the spread of the texels it weights, plus a few ulps of
@@ -387,4 +388,4 @@ def surface_texture_band(image, uv, lod, constants):
     value, low, high = _sample(image, uv, lod)
     ulps = constants.A * EPS * np.maximum(np.abs(low), np.abs(high))
     width = constants.T * (high - low) + ulps
-    return np.maximum(value - width, low - ulps), np.minimum(value + width, high + ulps)
+    return value, np.maximum(value - width, low - ulps), np.minimum(value + width, high + ulps)
