@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-__all__ = ["glb_chunks", "read_accessor", "read_gltf_primitives", "read_gltf_image", "texture_sampling"]
+__all__ = ["glb_chunks", "node_matrices", "read_accessor", "read_gltf_primitives", "read_gltf_image", "texture_sampling"]
 
 _COMPONENTS = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32, 5126: np.float32}
 _WIDTHS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT4": 16}
@@ -83,6 +83,37 @@ def read_accessor(buffers, index):
     return values
 
 
+def node_matrices(document):
+    """World matrices of every node reachable from the default scene, by node index."""
+    nodes = document.get("nodes", [])
+
+    def local(node):
+        if "matrix" in node:
+            return np.asarray(node["matrix"], dtype=np.float64).reshape(4, 4).T  # column-major in glTF
+        t = np.asarray(node.get("translation", (0.0, 0.0, 0.0)), dtype=np.float64)
+        x, y, z, w = node.get("rotation", (0.0, 0.0, 0.0, 1.0))
+        r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                      [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+        m = np.eye(4)
+        m[:3, :3] = r * np.asarray(node.get("scale", (1.0, 1.0, 1.0)), dtype=np.float64)
+        m[:3, 3] = t
+        return m
+
+    out = {}
+
+    def walk(index, parent):
+        world = parent @ local(nodes[index])
+        out[index] = world
+        for child in nodes[index].get("children", []):
+            walk(child, world)
+
+    scenes = document.get("scenes", [{"nodes": list(range(len(nodes)))}])
+    for root in scenes[document.get("scene", 0)].get("nodes", []):
+        walk(root, np.eye(4))
+    return out
+
+
 def read_gltf_primitives(path, document):
     """Every triangle primitive of the nodes of the file's scene.
 
@@ -93,11 +124,9 @@ def read_gltf_primitives(path, document):
         mesh of several.
     """
     from .geometry import MeshData
-    from .loaders import _node_matrices
-
     buffers = _Buffers(path, document)
     out = []
-    worlds = _node_matrices(document)
+    worlds = node_matrices(document)
     for index, node in enumerate(document.get("nodes", [])):
         if "mesh" not in node or index not in worlds:
             continue

@@ -358,37 +358,6 @@ def material_from_extras(entry, path, document):
                          f"made: {exc}") from None
 
 
-def _node_matrices(document):
-    """World matrices of every node reachable from the default scene, by node index."""
-    nodes = document.get("nodes", [])
-
-    def local(node):
-        if "matrix" in node:
-            return np.asarray(node["matrix"], dtype=np.float64).reshape(4, 4).T  # column-major in glTF
-        t = np.asarray(node.get("translation", (0.0, 0.0, 0.0)), dtype=np.float64)
-        x, y, z, w = node.get("rotation", (0.0, 0.0, 0.0, 1.0))
-        r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                      [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                      [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-        m = np.eye(4)
-        m[:3, :3] = r * np.asarray(node.get("scale", (1.0, 1.0, 1.0)), dtype=np.float64)
-        m[:3, 3] = t
-        return m
-
-    out = {}
-
-    def walk(index, parent):
-        world = parent @ local(nodes[index])
-        out[index] = world
-        for child in nodes[index].get("children", []):
-            walk(child, world)
-
-    scenes = document.get("scenes", [{"nodes": list(range(len(nodes)))}])
-    for root in scenes[document.get("scene", 0)].get("nodes", []):
-        walk(root, np.eye(4))
-    return out
-
-
 def gltf_view(document, camera_name=None, light_units=None, source=""):
     """The camera and lights of a glTF document: ``(camera or None, [lights])``.
 
@@ -400,11 +369,12 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
     W/m^2).  Spot lights are refused (glphong has point and directional lights).
     """
     from .camera import OrthographicCamera, PerspectiveCamera
+    from .gltf_data import node_matrices
     from .lights import DirectionalLight, PointLight
     from .radiometry import power_from_intensity
 
     nodes = document.get("nodes", [])
-    worlds = _node_matrices(document)
+    worlds = node_matrices(document)
     cameras = document.get("cameras", [])
     camera = None
     for index, node in enumerate(nodes):
@@ -463,7 +433,7 @@ def gltf_material(entry, base_color_texture=None, vertex_colors=False):
     ``baseColor`` is ``baseColorFactor`` times the base-colour texture (``base_color_texture``, an image
     array, sRGB, or a `glphong.materials.TextureImage`) times the mesh's ``COLOR_0`` (``vertex_colors``), as glTF defines it; the texture and the
     colours vary the diffuse albedo only (the metallic-roughness texture is not read)."""
-    from .materials import CookTorrance, SchlickFresnel, SurfaceInput, Texture
+    from .materials import CookTorrance, SchlickFresnel, Texture, VertexColors
 
     pbr = entry.get("pbrMetallicRoughness", {})
     base = np.asarray(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3], dtype=np.float64)
@@ -474,7 +444,7 @@ def gltf_material(entry, base_color_texture=None, vertex_colors=False):
     if base_color_texture is not None:
         rho_d = Texture(base_color_texture, scale=rho_d, srgb=True, vertex_colors=vertex_colors)
     elif vertex_colors:
-        rho_d = SurfaceInput(scale=rho_d, vertex_colors=True)
+        rho_d = VertexColors(scale=rho_d)
     return CookTorrance(rho_d, max(roughness * roughness, 1e-3), fresnel=SchlickFresnel(tuple(np.clip(f0, 0.0, 1.0))))
 
 
@@ -541,7 +511,7 @@ def _load_gltf(path, camera, lights, ambient, materials, light_units, camera_nam
     """A glTF file's scene: its own arrays (`glphong.gltf_data`), nodes in file order, materials from the
     user's ``materials``, else the stored glphong material (``extras``), else `gltf_material`."""
     from .gltf_data import read_gltf_image, read_gltf_primitives, texture_sampling
-    from .materials import Material, Texture
+    from .materials import Material, TextureImage
 
     document = read_gltf_json(path)
     file_camera, file_lights = gltf_view(document, camera_name, light_units, str(path))
@@ -567,8 +537,8 @@ def _load_gltf(path, camera, lights, ambient, materials, light_units, camera_nam
                 if textured:
                     reference = entry["pbrMetallicRoughness"]["baseColorTexture"]["index"]
                     wrap, filter_ = texture_sampling(document, reference)
-                    texture = Texture(read_gltf_image(path, document, reference), srgb=True, wrap=wrap, filter=filter_)
-                    texture = texture.texture
+                    texture = TextureImage(read_gltf_image(path, document, reference), srgb=True, wrap=wrap,
+                                           filter=filter_)
                 stored = gltf_material(entry, texture, mesh.colors is not None)
             made[key] = stored
         return made[key]
