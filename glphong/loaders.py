@@ -36,6 +36,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .filesafety import SceneFileError, decode_image, read_bytes, read_text, resolve_reference
+
 __all__ = ["load_scene", "read_obj", "read_gltf_json", "gltf_view", "gltf_material", "material_from_extras",
            "scene_from_trimesh", "parse_mtl",
            "material_from_mtl", "default_view", "scene_bounds", "LUMENS_PER_WATT"]
@@ -46,23 +48,33 @@ FORMATS = (".obj", ".gltf", ".glb")
 LUMENS_PER_WATT = 683.0
 
 
-def parse_mtl(path):
+def parse_mtl(path, limits=None, allow_outside=False):
     """The materials of an MTL file, keyword values as written.
+
+    Parameters
+    ----------
+    path : path-like
+    limits : glphong.filesafety.Limits, optional
+        The file-size cap (a regular file is required).
+    allow_outside : bool
+        Let ``map_Kd`` / ``map_Ks`` name images outside the MTL file's folder.
 
     Returns
     -------
     dict of str to dict
         Per ``newmtl`` name: ``Kd``, ``Ks``, ``Ka`` (tuples of 3 float, a single value repeated), ``Ns``
         (float), ``illum`` (int), ``map_Kd`` and ``map_Ks`` (the image's path, resolved against the MTL
-        file's folder; options such as ``-s`` are ignored, with a warning), where the file gives them.
+        file's folder and confined to it; options such as ``-s`` are ignored, with a warning), where the
+        file gives them.
 
     Raises
     ------
-    ValueError
-        A keyword with values that are not numbers, naming the file and line.
+    glphong.filesafety.SceneFileError
+        A keyword with values that are not finite numbers, or an image path leaving the folder, naming the
+        file and line.
     """
     out, current = {}, None
-    for number, raw in enumerate(Path(path).read_text(encoding="utf-8", errors="replace").splitlines(), start=1):
+    for number, raw in enumerate(read_text(path, limits).splitlines(), start=1):
         words = raw.split("#", 1)[0].split()
         if not words:
             continue
@@ -72,47 +84,65 @@ def parse_mtl(path):
             continue
         if current is None or keyword not in ("Kd", "Ks", "Ka", "Ns", "illum", "map_Kd", "map_Ks"):
             continue
+        where = f"line {number}"
         if keyword.startswith("map_"):
             if not values:
-                raise ValueError(f"{path}:{number}: {keyword} needs an image file")
+                raise SceneFileError(path, f"{keyword} needs an image file", where)
             if values[0].startswith("-"):
-                warnings.warn(f"{path}:{number}: {keyword} options {' '.join(values[:-1])!r} are ignored", stacklevel=2)
-            current[keyword] = Path(path).parent / values[-1]
+                warnings.warn(f"{path}:{number}: {keyword} options {' '.join(values[:-1])!r:.80} are ignored",
+                              stacklevel=2)
+            current[keyword] = resolve_reference(path, values[-1], where, allow_outside, percent_encoded=False)
             continue
         try:
             if keyword in ("Kd", "Ks", "Ka"):
                 numbers = [float(v) for v in values[:3]]
                 current[keyword] = tuple(numbers * 3 if len(numbers) == 1 else numbers)
-                if len(current[keyword]) != 3:
+                if len(current[keyword]) != 3 or not all(math.isfinite(v) for v in current[keyword]):
                     raise ValueError
             elif keyword == "Ns":
                 current["Ns"] = float(values[0])
+                if not math.isfinite(current["Ns"]):
+                    raise ValueError
             else:
                 current["illum"] = int(values[0])
         except (ValueError, IndexError):
-            raise ValueError(f"{path}:{number}: {keyword} needs numbers (got {' '.join(values)!r})") from None
+            raise SceneFileError(path, f"{keyword} needs finite numbers (got {' '.join(values)!r:.80})", where) from None
     return out
 
 
-def material_from_mtl(entry, name="", source=""):
+#: image formats an MTL map may be (Pillow plugins asked for; no EPS or PDF reaches Ghostscript)
+MTL_IMAGE_FORMATS = ("PNG", "JPEG", "BMP", "TGA", "TIFF")
+
+
+def material_from_mtl(entry, name="", source="", limits=None):
     """The glphong material an MTL entry (`parse_mtl`) means (see the module).  ``map_Kd`` and ``map_Ks``
-    are textures that ``Kd`` and ``Ks`` multiply (1 where the entry omits them)."""
+    are textures that ``Kd`` and ``Ks`` multiply (1 where the entry omits them); a map whose image is
+    missing is warned about and its constant used; an image beyond ``limits`` is an error."""
     from .materials import MtlPhong, Texture
 
     kd = entry.get("Kd", (1.0, 1.0, 1.0) if "map_Kd" in entry else (0.8, 0.8, 0.8))  # MTL's default diffuse colour
     ks = entry.get("Ks", (1.0, 1.0, 1.0) if "map_Ks" in entry else (0.0, 0.0, 0.0))
+    specular = "map_Ks" in entry or any(ks)
     for keyword, value in (("map_Kd", kd), ("map_Ks", ks)):
         if keyword in entry:
-            image = entry[keyword]
-            if not Path(image).is_file():
-                warnings.warn(f"{source}: material {name!r}: {keyword} {image} not found; its constant is used",
+            image = Path(entry[keyword])
+            if not image.exists():
+                warnings.warn(f"{source}: material {name!r}: {keyword} {image.name} not found; its constant is used",
                               stacklevel=3)
                 continue
-            texture = Texture(image, scale=value)
+            payload = read_bytes(image, limits, source or image, f"material {name!r} {keyword}")
+            pixels = decode_image(payload, limits, source or image, f"material {name!r} {keyword} {image.name}",
+                                  formats=MTL_IMAGE_FORMATS)
+            if pixels.ndim == 3 and pixels.shape[2] == 4:
+                pixels = pixels[:, :, :3]
+            try:
+                texture = Texture(pixels, scale=value)
+            except ValueError as exc:
+                raise SceneFileError(source or image, f"material {name!r}: {keyword} {image.name}: {exc}") from None
             kd, ks = (texture, ks) if keyword == "map_Kd" else (kd, texture)
     ka = entry.get("Ka", (0.0, 0.0, 0.0))
     q = entry.get("Ns", 0.0)
-    illum = entry.get("illum", 2 if any(ks) else 1)
+    illum = entry.get("illum", 2 if specular else 1)
     if illum == 0:
         if not isinstance(kd, tuple):
             warnings.warn(f"{source}: material {name!r} has illum 0 and map_Kd: rendered with the constant Kd",
@@ -247,7 +277,7 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
     return _with_view(scene, camera, lights, ambient)
 
 
-def read_obj(path):
+def read_obj(path, limits=None):
     """The triangles of a Wavefront OBJ file, one `MeshData` per material (``usemtl``) in order of first use.
 
     ``v``, ``vn``, ``vt`` and ``f`` (polygons fanned into triangles, negative indices counted from the end)
@@ -266,7 +296,7 @@ def read_obj(path):
     from .geometry import MeshData
 
     positions, normals, uvs, parts, current = [], [], [], {}, ""
-    text = Path(path).read_text(encoding="utf-8", errors="replace")
+    text = read_text(path, limits)
     for number, raw in enumerate(text.splitlines(), start=1):
         words = raw.split("#", 1)[0].split()
         if not words:
@@ -316,17 +346,18 @@ def read_obj(path):
     return out
 
 
-def read_gltf_json(path):
-    """The JSON document of a ``.gltf`` file, or of a ``.glb`` file's first chunk (dict)."""
-    from .gltf_data import glb_chunks
+def read_gltf_json(path, limits=None):
+    """The validated JSON document of a ``.gltf`` file, or of a ``.glb`` file's first chunk (dict;
+    `glphong.gltf_data.GltfFile`).
 
-    data = Path(path).read_bytes()
-    if data[:4] == b"glTF":
-        data = glb_chunks(path, data)[0]
-    try:
-        return json.loads(data.decode("utf-8"))
-    except (UnicodeDecodeError, ValueError) as exc:
-        raise ValueError(f"{path}: not a glTF document ({exc})") from None
+    Raises
+    ------
+    glphong.filesafety.SceneFileError
+        Anything wrong with the file, with its JSON path.
+    """
+    from .gltf_data import GltfFile
+
+    return GltfFile(path, limits).document
 
 
 def _glphong_extras(document):
@@ -336,9 +367,23 @@ def _glphong_extras(document):
     return stored if isinstance(stored, dict) else {}
 
 
-def material_from_extras(entry, path, document):
+def material_from_extras(entry, gltf, where=""):
     """The glphong material stored in a glTF material's ``extras: {"glphong": ...}``
-    (`glphong.materials.as_json`), or None where there is none."""
+    (`glphong.materials.as_json`), or None where there is none.
+
+    Parameters
+    ----------
+    entry : dict
+        The JSON ``materials`` entry.
+    gltf : glphong.gltf_data.GltfFile
+    where : str
+        The entry's JSON path (for errors).
+
+    Raises
+    ------
+    glphong.filesafety.SceneFileError
+        A stored material that cannot be made (an unknown class, a table, a value its class refuses).
+    """
     from .gltf_data import read_gltf_image
     from .materials.as_json import material_from_json
     from .materials.surface import TextureImage
@@ -349,13 +394,21 @@ def material_from_extras(entry, path, document):
         return None
 
     def textures(index, wrap, filter, srgb):
-        return TextureImage(read_gltf_image(path, document, index), srgb=srgb, wrap=wrap, filter=filter)
+        textures_count = len(gltf.document.get("textures", []))
+        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < textures_count:
+            raise ValueError(f"texture index {index!r:.20} is not one of the file's {textures_count} textures")
+        pixels = read_gltf_image(gltf, index)
+        if pixels is None:
+            raise ValueError(f"texture {index} has no image glphong decodes")
+        return TextureImage(pixels, srgb=srgb, wrap=wrap, filter=filter)
 
     try:
         return material_from_json(stored, textures)
-    except (TypeError, ValueError, KeyError) as exc:
-        raise ValueError(f"{path}: material {entry.get('name', '')!r} stores a glphong material that cannot be "
-                         f"made: {exc}") from None
+    except SceneFileError:
+        raise
+    except (TypeError, ValueError, KeyError, AttributeError) as exc:
+        raise SceneFileError(gltf.path, f"stores a glphong material that cannot be made: {exc}"[:400],
+                             f"{where}.extras.glphong") from None
 
 
 def gltf_view(document, camera_name=None, light_units=None, source=""):
@@ -436,9 +489,9 @@ def gltf_material(entry, base_color_texture=None, vertex_colors=False):
     from .materials import CookTorrance, SchlickFresnel, Texture, VertexColors
 
     pbr = entry.get("pbrMetallicRoughness", {})
-    base = np.asarray(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3], dtype=np.float64)
-    metallic = float(pbr.get("metallicFactor", 1.0))
-    roughness = float(pbr.get("roughnessFactor", 1.0))
+    base = np.clip(np.asarray(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3], dtype=np.float64), 0.0, 1.0)
+    metallic = min(float(pbr.get("metallicFactor", 1.0)), 1.0)  # factors above 1 (validated >= 0) are clamped
+    roughness = min(float(pbr.get("roughnessFactor", 1.0)), 1.0)
     f0 = 0.04 * (1 - metallic) + base * metallic
     rho_d = tuple(base * (1 - metallic))
     if base_color_texture is not None:
@@ -448,15 +501,22 @@ def gltf_material(entry, base_color_texture=None, vertex_colors=False):
     return CookTorrance(rho_d, max(roughness * roughness, 1e-3), fresnel=SchlickFresnel(tuple(np.clip(f0, 0.0, 1.0))))
 
 
-def load_scene(path, camera=None, lights=None, ambient=None, materials=None, light_units=None, camera_name=None):
+def load_scene(path, camera=None, lights=None, ambient=None, materials=None, light_units=None, camera_name=None,
+               allow_outside=False, limits=None):
     """Load a scene file as a `glphong.Scene` (see the module for what each format keeps).
+
+    Files are untrusted (`glphong.filesafety`): the file and every file it names must be regular files
+    within ``limits``, named files must lie inside the scene file's folder, and whatever is wrong with
+    the content is a `glphong.filesafety.SceneFileError` naming the file and where in it.
 
     Parameters
     ----------
     path : str or path-like
         A Wavefront ``.obj`` (with its ``.mtl`` files), or a glTF 2.0 ``.gltf`` / ``.glb``.
     camera, lights, ambient
-        As in `scene_from_trimesh`; default: the file's (glTF: `gltf_view`), else `default_view`'s.
+        As in `scene_from_trimesh`; default: the file's (glTF: `gltf_view`), else `default_view`'s.  A
+        file with no light gets `default_view`'s light and ambient light, with a warning (``lights=[]``
+        keeps it dark on purpose).
     materials : dict of str to Material, or callable, optional
         Overrides the file's materials by material name; a callable gets ``(name, MTL or glTF entry or
         None)`` and returns a Material (or None for the file's).
@@ -464,99 +524,138 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None, lig
         Required where a glTF file has lights (`gltf_view`).
     camera_name : str, optional
         The glTF camera to look through (default the first).
+    allow_outside : bool
+        Let the file name files outside its own folder (absolute paths, ``..``): for files you trust.
+    limits : glphong.filesafety.Limits, optional
+        File-size cap, image pixel budget, entry counts (default `glphong.filesafety.LIMITS`).
 
     Raises
     ------
     ValueError
-        A format glphong does not read (naming those it does), a missing file, or a line of the OBJ or
-        MTL file that cannot be read (naming the file and line).
+        A format glphong does not read (naming those it does), a missing file.
+    glphong.filesafety.SceneFileError
+        (a ValueError) Anything wrong with the file's content, naming the file and the line or JSON path.
     """
-    from .materials import Material
-
     path = Path(path)
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise ValueError(f"{path}: glphong reads {', '.join(FORMATS)} scene files (got {suffix or 'no suffix'!r})")
-    if not path.is_file():
-        raise ValueError(f"{path}: no such file")
+    if not path.exists():
+        raise SceneFileError(path, "no such file")
     if suffix in (".gltf", ".glb"):
-        return _load_gltf(path, camera, lights, ambient, materials, light_units, camera_name)
+        return _load_gltf(path, camera, lights, ambient, materials, light_units, camera_name, allow_outside, limits)
+    return _load_obj(path, camera, lights, ambient, materials, allow_outside, limits)
+
+
+def _mtl_libraries(path, text, allow_outside, limits):
+    """The materials of every ``mtllib`` an OBJ file's ``text`` names (each confined to its folder)."""
     mtl = {}
-    for line in path.read_text(encoding="utf-8", errors="replace").splitlines():
+    for number, line in enumerate(text.splitlines(), start=1):
         words = line.split("#", 1)[0].split()
-        if words and words[0] == "mtllib":
-            for name in words[1:]:
-                library = path.parent / name
-                if library.is_file():
-                    mtl.update(parse_mtl(library))
-                else:
-                    warnings.warn(f"{path}: mtllib {name} not found next to it; its materials get defaults",
-                                  stacklevel=2)
+        if not words or words[0] != "mtllib":
+            continue
+        for name in words[1:]:
+            library = resolve_reference(path, name, f"line {number}", allow_outside, percent_encoded=False)
+            if library.exists():
+                mtl.update(parse_mtl(library, limits, allow_outside))
+            else:
+                warnings.warn(f"{path}: mtllib {name!r:.80} not found next to it; its materials get defaults",
+                              stacklevel=3)
+    return mtl
+
+
+def _chosen_material(materials, name, entry):
+    """The user's material for part ``name`` (``materials`` mapping or callable), or None."""
+    from .materials import Material
+
+    material = None
+    if callable(materials):
+        material = materials(name, entry)
+    elif materials and name in materials:
+        material = materials[name]
+    if material is not None and not isinstance(material, Material):
+        raise TypeError(f"materials gave {type(material).__name__} for {name!r}: it must give a glphong material")
+    return material
+
+
+def _load_obj(path, camera, lights, ambient, materials, allow_outside, limits):
+    """An OBJ file's scene: one object per material (`read_obj`), its MTL materials."""
+    mtl = _mtl_libraries(path, read_text(path, limits), allow_outside, limits)
     scene = _scene(camera, lights, ambient)
-    for name, mesh in read_obj(path):
-        material = None
-        if callable(materials):
-            material = materials(name, mtl.get(name))
-        elif materials and name in materials:
-            material = materials[name]
+    made = {}
+    for name, mesh in read_obj(path, limits):
+        material = _chosen_material(materials, name, mtl.get(name))
         if material is None:
-            material = material_from_mtl(mtl[name], name, str(path)) if name in mtl else material_from_mtl({}, name)
-        if not isinstance(material, Material):
-            raise TypeError(f"materials gave {type(material).__name__} for {name!r}: it must give a glphong material")
+            if name not in made:
+                made[name] = material_from_mtl(mtl.get(name, {}), name, str(path), limits)
+            material = made[name]
         scene.add(mesh, material, name=name or path.stem)
     return _with_view(scene, camera, lights, ambient)
 
 
-def _load_gltf(path, camera, lights, ambient, materials, light_units, camera_name):
+def _gltf_object_material(gltf, entries, materials, made, name, mesh, index):
+    """The material of one glTF primitive: the user's, the stored glphong one, or `gltf_material`."""
+    from .gltf_data import read_gltf_image, texture_sampling
+    from .materials import TextureImage
+
+    entry = entries[index] if index is not None else None
+    material_name = entry.get("name") if entry is not None else None
+    if callable(materials):
+        chosen = _chosen_material(materials, material_name or name, entry)
+    else:
+        chosen = next((_chosen_material(materials, k, entry) for k in (material_name, name)
+                       if k is not None and materials and k in materials), None)
+    if chosen is not None:
+        return chosen
+    if entry is None:
+        return _trimesh_material(None)
+    textured = "baseColorTexture" in entry.get("pbrMetallicRoughness", {}) and mesh.uvs is not None
+    key = (index, textured, mesh.colors is not None)
+    if key not in made:
+        stored = material_from_extras(entry, gltf, f"materials[{index}]")
+        if stored is None:
+            texture = None
+            if textured:
+                reference = entry["pbrMetallicRoughness"]["baseColorTexture"]["index"]
+                pixels = read_gltf_image(gltf, reference)
+                if pixels is not None:
+                    wrap, filter_ = texture_sampling(gltf.document, reference)
+                    texture = TextureImage(pixels, srgb=True, wrap=wrap, filter=filter_)
+            stored = gltf_material(entry, texture, mesh.colors is not None)
+        made[key] = stored
+    return made[key]
+
+
+def _load_gltf(path, camera, lights, ambient, materials, light_units, camera_name, allow_outside, limits):
     """A glTF file's scene: its own arrays (`glphong.gltf_data`), nodes in file order, materials from the
     user's ``materials``, else the stored glphong material (``extras``), else `gltf_material`."""
-    from .gltf_data import read_gltf_image, read_gltf_primitives, texture_sampling
-    from .materials import Material, TextureImage
+    from .gltf_data import GltfFile, read_gltf_primitives
+    from .lights import AmbientLight
 
-    document = read_gltf_json(path)
+    gltf = GltfFile(path, limits, allow_outside)
+    document = gltf.document
     file_camera, file_lights = gltf_view(document, camera_name, light_units, str(path))
-    entries = document.get("materials", [])
-    made = {}
-
-    def resolve(name, mesh, index):
-        entry = entries[index] if index is not None else None
-        material_name = entry.get("name") if entry is not None else None
-        chosen = None
-        if callable(materials):
-            chosen = materials(material_name or name, entry)
-        elif materials:
-            chosen = next((materials[k] for k in (material_name, name) if k is not None and k in materials), None)
-        if chosen is not None or entry is None:
-            return chosen
-        textured = "baseColorTexture" in entry.get("pbrMetallicRoughness", {}) and mesh.uvs is not None
-        key = (index, textured, mesh.colors is not None)
-        if key not in made:
-            stored = material_from_extras(entry, str(path), document)
-            if stored is None:
-                texture = None
-                if textured:
-                    reference = entry["pbrMetallicRoughness"]["baseColorTexture"]["index"]
-                    wrap, filter_ = texture_sampling(document, reference)
-                    texture = TextureImage(read_gltf_image(path, document, reference), srgb=True, wrap=wrap,
-                                           filter=filter_)
-                stored = gltf_material(entry, texture, mesh.colors is not None)
-            made[key] = stored
-        return made[key]
-
     written = _glphong_extras(document)
     if lights is None and (file_lights or written):
         lights = file_lights
-    if ambient is None and written.get("ambient") is not None:
-        from .lights import AmbientLight
-
-        ambient = AmbientLight(tuple(written["ambient"]))
+    if ambient is None and isinstance(written.get("ambient"), (int, float, list)):
+        try:
+            ambient = AmbientLight(tuple(written["ambient"]) if isinstance(written["ambient"], list) else written["ambient"])
+        except (TypeError, ValueError) as exc:
+            raise SceneFileError(path, f"the stored ambient light cannot be made: {exc}", "asset.extras.glphong.ambient") \
+                from None
     chosen_camera = camera if camera is not None else file_camera
     scene = _scene(chosen_camera, lights, ambient)
-    for name, mesh, world, index in read_gltf_primitives(path, document):
-        material = resolve(name, mesh, index)
-        if material is None:
-            material = _trimesh_material(None)
-        if not isinstance(material, Material):
-            raise TypeError(f"materials gave {type(material).__name__} for {name!r}: it must give a glphong material")
-        scene.add(mesh, material, pose=world, name=name)
+    entries, made = document.get("materials", []), {}
+    for name, mesh, world, index in read_gltf_primitives(gltf):
+        scene.add(mesh, _gltf_object_material(gltf, entries, materials, made, name, mesh, index), pose=world, name=name)
+    if lights is None:  # a file without lights is not drawn black by accident
+        _, view_lights, view_ambient = default_view(scene)
+        warnings.warn(f"{path} has no lights: glphong adds its default point light and ambient light (give "
+                      "lights=[] to keep the scene dark)", stacklevel=3)
+        for light in view_lights:
+            scene.add_light(light)
+        if ambient is None:
+            scene.ambient = view_ambient
+        lights = list(view_lights)
     return _with_view(scene, chosen_camera, lights, ambient)

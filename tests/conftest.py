@@ -70,3 +70,32 @@ def session_gl(request):
     ctx = require_backend(request.param)
     yield ctx
     ctx.release()
+
+
+def _isolated_runner(code, timeout=120, memory_bytes=3 << 30, cwd=None, args=()):
+    """Run Python ``code`` in a fresh interpreter with an address-space limit and a timeout (see
+    `run_isolated`); returns the ``subprocess.CompletedProcess`` (``returncode`` -9 after the timeout)."""
+    import os
+    import resource
+    import subprocess
+    import sys
+
+    def limit():  # in the child, before exec: a runaway allocation fails instead of taking the machine
+        resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
+
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", PYTHONUNBUFFERED="1")
+    try:
+        return subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True, timeout=timeout,
+                              preexec_fn=limit, cwd=cwd, env=env)
+    except subprocess.TimeoutExpired as exc:
+        return subprocess.CompletedProcess(exc.cmd, -9, exc.stdout or "", (exc.stderr or "") +
+                                           f"\n[killed after the {timeout} s timeout]")
+
+
+@pytest.fixture
+def run_isolated():
+    """``run_isolated(code, timeout=120, memory_bytes=3 GiB, cwd=None, args=())``: Python ``code`` in a
+    subprocess under an address-space limit (``RLIMIT_AS``) and a timeout, so that a hostile input that
+    regresses into a hang or a memory blow-up fails its test instead of taking the machine down.  Returns
+    the ``subprocess.CompletedProcess`` (text output; ``returncode`` -9 on timeout)."""
+    return _isolated_runner

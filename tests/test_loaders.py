@@ -122,7 +122,7 @@ def test_errors_name_the_file(tmp_path):
     with pytest.raises(ValueError, match="no such file"):
         glphong.load_scene(tmp_path / "missing.obj")
     (tmp_path / "bad.mtl").write_text("newmtl x\nKd 0.1 red 0.3\n")
-    with pytest.raises(ValueError, match=r"bad.mtl:2: Kd needs numbers"):
+    with pytest.raises(ValueError, match=r"bad.mtl: line 2: Kd needs finite numbers"):
         parse_mtl(tmp_path / "bad.mtl")
 
 

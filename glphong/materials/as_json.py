@@ -66,15 +66,22 @@ def material_to_json(material, texture_index=None):
             "ka": _plain(material.ka), "two_sided": bool(material.two_sided)}
 
 
+def _subclasses(base):
+    """Every subclass of ``base`` defined so far (depth first)."""
+    out, stack = [], [base]
+    while stack:
+        for sub in stack.pop().__subclasses__():
+            out.append(sub)
+            stack.append(sub)
+    return out
+
+
 def _material_classes():
     from .model import Material
 
-    out, stack = {}, [Material]
-    while stack:
-        cls = stack.pop()
-        for sub in cls.__subclasses__():
-            out.setdefault((sub.__module__, sub.__name__), sub)
-            stack.append(sub)
+    out = {}
+    for sub in _subclasses(Material):
+        out.setdefault((sub.__module__, sub.__name__), sub)
     return out
 
 
@@ -93,8 +100,9 @@ def material_from_json(data, textures=None):
         An unknown class (naming it and where it should come from), a newer layout, or a value the
         class refuses (its own message).
     """
-    from . import fresnel as fresnel_module
+    from .fresnel import Fresnel
     from .surface import SurfaceInput
+    from .table import Table
 
     if not isinstance(data, dict) or data.get("version", 0) > VERSION or "class" not in data:
         raise ValueError(f"not a glphong material (layout version {VERSION}): {data!r}"[:300])
@@ -106,8 +114,18 @@ def material_from_json(data, textures=None):
             raise ValueError(f"no material class {data.get('module')}.{data['class']} is defined: import the module "
                              "that defines it before loading")
         cls = named[0]
+    declared = {argument.name: argument for argument in cls.arguments()}
+    factors = {factor.__name__: factor for factor in _subclasses(Fresnel)}
     arguments = {}
-    for name, value in data.get("arguments", {}).items():
+    stored = data.get("arguments", {})
+    if not isinstance(stored, dict):
+        raise ValueError(f"{cls.__name__}: 'arguments' must be an object")
+    for name, value in stored.items():
+        if name not in declared:
+            raise ValueError(f"{cls.__name__} has no argument {name!r:.40} (it has {', '.join(declared)})")
+        if isinstance(declared[name], Table):
+            raise ValueError(f"{cls.__name__}.{name} is a table: glphong never reads a table (or its path) from a "
+                             "scene file; give the material with load_scene(..., materials=...)")
         if isinstance(value, dict) and "surface" in value:
             s = value["surface"]
             texture = None
@@ -117,9 +135,10 @@ def material_from_json(data, textures=None):
                 texture = textures(s["texture"], s.get("wrap", "repeat"), s.get("filter", "trilinear"), s.get("srgb", True))
             value = SurfaceInput(tuple(s["scale"]), texture, bool(s.get("vertex_colors", False)))
         elif isinstance(value, dict) and "class" in value:
-            factor = getattr(fresnel_module, value["class"], None)
+            factor = factors.get(value["class"]) if isinstance(value["class"], str) else None
             if factor is None:
-                raise ValueError(f"{cls.__name__}.{name}: unknown Fresnel factor {value['class']!r}")
+                raise ValueError(f"{cls.__name__}.{name}: unknown Fresnel factor {value['class']!r:.40} (known: "
+                                 f"{', '.join(sorted(factors))})")
             value = factor(**{k: tuple(v) if isinstance(v, list) else v for k, v in value.items() if k != "class"})
         elif isinstance(value, list):
             value = tuple(value)
