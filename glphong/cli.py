@@ -7,7 +7,45 @@ import argparse
 import sys
 import time
 
-__all__ = ["main"]
+__all__ = ["main", "print_error", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED"]
+
+#: exit status of a command refused for its input (a file's content, an expression, a missing backend)
+EXIT_BAD_INPUT = 2
+#: exit status after Ctrl-C
+EXIT_INTERRUPTED = 130
+#: longest error message printed, in characters
+MAX_MESSAGE_LENGTH = 500
+
+
+def one_line(message, limit=MAX_MESSAGE_LENGTH):
+    """``message`` as one line: its whitespace runs (newlines included) collapsed to single spaces, and
+    cut to ``limit`` characters (ending in ``'...'``) where it is longer.
+
+    Parameters
+    ----------
+    message : object
+        The message (``str()`` of it is used, so an exception works).
+    limit : int
+
+    Returns
+    -------
+    str
+    """
+    text = " ".join(str(message).split())
+    return text if len(text) <= limit else text[:limit - 3] + "..."
+
+
+def print_error(command, message):
+    """Print ``glphong <command>: <message>`` to stderr as one line (see `one_line`).
+
+    Parameters
+    ----------
+    command : str
+        The subcommand (``'render'``, ``'brdf'``, ...).
+    message : object
+        The message or exception.
+    """
+    print(f"glphong {command}: {one_line(message)}", file=sys.stderr)
 
 
 def _render_file(args):
@@ -20,8 +58,8 @@ def _render_file(args):
     try:
         scene = load_scene(args.file, light_units=args.light_units, camera_name=args.camera)
     except ValueError as exc:
-        print(f"glphong render: {exc}", file=sys.stderr)
-        return 2
+        print_error("render", exc)
+        return EXIT_BAD_INPUT
     exposure = 1.0 if args.exposure is None else args.exposure
     if args.frames:
         from .batch import orbit_scene, render_many
@@ -191,22 +229,16 @@ def _bench(args):
 
 
 def _material(command, text):
-    """The material an expression such as ``"Phong(kd=0.2, ks=0.5, q=20)"`` builds, or None (the error printed)."""
-    from . import materials
+    """The material an expression such as ``"Phong(kd=0.2, ks=0.5, q=20)"`` describes, or None with the reason
+    printed as one line to stderr (`glphong.expressions.parse_material`: parsed, never evaluated)."""
+    from .expressions import ExpressionError, parse_material
 
-    namespace = {"__builtins__": {}}
-    namespace.update({name: getattr(materials, name) for name in materials.__all__
-                      if isinstance(getattr(materials, name), type) and not name.startswith("_")})
     try:
-        material = eval(text, namespace)  # noqa: S307 - no builtins, only the material classes
-    except Exception as error:  # noqa: BLE001 - any failure of the expression is the user's to fix
-        print(f"glphong {command}: cannot build a material from {text!r}: {type(error).__name__}: {error} "
-              f"(write a call such as \"Phong(kd=0.2, ks=0.5, q=20)\" of a glphong.materials class)", file=sys.stderr)
+        return parse_material(text)
+    except ExpressionError as error:
+        shown = text if len(text) <= 80 else text[:60] + f"... ({len(text)} characters)"
+        print_error(command, f"cannot build a material from {shown!r}: {error}")
         return None
-    if not isinstance(material, materials.Material):
-        print(f"glphong {command}: {text!r} is not a material (got {type(material).__name__})", file=sys.stderr)
-        return None
-    return material
 
 
 def _brdf(args):
@@ -214,7 +246,7 @@ def _brdf(args):
 
     material = _material("brdf", args.material)
     if material is None:
-        return 2
+        return EXIT_BAD_INPUT
     record = properties(material, gpu=args.gpu, backend=args.backend, directions=args.directions)
     print(record.to_json() if args.json else format_properties(record))
     return 0
@@ -243,7 +275,7 @@ def _plot(args):
     for text in args.materials:
         material = _material("plot", text)
         if material is None:
-            return 2
+            return EXIT_BAD_INPUT
         chosen[text] = material
     if args.kind == "lobe":
         plots.plot_lobes(chosen, np.radians(args.theta_i), args.out)
@@ -436,4 +468,37 @@ def main(argv=None):
             parser.error(f"argument --out: {exc}")
         if args.frames and args.file is None:
             parser.error("--frames needs a scene FILE (a turntable of it)")
-    return args.func(args)
+    return _run_command(args)
+
+
+def _run_command(args):
+    """Run the parsed command; refused input becomes one line on stderr and exit status 2.
+
+    A `ValueError` (glphong's convention for bad input: a scene file's content, an expression, a
+    parameter), an `OSError` (a missing or unreadable file), a `glphong.batch.BatchError` (a worker's
+    failure, reported by the parent) and a `glphong.contexts.BackendUnavailableError` are printed as
+    ``glphong <command>: <message>``; Ctrl-C exits with 130.  Anything else is a bug and propagates
+    with its traceback.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments, with ``func`` and ``command``.
+
+    Returns
+    -------
+    int
+        The exit status.
+    """
+    from .batch import BatchError
+    from .contexts import BackendUnavailableError
+
+    command = getattr(args, "command", None) or "render"
+    try:
+        return args.func(args)
+    except KeyboardInterrupt:
+        print_error(command, "interrupted")
+        return EXIT_INTERRUPTED
+    except (ValueError, OSError, BatchError, BackendUnavailableError) as error:
+        print_error(command, error)
+        return EXIT_BAD_INPUT

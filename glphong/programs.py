@@ -4,6 +4,7 @@ A program's source is generated from its `ProgramKey` alone: a ``#version`` line
 the key's ``#define`` lines, then the key's chunk files, each preceded by a
 ``#line 1 N`` marker so that a compile error names the chunk file and line.
 """
+import ast
 import functools
 import importlib.resources
 import os
@@ -139,13 +140,127 @@ _DIRECTIVE = re.compile(r"^\s*#\s*(if|ifdef|ifndef|elif|else|endif|define)\b(.*)
 _IDENTIFIER = re.compile(r"[A-Za-z_]\w*")
 
 
+#: bound on the magnitude of every value of a preprocessor condition (a larger one is refused)
+CONDITION_LIMIT = 2 ** 64
+#: longest preprocessor condition evaluated, in characters (after substituting the defines)
+CONDITION_MAX_LENGTH = 4096
+#: deepest nesting of a preprocessor condition's syntax tree
+CONDITION_MAX_DEPTH = 100
+
+
+def _bounded(value):
+    """``value`` where its magnitude is under `CONDITION_LIMIT`; ValueError otherwise."""
+    if abs(value) >= CONDITION_LIMIT:
+        raise ValueError(f"preprocessor condition: a value of magnitude 2**{abs(value).bit_length() - 1} or more "
+                         f"(at most 2**64 - 1 is evaluated)")
+    return value
+
+
+def _truncating_divide(a, b):
+    """C's ``a / b`` of integers: the quotient truncated toward zero."""
+    if b == 0:
+        raise ValueError("preprocessor condition: division by zero")
+    quotient = abs(a) // abs(b)
+    return quotient if (a < 0) == (b < 0) else -quotient
+
+
+def _truncating_remainder(a, b):
+    """C's ``a % b`` of integers: ``a - b * (a / b)``, with the sign of ``a``."""
+    return a - b * _truncating_divide(a, b)
+
+
+def _shift_count(count):
+    """A shift count from 0 to 64 (a larger or negative one is refused)."""
+    if not 0 <= count <= 64:
+        raise ValueError(f"preprocessor condition: shift by {count} (from 0 to 64 is evaluated)")
+    return count
+
+
+_BINARY_OPERATORS = {
+    ast.Add: lambda a, b: a + b, ast.Sub: lambda a, b: a - b, ast.Mult: lambda a, b: a * b,
+    ast.Div: _truncating_divide, ast.Mod: _truncating_remainder,
+    ast.LShift: lambda a, b: a << _shift_count(b), ast.RShift: lambda a, b: a >> _shift_count(b),
+    ast.BitAnd: lambda a, b: a & b, ast.BitOr: lambda a, b: a | b, ast.BitXor: lambda a, b: a ^ b,
+}
+_UNARY_OPERATORS = {ast.UAdd: lambda a: a, ast.USub: lambda a: -a, ast.Invert: lambda a: ~a,
+                    ast.Not: lambda a: int(not a)}
+_COMPARISONS = {ast.Eq: lambda a, b: a == b, ast.NotEq: lambda a, b: a != b, ast.Lt: lambda a, b: a < b,
+                ast.LtE: lambda a, b: a <= b, ast.Gt: lambda a, b: a > b, ast.GtE: lambda a, b: a >= b}
+
+
+def _condition_value(node, depth=0):
+    """The integer value of a node of a translated preprocessor condition (see `_evaluate_condition`)."""
+    if depth > CONDITION_MAX_DEPTH:
+        raise ValueError(f"preprocessor condition: nested deeper than {CONDITION_MAX_DEPTH} levels")
+    if isinstance(node, ast.Constant) and type(node.value) is int:
+        return _bounded(node.value)
+    if isinstance(node, ast.BinOp) and type(node.op) in _BINARY_OPERATORS:
+        left, right = _condition_value(node.left, depth + 1), _condition_value(node.right, depth + 1)
+        return _bounded(_BINARY_OPERATORS[type(node.op)](left, right))
+    if isinstance(node, ast.UnaryOp):
+        return _bounded(_UNARY_OPERATORS[type(node.op)](_condition_value(node.operand, depth + 1)))
+    if isinstance(node, ast.BoolOp):  # short-circuit, as C's && and || (and Python's and/or)
+        value = 0
+        for operand in node.values:
+            value = _condition_value(operand, depth + 1)
+            if bool(value) != isinstance(node.op, ast.And):
+                break
+        return value
+    if isinstance(node, ast.Compare) and all(type(op) in _COMPARISONS for op in node.ops):
+        left = _condition_value(node.left, depth + 1)
+        for op, comparator in zip(node.ops, node.comparators):
+            right = _condition_value(comparator, depth + 1)
+            if not _COMPARISONS[type(op)](left, right):
+                return 0
+            left = right
+        return 1
+    shown = type(node.op).__name__ if isinstance(node, (ast.BinOp, ast.UnaryOp)) else type(node).__name__
+    raise ValueError(f"preprocessor condition: {shown} is not evaluated (integers, + - * / % << >> & | ^ ~, "
+                     "comparisons, && || !, defined(NAME) and parentheses are)")
+
+
 def _evaluate_condition(expression, defines):
-    """Value of a preprocessor condition over integer object-like defines (undefined names are 0)."""
+    """Value of a preprocessor condition over integer object-like defines (undefined names are 0).
+
+    The condition is translated to Python syntax (``defined(NAME)`` and names to their integers,
+    ``&&``, ``||``, ``!`` to ``and``, ``or``, ``not``), parsed with `ast` and evaluated on integers:
+    ``+ - * / % << >> & | ^ ~``, comparisons, ``and``/``or``/``not`` and parentheses, with Python's
+    precedence and comparison chains; ``/`` and ``%`` truncate toward zero as in C.  Nothing else is
+    evaluated (no ``**``, no floats, no calls).
+
+    Parameters
+    ----------
+    expression : str
+        The text after ``#if`` or ``#elif``.
+    defines : dict of str to int
+
+    Returns
+    -------
+    bool
+
+    Raises
+    ------
+    ValueError
+        Where the condition is not such an expression, divides by zero, shifts by more than 64 or
+        less than 0, or has a value of magnitude ``2**64`` or more, or is longer than
+        `CONDITION_MAX_LENGTH` characters or nested deeper than `CONDITION_MAX_DEPTH`.
+    """
     expression = re.sub(r"defined\s*\(?\s*([A-Za-z_]\w*)\s*\)?", lambda m: "1" if m.group(1) in defines else "0", expression)
     python = _IDENTIFIER.sub(lambda m: str(defines.get(m.group(0), 0)), expression)
     python = python.replace("&&", " and ").replace("||", " or ").replace("!=", " __ne__ ")
-    python = re.sub(r"!(?!=)", " not ", python).replace(" __ne__ ", "!=")
-    return bool(eval(python, {"__builtins__": {}}, {}))  # noqa: S307 - digits and operators only
+    python = re.sub(r"!(?!=)", " not ", python).replace(" __ne__ ", "!=").strip()
+    if len(python) > CONDITION_MAX_LENGTH:
+        raise ValueError(f"preprocessor condition of {len(python)} characters (at most {CONDITION_MAX_LENGTH} are "
+                         "evaluated)")
+    try:
+        tree = ast.parse(python, mode="eval")
+    except (SyntaxError, RecursionError, MemoryError) as exc:
+        raise ValueError(f"preprocessor condition {expression.strip()[:200]!r} is not an integer expression "
+                         f"({type(exc).__name__})") from None
+    try:
+        return bool(_condition_value(tree.body))
+    except RecursionError:
+        raise ValueError(f"preprocessor condition: nested deeper than {CONDITION_MAX_DEPTH} levels") from None
 
 
 def effective_source(source):
