@@ -212,9 +212,9 @@ def open_image(payload, limits=None, source=None, where=None, formats=IMAGE_FORM
     source : path-like
         The file to blame.
     where : str, optional
-    formats : tuple of str
+    formats : tuple of str or None
         Pillow format names accepted (PNG and JPEG: glTF's image formats; nothing else is handed to a
-        Pillow plugin, so no EPS reaches Ghostscript).
+        Pillow plugin, so no EPS reaches Ghostscript); None: any (for files the caller chose).
 
     Returns
     -------
@@ -234,9 +234,10 @@ def open_image(payload, limits=None, source=None, where=None, formats=IMAGE_FORM
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", Image.DecompressionBombWarning)
-            image = Image.open(BytesIO(payload), formats=list(formats))
+            image = Image.open(BytesIO(payload), formats=None if formats is None else list(formats))
     except (UnidentifiedImageError, Image.DecompressionBombError, OSError, ValueError, SyntaxError):
-        raise SceneFileError(source, f"an image that is not {' or '.join(formats)} (or is damaged)", where) from None
+        kinds = "an image format Pillow reads" if formats is None else " or ".join(formats)
+        raise SceneFileError(source, f"an image that is not {kinds} (or is damaged)", where) from None
     width, height = image.size
     if width < 1 or height < 1 or width * height > limits.image_pixels:
         image.close()

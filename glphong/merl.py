@@ -23,6 +23,8 @@ from pathlib import Path
 
 import numpy as np
 
+from .filesafety import Limits, SceneFileError, read_bytes
+
 __all__ = ["SHAPE", "SCALE", "MerlFormatError", "read_merl", "write_merl", "half_diff", "merl_indices", "lookup",
            "bin_directions", "tabulate"]
 
@@ -55,24 +57,28 @@ def read_merl(path):
     Raises
     ------
     MerlFormatError
-        Naming what is wrong: a file shorter or longer than 34,992,012 bytes (truncated, or not a MERL
-        table), a header other than (90, 90, 180), non-finite values.
+        Naming what is wrong: not a regular file (a FIFO, a device), a file shorter or longer than
+        34,992,012 bytes (truncated, or not a MERL table), a header other than (90, 90, 180), non-finite
+        values.
     """
     path = Path(path)
-    size = path.stat().st_size
-    with path.open("rb") as f:
-        head = f.read(_HEADER.size)
-        if len(head) < _HEADER.size:
-            raise MerlFormatError(f"{path}: {size} bytes, too short for the MERL header (three int32 90, 90, 180)")
-        dims = _HEADER.unpack(head)
-        if dims != SHAPE:
-            raise MerlFormatError(f"{path}: header {dims}, expected {SHAPE} (theta_h, theta_d, phi_d bins): "
-                                  "not a MERL BRDF table, or one of another resolution")
-        if size != _SIZE:
-            kind = "truncated" if size < _SIZE else "longer than a MERL table"
-            raise MerlFormatError(f"{path}: {size} bytes, a MERL table has {_SIZE} (12-byte header and "
-                                  f"3 x {_CELLS} float64): {kind}")
-        data = np.frombuffer(f.read(), dtype="<f8")
+    try:  # a regular file of at most a table's size: a FIFO or /dev/zero is refused before any read
+        raw = read_bytes(path, Limits(file_bytes=_SIZE))
+    except SceneFileError as exc:
+        longer = "longer than a MERL table: " if "more than the limit" in exc.message else ""
+        raise MerlFormatError(f"{exc}; {longer}a MERL table has {_SIZE} bytes (12-byte header and 3 x {_CELLS} "
+                              "float64)") from None
+    size = len(raw)
+    if size < _HEADER.size:
+        raise MerlFormatError(f"{path}: {size} bytes, too short for the MERL header (three int32 90, 90, 180)")
+    dims = _HEADER.unpack_from(raw)
+    if dims != SHAPE:
+        raise MerlFormatError(f"{path}: header {dims}, expected {SHAPE} (theta_h, theta_d, phi_d bins): not a MERL "
+                              "BRDF table, or one of another resolution")
+    if size != _SIZE:
+        raise MerlFormatError(f"{path}: {size} bytes, a MERL table has {_SIZE} (12-byte header and 3 x {_CELLS} "
+                              "float64): truncated")
+    data = np.frombuffer(raw, dtype="<f8", offset=_HEADER.size)
     if not np.all(np.isfinite(data)):
         raise MerlFormatError(f"{path}: {int(np.sum(~np.isfinite(data)))} values are NaN or infinite")
     table = data.reshape(3, *SHAPE).transpose(1, 2, 3, 0) * SCALE

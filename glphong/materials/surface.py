@@ -128,14 +128,14 @@ class TextureImage:
         source = None
         if isinstance(image, (str, Path)):
             source = str(image)
-            try:
-                from PIL import Image
+            from ..filesafety import LIMITS, decode_image, read_bytes
 
-                with Image.open(image) as opened:
-                    pixels = np.asarray(opened.convert("RGB") if opened.mode not in ("L", "I;16", "RGB", "RGBA")
-                                        else opened)
-            except OSError as exc:
-                raise ValueError(f"cannot read a texture image from {source!r} ({exc})") from None
+            # the caller chose this file: any format Pillow reads, sides checked from the header before decoding
+            budget = LIMITS.replace(image_pixels=MAX_TEXTURE_SIZE * MAX_TEXTURE_SIZE)
+            pixels = decode_image(read_bytes(image, budget), budget, source, "texture image", formats=None)
+            if max(pixels.shape[:2]) > MAX_TEXTURE_SIZE:
+                raise ValueError(f"{source}: a texture image must be from 1x1 to {MAX_TEXTURE_SIZE}x{MAX_TEXTURE_SIZE} "
+                                 f"pixels (got {pixels.shape[1]}x{pixels.shape[0]})")
         else:
             pixels = np.asarray(image)
         if wrap not in WRAPS:
