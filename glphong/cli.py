@@ -56,7 +56,8 @@ def _render_file(args):
     from .renderer import Renderer
 
     try:
-        scene = load_scene(args.file, light_units=args.light_units, camera_name=args.camera)
+        scene = load_scene(args.file, light_units=args.light_units, camera_name=args.camera,
+                           allow_outside=args.allow_outside)
     except ValueError as exc:
         print_error("render", exc)
         return EXIT_BAD_INPUT
@@ -66,7 +67,7 @@ def _render_file(args):
 
         folder = args.out if args.out is not None else f"{Path(args.file).stem}_frames"
         start = time.perf_counter()
-        keywords = {"light_units": args.light_units, "camera_name": args.camera}
+        keywords = {"light_units": args.light_units, "camera_name": args.camera, "allow_outside": args.allow_outside}
         specs = [(str(Path(args.file).resolve()), 360.0 * k / args.frames, keywords) for k in range(args.frames)]
         paths = render_many(orbit_scene, specs, args.width, args.height, folder, fmt="png", backend=args.backend,
                             samples=args.samples)
@@ -386,6 +387,8 @@ def build_parser():
                         help="with a glTF FILE that has lights: candela and lux (the glTF specification) or W/sr "
                              "and W/m^2")
     render.add_argument("--camera", default=None, help="with a glTF FILE: the camera to look through (default the first)")
+    render.add_argument("--allow-outside", action="store_true",
+                        help="with FILE: let it name files outside its own folder (for files you trust)")
     render.add_argument("--frames", type=_positive_int, default=None,
                         help="with FILE: a turntable of N PNG frames (worker processes) into --out, a folder "
                              "(default FILE's name + _frames)")
@@ -493,9 +496,17 @@ def _run_command(args):
     from .batch import BatchError
     from .contexts import BackendUnavailableError
 
+    import warnings
+
     command = getattr(args, "command", None) or "render"
+
+    def one_line_warning(message, category, filename, lineno, file=None, line=None):
+        print(f"glphong {command}: warning: {one_line(str(message))}", file=sys.stderr)
+
     try:
-        return args.func(args)
+        with warnings.catch_warnings():
+            warnings.showwarning = one_line_warning  # a file's warnings as lines, not source excerpts
+            return args.func(args)
     except KeyboardInterrupt:
         print_error(command, "interrupted")
         return EXIT_INTERRUPTED

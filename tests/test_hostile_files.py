@@ -497,3 +497,23 @@ def test_limits_are_checked():
     with pytest.raises(ValueError, match="file_bytes"):
         Limits(file_bytes=0)
     assert Limits().image_pixels == 4096 * 4096 and math.isfinite(Limits().file_bytes)
+
+
+def test_command_line_one_line_errors_and_warnings(tmp_path, run_isolated):
+    document, blob = _document("../outside.bin", lights=False)
+    (tmp_path / "outside.bin").write_bytes(blob)
+    path = _write(tmp_path / "scene", document)
+    code = "import sys; from glphong.cli import main; raise SystemExit(main(sys.argv[1:]))"
+    refused = run_isolated(code, timeout=120, args=["render", str(path), "--width", "16", "--height", "16",
+                                                    "--out", str(tmp_path / "a.png")])
+    assert refused.returncode == 2 and "Traceback" not in refused.stderr
+    assert refused.stderr.strip().splitlines() == [f"glphong render: {path}: buffers[0].uri: '../outside.bin' leaves "
+                                                   f"the scene file's folder {path.parent}: glphong reads files inside "
+                                                   "it only (load_scene(..., allow_outside=True) for files you trust)"]
+    allowed = run_isolated(code, timeout=120, args=["render", str(path), "--width", "16", "--height", "16",
+                                                    "--out", str(tmp_path / "a.png"), "--allow-outside"])
+    assert allowed.returncode == 0, allowed.stderr
+    assert allowed.stderr.strip().splitlines() == [f"glphong render: warning: {path} has no lights: glphong adds its "
+                                                   "default point light and ambient light (give lights=[] to keep the "
+                                                   "scene dark)"]
+    assert (tmp_path / "a.png").exists()
