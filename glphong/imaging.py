@@ -149,6 +149,23 @@ def save_png(path, radiance, exposure=1.0, compress_level=1):
     Image.fromarray(encode_srgb8(radiance, exposure), mode="RGB").save(path, format="PNG", compress_level=level)
 
 
+def png_bytes(radiance, exposure=1.0, compress_level=1):
+    """``encode_srgb8(radiance, exposure)`` as the bytes of a PNG file (what `save_png` writes).
+
+    Returns
+    -------
+    bytes
+    """
+    from io import BytesIO
+
+    from PIL import Image
+
+    level = _validate.positive_int("compress_level", compress_level, 0, 9)
+    out = BytesIO()
+    Image.fromarray(encode_srgb8(radiance, exposure), mode="RGB").save(out, format="PNG", compress_level=level)
+    return out.getvalue()
+
+
 def save_npy(path, radiance):
     """Write raw float32 radiance ``(H, W, 3)`` as a ``.npy`` file."""
     np.save(path, np.asarray(radiance, dtype=np.float32))

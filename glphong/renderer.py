@@ -49,6 +49,9 @@ class Frame:
         With ``render(scene, normals=True)``: the world-space unit shading normal at the pixel centre
         (interpolated, renormalised, flipped toward the viewer on the back faces of two-sided
         materials, as shaded), 0 where not covered or where the normal is zero or not finite.
+    exposure : float
+        The linear exposure a notebook shows the frame at (``_repr_png_``: Jupyter displays a `Frame`
+        as a PNG of ``to_srgb8(exposure)``, the exact sRGB curve); 1 unless given (`with_exposure`).
     """
 
     radiance: np.ndarray
@@ -56,6 +59,16 @@ class Frame:
     coverage: np.ndarray = None
     depth: np.ndarray = None
     normal: np.ndarray = None
+    exposure: float = 1.0
+
+    def with_exposure(self, exposure):
+        """The same frame (arrays shared, not copied) shown at ``exposure`` in a notebook."""
+        return replace(self, exposure=_validate.scalar("exposure", exposure, low_inclusive=False))
+
+    def _repr_png_(self):
+        """PNG bytes of the frame at ``self.exposure`` (exact sRGB curve): how Jupyter shows a Frame."""
+        from .imaging import png_bytes
+        return png_bytes(self.radiance, self.exposure)
 
     def to_srgb8(self, exposure=1.0):
         """8-bit sRGB image, (H, W, 3) uint8 (see `glphong.imaging.encode_srgb8`)."""

@@ -150,3 +150,20 @@ def test_save_png_compress_level(tmp_path):
         assert np.array_equal(np.asarray(Image.open(tmp_path / f"{level}.png")), encode_srgb8(radiance))
     with pytest.raises(ValueError, match=r"compress_level must be in \[0, 9\]"):
         save_png(tmp_path / "x.png", radiance, compress_level=10)
+
+
+def test_frame_shows_itself_in_a_notebook(make_renderer):
+    """Jupyter calls ``_repr_png_``: the PNG holds exactly ``to_srgb8(exposure)``."""
+    from io import BytesIO
+
+    from PIL import Image
+
+    from glphong.figures import phong_examples_scene
+    from glphong.materials import Phong
+
+    renderer = make_renderer(24, 16, "egl")
+    frame = renderer.render(phong_examples_scene(Phong, 10.0, 45.0))
+    frame = frame.with_exposure(0.6)
+    shown = np.asarray(Image.open(BytesIO(frame._repr_png_())))
+    assert shown.shape == (16, 24, 3) and np.array_equal(shown, frame.to_srgb8(0.6))
+    assert not np.array_equal(shown, frame.to_srgb8(1.0))
