@@ -5,7 +5,10 @@ atomically with a manifest, resumed, never mixed, and a worker killed mid-batch 
 - a rerun renders nothing (every frame on disk), one deleted frame is rendered again and is identical;
 - another batch in the same folder is refused; a spec that cannot be pickled is refused;
 - a scene function that kills its worker the first time it meets spec 3 (a marker file says so): every
-  frame is present once, identical to the serial render, and no partial file is left.
+  frame is present once, identical to the serial render, and no partial file is left (the folder holds
+  the frames, the manifest, the journal ``frames.jsonl`` and the lock ``.lock``).
+
+Hostile folders (racing batches, a killed parent, symbolic links, corrupted frames): test_hostile_batch.py.
 """
 import os
 import sys
@@ -19,6 +22,7 @@ from glphong.batch import BatchError, render_many, turntable_scene
 
 W, H = 48, 32
 ANGLES = [0.0, 30.0, 60.0, 90.0, 120.0, 150.0]
+BOOKKEEPING = ["manifest.json", "frames.jsonl", ".lock"]
 
 
 @pytest.fixture(scope="module")
@@ -38,6 +42,7 @@ def test_pool_frames_equal_serial_and_resume(tmp_path, serial):
     assert all(np.array_equal(a, b) for a, b in zip(_frames(paths), serial))
     manifest = (out / "manifest.json").read_text()
     assert "llvmpipe" in manifest and glphong.__version__ in manifest
+    assert len((out / "frames.jsonl").read_text().splitlines()) == len(ANGLES)  # one record per frame
     stamp = {p: os.stat(p).st_mtime_ns for p in paths}
     os.remove(paths[4])
     again = render_many(turntable_scene, ANGLES, W, H, out, workers=1, progress=False)
@@ -78,7 +83,7 @@ def test_a_killed_worker_costs_no_frame(tmp_path, serial):
         sys.modules.pop("batch_helper_kill", None)
     assert (tmp_path / "died").exists()  # it did die
     assert all(np.array_equal(a, b) for a, b in zip(_frames(paths), serial))
-    assert sorted(os.listdir(out)) == sorted([os.path.basename(p) for p in paths] + ["manifest.json"])
+    assert sorted(os.listdir(out)) == sorted([os.path.basename(p) for p in paths] + BOOKKEEPING)
 
 
 def test_example_batch_turntable(tmp_path):
@@ -111,4 +116,4 @@ def test_dask_cluster_with_a_killed_worker(tmp_path, serial):
         sys.modules.pop("batch_helper_dask", None)
     assert (tmp_path / "died").exists()
     assert all(np.array_equal(a, b) for a, b in zip(_frames(paths), serial))
-    assert sorted(os.listdir(tmp_path / "frames")) == sorted([os.path.basename(p) for p in paths] + ["manifest.json"])
+    assert sorted(os.listdir(tmp_path / "frames")) == sorted([os.path.basename(p) for p in paths] + BOOKKEEPING)
