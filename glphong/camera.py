@@ -1,4 +1,4 @@
-"""Cameras with OpenGL conventions (DESIGN section 2): perspective, from OpenCV intrinsics, orthographic.
+"""Cameras with OpenGL conventions (docs/design.md section 2): perspective, from OpenCV intrinsics, orthographic.
 
 A camera looks down -Z of its own frame; +Y is up in the image; the world is
 right-handed.  ``pose`` maps camera coordinates to world coordinates.
@@ -20,7 +20,7 @@ def _look_at_pose(eye, target, up):
     back = eye - target
     if not np.any(back):
         raise ValueError("target must differ from eye")
-    # scaled normalisation (DESIGN section 3): no underflow for tiny vectors
+    # scaled normalisation (docs/design.md section 3): no underflow for tiny vectors
     z = back / np.max(np.abs(back))
     z /= np.linalg.norm(z)
     x = np.cross(up / np.max(np.abs(up)), z)

@@ -26,7 +26,7 @@ metallic-roughness microfacet BRDF, not Phong or Blinn):
   fixed by ``F0 = 0.04``.  pyrender clamps roughness below at 0.04.
 - ``ka`` (a radiance added to every pixel) becomes ``emissiveFactor = sqrt(ka)``: pyrender
   0.1.45's fragment shader multiplies the emissive factor in twice.
-- point lights: ``I = Phi / (4 pi)`` (DESIGN section 2) as ``color * intensity`` with
+- point lights: ``I = Phi / (4 pi)`` (docs/design.md section 2) as ``color * intensity`` with
   ``color = Phi / max(Phi)`` and ``intensity = max(Phi) / (4 pi)``.
 - directional lights: ``intensity = max(E)``, ``color = E / max(E)``, shining along the
   node's -Z axis, which the pose points along the light's direction.

@@ -1,4 +1,4 @@
-"""Back-face culling where it cannot change the image (DESIGN section 5: leave out what a scene does not need).
+"""Back-face culling where it cannot change the image (docs/design.md section 5: leave out what a scene does not need).
 
 The back faces of a closed surface whose every part encloses positive volume (outward winding) can only
 be seen from inside it, or through a clip plane that cuts it open.  A renderer culls an object's back

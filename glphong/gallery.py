@@ -1,6 +1,6 @@
 """The model gallery: one sphere per reflectance model under the same lights (``glphong gallery``).
 
-A companion to the default figure: every built-in model of the lecture and DESIGN section 9 at
+A companion to the default figure: every built-in model of the lecture and docs/design.md section 9 at
 representative parameters, the same albedo colour for the diffuse parts, one key light (a point light
 up and to the left, 2.5 W/m^2 at the sphere), a rim light from behind-right grazing the silhouette (where
 Fresnel factors brighten and Oren-Nayar flattens), and a faint ambient light.  The spheres carry analytic

@@ -3,7 +3,7 @@
 `MeshData` is an immutable float32 copy of a `trimesh.Trimesh`: positions, one
 normal per vertex (smooth: the mesh's vertex normals; flat: each face's normal on
 its own three vertices) and triangle indices; optionally texture coordinates and
-tangents, for materials whose terms need ``'uv'`` or ``'tangent'`` (DESIGN section 8), and linear
+tangents, for materials whose terms need ``'uv'`` or ``'tangent'`` (docs/design.md section 8), and linear
 vertex colours, for parameters that take them (`glphong.VertexColors`).
 
 Tangents, where a mesh does not supply them, come from its UVs by the standard method of

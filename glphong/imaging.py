@@ -1,4 +1,4 @@
-"""Output encoding: explicit exposure, the exact sRGB curve, PNG and .npy files (DESIGN section 2).
+"""Output encoding: explicit exposure, the exact sRGB curve, PNG and .npy files (docs/design.md section 2).
 
 Radiance stays linear float32 until here; nothing is clamped or gamma-encoded in a shader.
 """

@@ -1,4 +1,4 @@
-"""Program keys: the one source of truth for what a GLSL program contains (DESIGN sections 5 and 8).
+"""Program keys: the one source of truth for what a GLSL program contains (docs/design.md sections 5 and 8).
 
 A `ProgramKey` is frozen and hashable.  It is the program-cache key, and it alone generates
 the ``#define`` lines, the list of chunks a program is assembled from, the generated material
@@ -110,7 +110,7 @@ class ProgramKey:
     two_sided : bool
         Flip the normal on back faces.
     formulation : {'stable', 'naive'}
-        The stable float32 formulation of DESIGN section 3, or the textbook one (``normalize``,
+        The stable float32 formulation of docs/design.md section 3, or the textbook one (``normalize``,
         ``d*d``, ``pow(dot(v, r), q)``, through the ``NAIVE`` define every chunk may honour) kept
         only to show why the stable one exists.
     uber : bool
@@ -381,7 +381,7 @@ def material_chunk(key):
     ``material_response(f, wi, wo, n_dot_l) = sum_lit_terms <model>_response(f, wi, wo, n_dot_l)``;
     in the uber-shader every term is behind a ``SWITCH(u_use_<model>)`` uniform flag.
     """
-    lines = ["// material (generated from the program key) -- the material as a sum of its terms (DESIGN section 8):",
+    lines = ["// material (generated from the program key) -- the material as a sum of its terms (docs/design.md section 8):",
              "//   material_emission() = k_a + sum_terms k L_a                          [W/(m^2 sr)]",
              "//   material_response(f, wi, wo, n_dot_l) = sum_terms <model>_response    [1/sr], times cos"]
     if key.uber:

@@ -1,4 +1,4 @@
-"""Lights: where light comes from and how much (DESIGN E1, E2, section 2).
+"""Lights: where light comes from and how much (docs/design.md E1, E2, section 2).
 
 Kinds and the irradiance ``E`` [W/m^2] each delivers at a surface point:
 
@@ -25,7 +25,7 @@ _MAX_POWER = 4.0 * np.pi * _validate.FLT_MAX
 
 @dataclass(frozen=True)
 class PointLight:
-    """Isotropic point source given by its power (DESIGN E1).
+    """Isotropic point source given by its power (docs/design.md E1).
 
     Parameters
     ----------
@@ -57,7 +57,7 @@ class PointLight:
 
 @dataclass(frozen=True)
 class UnattenuatedPointLight:
-    """A positional light of value ``L_i`` with no distance falloff (DESIGN E2).
+    """A positional light of value ``L_i`` with no distance falloff (docs/design.md E2).
 
     Parameters
     ----------
@@ -111,7 +111,7 @@ class DirectionalLight:
 
 @dataclass(frozen=True)
 class AmbientLight:
-    """Ambient illumination ``L_a`` [W/m^2] of the term ``k_d L_a`` (DESIGN E6).
+    """Ambient illumination ``L_a`` [W/m^2] of the term ``k_d L_a`` (docs/design.md E6).
 
     Parameters
     ----------

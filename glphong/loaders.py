@@ -44,7 +44,7 @@ __all__ = ["load_scene", "read_obj", "read_gltf_json", "gltf_view", "gltf_materi
 
 #: formats `load_scene` reads
 FORMATS = (".obj", ".gltf", ".glb")
-#: luminous efficacy of 555 nm light [lm/W]: photometric glTF intensities to watts (DESIGN section 2)
+#: luminous efficacy of 555 nm light [lm/W]: photometric glTF intensities to watts (docs/design.md section 2)
 LUMENS_PER_WATT = 683.0
 
 

@@ -1,4 +1,4 @@
-"""The MERL measured-BRDF binary format (Matusik et al. 2003; DESIGN section 9): read, write, index, look up.
+"""The MERL measured-BRDF binary format (Matusik et al. 2003; docs/design.md section 9): read, write, index, look up.
 
 A file holds a header of three int32 ``(90, 90, 180)`` (the bins of ``theta_h``, ``theta_d``, ``phi_d``),
 then 3 x 1,458,000 float64, channels planar (every red value, then green, then blue), each indexed

@@ -1,7 +1,7 @@
 """Evaluate single GLSL functions on the GPU, one input row per vertex, via transform feedback.
 
 This is how each GLSL chunk function is tested against its numpy twin of the same
-name (DESIGN section 7, layer 1): the function is called from a generated vertex
+name (docs/design.md section 7, layer 1): the function is called from a generated vertex
 shader on float32 inputs and its return value and ``out`` parameters are captured.
 
 Example

@@ -1,4 +1,4 @@
-"""A converged float64 reference image of exact analytic geometry (DESIGN sections 4 and 7, layer 3).
+"""A converged float64 reference image of exact analytic geometry (docs/design.md sections 4 and 7, layer 3).
 
 The GPU draws tessellated meshes sampled once at each pixel centre; this module ray
 casts the *true* surfaces (`Sphere`, `Plane`) with ``samples_per_axis**2`` rays per

@@ -1,4 +1,4 @@
-"""The numpy twin of the GLSL shaders (DESIGN sections 1 and 3).
+"""The numpy twin of the GLSL shaders (docs/design.md sections 1 and 3).
 
 Every GLSL function of the library chunks (common, lights, lobe, fresnel, shade and the generated
 material chunk) has a twin here with the same name, the same argument order and the same

@@ -282,7 +282,7 @@ class Renderer:
         Render at ``supersample`` times the size in each direction and box-filter down
         (anti-aliases shading too), 1 to 8.
     formulation : {'stable', 'naive'}
-        'stable' (default): DESIGN section 3.  'naive': the textbook float32 formulation,
+        'stable' (default): docs/design.md section 3.  'naive': the textbook float32 formulation,
         for measuring what stability costs and buys; not for real use.
     culling : {'auto', 'off'}
         'auto' (default): cull the back faces of an object where they cannot be seen (a closed,

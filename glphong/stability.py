@@ -259,7 +259,7 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
     so a wrong value on its way from a constructor to a shader uniform shows.  Each term's response
     comes from its model's ``oracle`` method (mpmath); a model without one is evaluated by its twin
     in float64 on the oracle's geometry (rounded to float64), and judged as well as that allows.
-    The conventions are those of DESIGN section 1 (a zero or non-finite normal gives the emission
+    The conventions are those of docs/design.md section 1 (a zero or non-finite normal gives the emission
     terms only).
 
     The GPU computes in float32, so every input coordinate and coefficient is first rounded to

@@ -1,4 +1,4 @@
-"""glphong.testing: the shader unit-testing toolkit (DESIGN sections 7 and 8).
+"""glphong.testing: the shader unit-testing toolkit (docs/design.md sections 7 and 8).
 
 - `evaluate`: run a material's GLSL response on the GPU for arrays of direction pairs, with no
   scene (a vertex program captured by transform feedback), or its numpy twin on the same inputs;

@@ -1,4 +1,4 @@
-"""The tolerance band GPU float32 results are held to against the float64 twin (DESIGN section 4).
+"""The tolerance band GPU float32 results are held to against the float64 twin (docs/design.md section 4).
 
 With ``eps = 2^-24`` (float32 unit roundoff) and the constants below, the band
 around the twin's value of each term is:
@@ -35,7 +35,7 @@ FLT_MAX = float(np.finfo(np.float32).max)
 
 @dataclass(frozen=True)
 class BandConstants:
-    """Multipliers of eps in the band (DESIGN section 4).
+    """Multipliers of eps in the band (docs/design.md section 4).
 
     Attributes
     ----------

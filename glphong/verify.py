@@ -1,4 +1,4 @@
-"""Pixel-by-pixel cross-check of a GPU render against the float64 twin (DESIGN section 4)."""
+"""Pixel-by-pixel cross-check of a GPU render against the float64 twin (docs/design.md section 4)."""
 from dataclasses import dataclass
 
 import numpy as np

@@ -1,4 +1,4 @@
-// angle.glsl -- accurate angles from a sine and a cosine (library chunk; DESIGN section 3).
+// angle.glsl -- accurate angles from a sine and a cosine (library chunk; docs/design.md section 3).
 //
 // atan2_first_quadrant(y, x) -> atan(y / x) [rad] in [0, pi/2] for y, x >= 0; 0 where both are 0.
 //   Cephes' atanf polynomial (S. L. Moshier, Cephes Math Library) after reduction to |t| <= tan(pi/8)

@@ -1,4 +1,4 @@
-// common.glsl -- numeric helpers and the shading frame shared by every chunk (DESIGN sections 3, 8).
+// common.glsl -- numeric helpers and the shading frame shared by every chunk (docs/design.md sections 3, 8).
 //
 // safe_normalize(x, out x_hat, out len) -> valid
 //   s = max_i |x_i|;  valid  <=>  no x_i is NaN or Inf, and s > 0   (false for zero, NaN, Inf)
@@ -13,7 +13,7 @@
 //   NAIVE (the textbook formulation, for the stability report only): x_hat = normalize(x),
 //   len = length(x), always valid.
 //
-// ShadingFrame: the local frame a material's response reads (DESIGN section 8):
+// ShadingFrame: the local frame a material's response reads (docs/design.md section 8):
 //   n the unit normal; t, b the unit tangent and bitangent (0 unless HAS_TANGENT); uv (0 unless HAS_UV).
 // frame_from_tangent(n, tangent, out t, out b)
 //   t = normalize(tangent.xyz - (n . tangent.xyz) n)   (Gram-Schmidt against the shading normal);

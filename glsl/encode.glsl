@@ -1,4 +1,4 @@
-// encode.glsl -- 8-bit output pass: box filter, exposure, the exact sRGB curve (DESIGN section 2).
+// encode.glsl -- 8-bit output pass: box filter, exposure, the exact sRGB curve (docs/design.md section 2).
 //
 //   c = exposure * mean of the SUPERSAMPLE x SUPERSAMPLE linear radiance texels of this pixel;
 //   out = srgb_encode(c) (srgb.glsl); the UNORM8 target rounds it to 8 bits.  Shading stays

@@ -1,4 +1,4 @@
-// fresnel.glsl -- the Fresnel factors a glossy term can take (DESIGN section 9), clamped and
+// fresnel.glsl -- the Fresnel factors a glossy term can take (docs/design.md section 9), clamped and
 // branchless, never NaN for a valid cosine or index.
 //
 // fresnel_schlick(f0, c) -> f0 + (1 - f0) (1 - c)^5            Schlick 1994, f0 in [0, 1] per channel

@@ -1,4 +1,4 @@
-// lights.glsl -- irradiance delivered by one light (DESIGN E1, E2).
+// lights.glsl -- irradiance delivered by one light (docs/design.md E1, E2).
 //
 // point_irradiance(intensity, d) -> E           E1:  E = Phi / (4 pi d^2)
 //   evaluated as min((I / d) / d, FLT_MAX) with I = Phi / (4 pi) [W/sr] computed on the host in

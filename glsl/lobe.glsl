@@ -1,4 +1,4 @@
-// lobe.glsl -- stable evaluation of a cosine-power lobe (DESIGN section 3).
+// lobe.glsl -- stable evaluation of a cosine-power lobe (docs/design.md section 3).
 //
 // log_one_minus(delta) -> ln(1 - delta),  0 <= delta < 1
 //   delta < 1/2:  -2 artanh(sigma),  sigma = delta / (2 - delta)  (2 sigma formed directly, so that

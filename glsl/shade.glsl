@@ -1,4 +1,4 @@
-// shade.glsl -- the whole local-illumination model (DESIGN E6, section 8), specialised by the program key.
+// shade.glsl -- the whole local-illumination model (docs/design.md E6, section 8), specialised by the program key.
 //
 //   L = material_emission() + sum_j [n.l_j > 0] material_response(f, l_j, v, n.l_j) E_j
 //

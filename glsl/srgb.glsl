@@ -1,4 +1,4 @@
-// srgb.glsl -- the exact piecewise sRGB transfer function (IEC 61966-2-1, DESIGN section 2).
+// srgb.glsl -- the exact piecewise sRGB transfer function (IEC 61966-2-1, docs/design.md section 2).
 //
 // srgb_encode(linear) -> 12.92 x for x <= 0.0031308, else 1.055 x^(1/2.4) - 0.055,
 //   x = clamp(linear, 0, 1), NaN -> 0.  Display values in [0, 1].

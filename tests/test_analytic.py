@@ -1,4 +1,4 @@
-"""Analytic scenes against exact geometry (DESIGN section 7, layer 3).
+"""Analytic scenes against exact geometry (docs/design.md section 7, layer 3).
 
 The GPU renders tessellated or exact-planar meshes; the reference is an exact
 float64 ray cast of the true surface (a sphere, a plane) through the pixel centres

@@ -1,4 +1,4 @@
-"""The tolerance band's width, pinned in closed form (DESIGN section 4).
+"""The tolerance band's width, pinned in closed form (docs/design.md section 4).
 
 Every GPU-against-twin check is only as strict as the band.  These tests write the band's
 formulas out with literal numbers, (A, B, C, D) = (16, 4, 6, 8) and eps = 2^-24, and compare

@@ -1,4 +1,4 @@
-"""Layer 1 of DESIGN section 7: each GLSL chunk function against its numpy twin of the same name.
+"""Layer 1 of docs/design.md section 7: each GLSL chunk function against its numpy twin of the same name.
 
 Inputs are float32 (seeded random plus edge cases); the GPU evaluates the GLSL function
 through transform feedback, the twin evaluates the same float32 inputs in float64, and

@@ -1,4 +1,4 @@
-"""Physics invariants of rendered images (DESIGN section 7, layer 4), on every backend.
+"""Physics invariants of rendered images (docs/design.md section 7, layer 4), on every backend.
 
 Each invariant is checked on the GPU images themselves, independently of
 `glphong.verify` (which has its own test at the end): inverse-square falloff,

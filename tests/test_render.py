@@ -1,4 +1,4 @@
-"""Renderer, G-buffer, program cache and pixel parity with the float64 twin (DESIGN section 7, layers 2 and 5)."""
+"""Renderer, G-buffer, program cache and pixel parity with the float64 twin (docs/design.md section 7, layers 2 and 5)."""
 import gc
 import re
 

@@ -1,4 +1,4 @@
-"""Per-scene program specialisation (DESIGN section 5): what is left out, and that it changes nothing."""
+"""Per-scene program specialisation (docs/design.md section 5): what is left out, and that it changes nothing."""
 import re
 import subprocess
 import sys

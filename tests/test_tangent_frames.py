@@ -1,4 +1,4 @@
-"""Tangent frames and texture coordinates: from the mesh to the shader and its twin (DESIGN section 8).
+"""Tangent frames and texture coordinates: from the mesh to the shader and its twin (docs/design.md section 8).
 
 What is tested:
 

@@ -1,4 +1,4 @@
-"""Bad input gives a clear error (DESIGN section 7, layer 6).
+"""Bad input gives a clear error (docs/design.md section 7, layer 6).
 
 Every public constructor and entry point is fed bad values; each error must be of
 the right type and its message must name the parameter *and* state the valid range

@@ -17,7 +17,7 @@ they choose a `GlphongMaterial`, and calls `enable` once on the renderer::
 Primitives with a `GlphongMaterial` are drawn by programs generated from glphong's own chunks and
 `ProgramKey` (output ``'display'``: the same linear shading, then the exposure and the exact sRGB
 curve, since pyrender's framebuffer is 8-bit), with glphong's strict uniform binding; every other
-primitive keeps pyrender's shaders.  Lights map with the units of DESIGN section 2:
+primitive keeps pyrender's shaders.  Lights map with the units of docs/design.md section 2:
 
 - ``pyrender.PointLight(color, intensity)``: intensity I [W/sr] per channel ``color * intensity``,
   so ``Phi = 4 pi I`` (`glphong.PointLight`);
@@ -89,7 +89,7 @@ _DRAWING = threading.local()
 
 
 def glphong_lights_of(scene):
-    """The glphong lights of a pyrender scene (SI units of DESIGN section 2).
+    """The glphong lights of a pyrender scene (SI units of docs/design.md section 2).
 
     Returns
     -------

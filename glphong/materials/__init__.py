@@ -1,4 +1,4 @@
-"""Materials: the lecture's Material class as open definitions (DESIGN section 8).
+"""Materials: the lecture's Material class as open definitions (docs/design.md section 8).
 
 Every material is a sum of terms; each term is a `MaterialModel` (a reflectance model: its
 parameters, GLSL response, numpy twin, band, properties and stability cases).  The built-ins use
@@ -10,7 +10,7 @@ The lecture's models (``kd``, ``ks`` are BRDF values [1/sr]):
 - `PhongLobe` (``phong_lobe``) and `Phong` = ``Lambert + PhongLobe``: ``k_d (n.l) + k_s (v.r)^q``;
 - `BlinnLobe` (``blinn_lobe``) and `BlinnPhong` = ``Lambert + BlinnLobe``: ``k_d (n.l) + k_s (n.h)^q``.
 
-The physically based models of DESIGN section 9 (``rho_*`` are albedos, dimensionless in [0, 1]):
+The physically based models of docs/design.md section 9 (``rho_*`` are albedos, dimensionless in [0, 1]):
 
 - `Diffuse` (``diffuse``): ``rho_d / pi``, the diffuse term of the sums below;
 - `NormalizedPhong` = ``Diffuse + NormalizedPhongLobe`` (Lafortune and Willems 1994) and

@@ -1,4 +1,4 @@
-"""The model 'ashikhmin_shirley': the anisotropic Phong BRDF (DESIGN section 9; GLSL:
+"""The model 'ashikhmin_shirley': the anisotropic Phong BRDF (docs/design.md section 9; GLSL:
 ``glsl/materials/ashikhmin_shirley.glsl``).
 
 Ashikhmin and Shirley 2000, "An anisotropic Phong BRDF model", Journal of Graphics Tools 5(2),
@@ -47,7 +47,7 @@ answer to a uniform ``L_a`` would be the directional albedo of ``f_d + f_s`` at 
 factor ``1 - rho_s``, a view dependence and the specular part); glphong keeps the ambient term a
 constant times a parameter.
 
-Stable evaluation (DESIGN section 3): the exponent as the weighted mean
+Stable evaluation (docs/design.md section 3): the exponent as the weighted mean
 ``e = (nu (h.t)^2 + nv (h.b)^2) / ((h.t)^2 + (h.b)^2)`` (``1 - (n.h)^2 = (h.t)^2 + (h.b)^2``: never 0/0
 as ``n.h`` rounds to 1; h.t and h.b scaled by the larger of them first; positive terms only, so e is
 good to a few ulp, where ``mix(nu, nv, w)`` would carry an absolute error ``nu eps``, 2% in ``(n.h)^e``

@@ -1,9 +1,9 @@
-"""The model 'blinn_lobe' and the material `BlinnPhong` (DESIGN E5, E6; GLSL: ``glsl/materials/blinn_lobe.glsl``).
+"""The model 'blinn_lobe' and the material `BlinnPhong` (docs/design.md E5, E6; GLSL: ``glsl/materials/blinn_lobe.glsl``).
 
 The lobe's response is ``k_s max(n.h, 0)^q`` with ``h = (l + v)/|l + v|`` (0 where ``n.v <= 0``
 or ``l + v`` is below a floor), so its BRDF is ``k_s (n.h)^q / (n.l)``: non-negative, not
 reciprocal, isotropic, not energy-conserving.  `BlinnPhong` is ``Lambert + BlinnLobe``.  Evaluated
-in the chord form of DESIGN section 3: ``delta = |h - n|^2 / 2``.  `blinn_delta`, `blinn_lobe`,
+in the chord form of docs/design.md section 3: ``delta = |h - n|^2 / 2``.  `blinn_delta`, `blinn_lobe`,
 `half_cosine` and `BLINN_HALF_FLOOR` are library functions (GLSL in ``glsl/lobe.glsl``, twins in
 `glphong.reference`), shared with `glphong.materials.NormalizedBlinnLobe`; re-exported here.
 
@@ -108,7 +108,7 @@ class BlinnLobe(MaterialModel):
 
 
 class BlinnPhong(MaterialSum):
-    """The Blinn-Torrance variation (DESIGN E5, E6): ``k_d (n.l) + k_s max(n.h, 0)^q`` per light.
+    """The Blinn-Torrance variation (docs/design.md E5, E6): ``k_d (n.l) + k_s max(n.h, 0)^q`` per light.
 
     Parameters are those of `Phong`; the lobe uses the half vector ``h = (l + v)/|l + v|``.
     """

@@ -1,4 +1,4 @@
-"""The model 'cook_torrance_lobe' and the material `CookTorrance` (DESIGN section 9; GLSL:
+"""The model 'cook_torrance_lobe' and the material `CookTorrance` (docs/design.md section 9; GLSL:
 ``glsl/materials/cook_torrance_lobe.glsl``).
 
 Cook and Torrance 1982, "A Reflectance Model for Computer Graphics", ACM Transactions on Graphics
@@ -77,7 +77,7 @@ Where the paper and common implementations differ, and what glphong follows:
   paper's).
 - D is Beckmann's (the paper's first choice; the Gaussian ``c exp(-(alpha/m)^2)`` it mentions is not
   offered); G is the paper's V-cavity min(), not the Smith masking of later implementations.
-- the paper does not say what happens below the horizon; glphong gates on ``n.l > 0`` (DESIGN section 1)
+- the paper does not say what happens below the horizon; glphong gates on ``n.l > 0`` (docs/design.md section 1)
   and on ``n.v > 0`` (a one-sided surface seen from behind reflects nothing toward the viewer).
 
 Properties: non-negative, reciprocal (D, G and F(h.l) are symmetric in l and v), isotropic.  The

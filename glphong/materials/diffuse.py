@@ -1,4 +1,4 @@
-"""The model 'diffuse': Lambert's law by its albedo (DESIGN section 9; GLSL: ``glsl/materials/diffuse.glsl``).
+"""The model 'diffuse': Lambert's law by its albedo (docs/design.md section 9; GLSL: ``glsl/materials/diffuse.glsl``).
 
 ``f_r = rho_d / pi`` [1/sr]; response ``rho_d (n.l) / pi``; answers the ambient light with
 ``(rho_d / pi) L_a`` (the same as `Lambert` with ``kd = rho_d / pi``).  Non-negative, reciprocal,

@@ -1,4 +1,4 @@
-"""Fresnel factors a glossy term takes as ``fresnel=`` (DESIGN section 9; GLSL: ``glsl/fresnel.glsl``).
+"""Fresnel factors a glossy term takes as ``fresnel=`` (docs/design.md section 9; GLSL: ``glsl/fresnel.glsl``).
 
 A glossy model that declares a `FresnelSlot` multiplies its lobe by ``F(c)``, with the cosine ``c``
 the model states (``n.l`` for Phong-type lobes, ``h.l`` for half-vector lobes and microfacets):

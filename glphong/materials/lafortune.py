@@ -1,4 +1,4 @@
-"""The model 'lafortune_lobes' and the material `Lafortune` (DESIGN section 9; GLSL:
+"""The model 'lafortune_lobes' and the material `Lafortune` (docs/design.md section 9; GLSL:
 ``glsl/materials/lafortune_lobes.glsl``).
 
 The generalised cosine lobes of Lafortune, Foo, Torrance and Greenberg (1997)::
@@ -58,7 +58,7 @@ Fresnel: the model takes no Fresnel factor (no ``fresnel=``): the paper fits the
 effects included, to measured or simulated data (off-specular lobes with ``|C o l|`` growing toward
 grazing are how it represents them).
 
-Stable evaluation (DESIGN section 3): the textbook ``pow(x, n)`` with ``x`` formed by a dot product has
+Stable evaluation (docs/design.md section 3): the textbook ``pow(x, n)`` with ``x`` formed by a dot product has
 an absolute error ``~ eps |C|`` in ``x``, so a relative error ``~ n eps |C| / x`` (measured up to 17 % at
 ``n = 1e6`` near the peak) and no resolution of a narrow peak.  glphong uses a generalised chord form (see
 the GLSL header): ``x = m |c^ o l| (w.v)`` with ``m = max|C_i|``, ``c^ = C/m``, ``w`` the unit peak
@@ -76,7 +76,7 @@ otherwise, e.g. ``n <~ 5e3`` where the ``|C_i|`` differ by 10 % and ``n <~ 1.5e4
 exponent is clamped to [-104, 88]: a lobe above ``e^88 ~ 1.65e38`` (``|C| > 1`` with a large ``n``)
 saturates there, so the response is at most FLT_MAX or +Inf, never NaN.
 
-Where the paper and common implementations differ (glphong follows the paper, DESIGN section 9, with
+Where the paper and common implementations differ (glphong follows the paper, docs/design.md section 9, with
 the lobe's scale made explicit as the issue specifies):
 
 - Scale: the paper folds each lobe's magnitude into ``C`` (``f_r = sum_i [C_i . (u o v)]^(n_i)``, e.g.

@@ -1,4 +1,4 @@
-"""The model 'lambert': ideal diffuse reflection (DESIGN E3; GLSL: ``glsl/materials/lambert.glsl``).
+"""The model 'lambert': ideal diffuse reflection (docs/design.md E3; GLSL: ``glsl/materials/lambert.glsl``).
 
 ``f_r = k_d`` [1/sr] (an albedo rho gives ``k_d = rho / pi``); response ``k_d (n.l)``; answers the
 ambient light with ``k_d L_a``.  Non-negative, reciprocal, isotropic; energy-conserving when
@@ -23,7 +23,7 @@ def lambert(kd, n_dot_l):
 
 
 class Lambert(MaterialModel):
-    """Ideal diffuse reflector (DESIGN E3): ``L = k_a + k_d L_a + sum_j k_d (n.l_j) E_j``.
+    """Ideal diffuse reflector (docs/design.md E3): ``L = k_a + k_d L_a + sum_j k_d (n.l_j) E_j``.
 
     Parameters
     ----------
@@ -47,7 +47,7 @@ class Lambert(MaterialModel):
         return lambert(p.kd, n_dot_l)
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
-        """``k_d [max(n.l - D eps, 0), n.l + D eps]``: the dot product's absolute error (DESIGN section 4)."""
+        """``k_d [max(n.l - D eps, 0), n.l + D eps]``: the dot product's absolute error (docs/design.md section 4)."""
         from ..tolerances import EPS
 
         tol = constants.D * EPS

@@ -1,4 +1,4 @@
-r"""The measured BRDF: a table in the MERL layout, sampled from a 3D texture (issue 13; DESIGN section 9).
+r"""The measured BRDF: a table in the MERL layout, sampled from a 3D texture (issue 13; docs/design.md section 9).
 
 Matusik, Pfister, Brand and McMillan 2003, "A data-driven reflectance model" (SIGGRAPH 2003), measured
 100 isotropic materials and published each as a table of ``f_r`` over Rusinkiewicz's (1998) half and

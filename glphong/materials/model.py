@@ -1,4 +1,4 @@
-"""The material mechanism: the lecture's Material class as an open definition (DESIGN section 8).
+"""The material mechanism: the lecture's Material class as an open definition (docs/design.md section 8).
 
 One reflectance model is one `MaterialModel` subclass: its parameters (`Param`), what it needs
 (the view vector, a tangent frame, UVs), its GLSL response ``<name>_response(f, wi, wo, n_dot_l)``
@@ -239,7 +239,7 @@ class Choice:
 
 @dataclass(frozen=True)
 class Properties:
-    """What a model declares about its BRDF, for the analysis to check (DESIGN section 8).
+    """What a model declares about its BRDF, for the analysis to check (docs/design.md section 8).
 
     Attributes
     ----------

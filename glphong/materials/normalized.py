@@ -1,5 +1,5 @@
 """The models 'normalized_phong_lobe' and 'normalized_blinn_lobe' and the materials `NormalizedPhong` and
-`NormalizedBlinnPhong` (DESIGN sections 1 and 9; GLSL: ``glsl/materials/normalized_phong_lobe.glsl`` and
+`NormalizedBlinnPhong` (docs/design.md sections 1 and 9; GLSL: ``glsl/materials/normalized_phong_lobe.glsl`` and
 ``glsl/materials/normalized_blinn_lobe.glsl``).
 
 The normalised, physically plausible forms of the lecture's two lobes, parameterised by albedos:
@@ -41,17 +41,17 @@ Papers: E. P. Lafortune and Y. D. Willems, 1994, "Using the modified Phong refle
 physically based rendering", technical report CW197, Department of Computer Science, K.U. Leuven
 (the modified Phong model).  The half-vector lobe is J. F. Blinn, 1977, "Models of light reflection
 for computer synthesized pictures", SIGGRAPH '77 (Computer Graphics 11(2)); its exact energy
-normalisation ``c(q)`` is the closed form of the normal-incidence albedo integral (DESIGN section 9;
+normalisation ``c(q)`` is the closed form of the normal-incidence albedo integral (docs/design.md section 9;
 derived in tests/materials/test_normalized.py; also in F. Giesen, 2009, "Derivation of Phong and
 Blinn-Phong BRDF normalization factors", with the ``(q + 8)/(8 pi)`` approximation).
 
-Fresnel (``fresnel=``; DESIGN section 9): `NormalizedPhong` takes ``F`` at ``c = n.l`` (the Phong-type
+Fresnel (``fresnel=``; docs/design.md section 9): `NormalizedPhong` takes ``F`` at ``c = n.l`` (the Phong-type
 lobe has no half vector; this is the cosine `PhongLobe` uses) and then is no longer reciprocal
 (``F(n.l) != F(n.v)``: declared reciprocity is that of the paper's model, ``fresnel=None``);
 `NormalizedBlinnPhong` takes it at ``c = h.l``, which equals ``h.v``, so it stays reciprocal.  ``F <= 1``
 keeps energy conservation.
 
-Where the paper and common implementations differ (glphong follows the paper, DESIGN section 9):
+Where the paper and common implementations differ (glphong follows the paper, docs/design.md section 9):
 
 - Phong normalisation: the paper's ``(q + 2)/(2 pi)`` includes the cosine of the reflection integral;
   many renderers (and importance-sampling code) use ``(q + 1)/(2 pi)``, which normalises the lobe's
@@ -69,7 +69,7 @@ Where the paper and common implementations differ (glphong follows the paper, DE
   implementations that only clamp ``n.h`` return light toward a viewer below the surface, which is
   neither physical nor reciprocal with the light loop's ``n.l > 0`` gate.
 
-Numerics (DESIGN section 3): the lobes are evaluated in the chord form (``delta = |r - v|^2 / 2``,
+Numerics (docs/design.md section 3): the lobes are evaluated in the chord form (``delta = |r - v|^2 / 2``,
 ``|h - n|^2 / 2``, then `lobe_from_delta`), stable for q up to 1e7 at and around the peak.  The
 normalisation constants are formed in float32 without overflow or cancellation: ``(q + 2) / (2 pi)``,
 and ``((q + 2)/(8 pi)) ((q + 4)/(q + 2^(-q/2)))`` (the denominator is at least 1; ``2^(-q/2)``
@@ -177,7 +177,7 @@ class NormalizedPhongLobe(MaterialModel):
         return p.rho_s * fresnel_factor(p, n_dot_l) * s[..., None]
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
-        """The lobe band of the Phong delta (`glphong.tolerances.lobe_band`, DESIGN section 4) times the
+        """The lobe band of the Phong delta (`glphong.tolerances.lobe_band`, docs/design.md section 4) times the
         normalisation (widened by a few eps), ``n.l +- D eps`` and the Fresnel band at ``n.l +- D eps``;
         0 where the lower end is below FLT_MIN.
 

@@ -1,4 +1,4 @@
-"""The model 'oren_nayar': rough diffuse reflection (DESIGN section 9; GLSL: ``glsl/materials/oren_nayar.glsl``).
+"""The model 'oren_nayar': rough diffuse reflection (docs/design.md section 9; GLSL: ``glsl/materials/oren_nayar.glsl``).
 
 Oren, M. and Nayar, S. K. (1994), "Generalization of Lambert's reflectance model", Proceedings of
 SIGGRAPH 94 (Computer Graphics, Annual Conference Series), pp. 239-246.  The surface is a collection
@@ -64,7 +64,7 @@ form       choice  'full' (0) or  --      the full model with inter-reflection, 
 Units: ``f_r`` and the response in 1/sr; ``rho`` dimensionless; ``sigma`` in radians.  No Fresnel
 factor (the facets are Lambertian).
 
-Where common implementations differ from the paper (glphong follows the paper, DESIGN section 9):
+Where common implementations differ from the paper (glphong follows the paper, docs/design.md section 9):
 
 - pbrt-v3's ``OrenNayar`` (and the many renderers that port it) implements only the qualitative
   form and takes ``sigma`` in degrees; glphong takes radians and offers both forms

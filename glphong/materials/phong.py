@@ -1,10 +1,10 @@
-"""The model 'phong_lobe' and the material `Phong` (DESIGN E4, E6; GLSL: ``glsl/materials/phong_lobe.glsl``).
+"""The model 'phong_lobe' and the material `Phong` (docs/design.md E4, E6; GLSL: ``glsl/materials/phong_lobe.glsl``).
 
 The lobe's response is the lecture's ``k_s max(v.r, 0)^q`` with ``r = 2 (n.l) n - l``, so its BRDF
 is ``k_s (v.r)^q / (n.l)``: non-negative with the clamp, not reciprocal, isotropic, not
 energy-conserving (its albedo grows without bound at grazing incidence).  `Phong` is the sum
 ``Lambert + PhongLobe``: ``k_d (n.l) + k_s (v.r)^q`` per light.  Evaluated in the chord form of
-DESIGN section 3: ``delta = |r - v|^2 / 2``, ``lobe = (1 - delta)^q`` by `lobe_from_delta`, stable
+docs/design.md section 3: ``delta = |r - v|^2 / 2``, ``lobe = (1 - delta)^q`` by `lobe_from_delta`, stable
 for q up to FLT_MAX.  `phong_delta` and `phong_lobe` are library functions (GLSL in ``glsl/lobe.glsl``,
 twins in `glphong.reference`), shared with `glphong.materials.NormalizedPhongLobe`; re-exported here.
 
@@ -67,7 +67,7 @@ class PhongLobe(MaterialModel):
         return p.ks * fresnel_factor(p, n_dot_l) * phong_lobe(f.n, wi, wo, p.q)[..., None]
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
-        """``k_s`` times `glphong.tolerances.lobe_band` of the Phong delta (DESIGN section 4), times the
+        """``k_s`` times `glphong.tolerances.lobe_band` of the Phong delta (docs/design.md section 4), times the
         Fresnel band at ``n.l +- D eps``."""
         from ..tolerances import EPS, lobe_band
 
@@ -94,7 +94,7 @@ class PhongLobe(MaterialModel):
 
 
 class Phong(MaterialSum):
-    """The Phong model (DESIGN E4, E6): ``k_d (n.l) + k_s max(v.r, 0)^q`` per light, plus ambient.
+    """The Phong model (docs/design.md E4, E6): ``k_d (n.l) + k_s max(v.r, 0)^q`` per light, plus ambient.
 
     Parameters
     ----------

@@ -1,6 +1,6 @@
 """Tables: float32 arrays a material model samples, as a texture on the GPU and as the same values in its twin.
 
-A model declares a table the way it declares a parameter (DESIGN section 8): ``tables = (Table(...),)``.
+A model declares a table the way it declares a parameter (docs/design.md section 8): ``tables = (Table(...),)``.
 glphong then declares the sampler ``uniform sampler<N>D u_<model>_<name>;`` (generated, like a
 parameter's uniform), validates the value a constructor is given (shape, channels, finite), and
 uploads it as a texture the first time a drawn object's program reads it (`glphong.textures`), once

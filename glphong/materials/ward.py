@@ -1,4 +1,4 @@
-"""The model 'ward_lobe' and the material `Ward` (DESIGN section 9; GLSL: ``glsl/materials/ward_lobe.glsl``).
+"""The model 'ward_lobe' and the material `Ward` (docs/design.md section 9; GLSL: ``glsl/materials/ward_lobe.glsl``).
 
 The anisotropic Ward lobe (G. J. Ward 1992, "Measuring and modeling anisotropic reflection",
 SIGGRAPH 92, Computer Graphics 26(2)) in the form of B. Walter 2005 ("Notes on the Ward BRDF",
@@ -55,7 +55,7 @@ a time and never an underflowed one; Walter's ``1/sqrt((n.l)(n.v))`` as ``sqrt(n
 Valid range: ``n.v >= 2^-64`` (below, the value is that at 2^-64; float32 cannot resolve such an
 ``n.v`` anyway), ``|l + v| > 2^-20`` (else 0: h undefined).
 
-Where the papers and common implementations differ (glphong follows the papers, DESIGN section 9):
+Where the papers and common implementations differ (glphong follows the papers, docs/design.md section 9):
 
 - the exponent: glphong uses Walter's ``-((h.t/ax)^2 + (h.b/ay)^2)/(h.n)^2``, which equals Ward's
   ``-tan^2(theta_h)(cos^2 phi_h/ax^2 + sin^2 phi_h/ay^2)``.  Several shader libraries (e.g.

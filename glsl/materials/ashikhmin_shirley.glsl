@@ -1,5 +1,5 @@
 // materials/ashikhmin_shirley.glsl -- the model 'ashikhmin_shirley': the anisotropic Phong BRDF of
-// Ashikhmin and Shirley 2000 (JGT 5(2)), specular and coupled diffuse in one term (DESIGN section 9).
+// Ashikhmin and Shirley 2000 (JGT 5(2)), specular and coupled diffuse in one term (docs/design.md section 9).
 //
 // f_r = f_s + f_d   [1/sr], local frame (t, b, n), h = (l + v) / |l + v|:
 //   f_s = sqrt((nu + 1)(nv + 1)) / (8 pi) (n.h)^e F(v.h) / ((v.h) max(n.l, n.v))
@@ -7,7 +7,7 @@
 //   f_d = 28 rho_d / (23 pi) (1 - rho_s) (1 - (1 - n.l/2)^5) (1 - (1 - n.v/2)^5)
 // rho_d, rho_s: rgb in [0, 1]; nu, nv: exponents in [0, 1e6] (a larger nu: a narrower lobe along t).
 //
-// Stable formulation (DESIGN section 3), branchless (selects only):
+// Stable formulation (docs/design.md section 3), branchless (selects only):
 // ashikhmin_shirley_norm(nu, nv) -> sqrt((nu + 1)(nv + 1)) / (8 pi)
 // ashikhmin_shirley_exponent(h_t, h_b, nu, nv) -> e
 //   1 - (n.h)^2 = (h.t)^2 + (h.b)^2, so e = (nu a^2 + nv c^2) / (a^2 + c^2), a = h.t / m, c = h.b / m,

@@ -1,5 +1,5 @@
 // materials/cook_torrance_lobe.glsl -- the model 'cook_torrance_lobe': the Cook-Torrance specular term
-// (Cook and Torrance 1982, DESIGN section 9), Beckmann distribution, Torrance-Sparrow masking,
+// (Cook and Torrance 1982, docs/design.md section 9), Beckmann distribution, Torrance-Sparrow masking,
 // branchless, never NaN or Inf for valid input.
 //
 //   form "microfacet" (COOK_TORRANCE_LOBE_FORM == 0):  f_r = F D G / (4 (n.l)(n.v))

@@ -1,5 +1,5 @@
 // materials/diffuse.glsl -- the model 'diffuse': Lambert's ideal diffuse reflection parameterised by its
-// albedo (DESIGN section 9: the rho_d / pi term of the normalised and physically based models).
+// albedo (docs/design.md section 9: the rho_d / pi term of the normalised and physically based models).
 //
 // diffuse_response(f, wi, wo, n_dot_l) -> u_diffuse_rho_d (n.l / pi)      [1/sr]
 //   f_r = rho_d / pi, so the directional albedo is rho_d at every incident angle.

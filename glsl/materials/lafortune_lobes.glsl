@@ -1,5 +1,5 @@
 // materials/lafortune_lobes.glsl -- the model 'lafortune_lobes': the generalised cosine lobes of
-// Lafortune, Foo, Torrance and Greenberg 1997 (DESIGN section 9), in a generalised chord form.
+// Lafortune, Foo, Torrance and Greenberg 1997 (docs/design.md section 9), in a generalised chord form.
 //
 // f_r = sum_{i=1..LAFORTUNE_LOBES_COUNT} rho_i max(x_i, 0)^(n_i)   [1/sr],
 //   x_i = Cx_i l_x v_x + Cy_i l_y v_y + Cz_i l_z v_z,  components in the local frame (t, b, n):

@@ -1,4 +1,4 @@
-// materials/lambert.glsl -- the model 'lambert': ideal diffuse reflection (DESIGN E3).
+// materials/lambert.glsl -- the model 'lambert': ideal diffuse reflection (docs/design.md E3).
 //
 // lambert(kd, n_dot_l) -> kd (n.l)
 //   kd: BRDF value [1/sr] per RGB channel (an albedo rho is kd = rho / pi);

@@ -1,6 +1,6 @@
 // materials/measured_brdf.glsl -- the model 'measured_brdf': an isotropic BRDF measured (or tabulated)
 // in the MERL layout (Matusik, Pfister, Brand and McMillan 2003, "A data-driven reflectance model",
-// SIGGRAPH 2003; Rusinkiewicz 1998 for the angles; DESIGN section 9).
+// SIGGRAPH 2003; Rusinkiewicz 1998 for the angles; docs/design.md section 9).
 //
 // f_r [1/sr] (rgb) = the table at the bin of (theta_h, theta_d, phi_d):
 //   h = (l + v)/|l + v|,  theta_h = angle(n, h),  theta_d = angle(h, l),

@@ -1,5 +1,5 @@
 // materials/mtl_phong.glsl -- the model 'mtl_phong': the Wavefront MTL material (illum 1 and 2), the
-// lecture's Phong with MTL's own ambient coefficient (DESIGN E6).
+// lecture's Phong with MTL's own ambient coefficient (docs/design.md E6).
 //
 // mtl_phong_response(f, wi, wo, n_dot_l) -> Kd (n.l) + Ks max(v.r, 0)^Ns   [1/sr], times cos
 //   Kd, Ks: MTL's diffuse and specular colours, used as the lecture's k_d and k_s (an MTL file means

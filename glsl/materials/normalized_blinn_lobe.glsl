@@ -1,5 +1,5 @@
 // materials/normalized_blinn_lobe.glsl -- the model 'normalized_blinn_lobe': the normalised Blinn-Phong
-// lobe with its exact normalisation (DESIGN section 9), in the chord form of DESIGN section 3, branchless.
+// lobe with its exact normalisation (docs/design.md section 9), in the chord form of docs/design.md section 3, branchless.
 //
 // f_r = rho_s c(q) max(n.h, 0)^q   [1/sr],   h = (l + v) / |l + v|,
 // c(q) = (q + 2)(q + 4) / (8 pi (q + 2^(-q/2)))

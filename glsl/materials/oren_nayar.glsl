@@ -1,5 +1,5 @@
 // materials/oren_nayar.glsl -- the model 'oren_nayar': Oren and Nayar's rough diffuse reflection
-// (Oren and Nayar 1994, "Generalization of Lambert's reflectance model", SIGGRAPH 94; DESIGN section 9),
+// (Oren and Nayar 1994, "Generalization of Lambert's reflectance model", SIGGRAPH 94; docs/design.md section 9),
 // in a stable float32 formulation: no acos, no tan, no 1 - cos by subtraction.
 //
 // f_r [1/sr], with s2 = sigma^2 (sigma in radians), theta_i, theta_o the polar angles of l and v,

@@ -1,5 +1,5 @@
-// materials/phong_lobe.glsl -- the model 'phong_lobe': the Phong lobe (DESIGN E4), in the chord
-// form of DESIGN section 3 (phong_delta and phong_lobe are library functions of lobe.glsl).
+// materials/phong_lobe.glsl -- the model 'phong_lobe': the Phong lobe (docs/design.md E4), in the chord
+// form of docs/design.md section 3 (phong_delta and phong_lobe are library functions of lobe.glsl).
 //
 // phong_lobe_response(f, wi, wo, n_dot_l) -> u_phong_lobe_ks F(n.l) phong_lobe(n, wi, wo, u_phong_lobe_q)
 //   [1/sr]: the lecture's k_s (v.r)^q, whose BRDF is k_s (v.r)^q / (n.l); F = phong_lobe_fresnel(n.l),
