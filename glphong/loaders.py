@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from .filesafety import SceneFileError, decode_image, read_bytes, read_text, resolve_reference
+from .obj_reader import read_obj
 
 __all__ = ["load_scene", "read_obj", "read_gltf_json", "gltf_view", "gltf_material", "material_from_extras",
            "scene_from_trimesh", "parse_mtl",
@@ -275,75 +276,6 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
     for geometry, material, transform, name in parts:
         scene.add(MeshData.from_trimesh(geometry, colors=vertex_colors), material, pose=transform, name=name)
     return _with_view(scene, camera, lights, ambient)
-
-
-def read_obj(path, limits=None):
-    """The triangles of a Wavefront OBJ file, one `MeshData` per material (``usemtl``) in order of first use.
-
-    ``v``, ``vn``, ``vt`` and ``f`` (polygons fanned into triangles, negative indices counted from the end)
-    are read; a part whose corners all carry a normal keeps the file's normals, the others get smooth
-    vertex normals (trimesh's, area-weighted).  Faces before any ``usemtl`` form the part ``""``.
-
-    Returns
-    -------
-    list of (str, MeshData)
-
-    Raises
-    ------
-    ValueError
-        Naming the file and line: a face index out of range, a value that is not a number.
-    """
-    from .geometry import MeshData
-
-    positions, normals, uvs, parts, current = [], [], [], {}, ""
-    text = read_text(path, limits)
-    for number, raw in enumerate(text.splitlines(), start=1):
-        words = raw.split("#", 1)[0].split()
-        if not words:
-            continue
-        keyword = words[0]
-        try:
-            if keyword == "v":
-                positions.append([float(x) for x in words[1:4]])
-            elif keyword == "vn":
-                normals.append([float(x) for x in words[1:4]])
-            elif keyword == "vt":
-                uvs.append([float(x) for x in (words[1:3] + ["0"])[:2]])
-            elif keyword == "usemtl":
-                current = " ".join(words[1:])
-            elif keyword == "f":
-                corners = []
-                for word in words[1:]:
-                    fields = (word.split("/") + ["", ""])[:3]
-                    index = []
-                    for field, count in zip(fields, (len(positions), len(uvs), len(normals))):
-                        k = int(field) if field else 0
-                        k = k - 1 if k > 0 else (count + k if k < 0 else -1)
-                        if field and not 0 <= k < count:
-                            raise IndexError
-                        index.append(k)
-                    corners.append(tuple(index))
-                part = parts.setdefault(current, [])
-                part += [(corners[0], corners[i], corners[i + 1]) for i in range(1, len(corners) - 1)]
-        except (ValueError, IndexError):
-            raise ValueError(f"{path}:{number}: cannot read {raw.strip()!r} (a number or an index out of range)") from None
-    positions = np.asarray(positions, dtype=np.float64).reshape(-1, 3)
-    out = []
-    for name, triangles in parts.items():
-        corners = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)  # (3T, [v, vt, vn])
-        unique, inverse = np.unique(corners, axis=0, return_inverse=True)
-        faces = inverse.reshape(-1, 3)
-        with_normals = bool(np.all(unique[:, 2] >= 0))
-        if with_normals:
-            vertex_normals = np.asarray(normals, dtype=np.float64)[unique[:, 2]]
-        else:
-            import trimesh
-
-            merged = trimesh.Trimesh(positions[unique[:, 0]], faces, process=False)
-            vertex_normals = merged.vertex_normals
-        vertex_uvs = np.asarray(uvs, dtype=np.float64)[unique[:, 1]] if len(uvs) and np.all(unique[:, 1] >= 0) else None
-        out.append((name, MeshData(positions[unique[:, 0]], vertex_normals, faces, uvs=vertex_uvs)))
-    return out
 
 
 def read_gltf_json(path, limits=None):

@@ -133,10 +133,12 @@ def test_cli_render_file(tmp_path, capsys):
 
     path = _write_obj(tmp_path)
     out = tmp_path / "out.png"
-    with pytest.warns(UserWarning, match="illum 5"):
-        code = main(["render", str(path), "--width", "64", "--height", "48", "--verify", "--out", str(out)])
-    text = capsys.readouterr().out
+    code = main(["render", str(path), "--width", "64", "--height", "48", "--verify", "--out", str(out)])
+    captured = capsys.readouterr()
+    text = captured.out
     assert code == 0 and "4 object(s), 64x48" in text and "PASS" in text
+    warnings = [line for line in captured.err.splitlines() if "warning" in line]
+    assert len(warnings) == 1 and warnings[0].startswith("glphong render: warning: ") and "illum 5" in warnings[0]
     assert Image.open(out).size == (64, 48)
     assert main(["render", str(tmp_path / "scene.stl")]) == 2
     assert "glphong reads .obj, .gltf, .glb scene files" in capsys.readouterr().err
