@@ -1,4 +1,4 @@
-"""User-defined materials (DESIGN section 8): what a definition is checked for, and that a user's
+"""User-defined materials (docs/design.md section 8): what a definition is checked for, and that a user's
 material works everywhere a built-in one does.
 
 - A definition with a missing twin, a GLSL function of the wrong name or signature, a parameter
@@ -307,7 +307,7 @@ class _Linear1e4(_Linear):
 
 def test_the_generic_band_has_its_documented_closed_form():
     """Response k (n.l): the directions do not move it, n.l +- D eps moves it by k D eps, and the
-    result widens by eps (A + B |ln r|) relative (DESIGN section 4's constants (16, 4, 6, 8))."""
+    result widens by eps (A + B |ln r|) relative (the constants (16, 4, 6, 8) of docs/design.md section 4)."""
     from glphong.materials import ShadingFrame
     from glphong.tolerances import BAND, EPS
 

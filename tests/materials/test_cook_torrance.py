@@ -1,8 +1,11 @@
 """The built-in model 'cook_torrance_lobe' (`glphong.materials.CookTorranceLobe`) and the material
 `glphong.materials.CookTorrance` (= ``Diffuse + CookTorranceLobe``), tested the way a user tests a model.
 
-What is tested (GPU parts on both backends, fixture ``glphong_backend``; the figures were measured on Mesa
-llvmpipe and are identical through EGL and OSMesa):
+What is specific to it (twin agreement for m = 1e-3 to 10, both forms, the Fresnel choices and with the
+diffuse term, never NaN or Inf with F = 1 at both ends of the m range, the definition's mechanics, the
+program key, the sum of the terms, the declared properties and the stability cases are in
+tests/test_conformance.py; GPU parts on both backends, fixture ``glphong_backend``; the figures were
+measured on Mesa llvmpipe and are identical through EGL and OSMesa):
 
 - the closed form, written here in float64 from the textbook formulas (h = (l + v)/|l + v|, ``sin^2`` from
   ``|n x h|^2``, ``D = exp(-tan^2/m^2) / (pi m^2 cos^4)``, the min() masking, Schlick on ``h.l``, divided by
@@ -30,18 +33,14 @@ llvmpipe and are identical through EGL and OSMesa):
   incident angles 0, 45, 75, 85 degrees (m = 0.05: 1.0000, 1.0000, 0.9991, 0.9431; m = 0.3: 0.9956,
   0.9567, 0.9273, 0.9702; m = 1: 0.4534, 0.6405, 0.9063, 0.9695; quadrature converged to 2e-4); the 1982
   form's is 4 times it (3.6 to 4.0 at 75 degrees: above 1, as documented);
-- the GLSL response against the twin (`assert_twin_matches`, 2150 pairs of seeded random and edge sets):
-  m = 1e-3, 0.05, 0.3, 1, 10 (microfacet, Schlick 0.04), m = 1e-3 and 0.3 (1982), F = 1, the dielectric
-  Fresnel, and `CookTorrance` with its diffuse term: no pair outside the band, ``max_relative_error`` at
-  most 2.6e-5 for the lobe and 3.8e-5 with the diffuse term (bound 1e-4); never NaN or Inf;
-- the model's 59 stability cases (generic geometry for both forms, grazing view down to n.v = 1e-30,
-  mirrored grazing pairs with (n.l)(n.v) = 1e-20 and 1e-40, one beyond FLT_MAX that saturates, grazing
-  half vectors with tan^2/m^2 up to 1e4 and (n.h)^2 underflowing, m = 1e-3 to 10 at and around the peak,
-  v.h down to 1e-6, Schlick at h.l rounding to 1) against the mpmath oracle: 59/59 pass, 0 NaN, 0 Inf;
-- the definition: params and ranges (errors name m and [0.001, 10]), needs 'view', the form choice and its
-  define ``COOK_TORRANCE_LOBE_FORM``, the default ``SchlickFresnel(0.04)``, an empty ``vanishes_with`` (the
-  lobe stays in the key even with f0 = 0; the diffuse term leaves it at rho_d = 0), uniform names, the
-  declared properties;
+- the model's 59 stability cases (run in the conformance test: generic geometry for both forms, grazing
+  view down to n.v = 1e-30, mirrored grazing pairs with (n.l)(n.v) = 1e-20 and 1e-40, one beyond
+  FLT_MAX that saturates, grazing half vectors with tan^2/m^2 up to 1e4 and (n.h)^2 underflowing,
+  m = 1e-3 to 10 at and around the peak, v.h down to 1e-6, Schlick at h.l rounding to 1): the
+  saturating one is the only case outside the valid range, and gives FLT_MAX, not Inf;
+- the declaration: params and range [0.001, 10], needs 'view', the form choice, the Fresnel cosine and
+  the default ``SchlickFresnel(0.04)``, an empty ``vanishes_with`` (the lobe stays in the key even with
+  f0 = 0, where F is still > 0 off the normal), the declared properties and their conditions;
 - a sphere under a point light rendered through ``glphong_renderer``, passing `assert_render_matches`
   (relative error below 1e-4 where the twin is at least 2^-100; measured 3.7e-5).
 """
@@ -50,14 +49,12 @@ import pytest
 
 import glphong
 import glphong.primitives
-from glphong.key import program_key, response_key
+from glphong.key import program_key
 from glphong.materials import (CookTorrance, CookTorranceLobe, DielectricFresnel, Diffuse, SchlickFresnel,
                                ShadingFrame)
 from glphong.materials.cook_torrance import COOK_TORRANCE_FORM_RATIO, cook_torrance_beckmann
-from glphong.programs import assemble
 from glphong.stability import cases_for, run_stability
-from glphong.testing import (assert_render_matches, assert_twin_matches, direction, direction_sets, evaluate,
-                             frame_around, rotate_toward)
+from glphong.testing import assert_render_matches, direction, direction_sets, evaluate, frame_around, rotate_toward
 
 EPS = 2.0 ** -24
 FLT_MIN = 2.0 ** -126
@@ -331,57 +328,19 @@ def test_specular_albedo(m):
     assert abs(b - 4 * albedo[75.0]) < 1e-12 and b > 3.6  # 4 times the microfacet form's: above 1
 
 
-# --------------------------------------------------------------------------- GPU against the twin
-TWIN_CASES = [(m, "microfacet", SchlickFresnel(0.04)) for m in MS] + [
-    (1e-3, "1982", SchlickFresnel(0.04)), (0.3, "1982", SchlickFresnel(0.04)), (0.3, "microfacet", None),
-    (0.05, "microfacet", DielectricFresnel(1.5))]
-
-
-@pytest.mark.parametrize("m, form, fresnel", TWIN_CASES,
-                         ids=[f"m={m:g}-{form}-{type(f).__name__}" for m, form, f in TWIN_CASES])
-def test_twin_matches(glphong_backend, m, form, fresnel):
-    figures = assert_twin_matches(CookTorranceLobe(m, fresnel, form=form), n=1000, seed=0, backend=glphong_backend)
-    assert figures["pairs"] == 2150
-    assert figures["nonzero"] > (400 if m <= 1e-3 else 700)  # narrow lobes are 0 at most random pairs
-    assert figures["max_relative_error"] < 1e-4  # measured at most 2.6e-5
-
-
-def test_twin_matches_with_the_diffuse_term(glphong_backend):
-    figures = assert_twin_matches(CookTorrance((0.5, 0.0, 0.2), 0.2), n=1000, seed=1, backend=glphong_backend)
-    assert figures["nonzero"] > 1500 and figures["max_relative_error"] < 1e-4  # measured 3.8e-5
-
-
-def test_cook_torrance_is_diffuse_plus_lobe(glphong_backend):
-    wi, wo, _ = direction_sets(200, 2)
-    total = evaluate(CookTorrance(0.3, 0.2), wi, wo, backend=glphong_backend).astype(np.float64)
-    parts = sum(evaluate(m, wi, wo, backend=glphong_backend).astype(np.float64)
-                for m in (Diffuse(0.3), CookTorranceLobe(0.2)))
-    np.testing.assert_allclose(total, parts, rtol=2 * EPS, atol=0)  # one float32 addition
-
-
-def test_never_nan_or_inf(glphong_backend):
-    wi, wo, _ = direction_sets(1000, 9)
-    for m in (1e-3, 10.0):
-        for form in ("microfacet", "1982"):
-            gpu = evaluate(CookTorranceLobe(m, SchlickFresnel(1.0), form=form), wi, wo, backend=glphong_backend)
-            assert np.all(np.isfinite(gpu)) and np.all(gpu >= 0)
-
-
 # --------------------------------------------------------------------------- stability
-def test_stability_cases(glphong_backend):
-    report = run_stability(backend=glphong_backend, cases=cases_for(CookTorranceLobe))
-    assert len(report.rows) == 59
-    assert report.passed_count == len(report.rows), report.format_table()
-    assert report.nan_count == 0 and report.inf_count == 0
-    saturated = [r for r in report.rows if not r.in_range]
-    assert [r.case for r in saturated] == ["cook_torrance mirrored grazing n.l=n.v=1e-36 m=1e-3"]
-    assert saturated[0].gpu == [FLT_MAX] * 3
+def test_the_stability_cases_and_the_saturating_one(glphong_backend):
+    cases = cases_for(CookTorranceLobe)
+    assert len(cases) == 59
+    saturated = [c for c in cases if not c.in_range]
+    assert [c.name for c in saturated] == ["cook_torrance mirrored grazing n.l=n.v=1e-36 m=1e-3"]
+    report = run_stability(backend=glphong_backend, cases=saturated)
+    assert report.passed_count == 1 and report.rows[0].gpu == [FLT_MAX] * 3
 
 
-# --------------------------------------------------------------------------- the definition
-def test_definition():
+# --------------------------------------------------------------------------- the declaration
+def test_declaration():
     assert CookTorranceLobe.name == "cook_torrance_lobe" and CookTorrance.name == "cook_torrance"
-    assert glphong.materials.model_named("cook_torrance_lobe") is CookTorranceLobe
     assert CookTorrance.terms == (Diffuse, CookTorranceLobe)
     (m,) = CookTorranceLobe.params
     assert (m.name, m.kind, m.glsl_type, m.interval, m.default) == ("m", "scalar", "float", "[0.001, 10]", None)
@@ -389,51 +348,16 @@ def test_definition():
     assert CookTorranceLobe.needs == ("view",) and CookTorranceLobe.ambient is None
     assert CookTorranceLobe.vanishes_with == ()
     assert CookTorranceLobe.fresnel_slot.cosine == "h.l"
+    assert CookTorranceLobe.fresnel_slot.default == SchlickFresnel(0.04)
     (form,) = CookTorranceLobe.choices
     assert (form.name, form.values, form.default) == ("form", ("microfacet", "1982"), "microfacet")
     p = CookTorranceLobe.properties
     assert (p.reciprocal, p.isotropic, p.energy_conserving, p.non_negative) == (True, True, True, True)
     assert "1982" in p.condition and "microfacet" in CookTorrance.properties.condition
-    material = CookTorrance(0.2, 0.3)
-    diffuse, lobe = material.components
-    assert diffuse.rho_d == (0.2, 0.2, 0.2) and lobe.m == 0.3 and lobe.form == "microfacet"
-    assert lobe.fresnel == SchlickFresnel(0.04) and material.form == "microfacet"
-    assert CookTorrance(0.2, 0.3, None, "1982").fresnel is None
-    for bad in (0.0, 1e-4, 20.0, np.inf, np.nan):
-        with pytest.raises(ValueError, match=r"m .*\[0\.001, 10\]"):
-            CookTorrance(0.2, bad)
-    with pytest.raises(ValueError, match="rho_d"):
-        CookTorrance(1.5, 0.3)
-    with pytest.raises(ValueError, match="form"):
-        CookTorrance(0.2, 0.3, form="1981")
-    with pytest.raises(TypeError, match="fresnel"):
-        CookTorrance(0.2, 0.3, 0.04)
-    with pytest.raises(TypeError, match="m"):
-        CookTorranceLobe()
-
-
-def test_program_key_and_uniform_names():
-    names = lambda material: [t.name for t in program_key(material, {"point": 1}, None).terms]  # noqa: E731
-    assert names(CookTorrance(0.2, 0.3)) == ["diffuse", "cook_torrance_lobe"]
-    assert names(CookTorrance(0.0, 0.3)) == ["cook_torrance_lobe"]
-    assert names(CookTorrance(0.0, 0.3, SchlickFresnel(0.0))) == ["cook_torrance_lobe"]  # F still > 0 off normal
+    # F(h.l) > 0 off the normal even with f0 = 0: no value of the lobe's parameters removes it
     assert not CookTorranceLobe(0.3, SchlickFresnel(0.0)).vanishes()
-
-    key = program_key(CookTorrance(0.2, 0.3, form="1982"), {"point": 1}, None)
-    assert key.needs_view and not key.has_tangent
-    uniforms = CookTorrance(0.2, 0.3, form="1982").uniform_values(key)
-    wanted = {"u_diffuse_rho_d", "u_cook_torrance_lobe_m", "u_cook_torrance_lobe_fresnel_f0",
-              "u_cook_torrance_lobe_fresnel_ior"}
-    assert wanted <= uniforms.keys() <= wanted | {"u_cook_torrance_lobe_fresnel_form"}  # the uber-shader's switch
-    assert uniforms["u_cook_torrance_lobe_m"] == np.float32(0.3) and uniforms["u_cook_torrance_lobe_m"].shape == ()
-    np.testing.assert_array_equal(uniforms["u_cook_torrance_lobe_fresnel_f0"], np.float32([0.04] * 3))
-    defines = dict(key.defines())
-    assert defines["COOK_TORRANCE_LOBE_FORM"] == "1" and defines["COOK_TORRANCE_LOBE_FRESNEL_SCHLICK"] == "1"
-    source = assemble(key.fragment_chunks(), key.defines(), key.generated_chunks())
-    assert "uniform float u_cook_torrance_lobe_m;" in source
-    assert "response += cook_torrance_lobe_response(f, wi, wo, n_dot_l);" in source
-    assert dict(response_key(CookTorranceLobe(0.3)).defines())["COOK_TORRANCE_LOBE_FORM"] == "0"
-    assert "COOK_TORRANCE_LOBE_FRESNEL_SCHLICK" not in dict(response_key(CookTorranceLobe(0.3, None)).defines())
+    assert [t.name for t in program_key(CookTorrance(0.0, 0.3, SchlickFresnel(0.0)), {"point": 1}, None).terms] == [
+        "cook_torrance_lobe"]
 
 
 # --------------------------------------------------------------------------- a render

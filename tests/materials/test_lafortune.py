@@ -2,8 +2,11 @@
 `glphong.materials.Lafortune` (Lafortune, Foo, Torrance and Greenberg 1997), tested the way a user tests
 their own model.
 
-What is tested, with the toolkit of `glphong.testing` on both backends (fixture ``glphong_backend``);
-figures measured on Mesa llvmpipe, the same through EGL and OSMesa:
+What is specific to it (twin agreement for the lobes below, n = 0 to 1e6, four lobes with the diffuse term,
+a tilted mirrored frame and every rho 0, the definition's mechanics, the sum of the terms, the declared
+properties and the stable run of the stability cases are in tests/test_conformance.py), with the toolkit
+of `glphong.testing` on both backends (fixture ``glphong_backend``); figures measured on Mesa llvmpipe,
+the same through EGL and OSMesa:
 
 - closed form: ``f_r = rho_d/pi + sum_i rho_i max(Cx l_x v_x + Cy l_y v_y + Cz l_z v_z, 0)^n_i``
   written here in float64 at the unit directions the GPU is given, against `evaluate` (GPU) and the
@@ -35,22 +38,21 @@ figures measured on Mesa llvmpipe, the same through EGL and OSMesa:
   30, 60 and 80 degrees (about rho_s cos(theta_i)); an off-specular lobe (C = (-1.5, -1.5, 1), n = 10)
   scaled to reflect rho_s = 0.7 at normal incidence reflects 7.0 at 80 degrees (why energy
   conservation is not declared);
-- GPU against twin (`assert_twin_matches`, 2150 pairs each: seeded random and the edge sets), for the
-  lobes above, n = 0, 0.5, 1e6 and a lobe saturating at e^88 (|C| = 2, n = 1e6); figures asserted
-  (max relative error over the decided channels, measured 5.5e-4 at n = 1 near x = 0, at most 1.8e-4
-  otherwise, and no pair outside the band); with a tilted normal and a mirrored tangent frame as well
-  (measured at most 2.1e-4, bound 1e-3);
+- a lobe saturating at e^88 (|C| = 2, n = 1e6) at l = v: finite on the GPU, e^88 (n.l) to 1e-4, its zero
+  channel exactly 0;
 - a render of `glphong.primitives.sphere` (analytic tangents) with an anisotropic two-lobe material
   under a point light through ``glphong_renderer``, passing `assert_render_matches`;
-- the definition: params and ranges (a bad value raises ValueError naming the lobe and the range),
-  needs ('view', 'tangent'), no choices, the structural define LAFORTUNE_LOBES_COUNT, the lobe term
-  leaves the key when every rho is 0, the uniform names (only the used lobes' are bound), the
-  constructors (lobes= or per-lobe keywords, 1 to 4 lobes), `parameter_values` and repr round trips;
-- the stability cases (`LafortuneLobes.stability_cases`): all pass on both backends, 0 NaN/Inf; the
-  float64 twin agrees with the mpmath oracle on every in-range case to 1e-7 (measured 3.5e-8; checked,
-  for every registered case, by tests/test_stability.py::test_float64_twin_agrees_with_the_mpmath_oracle); the
-  textbook formulation (``NAIVE``) fails the n = 1e6 case near the peak (1.7e-2 off) and the saturating
-  lobe (``pow(2, 1e6)`` is Inf).
+- the declaration: params and ranges, needs ('view', 'tangent'), no choices, declared properties; the
+  constructors (lobes= or per-lobe keywords, 1 to 4 lobes; a bad lobe raises naming the lobe and the
+  range), `parameter_values` and repr round trips; the structural define LAFORTUNE_LOBES_COUNT and the
+  uniform names (only the used lobes' are bound, every lobe's is declared);
+- the stability cases (`LafortuneLobes.stability_cases`, 25, all passing in the conformance test): the
+  Phong-type lobe at n = 1e6 exact at its peak (1e-6) and to 1e-4 near it, the saturating lobe finite
+  with its zero channel at the diffuse term; the float64 twin agrees with the mpmath oracle on every
+  in-range case to 1e-7 (measured 3.5e-8; checked, for every registered case, by
+  tests/test_stability.py::test_float64_twin_agrees_with_the_mpmath_oracle); the textbook formulation
+  (``NAIVE``) fails the n = 1e6 case near the peak (1.7e-2 off) and the saturating lobe (``pow(2, 1e6)``
+  is Inf).
 """
 import numpy as np
 import pytest
@@ -61,7 +63,7 @@ from glphong.key import program_key, response_key
 from glphong.materials import Diffuse, Lafortune, LafortuneLobes, PhongLobe
 from glphong.materials.lafortune import LAFORTUNE_MAX_LOBES
 from glphong.programs import assemble, effective_source
-from glphong.testing import assert_render_matches, assert_twin_matches, evaluate, float32_units
+from glphong.testing import assert_render_matches, evaluate, float32_units
 
 EPS = 2.0 ** -24
 FLT_MIN = 2.0 ** -126
@@ -413,54 +415,15 @@ def test_directional_albedo():
     assert LafortuneLobes.properties.energy_conserving is False and Lafortune.properties.energy_conserving is False
 
 
-# --------------------------------------------------------------------------- GPU against twin
-TWIN_SETS = {
-    "phong n=0": [(1.0, *PHONG, 0.0)],
-    "phong n=0.5": [(1.0, -1.0, -0.5, 0.7, 0.5)],
-    "phong n=1": [((0.7, 0.0, 0.3), *PHONG, 1.0)],
-    "phong n=50": [(1.0, *PHONG, 50.0)],
-    "phong n=1e6": [(1.0, *PHONG, 1e6)],
-    "off-specular n=1e3": [(1.0, *OFF, 1e3)],
-    "retro n=1e6": [(1.0, 1.0, 1.0, 1.0, 1e6)],
-    "anisotropic n=1e4": [(1.0, *ANISO, 1e4)],
-    "four lobes": FOUR,
-    "saturating |C|=2 n=1e6": [((1.0, 0.0, 0.5), 2.0, 2.0, 2.0, 1e6)],
-}
-#: measured max_relative_error (EGL and OSMesa alike) -> asserted bound
-TWIN_BOUNDS = {"phong n=0": 0.0, "phong n=0.5": 1e-4, "phong n=1": 2e-3, "phong n=50": 1e-4, "phong n=1e6": 1e-3,
-               "off-specular n=1e3": 2e-4, "retro n=1e6": 1e-6, "anisotropic n=1e4": 1e-4, "four lobes": 1e-5,
-               "saturating |C|=2 n=1e6": 1e-5}
-# measured: 0, 3.3e-5, 5.5e-4 (n = 1, near x = 0), 3.3e-5, 1.8e-4, 5.9e-5, 1.2e-7, 1.8e-5, 4.7e-7, 1.8e-6
-
-
-@pytest.mark.parametrize("set_name", list(TWIN_SETS))
-def test_twin_matches(glphong_backend, set_name):
-    lobes = TWIN_SETS[set_name]
-    material = Lafortune(0.2, lobes) if set_name == "four lobes" else LafortuneLobes(lobes)
-    figures = assert_twin_matches(material, n=1000, seed=0, backend=glphong_backend)
-    assert figures["pairs"] == 2150 and figures["nonzero"] > 1000
-    assert figures["max_relative_error"] <= TWIN_BOUNDS[set_name], figures
-    if set_name == "saturating |C|=2 n=1e6":  # e^88 at l = v: finite, the zero channel 0
-        wi = np.array([[0.3, 0.1, 0.9]])
-        gpu = evaluate(material, wi, wi, backend=glphong_backend)
-        assert np.isfinite(gpu).all() and gpu[0, 1] == 0.0
-        np.testing.assert_allclose(gpu[0, 0], np.exp(88.0) * float(unit(float32_units(wi))[0, 2]), rtol=1e-4)
-
-
-@pytest.mark.parametrize("set_name", ["phong n=1e6", "off-specular n=1e3", "four lobes"])
-def test_twin_matches_tilted_frame(glphong_backend, set_name):
-    normal, tangent = FRAMES["tilted"]
-    lobes = TWIN_SETS[set_name]
-    material = Lafortune(0.2, lobes) if set_name == "four lobes" else LafortuneLobes(lobes)
-    figures = assert_twin_matches(material, n=1000, seed=1, backend=glphong_backend, normal=normal,
-                                  tangent=np.append(tangent, -1.0))  # a mirrored frame: b = -n x t
-    assert figures["nonzero"] > 800 and figures["max_relative_error"] < 1e-3, figures
-
-
-def test_twin_matches_rho_zero(glphong_backend):
-    figures = assert_twin_matches(LafortuneLobes([(0.0, *PHONG, 50.0), (0.0, *RETRO, 5.0)]), backend=glphong_backend,
-                                  n=200)
-    assert figures["nonzero"] == 0 and figures["max_relative_error"] == 0.0
+# --------------------------------------------------------------------------- saturation
+def test_a_saturating_lobe_is_finite_at_e88(glphong_backend):
+    """|C| = 2, n = 1e6 at l = v: the exponent is clamped at 88 (the twin check of the conformance test covers
+    the other pairs); the zero channel stays 0, no 0 * Inf."""
+    material = LafortuneLobes([((1.0, 0.0, 0.5), 2.0, 2.0, 2.0, 1e6)])
+    wi = np.array([[0.3, 0.1, 0.9]])
+    gpu = evaluate(material, wi, wi, backend=glphong_backend)
+    assert np.isfinite(gpu).all() and gpu[0, 1] == 0.0
+    np.testing.assert_allclose(gpu[0, 0], np.exp(88.0) * float(unit(float32_units(wi))[0, 2]), rtol=1e-4)
 
 
 # --------------------------------------------------------------------------- a render
@@ -478,10 +441,9 @@ def test_render_matches(glphong_renderer):
     assert key.has_tangent and ("LAFORTUNE_LOBES_COUNT", "2") in key.defines()
 
 
-# --------------------------------------------------------------------------- the definition
-def test_definition():
+# --------------------------------------------------------------------------- the declaration
+def test_declaration():
     assert LafortuneLobes.name == "lafortune_lobes"
-    assert glphong.materials.model_named("lafortune_lobes") is LafortuneLobes
     assert Lafortune.name == "lafortune" and Lafortune.terms == (Diffuse, LafortuneLobes)
     assert LAFORTUNE_MAX_LOBES == 4
     names = [p.name for p in LafortuneLobes.params]
@@ -563,8 +525,6 @@ def test_bad_constructor_calls_are_refused():
 def test_program_key_defines_and_uniform_names():
     terms = lambda m: [t.name for t in program_key(m, {"point": 1}, None).terms]  # noqa: E731
     lobes2 = [(0.5, -1, -1, 1, 20.0), ((0.0, 0.1, 0.2), 0.9, 0.9, 0.9, 3.0)]
-    assert terms(Lafortune(0.2, lobes2)) == ["diffuse", "lafortune_lobes"]
-    assert terms(Lafortune(0.0, lobes2)) == ["lafortune_lobes"]
     assert terms(Lafortune(0.2, [(0.0, -1, -1, 1, 20.0), (0.0, 0.9, 0.9, 0.9, 3.0)])) == ["diffuse"]  # every rho 0
     assert LafortuneLobes([(0.0, -1, -1, 1, 20.0)]).vanishes() and not LafortuneLobes(lobes2[1:]).vanishes()
     assert response_key(LafortuneLobes([(0.0, -1, -1, 1, 20.0)])).terms == ()
@@ -586,23 +546,10 @@ def test_program_key_defines_and_uniform_names():
     four = Lafortune(0.2, FOUR)
     uniforms = four.uniform_values(program_key(four, {"point": 1}, None))
     np.testing.assert_array_equal(uniforms["u_lafortune_lobes_lobe4_c"], np.float32([-0.6, -0.9, 1.0]))
-    # no light, an ambient light: only the diffuse term answers L_a (the lobes have no ambient answer)
-    assert [t.name for t in program_key(Lafortune(0.2, lobes2), {}, (0.1, 0.1, 0.1)).terms] == ["diffuse"]
-
-
-def test_lafortune_response_is_the_sum_of_its_terms(glphong_backend):
-    rng = np.random.default_rng(2)
-    wi, wo = _hemisphere(rng, 100, np.array([0.0, 0.0, 1.0])), _hemisphere(rng, 100, np.array([0.0, 0.0, 1.0]))
-    count = min(len(wi), len(wo))
-    wi, wo = wi[:count], wo[:count]
-    total = evaluate(Lafortune(0.2, FOUR), wi, wo, backend=glphong_backend).astype(np.float64)
-    parts = sum(evaluate(m, wi, wo, backend=glphong_backend).astype(np.float64)
-                for m in (Diffuse(0.2), LafortuneLobes(FOUR)))
-    np.testing.assert_allclose(total, parts, rtol=2 * EPS, atol=0)  # one float32 addition
 
 
 # --------------------------------------------------------------------------- stability
-def test_stability_cases_pass(glphong_backend):
+def test_stability_cases(glphong_backend):
     from glphong.stability import cases_for, run_stability
 
     cases = cases_for(LafortuneLobes)
@@ -611,10 +558,8 @@ def test_stability_cases_pass(glphong_backend):
     for needle in ("grazing light", "off-specular", "retro-reflective C=0.98 n=100 at l = v", "anisotropic",
                    "n=1e+06 peak", "four lobes", "saturating"):
         assert needle in names, needle
-    report = run_stability(backend=glphong_backend, cases=cases)
-    assert report.passed_count == len(cases), report.format_table()
-    assert report.nan_count == 0 and report.inf_count == 0
-    rows = {r.case: r for r in report.rows}
+    chosen = [c for c in cases if "n=1e+06 peak" in c.name or "n=1e+06 near" in c.name or "saturating" in c.name]
+    rows = {r.case: r for r in run_stability(backend=glphong_backend, cases=chosen).rows}
     assert rows["lafortune phong-type C=(-1,-1,1) n=1e+06 peak"].relative_error < 1e-6  # exact at the peak
     assert rows["lafortune phong-type C=(-1,-1,1) n=1e+06 near"].relative_error < 1e-4  # measured 2e-5
     saturated = rows["lafortune saturating C=2 n=1e6 at l = v"]
@@ -623,5 +568,3 @@ def test_stability_cases_pass(glphong_backend):
     naive = {r.case: r for r in run_stability(backend=glphong_backend, formulation="naive", cases=[
         c for c in cases if "n=1e+06 near" in c.name or "saturating" in c.name]).rows}
     assert not any(r.passed for r in naive.values())  # pow(dot, 1e6): 1.7e-2 off near the peak; 2^1e6 = Inf
-
-

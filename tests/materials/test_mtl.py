@@ -1,24 +1,20 @@
 """MtlPhong, the MTL material of OBJ files: the lecture's Phong with MTL's own ambient coefficient.
 
-- GPU against twin on both backends (4300 direction pairs).
+What is specific to it (twin agreement on both backends, 4300 direction pairs, the definition's mechanics
+and its stability cases, the generic geometry against the mpmath oracle of the textbook formula, are in
+tests/test_conformance.py):
+
 - Without an ambient light it renders the very image `Phong(Kd, Ks, Ns)` does (bit for bit: the same
   arithmetic); with ``L_a`` it adds ``Ka L_a`` where Phong adds ``Kd L_a``: the difference of the two
   images is ``(Ka - Kd) L_a`` at every covered pixel (to float32 rounding).
-- Its stability cases (the generic geometry) pass against the mpmath oracle of the textbook formula.
 """
 import numpy as np
 
 import glphong
-from glphong import primitives, stability
+from glphong import primitives
 from glphong.materials import MtlPhong
-from glphong.testing import assert_twin_matches
 
 KD, KS, NS, KA = (0.3, 0.2, 0.1), (0.5, 0.4, 0.3), 40.0, (0.05, 0.1, 0.2)
-
-
-def test_gpu_matches_the_twin(glphong_backend):
-    figures = assert_twin_matches(MtlPhong(KD, KS, NS, KA), backend=glphong_backend)
-    assert figures["nonzero"] > 3000 and figures["max_relative_error"] < 1e-4
 
 
 def test_it_is_the_lecture_phong_with_mtl_ambient(glphong_backend, glphong_make_renderer):
@@ -36,8 +32,3 @@ def test_it_is_the_lecture_phong_with_mtl_ambient(glphong_backend, glphong_make_
     np.testing.assert_allclose(difference, np.broadcast_to(0.5 * (np.array(KA) - np.array(KD)), difference.shape),
                                atol=2e-7)
 
-
-def test_stability_cases():
-    cases = [c for c in stability.CASES if c.name.startswith("mtl_phong")]
-    report = stability.run_stability("auto", "stable", cases)
-    assert len(cases) >= 9 and report.passed_count == len(cases) and report.nan_count == 0
