@@ -1,6 +1,6 @@
 """The lecture's four questions answered for every built-in model: the README's table.
 
-For each entry of the gallery (`glphong.gallery.GALLERY`: every built-in model at the parameters of its
+For each entry of the gallery (`glphong.analysis.gallery.GALLERY`: every built-in model at the parameters of its
 tile) `glphong.analysis.properties` measures, through the float64 twin, whether its BRDF is non-negative
 (min ``f_r`` over 90,000 direction pairs), energy-conserving (the largest directional albedo over 15
 incident angles, cos(theta_i) from 1 to 1e-3, with the quadrature's error estimate), reciprocal (largest
@@ -19,7 +19,7 @@ import numpy as np
 
 import glphong
 from glphong import analysis
-from glphong.gallery import GALLERY
+from glphong.analysis.gallery import GALLERY
 
 #: parameters that meet a model's stated energy condition where the gallery tile's do not
 #: (the tiles share a diffuse albedo of 0.6, which with a Fresnel factor reaching 1 exceeds 1)

@@ -16,7 +16,7 @@ import numpy as np
 import trimesh
 
 import glphong
-from glphong.figures import phong_examples
+from glphong.analysis.figures import phong_examples
 
 MATERIALS = {
     "Lambert": glphong.Lambert(kd=(0.3, 0.2, 0.1), ka=0.01),

@@ -1,8 +1,8 @@
 """What each reflectance model costs: frame time relative to Lambert, and its error against the twin.
 
-Every entry of the gallery (`glphong.gallery.GALLERY`: one sphere per model, the same lights, a key point
+Every entry of the gallery (`glphong.analysis.gallery.GALLERY`: one sphere per model, the same lights, a key point
 light, a rim directional light and ambient) is rendered at SIZE x SIZE (default 1024; the sphere covers
-about 55 % of the image), alternating all models each round after a warm-up (`glphong.timing.alternating_medians`),
+about 55 % of the image), alternating all models each round after a warm-up (`glphong.core.timing.alternating_medians`),
 and reported as the median frame time (render + float32 readback), its ratio to Lambert measured in the
 same process, and the cross-check against the float64 twin at that size (`glphong.verify`: covered
 pixels, max relative error, pixels outside the band).
@@ -13,8 +13,8 @@ import argparse
 import json
 
 import glphong
-from glphong.gallery import GALLERY, gallery_scene
-from glphong.timing import alternating_medians
+from glphong.analysis.gallery import GALLERY, gallery_scene
+from glphong.core.timing import alternating_medians
 
 
 def main(argv=None):

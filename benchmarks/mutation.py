@@ -14,7 +14,7 @@ copy) with ``PYTHONPATH=<copy>`` prepended, ``GLPHONG_GLSL_DIR=<copy>/glsl`` (gl
 GLSL chunks from there), ``GLPHONG_REQUIRE_BACKENDS=egl,osmesa`` and
 ``PYTHONDONTWRITEBYTECODE=1``.  glphong is usually installed in editable mode pointing at the
 main checkout, so before any run the script checks, in the copy with that environment, that
-both ``glphong.__file__`` and ``glphong.programs.glsl_root()`` lie inside the copy, and stops
+both ``glphong.__file__`` and ``glphong.gpu.programs.glsl_root()`` lie inside the copy, and stops
 if not.  The temporary copies are removed at the end.
 
 Examples
@@ -446,7 +446,7 @@ def environment(copy):
 
 def check_import_paths(copy):
     """Stop unless glphong's Python files and GLSL chunks both come from the copy at ``copy``."""
-    code = "import glphong, glphong.programs as p; print(glphong.__file__); print(p.glsl_root())"
+    code = "import glphong, glphong.gpu.programs as p; print(glphong.__file__); print(p.glsl_root())"
     out = subprocess.run([sys.executable, "-c", code], cwd=copy, env=environment(copy), capture_output=True,
                          text=True, timeout=300)
     if out.returncode != 0:

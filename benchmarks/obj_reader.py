@@ -1,4 +1,4 @@
-"""OBJ reading cost: glphong's reader (`glphong.obj_reader.read_obj`) against trimesh's (not a test).
+"""OBJ reading cost: glphong's reader (`glphong.formats.obj.read_obj`) against trimesh's (not a test).
 
 Writes three files into a folder, then reads each with each reader in fresh Python processes
 (``--repeat`` of them, the least time and memory kept) and prints a table of peak memory and wall time:
@@ -10,7 +10,7 @@ Writes three files into a folder, then reads each with each reader in fresh Pyth
 - ``plain_1m_faces.obj``: a 708 x 708 grid of ``v`` lines and 999,698 ``f a b c`` triangles.
 
 Peak memory is ``resource.getrusage(RUSAGE_SELF).ru_maxrss`` after the read minus its value before it,
-after the imports (numpy, trimesh, glphong.obj_reader) and a first read of a tiny OBJ file (so lazy
+after the imports (numpy, trimesh, glphong.formats.obj) and a first read of a tiny OBJ file (so lazy
 imports are paid before).  On Linux a process starts with its parent's peak as its own, so the files
 are written by a separate process and the parent stays small.  trimesh reads with
 ``trimesh.load(path, force="mesh")``, which parses the whole file; it computes no vertex normals where
@@ -27,11 +27,11 @@ Measured on this box (2 cores shared with other work, whose load moves the times
     plain_1m_faces.obj        glphong      285      2.54     999698
     plain_1m_faces.obj        trimesh      254      3.03     999698
 
-The previous glphong reader (a Python tuple per corner; ``--extra glphong.loaders:read_obj`` while
-`glphong.loaders.read_obj` was that reader) took 190 MB and 2.9 s, 725 MB and 12.2 s, 786 MB and
+The previous glphong reader (a Python tuple per corner; ``--extra glphong.formats:read_obj`` while
+`glphong.formats.read_obj` was that reader) took 190 MB and 2.9 s, 725 MB and 12.2 s, 786 MB and
 17.4 s on the same files, one run each.
 
-Run:  python benchmarks/obj_reader.py [--folder DIR] [--repeat 3] [--extra glphong.loaders:read_obj]
+Run:  python benchmarks/obj_reader.py [--folder DIR] [--repeat 3] [--extra glphong.formats:read_obj]
 """
 import argparse
 import json
@@ -97,11 +97,11 @@ def child(reader, path, tiny):
 
     import trimesh
 
-    import glphong.obj_reader
+    import glphong.formats.obj
 
     if reader == "glphong":
         def read(p):
-            return sum(mesh.triangle_count for _, mesh in glphong.obj_reader.read_obj(p))
+            return sum(mesh.triangle_count for _, mesh in glphong.formats.obj.read_obj(p))
     elif reader == "trimesh":
         def read(p):
             return len(trimesh.load(p, force="mesh").faces)

@@ -17,7 +17,7 @@ import numpy as np
 import trimesh
 
 import glphong
-from glphong.timing import alternating_medians
+from glphong.core.timing import alternating_medians
 
 
 def _scene(materials, lights):

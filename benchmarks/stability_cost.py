@@ -13,7 +13,7 @@ import numpy as np
 import trimesh
 
 import glphong
-from glphong.timing import alternating_medians
+from glphong.core.timing import alternating_medians
 
 
 def plane_scene(material):

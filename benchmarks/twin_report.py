@@ -1,6 +1,6 @@
 """GPU against twin per reflectance model, on every backend: the figures of `glphong.testing.assert_twin_matches`.
 
-For every entry of the gallery (`glphong.gallery.GALLERY`) and each of its terms, the GLSL response is
+For every entry of the gallery (`glphong.analysis.gallery.GALLERY`) and each of its terms, the GLSL response is
 evaluated on N seeded random direction pairs plus the 17 edge sets of `glphong.testing.direction_sets`
 (the +z normal, a tangent along x for the anisotropic terms) and compared with the float64 twin under the
 term's band: pairs, non-zero responses, the maximum relative error over the decided channels and the
@@ -10,7 +10,7 @@ Run:  python benchmarks/twin_report.py [--n 2000] [--backends egl osmesa]
 """
 import argparse
 
-from glphong.gallery import GALLERY
+from glphong.analysis.gallery import GALLERY
 from glphong.testing import TwinMismatch, assert_twin_matches
 
 

@@ -52,7 +52,7 @@ class Minnaert(MaterialModel):
     @classmethod
     def stability_cases(cls):
         """glphong's generic extreme geometry, at a limb-brightening and a darkening exponent."""
-        from glphong.stability import generic_cases
+        from glphong.checks.stability import generic_cases
 
         return generic_cases("minnaert m=0.6", cls(k=0.25, m=0.6)) + generic_cases("minnaert m=1.5", cls(k=0.25, m=1.5))
 

@@ -13,7 +13,7 @@ import numpy as np
 
 import glphong
 from glphong import primitives
-from glphong.geometry import MeshData
+from glphong.scene.geometry import MeshData
 
 
 def checker(size=128, cells=8):

@@ -11,21 +11,36 @@ Typical use::
         frame = r.render(scene)          # frame.radiance: (256, 256, 3) float32, W/(m^2 sr)
         report = glphong.verify(scene, r)
 """
-from . import imaging, materials, primitives, radiometry, reference
-from .camera import Camera, IntrinsicsCamera, OrthographicCamera, PerspectiveCamera, opencv_pose
-from .contexts import BackendUnavailableError, available_backends, create_context
-from .describe import describe, format_descriptions
-from .lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
-from .gltf_export import save_gltf
-from .loaders import load_scene
-from .materials import (AshikhminShirley, BlinnPhong, CookTorrance, DielectricFresnel, Diffuse, Lafortune, Lambert,
-                        Material, MaterialModel, MaterialSum, MeasuredBRDF, MtlPhong, NormalizedBlinnPhong,
-                        NormalizedPhong, OrenNayar, Param, Phong, SchlickFresnel, Texture, VertexColors, Ward)
-from .renderer import Frame, GBuffer, Renderer
-from .scene import Scene, SceneObject
-from .verify import VerifyReport, verify
+from glphong import _moved, materials
+from glphong.checks import reference
+from glphong.core import filesafety, imaging, radiometry
+from glphong.core.version import __version__
+from glphong.scene import primitives
+from glphong.scene.camera import Camera, IntrinsicsCamera, OrthographicCamera, PerspectiveCamera, opencv_pose
+from glphong.gpu.contexts import BackendUnavailableError, available_backends, create_context
+from glphong.gpu.describe import describe, format_descriptions
+from glphong.scene.lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
+from glphong.formats.gltf_export import save_gltf
+from glphong.formats.load import load_scene
+from glphong.materials import Material, MaterialModel, MaterialSum, Param, Texture, VertexColors
+from glphong.materials.ashikhmin_shirley import AshikhminShirley
+from glphong.materials.blinn import BlinnPhong
+from glphong.materials.cook_torrance import CookTorrance
+from glphong.materials.fresnel import DielectricFresnel, SchlickFresnel
+from glphong.materials.diffuse import Diffuse
+from glphong.materials.lafortune import Lafortune
+from glphong.materials.lambert import Lambert
+from glphong.materials.measured import MeasuredBRDF
+from glphong.materials.mtl import MtlPhong
+from glphong.materials.normalized import NormalizedBlinnPhong, NormalizedPhong
+from glphong.materials.oren_nayar import OrenNayar
+from glphong.materials.phong import Phong
+from glphong.materials.ward import Ward
+from glphong.gpu.renderer import Frame, GBuffer, Renderer
+from glphong.scene.scene import Scene, SceneObject
+from glphong.checks.verify import VerifyReport, verify
 
-__version__ = "0.1.0"
+_moved.install()  # the module paths of 0.1.0 keep working (glphong._moved)
 
 __all__ = [
     "Camera", "PerspectiveCamera", "IntrinsicsCamera", "OrthographicCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
@@ -33,5 +48,5 @@ __all__ = [
     "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
     "DielectricFresnel", "Texture", "VertexColors", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
-    "imaging", "materials", "primitives", "radiometry", "reference",
+    "imaging", "materials", "primitives", "radiometry", "reference", "filesafety", "__version__",
 ]

@@ -1,6 +1,6 @@
 """``python -m glphong``: see `glphong.cli`."""
 import sys
 
-from .cli import main
+from glphong.tools.cli import main
 
 sys.exit(main())

@@ -25,12 +25,16 @@ import threading
 
 import numpy as np
 
-from .contexts import BACKENDS, BackendUnavailableError, create_context
-from .key import response_key
-from .materials.model import Material
-from .materials.table import uniform_as
-from .programs import ProgramCache
-from .tolerances import BAND, EPS, response_band
+from glphong.gpu.contexts import BACKENDS, BackendUnavailableError, create_context
+from glphong.shaders.key import response_key
+from glphong.materials.model import Material
+from glphong.materials.table import uniform_as
+from glphong.gpu.programs import ProgramCache
+from glphong.checks.tolerances import BAND, EPS, response_band
+from glphong.checks import reference as ref
+from glphong.checks.verify import verify
+from glphong.gpu.contexts import EGLDisplayTerminatedError
+from glphong.gpu.renderer import Renderer
 
 __all__ = ["evaluate", "direction_sets", "assert_twin_matches", "assert_render_matches", "TwinMismatch",
            "frame_around", "direction", "rotate_toward", "float32_units", "cosine_power_interval",
@@ -42,7 +46,6 @@ _POOL_LOCK = threading.Lock()
 
 def _pooled(backend):
     """A context and its program cache per backend, created on first use and kept until exit."""
-    from .contexts import EGLDisplayTerminatedError
 
     with _POOL_LOCK:
         entry = _POOL.get(backend)
@@ -108,8 +111,6 @@ def _inputs(material, wi, wo, normal, tangent, uv):
 
 
 def _twin(material, key, uniforms, wi, wo, normal, tangent, uv):
-    from . import reference as ref
-
     u = {k: uniform_as(v, np.float64) for k, v in uniforms.items()}
     f = ref.shading_frame(normal.astype(np.float64), tangent.astype(np.float64), uv.astype(np.float64), key)
     wi64, wo64 = wi.astype(np.float64), wo.astype(np.float64)
@@ -419,7 +420,6 @@ def assert_render_matches(scene, renderer, band=BAND, worst=5):
     AssertionError
         With the report's summary and the worst pixels (row, column, GPU, twin, band).
     """
-    from .verify import verify
 
     report = verify(scene, renderer, band)
     if report.passed:
@@ -459,7 +459,6 @@ def require_backend(name):
 def renderer_factory():
     """``(make, made)``: ``make(width, height, backend, **options)`` opens a `glphong.Renderer` with the
     skip-or-fail semantics of `require_backend`; ``made`` lists what it opened (release them)."""
-    from .renderer import Renderer
 
     made = []
 

@@ -2,7 +2,7 @@
 
 import pytest
 
-from glphong.contexts import BACKENDS
+from glphong.gpu.contexts import BACKENDS
 
 # glphong's own pytest plugin (fixtures glphong_backend, glphong_context, glphong_renderer,
 # glphong_make_renderer): the suite uses it the way a user's conftest.py would

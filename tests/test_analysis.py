@@ -7,7 +7,7 @@ import pytest
 
 from glphong import analysis
 from glphong.analysis import albedo, format_properties, properties
-from glphong.cli import main
+from glphong.tools.cli import main
 from glphong.materials import (CookTorrance, Diffuse, Lambert, NormalizedBlinnPhong, NormalizedPhong, OrenNayar, Phong,
                                SchlickFresnel, Ward)
 

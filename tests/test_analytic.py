@@ -18,7 +18,7 @@ import trimesh
 
 import glphong
 from glphong import reference
-from glphong.contexts import BACKENDS
+from glphong.gpu.contexts import BACKENDS
 
 SPHERE_SIZE = 128
 SPHERE_LEVELS = (1, 2, 3, 4, 5)

@@ -2,7 +2,7 @@
 
 Every GPU-against-twin check is only as strict as the band.  These tests write the band's
 formulas out with literal numbers, (A, B, C, D) = (16, 4, 6, 8) and eps = 2^-24, and compare
-`glphong.tolerances` with them at a few known inputs, so a band made wider (or narrower) by any
+`glphong.checks.tolerances` with them at a few known inputs, so a band made wider (or narrower) by any
 factor fails here even if every image still passes.  The expected values use only ``math``.
 """
 import math
@@ -12,8 +12,8 @@ import numpy as np
 import pytest
 
 import glphong
-from glphong import tolerances
-from glphong.key import program_key
+from glphong.checks import tolerances
+from glphong.shaders.key import program_key
 
 EPS = 2.0 ** -24
 A, B, C, D = 16.0, 4.0, 6.0, 8.0

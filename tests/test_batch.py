@@ -117,3 +117,16 @@ def test_dask_cluster_with_a_killed_worker(tmp_path, serial):
     assert (tmp_path / "died").exists()
     assert all(np.array_equal(a, b) for a, b in zip(_frames(paths), serial))
     assert sorted(os.listdir(tmp_path / "frames")) == sorted([os.path.basename(p) for p in paths] + BOOKKEEPING)
+
+
+def test_a_scene_function_that_kills_every_worker_stops_the_batch(tmp_path):
+    """A pool broken three times in a row without a frame written is a batch that cannot finish: it stops with
+    the reason instead of making pools forever."""
+    (tmp_path / "batch_helper_always_dies.py").write_text("import os\n\ndef always_dies(angle):\n    os._exit(7)\n")
+    sys.path.insert(0, str(tmp_path))
+    try:
+        module = __import__("batch_helper_always_dies")
+        with pytest.raises(BatchError, match="died 3 times in a row without writing a frame"):
+            render_many(module.always_dies, ANGLES[:2], W, H, tmp_path / "frames", workers=1, progress=False)
+    finally:
+        sys.path.remove(str(tmp_path))

@@ -37,7 +37,7 @@ def test_png_and_npy_round_trip(tmp_path):
 
 def test_glsl_sources_ship_with_the_package():
     from glphong.materials import registered_models
-    from glphong.programs import chunk_source, glsl_root
+    from glphong.core.glsl_files import chunk_source, glsl_root
 
     for name in ("common", "lights", "lobe", "shade", "mesh_vertex", "mesh_fragment", "shade_points", "srgb", "encode"):
         text = chunk_source(name)
@@ -64,7 +64,7 @@ def test_main_job_from_outside_the_checkout(tmp_path):
 
 
 def test_cli_verify_reports_cross_check(tmp_path):
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     code = main(["render", "--tile", "24", "--verify", "--out", str(tmp_path / "f.png"), "--npy", str(tmp_path / "f.npy")])
     assert code == 0
@@ -74,7 +74,7 @@ def test_cli_verify_reports_cross_check(tmp_path):
 
 
 def test_cli_rejects_unknown_backend(capsys):
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     with pytest.raises(SystemExit):
         main(["render", "--backend", "vulkan"])
@@ -106,8 +106,8 @@ def test_setup_cfg_ships_every_subpackage():
 def test_cli_gallery_renders_every_model_and_cross_checks_each_tile(tmp_path, capsys):
     from PIL import Image
 
-    from glphong.cli import main
-    from glphong.gallery import GALLERY
+    from glphong.tools.cli import main
+    from glphong.analysis.gallery import GALLERY
     from glphong.materials import registered_models
 
     out = tmp_path / "gallery.png"
@@ -158,7 +158,7 @@ def test_frame_shows_itself_in_a_notebook(make_renderer):
 
     from PIL import Image
 
-    from glphong.figures import phong_examples_scene
+    from glphong.analysis.figures import phong_examples_scene
     from glphong.materials import Phong
 
     renderer = make_renderer(24, 16, "egl")

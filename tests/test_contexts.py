@@ -1,11 +1,11 @@
-"""Tests for glphong.contexts on the real EGL and OSMesa drivers."""
+"""Tests for glphong.gpu.contexts on the real EGL and OSMesa drivers."""
 
 import moderngl
 import numpy as np
 import pytest
 
-from glphong import contexts
-from glphong.contexts import (
+from glphong.gpu import contexts
+from glphong.gpu.contexts import (
     BACKENDS,
     SYSTEM_PACKAGES,
     BackendUnavailableError,
@@ -257,7 +257,7 @@ import os, sys
 os.environ["PYOPENGL_PLATFORM"] = "egl"
 import numpy as np, glphong, pyrender
 from glphong import primitives
-from glphong.contexts import EGLDisplayTerminatedError
+from glphong.gpu.contexts import EGLDisplayTerminatedError
 scene = glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0)), [glphong.PointLight((2, 2, 2), 100.0)])
 scene.add(primitives.sphere(2), glphong.Lambert(0.3))
 old = glphong.Renderer(32, 32, backend="egl")
@@ -303,7 +303,7 @@ def test_egl_device_selection(make_context):
     """``device`` selects an EGL device; an index this machine does not have is refused with how many it
     has (it suggested installing packages before), and a non-EGL backend with a device is refused."""
     import glphong
-    from glphong.contexts import egl_device_count
+    from glphong.gpu.contexts import egl_device_count
 
     make_context("egl")  # skips (or fails where required) without EGL
     count = egl_device_count()

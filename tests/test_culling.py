@@ -1,4 +1,4 @@
-"""Back-face culling only where it cannot be seen (`glphong.culling`, ``Renderer(culling='auto')``).
+"""Back-face culling only where it cannot be seen (`glphong.scene.culling`, ``Renderer(culling='auto')``).
 
 - `closed_outward`: closed, outward-wound meshes (glphong's sphere with its UV seam, trimesh's icosphere
   and box) pass; an open plane, an inside-out sphere, a sphere with a second inside-out part, a mesh with
@@ -14,8 +14,8 @@ import trimesh
 
 import glphong
 from glphong import primitives
-from glphong.culling import closed_outward
-from glphong.geometry import MeshData
+from glphong.scene.culling import closed_outward
+from glphong.scene.geometry import MeshData
 
 
 def test_closed_outward_meshes():
@@ -99,7 +99,7 @@ def test_describe_reports_each_objects_decision(glphong_make_renderer):
     # the renderer decides alike: what it draws with culling enabled
     auto = glphong_make_renderer(16, 16, "egl")
     auto.render(scene)
-    from glphong.culling import view_allows_culling
+    from glphong.scene.culling import view_allows_culling
 
     eye, forward = tuple(camera.pose[:3, 3]), tuple(-camera.pose[:3, 2])
     culled = [e["radiance"].sphere is not None and view_allows_culling(*e["radiance"].sphere, eye, forward,

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import glphong
-import glphong.stability
+import glphong.checks.stability
 from glphong import primitives
 from glphong.testing import TwinMismatch, assert_render_matches, assert_twin_matches, evaluate
 
@@ -128,7 +128,7 @@ def test_its_stability_cases_run_from_the_command_line():
     out = subprocess.run([sys.executable, "-m", "glphong", "stability", "--import", str(EXAMPLE)],
                          capture_output=True, text=True, timeout=300)
     assert out.returncode == 0, out.stdout[-3000:] + out.stderr[-2000:]
-    cases = len(glphong.stability.CASES) + len(Minnaert.stability_cases())
+    cases = len(glphong.checks.stability.CASES) + len(Minnaert.stability_cases())
     assert f"{cases}/{cases} cases inside the tolerance band; 0 NaN and 0 Inf channels" in out.stdout
     assert "minnaert m=0.6 grazing light n.l=1e-06" in out.stdout and "minnaert m=1.5 l = -v" in out.stdout
 

@@ -2,14 +2,14 @@
 
 Inputs are float32 (seeded random plus edge cases); the GPU evaluates the GLSL function
 through transform feedback, the twin evaluates the same float32 inputs in float64, and
-the two are compared under the tolerance model of `glphong.tolerances`.
+the two are compared under the tolerance model of `glphong.checks.tolerances`.
 """
 import numpy as np
 import pytest
 
-from glphong import probe
+from glphong.checks import probe
 from glphong import reference as ref
-from glphong.tolerances import BAND, EPS, FLT_MIN, lobe_band
+from glphong.checks.tolerances import BAND, EPS, FLT_MIN, lobe_band
 
 RNG_SEED = 20261122
 

@@ -20,7 +20,7 @@ import pytest
 import trimesh
 
 import glphong
-from glphong.loaders import gltf_view, read_gltf_json
+from glphong.formats import gltf_view, read_gltf_json
 
 BASE = [0.123457, 0.5, 0.75, 1.0]
 
@@ -103,7 +103,7 @@ def test_refusals(tmp_path):
 
 
 def test_cli_render_gltf(tmp_path, capsys):
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     path = _document(tmp_path)
     assert main(["render", str(path), "--light-units", "photometric", "--camera", "main", "--width", "32",

@@ -8,11 +8,11 @@ import json
 
 import pytest
 
-from glphong import cli
-from glphong.contexts import BackendUnavailableError
-from glphong.expressions import MAX_TEXT_LENGTH, ExpressionError, parse_material
+from glphong.tools import cli
+from glphong.gpu.contexts import BackendUnavailableError
+from glphong.tools.expressions import MAX_TEXT_LENGTH, ExpressionError, parse_material
 from glphong.materials import CookTorrance, Lafortune, Phong, SchlickFresnel
-from glphong.programs import _evaluate_condition, effective_source
+from glphong.shaders.assembly import _evaluate_condition, effective_source
 
 #: the way to the builtins the first exploit takes (the module globals of a material class's __init__)
 BUILTINS = "Phong.__init__.__globals__['__builtins__']"
@@ -60,11 +60,11 @@ OVERSIZED = [
 ]
 
 #: runs each payload spec (``{"argv": [...], "marker": name}``, read from the JSON file argv[1]) through
-#: ``glphong.cli.main`` in this process and prints, as JSON, the exit status, stderr, whether an
+#: ``glphong.tools.cli.main`` in this process and prints, as JSON, the exit status, stderr, whether an
 #: exception escaped, and whether the marker file exists afterwards
 LOOP = """
 import contextlib, io, json, os, sys, traceback
-from glphong.cli import main
+from glphong.tools.cli import main
 
 results = []
 for spec in json.load(open(sys.argv[1])):
@@ -81,7 +81,7 @@ for spec in json.load(open(sys.argv[1])):
 print(json.dumps(results))
 """
 
-CLI = "from glphong.cli import main; import sys; raise SystemExit(main(sys.argv[1:]))"
+CLI = "from glphong.tools.cli import main; import sys; raise SystemExit(main(sys.argv[1:]))"
 
 
 def _run_specs(run_isolated, folder, specs, timeout=60):
@@ -334,7 +334,7 @@ def test_effective_source_keeps_its_branches():
 
 BOMBS = """
 import json, time
-from glphong.programs import _evaluate_condition, effective_source
+from glphong.shaders.assembly import _evaluate_condition, effective_source
 
 cases = ["9**9**9", "1<<100000", "(1<<62)*(1<<62)*(1<<62)", "'a'*10**10", "1+" * 3000 + "1", "-" * 3000 + "1",
          "(" * 500 + "1" + ")" * 500]

@@ -503,7 +503,7 @@ def test_command_line_one_line_errors_and_warnings(tmp_path, run_isolated):
     document, blob = _document("../outside.bin", lights=False)
     (tmp_path / "outside.bin").write_bytes(blob)
     path = _write(tmp_path / "scene", document)
-    code = "import sys; from glphong.cli import main; raise SystemExit(main(sys.argv[1:]))"
+    code = "import sys; from glphong.tools.cli import main; raise SystemExit(main(sys.argv[1:]))"
     refused = run_isolated(code, timeout=120, args=["render", str(path), "--width", "16", "--height", "16",
                                                     "--out", str(tmp_path / "a.png")])
     assert refused.returncode == 2 and "Traceback" not in refused.stderr

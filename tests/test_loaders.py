@@ -13,7 +13,7 @@ import pytest
 import trimesh
 
 import glphong
-from glphong.loaders import parse_mtl
+from glphong.formats import parse_mtl
 
 MTL = """# test materials
 newmtl glossy
@@ -129,7 +129,7 @@ def test_errors_name_the_file(tmp_path):
 def test_cli_render_file(tmp_path, capsys):
     from PIL import Image
 
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     path = _write_obj(tmp_path)
     out = tmp_path / "out.png"
@@ -149,7 +149,7 @@ def test_cli_render_file(tmp_path, capsys):
 def test_cli_turntable_frames(tmp_path, capsys):
     from PIL import Image
 
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     folder = tmp_path / "spin"
     assert main(["render", "examples/data/torus.obj", "--frames", "3", "--width", "40", "--height", "30",

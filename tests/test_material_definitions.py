@@ -21,7 +21,7 @@ import glphong
 from glphong import primitives
 from glphong.materials import (Choice, FresnelSlot, MaterialDefinitionError, MaterialModel, MaterialSum, Param, PhongLobe,
                                SchlickFresnel, model_named)
-from glphong.programs import ShaderCompileError
+from glphong.gpu.programs import ShaderCompileError
 from glphong.testing import assert_render_matches, assert_twin_matches
 
 
@@ -272,7 +272,7 @@ def test_describe_and_the_key_name_the_user_model():
 
 
 def test_stability_runs_the_models_own_cases(session_gl):
-    from glphong.stability import cases_for, run_stability
+    from glphong.checks.stability import cases_for, run_stability
 
     cases = cases_for(Rim)
     assert len(cases) >= 8 and all(c.material.name == "test_rim" for c in cases)
@@ -309,7 +309,7 @@ def test_the_generic_band_has_its_documented_closed_form():
     """Response k (n.l): the directions do not move it, n.l +- D eps moves it by k D eps, and the
     result widens by eps (A + B |ln r|) relative (the constants (16, 4, 6, 8) of docs/design.md section 4)."""
     from glphong.materials import ShadingFrame
-    from glphong.tolerances import BAND, EPS
+    from glphong.checks.tolerances import BAND, EPS
 
     model = _Linear(0.5)
     n_dot_l = np.array([0.8, 0.1, 1e-3])
@@ -391,7 +391,7 @@ def test_a_tangent_model_beside_a_mesh_without_tangents(glphong_make_renderer, g
 
 
 def test_the_uber_shader_refuses_two_variants_of_one_model():
-    from glphong.key import uber_key
+    from glphong.shaders.key import uber_key
 
     with pytest.raises(ValueError, match=r"one variant of each model.*'test_power'.*specialise=True"):
         uber_key([_Power(0.3, n=1.0), _Power(0.3, n=4.0)])
@@ -499,7 +499,7 @@ def test_a_mirroring_pose_keeps_two_sided_shading_facing_the_viewer(glphong_rend
 
 def test_stability_cases_of_a_tangent_model(session_gl):
     """The oracle builds the frame in mpmath (t from the case's tangent by Gram-Schmidt, b = n x t)."""
-    from glphong.stability import cases_for, run_stability
+    from glphong.checks.stability import cases_for, run_stability
 
     report = run_stability(context=session_gl, cases=cases_for(_Stripe))
     assert report.passed_count == len(report.rows) >= 8, report.format_table()
@@ -540,7 +540,7 @@ class Sheen(MaterialModel):
 
 
 def test_a_user_model_takes_choices_and_fresnel_like_the_built_ins(glphong_backend):
-    from glphong.key import program_key
+    from glphong.shaders.key import program_key
     from glphong.materials import DielectricFresnel
 
     default = Sheen(0.5)

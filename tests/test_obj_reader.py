@@ -1,4 +1,4 @@
-"""`glphong.obj_reader.read_obj`: OBJ geometry read with numpy, errors and warnings that say where.
+"""`glphong.formats.obj.read_obj`: OBJ geometry read with numpy, errors and warnings that say where.
 
 - Handwritten files give their values and faces exactly (vertices are the sorted distinct index
   triples, polygons fanned from the first corner, parts in order of first use); random valid files give
@@ -20,7 +20,7 @@ import pytest
 import trimesh
 
 from glphong.filesafety import Limits, SceneFileError
-from glphong.obj_reader import _smooth_normals, read_obj
+from glphong.formats.obj import _smooth_normals, read_obj
 
 SQUARE = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
 
@@ -151,7 +151,7 @@ def test_line_numbers_count_the_files_lines_across_continuations(tmp_path):
 
 
 def test_chunk_boundaries_change_nothing(tmp_path, monkeypatch):
-    import glphong.obj_reader
+    import glphong.formats.obj.statements
 
     text = ("# header \\\n continued comment\n" + SQUARE + "vt 0 0\\\n 1\nvt 1 1\n\t usemtl  a # b\n"
             "f 1/1 2/2 \\\n 3/1 \\\n\\\n 4/2\n  \n# f 9 9 9\nusemtl c\nf -4/1 -3/2 -2/1 # x\n")
@@ -160,7 +160,7 @@ def test_chunk_boundaries_change_nothing(tmp_path, monkeypatch):
     assert [(name, mesh.triangle_count) for name, mesh in whole] == [("a", 2), ("c", 1)]
     bad = _write(tmp_path, text + "f 1 \\\n 2 x\n", "bad.obj")
     for size in (1, 5, 13, 64):
-        monkeypatch.setattr(glphong.obj_reader, "CHUNK_BYTES", size)
+        monkeypatch.setattr(glphong.formats.obj.statements, "CHUNK_BYTES", size)
         _assert_same(_read(path)[0], whole)
         with pytest.raises(SceneFileError) as caught:
             read_obj(bad)
@@ -283,7 +283,7 @@ def test_limits_bound_the_file(tmp_path):
 def test_a_fifo_and_dev_zero_are_refused_at_once(tmp_path, run_isolated):
     fifo = tmp_path / "pipe.obj"
     os.mkfifo(fifo)
-    code = ("import sys\nfrom glphong.obj_reader import read_obj\nfrom glphong.filesafety import SceneFileError\n"
+    code = ("import sys\nfrom glphong.formats.obj import read_obj\nfrom glphong.filesafety import SceneFileError\n"
             "for path in sys.argv[1:]:\n"
             "    try:\n        read_obj(path)\n    except SceneFileError as e:\n        print('refused', e)\n")
     done = run_isolated(code, timeout=30, memory_bytes=3 << 29, args=(str(fifo), "/dev/zero"))
@@ -296,7 +296,7 @@ def test_a_face_of_a_million_corners_loads_in_bounded_memory_and_time(tmp_path, 
     angle = np.arange(1000) * (2 * np.pi / 1000)
     lines = [f"v {np.cos(a):.6f} {np.sin(a):.6f} 0" for a in angle]
     path = _write(tmp_path, "\n".join(lines) + "\nf " + " ".join(str(k % 1000 + 1) for k in range(10 ** 6)) + "\n")
-    code = ("import sys, time\nfrom glphong.obj_reader import read_obj\nstart = time.perf_counter()\n"
+    code = ("import sys, time\nfrom glphong.formats.obj import read_obj\nstart = time.perf_counter()\n"
             "[(name, mesh)] = read_obj(sys.argv[1])\n"
             "print(mesh.triangle_count, len(mesh.positions), round(time.perf_counter() - start, 2))\n")
     done = run_isolated(code, timeout=60, memory_bytes=3 << 29, args=(str(path),))
@@ -319,7 +319,7 @@ def test_smooth_normals_are_trimeshs_vertex_normals():
 
 def _reference_read_obj(path):
     """The previous reader, one Python tuple per corner (valid files only): the result to match bit for bit."""
-    from glphong.geometry import MeshData
+    from glphong.scene.geometry import MeshData
 
     positions, normals, uvs, parts, current = [], [], [], {}, ""
     for raw in path.read_text().splitlines():

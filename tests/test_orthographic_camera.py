@@ -15,7 +15,7 @@ import pytest
 
 import glphong
 from glphong import primitives
-from glphong.raycast import AnalyticObject, Sphere, render_reference
+from glphong.checks.raycast import AnalyticObject, Sphere, render_reference
 
 
 def test_plane_has_one_view_direction(glphong_backend, glphong_make_renderer):

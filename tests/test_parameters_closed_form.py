@@ -5,7 +5,7 @@ the GPU is given), through the numpy twin, the tolerance band or the stability o
 wrong on its way from a constructor argument to a shader uniform (``u_ks`` uploaded 1% too large, a
 directional light's direction negated, ``yfov`` halved before the projection matrix) is then wrong on
 both sides of the comparison and invisible.  These tests read no uniform, and use none of
-glphong.reference, glphong.tolerances, glphong.stability, glphong.verify, glphong.imaging,
+glphong.reference, glphong.checks.tolerances, glphong.checks.stability, glphong.verify, glphong.imaging,
 glphong.radiometry, ``uniform_row()``, ``light_uniform_values`` or the camera's ray and matrix methods:
 every expected value is a closed form of the arguments the test passed (pinhole rays, ray-plane and
 ray-triangle hits, E = Phi / (4 pi d^2), the Phong and Blinn lobes, the sRGB curve), evaluated in float64.
@@ -66,7 +66,7 @@ import pytest
 import trimesh
 
 import glphong
-from glphong.contexts import BACKENDS
+from glphong.gpu.contexts import BACKENDS
 
 #: image size of most tests: odd, so the centre pixel's ray is the optical axis
 N = 33

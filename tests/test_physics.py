@@ -13,7 +13,7 @@ import trimesh
 
 import glphong
 from glphong import reference
-from glphong.contexts import BACKENDS
+from glphong.gpu.contexts import BACKENDS
 
 N = 65  # odd: the centre pixel's ray is the optical axis
 F32_EPS = float(np.finfo(np.float32).eps)  # 2^-23

@@ -1,4 +1,4 @@
-"""Lobe and albedo plots (`glphong.plots`, ``glphong plot``): the curves are the twin's BRDF, checked against
+"""Lobe and albedo plots (`glphong.analysis.plots`, ``glphong plot``): the curves are the twin's BRDF, checked against
 closed forms, and the PNGs are written.
 
 - The lecture's Phong lobe in the plane of incidence is ``ks cos^q(theta_o - theta_i) cos(theta_o) / cos(theta_i)``
@@ -12,8 +12,8 @@ import pytest
 from PIL import Image
 
 import glphong
-from glphong import plots
-from glphong.cli import main
+from glphong.analysis import plots
+from glphong.tools.cli import main
 
 
 def test_phong_lobe_curve_is_the_closed_form(tmp_path):

@@ -1,4 +1,4 @@
-"""The converged ray-cast reference of exact geometry (glphong.raycast) against closed forms.
+"""The converged ray-cast reference of exact geometry (glphong.checks.raycast) against closed forms.
 
 Measured (numpy float64, Mesa llvmpipe for the GPU test):
 - sphere silhouette, 161x121 px, 8x8 samples: radius from the central row and column
@@ -19,7 +19,7 @@ import pytest
 import trimesh
 
 import glphong
-from glphong.raycast import (AnalyticObject, Plane, RayCastImage, Sphere, compare_to_reference,
+from glphong.checks.raycast import (AnalyticObject, Plane, RayCastImage, Sphere, compare_to_reference,
                              render_reference, stratified_offsets)
 
 

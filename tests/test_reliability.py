@@ -111,7 +111,7 @@ def test_renderers_dropped_without_release_are_released(backend, make_context, t
 
 # --------------------------------------------------------------------------- sizes and raw errors
 def test_sizes_are_checked_against_the_context_and_memory_before_any_work(glphong_backend, monkeypatch):
-    from glphong import renderer as renderer_module
+    from glphong.gpu import renderer as renderer_module
 
     with pytest.raises(ValueError, match=r"width must be in \[1, 16384\]"):
         glphong.Renderer(16385, 8, backend=glphong_backend)
@@ -151,7 +151,7 @@ def test_clear_errors_instead_of_raw_ones(glphong_backend):
 
 
 def test_command_line_limits_and_version(capsys):
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     for argv, message in ((["--tile", "0"], "--tile must be from 1 to 1024 pixels (got 0"),
                           (["--tile", "5000"], "--tile must be from 1 to 1024 pixels (got 5000"),
@@ -321,7 +321,7 @@ def test_no_stray_warnings_before_the_errors_or_from_extreme_valid_input():
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # any warning fails
         with pytest.raises(ValueError, match="positions must be finite"):
-            glphong.geometry.MeshData.from_trimesh(inf_vertex)
+            glphong.scene.geometry.MeshData.from_trimesh(inf_vertex)
         values = scene.uniform_values(0, scene.program_key(scene.objects[0]), 1.0)
     assert all(v.dtype == np.float32 for v in values.values())
 
@@ -329,7 +329,7 @@ def test_no_stray_warnings_before_the_errors_or_from_extreme_valid_input():
 def test_bench_says_at_once_which_extra_it_needs(monkeypatch, capsys):
     import importlib.util
 
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     real = importlib.util.find_spec
     monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "matplotlib" else real(name, *a))
@@ -358,7 +358,7 @@ if pid == 0:
     try:
         r.render(glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0))))
         os._exit(3)
-    except glphong.contexts.ForkedProcessError:
+    except glphong.gpu.contexts.ForkedProcessError:
         os._exit(0)
 _, status = os.waitpid(pid, 0)
 print(os.waitstatus_to_exitcode(status))
@@ -390,7 +390,7 @@ def test_dropped_renderers_are_released_even_when_warnings_are_errors(backend="e
 
 
 def test_more_clear_errors(capsys, tmp_path):
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     for bad in ((True, 0.5, 0.0), (0.5, True, 0.2)):
         with pytest.raises(TypeError, match="not booleans"):

@@ -7,8 +7,9 @@ import pytest
 import trimesh
 
 import glphong
-from glphong.key import ProgramKey, program_key, uber_key
-from glphong.programs import Program, ShaderCompileError, UniformError, _name_chunks
+from glphong.shaders.key import ProgramKey, program_key, uber_key
+from glphong.gpu.programs import Program, ShaderCompileError, UniformError
+from glphong.shaders.assembly import name_chunks as _name_chunks
 
 BACKENDS = ("egl", "osmesa")
 
@@ -77,7 +78,7 @@ def test_verify_detects_a_wrong_shader(renderer):
     The GPU renders k_d = 0.3 (1 + 1e-4); the twin and its band shade the same fragments with k_d = 0.3.
     """
     from glphong import reference
-    from glphong.tolerances import radiance_band
+    from glphong.checks.tolerances import radiance_band
     from glphong.verify import compare
 
     kd = 0.3
@@ -219,7 +220,7 @@ def test_uniform_binding_is_strict(renderer):
 
 
 def test_compile_error_names_chunk_file_and_line(renderer, monkeypatch):
-    from glphong import programs
+    from glphong.gpu import programs
 
     original = programs.chunk_source
 
@@ -241,7 +242,7 @@ def test_compile_error_names_chunk_file_and_line(renderer, monkeypatch):
 
 def test_name_chunks_rewrites_both_log_formats():
     # Mesa: source:line(column); NVIDIA: source(line); string 0 is the generated #version/#define header
-    from glphong.programs import chunk_source
+    from glphong.core.glsl_files import chunk_source
 
     line12 = chunk_source("lights").splitlines()[11].strip()
     assert _name_chunks("0:3(7): error: x", ["common"]) == "<generated header>:3:7: error: x"
@@ -253,7 +254,7 @@ def test_name_chunks_rewrites_both_log_formats():
 
 def test_specialised_sources_leave_out_unused_code():
     lambert = program_key(glphong.Lambert(0.3), {"point": 2}, None)
-    from glphong.programs import assemble, effective_source
+    from glphong.shaders.assembly import assemble, effective_source
     fragment = effective_source(assemble(lambert.fragment_chunks(), lambert.defines(), lambert.generated_chunks()))
     for absent in ("lobe_from_delta", "log_one_minus", "pow(", "phong", "blinn", "uber", "in_tangent",
                    "safe_normalize(eye"):
@@ -276,7 +277,7 @@ def test_specialised_sources_leave_out_unused_code():
 
 
 def test_effective_source_evaluates_conditions():
-    from glphong.programs import effective_source
+    from glphong.shaders.assembly import effective_source
 
     src = "#define A 1\n#define B 0\n#if A && !B\nyes1 // c\n#elif A\nno1\n#else\nno2\n#endif\n" \
           "#if B\nno3\n#if A\nno4\n#endif\n#elif A > 0 || B\nyes2\n#endif\n#if B\nno5\n#else\nyes3\n#endif\n"

@@ -9,8 +9,8 @@ import trimesh
 
 import glphong
 from glphong import reference
-from glphong.describe import describe, format_descriptions
-from glphong.key import uber_key
+from glphong.gpu.describe import describe, format_descriptions
+from glphong.shaders.key import uber_key
 from glphong.materials import registered_models
 
 

@@ -9,11 +9,11 @@ from hypothesis import strategies as st
 
 import glphong
 from glphong import reference as ref
-from glphong.key import program_key
-from glphong.probe import shade_points
-from glphong.programs import ProgramCache
-from glphong.stability import CASES, oracle, run_stability
-from glphong.tolerances import FLT_MAX, FLT_MIN, point_band
+from glphong.shaders.key import program_key
+from glphong.checks.probe import shade_points
+from glphong.gpu.programs import ProgramCache
+from glphong.checks.stability import CASES, case_scene, oracle, run_stability
+from glphong.checks.tolerances import FLT_MAX, FLT_MIN, point_band
 
 
 def test_suite_covers_what_the_issue_lists():
@@ -37,7 +37,7 @@ def test_float64_twin_agrees_with_the_mpmath_oracle():
         frame = ref.shading_frame(n, np.asarray([case.tangent], dtype=np.float32).astype(np.float64),
                                   np.asarray([case.uv], dtype=np.float32).astype(np.float64), key)
         twin = ref.shade_point(np.zeros((1, 3)), frame, n_valid, u64.get("u_eye"), key, u64, case.material)[0]
-        expected = oracle(case.scene(), case.normal, tangent=case.tangent, uv=case.uv)
+        expected = oracle(case_scene(case), case.normal, tangent=case.tangent, uv=case.uv)
         if case.in_range:
             # the oracle rounds the constructors' values to float32; the uniforms are derived in float64
             # first (I = Phi / (4 pi), a unit direction) and then rounded: one float32 rounding apart,
@@ -73,7 +73,7 @@ WIRED = {"ks": ("u_phong_lobe_ks", "u_blinn_lobe_ks"), "q": ("u_phong_lobe_q", "
 def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, uniform):
     """Pass/fail is judged against the oracle, which reads the constructors: a uniform uploaded 1% off
     (the twin and the band, reading the same uniforms, would follow it) fails its cases."""
-    from glphong import stability
+    from glphong.checks import stability
 
     original = stability.Case.inputs
 
@@ -115,7 +115,7 @@ def test_json_output_round_trips(session_gl, tmp_path):
 
 
 def test_cli_stability_json(tmp_path, capsys):
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     assert main(["stability", "--json", str(tmp_path / "s.json")]) == 0
     out = capsys.readouterr().out

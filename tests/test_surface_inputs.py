@@ -17,10 +17,10 @@ import pytest
 
 import glphong
 from glphong import primitives
-from glphong.geometry import MeshData
+from glphong.scene.geometry import MeshData
 from glphong.materials import surface as surface_module
 from glphong.materials.surface import TextureImage, surface_texture
-from glphong.tolerances import BAND, BandConstants
+from glphong.checks.tolerances import BAND, BandConstants
 
 
 def _srgb_decode(b):
@@ -222,7 +222,7 @@ def test_refusals_name_the_parameter_and_the_way_out(glphong_make_renderer):
     with pytest.raises(ValueError, match="lambert.kd takes vertex colours, but the mesh has none"):
         _oblique_scene(glphong.Lambert(kd=glphong.VertexColors()), bare)
     with pytest.raises(ValueError, match="vary over the surface"):
-        from glphong.key import response_key
+        from glphong.shaders.key import response_key
 
         response_key(textured)
     with pytest.raises(ValueError, match=r"colors must be linear values in \[0, 1\]"):

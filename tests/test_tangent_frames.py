@@ -2,12 +2,12 @@
 
 What is tested:
 
-- `glphong.geometry.tangents_from_uvs` (Lengyel's method): the plane's UVs give t = +x, w = +1; UVs
+- `glphong.scene.geometry.tangents_from_uvs` (Lengyel's method): the plane's UVs give t = +x, w = +1; UVs
   mirrored in u give t = -x, w = -1; on an icosphere with spherical UVs the derived tangent agrees
   with the analytic dp/dphi away from the poles and the u seam (measured tolerance below), the
   handedness is the one the UV map has, and it matches `glphong.primitives.sphere`'s analytic
   tangents; t is orthogonal to the normal; degenerate UV triangles give t = 0 and no NaN.
-- common.glsl ``frame_from_tangent`` on the GPU (`glphong.probe`) against its numpy twin on seeded
+- common.glsl ``frame_from_tangent`` on the GPU (`glphong.checks.probe`) against its numpy twin on seeded
   random normals and tangents and on the edge cases: tangent parallel to n (Duff et al.'s fallback
   basis), zero tangent, negative and zero handedness; (t, b, n) orthonormal.
 - A user material that needs ``'tangent'`` (``test_aniso``) defined through `MaterialModel`: its
@@ -25,12 +25,13 @@ import pytest
 import trimesh
 
 import glphong
-from glphong import primitives, probe
+from glphong import primitives
+from glphong.checks import probe
 from glphong import reference as ref
-from glphong.geometry import MeshData, tangents_from_uvs
+from glphong.scene.geometry import MeshData, tangents_from_uvs
 from glphong.materials import MaterialModel, Param, Properties
 from glphong.testing import assert_render_matches, assert_twin_matches, direction_sets
-from glphong.tolerances import EPS
+from glphong.checks.tolerances import EPS
 
 RNG_SEED = 20261207
 BACKENDS = ("egl", "osmesa")
@@ -350,7 +351,7 @@ def test_frame_from_tangent_is_orthonormal_on_the_gpu(session_gl):
 
 def test_shading_frame_twin_reads_the_key():
     """`reference.shading_frame` builds t, b only where the key has a tangent, uv only with has_uv."""
-    from glphong.key import response_key
+    from glphong.shaders.key import response_key
 
     n = np.array([[0.0, 0.0, 1.0]])
     tangent = np.array([[0.0, 2.0, 0.5, -1.0]])

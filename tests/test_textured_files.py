@@ -20,7 +20,7 @@ from PIL import Image
 
 import glphong
 from glphong import primitives
-from glphong.geometry import MeshData
+from glphong.scene.geometry import MeshData
 from glphong.materials.as_json import material_from_json, material_to_json
 from glphong.materials.surface import TextureImage
 
@@ -69,7 +69,7 @@ def _marker_gltf(tmp_path, with_colors):
 
 def test_gltf_base_colour_texture_and_vertex_colours(tmp_path, glphong_make_renderer):
     path = _marker_gltf(tmp_path, with_colors=False)
-    assert "TEXCOORD_0" in glphong.loaders.read_gltf_json(path)["meshes"][0]["primitives"][0]["attributes"]
+    assert "TEXCOORD_0" in glphong.formats.read_gltf_json(path)["meshes"][0]["primitives"][0]["attributes"]
     camera = glphong.PerspectiveCamera.look_at((0.0, 0.0, 3.0), (0.0, 0.0, 0.0), yfov=0.8)
     scene = glphong.load_scene(path, camera=camera, lights=[], ambient=glphong.AmbientLight(1.0))
     rho = scene.objects[0].material.rho_d
@@ -83,7 +83,7 @@ def test_gltf_base_colour_texture_and_vertex_colours(tmp_path, glphong_make_rend
                                   ambient=glphong.AmbientLight(1.0))
     obj = coloured.objects[0]
     assert obj.material.rho_d.vertex_colors
-    accessor = glphong.loaders.read_gltf_json(tmp_path / "marker.glb")["accessors"]
+    accessor = glphong.formats.read_gltf_json(tmp_path / "marker.glb")["accessors"]
     assert any(a.get("componentType") == 5121 for a in accessor)  # COLOR_0 as normalised bytes: linear, not sRGB
     np.testing.assert_array_equal(obj.mesh.colors, np.float32([[128 / 255, 1.0, 1.0]] * len(obj.mesh.colors)))
     assert glphong.verify(coloured, glphong_make_renderer(64, 64, "egl")).passed

@@ -15,9 +15,9 @@ import trimesh
 
 import glphong
 from glphong import imaging
-from glphong.contexts import BACKENDS
-from glphong.geometry import MeshData
-from glphong.lights import _MAX_POWER
+from glphong.gpu.contexts import BACKENDS
+from glphong.scene.geometry import MeshData
+from glphong.scene.lights import _MAX_POWER
 
 FLT_MAX = float(np.finfo(np.float32).max)
 NAN, INF = float("nan"), float("inf")
@@ -505,10 +505,10 @@ def box():
 def _bad_add_cases():
     lam = glphong.Lambert(0.2)
     box = trimesh.creation.box()
-    yield pytest.param("mesh", lam, None, TypeError, "mesh must be a trimesh.Trimesh or a glphong.geometry.MeshData (got str)", id="mesh-str")
-    yield pytest.param(np.zeros((3, 3)), lam, None, TypeError, "mesh must be a trimesh.Trimesh or a glphong.geometry.MeshData (got ndarray)", id="mesh-array")
-    yield pytest.param(trimesh.PointCloud(np.zeros((3, 3))), lam, None, TypeError, "mesh must be a trimesh.Trimesh or a glphong.geometry.MeshData (got PointCloud)", id="mesh-pointcloud")
-    yield pytest.param(trimesh.Scene([box]), lam, None, TypeError, "mesh must be a trimesh.Trimesh or a glphong.geometry.MeshData (got Scene)", id="mesh-scene")
+    yield pytest.param("mesh", lam, None, TypeError, "mesh must be a trimesh.Trimesh or a glphong.scene.geometry.MeshData (got str)", id="mesh-str")
+    yield pytest.param(np.zeros((3, 3)), lam, None, TypeError, "mesh must be a trimesh.Trimesh or a glphong.scene.geometry.MeshData (got ndarray)", id="mesh-array")
+    yield pytest.param(trimesh.PointCloud(np.zeros((3, 3))), lam, None, TypeError, "mesh must be a trimesh.Trimesh or a glphong.scene.geometry.MeshData (got PointCloud)", id="mesh-pointcloud")
+    yield pytest.param(trimesh.Scene([box]), lam, None, TypeError, "mesh must be a trimesh.Trimesh or a glphong.scene.geometry.MeshData (got Scene)", id="mesh-scene")
     yield pytest.param(trimesh.Trimesh(), lam, None, ValueError, "mesh must have at least one face", id="mesh-empty")
     yield pytest.param(trimesh.Trimesh(vertices=np.eye(3), faces=np.zeros((0, 3), int)), lam, None, ValueError,
                        "mesh must have at least one face", id="mesh-no-faces")

@@ -38,15 +38,15 @@ import pyrender
 from pyrender.constants import ProgramFlags, RenderFlags
 from pyrender.renderer import Renderer as _PyrenderRenderer
 
-from .. import lights as glphong_lights
-from .._validate import scalar
-from ..camera import PerspectiveCamera
-from ..contexts import attach_current
-from ..geometry import MeshData
-from ..key import program_key
-from ..materials import Material
-from ..programs import ProgramCache
-from ..scene import Scene
+from glphong.scene import lights as glphong_lights
+from glphong.core.validate import scalar
+from glphong.scene.camera import PerspectiveCamera
+from glphong.gpu.contexts import attach_current
+from glphong.scene.geometry import MeshData
+from glphong.shaders.key import program_key
+from glphong.materials import Material
+from glphong.gpu.programs import ProgramCache
+from glphong.scene.scene import Scene
 
 __all__ = ["GlphongMaterial", "enable", "glphong_lights_of", "scene_from_pyrender"]
 

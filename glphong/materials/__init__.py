@@ -32,10 +32,9 @@ and `FresnelSlot` (see README, "Write your own material").
 import importlib as _importlib
 import pkgutil as _pkgutil
 
-from .model import (Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues,
-                    Properties, ShadingFrame, model_named, registered_models)
-from .surface import SurfaceInput, Texture, TextureImage, VertexColors
-from .table import Table, TableData
+from glphong.materials.model import Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues, Properties, ShadingFrame, model_named, registered_models
+from glphong.materials.surface import SurfaceInput, Texture, TextureImage, VertexColors
+from glphong.materials.table import Table, TableData
 
 __all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "Table", "TableData", "ParamValues",
            "Properties", "ShadingFrame", "MaterialDefinitionError", "GlslFile", "registered_models", "model_named",

@@ -14,6 +14,11 @@ the index names a texture of the file (the writer's ``texture_index``, the reade
 Tables (`MeasuredBRDF`) are not stored: a file would hold megabytes of JSON.  On reading, the class is
 found among the defined materials by module and name (a user's module must have been imported).
 """
+
+from glphong.materials.fresnel import Fresnel
+from glphong.materials.model import Choice, Material, Param
+from glphong.materials.surface import SurfaceInput
+from glphong.materials.table import Table
 __all__ = ["material_to_json", "material_from_json"]
 
 #: the version of the layout above
@@ -39,10 +44,6 @@ def material_to_json(material, texture_index=None):
     ValueError
         A table argument, or a texture without ``texture_index``.
     """
-    from .fresnel import Fresnel
-    from .model import Choice, Param
-    from .surface import SurfaceInput
-    from .table import Table
 
     cls = type(material)
     arguments = {}
@@ -77,8 +78,6 @@ def _subclasses(base):
 
 
 def _material_classes():
-    from .model import Material
-
     out = {}
     for sub in _subclasses(Material):
         out.setdefault((sub.__module__, sub.__name__), sub)
@@ -100,9 +99,6 @@ def material_from_json(data, textures=None):
         An unknown class (naming it and where it should come from), a newer layout, or a value the
         class refuses (its own message).
     """
-    from .fresnel import Fresnel
-    from .surface import SurfaceInput
-    from .table import Table
 
     if not isinstance(data, dict) or data.get("version", 0) > VERSION or "class" not in data:
         raise ValueError(f"not a glphong material (layout version {VERSION}): {data!r}"[:300])

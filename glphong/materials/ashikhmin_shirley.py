@@ -78,8 +78,11 @@ Where the paper and common implementations differ (glphong follows the paper):
 """
 import numpy as np
 
-from .model import GlslFile, MaterialModel, Param, Properties
-from .phong import _dot, lobe_oracle
+from glphong.materials.model import GlslFile, MaterialModel, Param, Properties
+from glphong.materials.phong import _dot, lobe_oracle
+from glphong.materials.cases import Case, generic_cases
+from glphong.twin.band import EPS, FLT_MIN
+from glphong.twin.functions import fresnel_schlick, lobe_from_delta, safe_normalize
 
 __all__ = ["AshikhminShirley", "ashikhmin_shirley_norm", "ashikhmin_shirley_exponent",
            "ashikhmin_shirley_diffuse_factor", "ashikhmin_shirley_diffuse", "ashikhmin_shirley_half",
@@ -147,7 +150,6 @@ def ashikhmin_shirley_half(wi, wo):
     h_len : (...) ndarray
         ``|l + v|`` (``v.h = |l + v| / 2``).
     """
-    from ..reference import safe_normalize
 
     ok, h, h_len = safe_normalize(wi + wo)
     return ok & (h_len > ASHIKHMIN_SHIRLEY_HALF_FLOOR), h, h_len
@@ -159,7 +161,6 @@ def ashikhmin_shirley_lobe(f, h, nu, nv):
 
     1 where ``e = 0``, 0 where ``delta >= 1``, else ``exp(max(e ln(1 - delta), -104))``.
     """
-    from ..reference import lobe_from_delta
 
     d = h - f.n
     delta = 0.5 * _dot(d, d)
@@ -171,7 +172,6 @@ def ashikhmin_shirley_specular(f, wi, wo, n_dot_l, n_dot_v, rho_s, nu, nv):
 
     ``C (n.h)^e F(v.h) (n.l / max(n.l, n.v)) / (v.h)``, ``v.h = |l + v| / 2``; (..., 3).
     """
-    from ..reference import fresnel_schlick
 
     valid, h, h_len = ashikhmin_shirley_half(wi, wo)
     lobe = ashikhmin_shirley_lobe(f, h, nu, nv)
@@ -225,7 +225,6 @@ class AshikhminShirley(MaterialModel):
         reaching down to the diffuse part's lower bound where the lobe ``(n.h)^e`` is below 2 FLT_MIN:
         float32 may flush the lobe to 0 before it is scaled by ``C / (v.h)`` (up to 8e10), so the
         specular part may vanish where the product is still representable."""
-        from ..tolerances import EPS, FLT_MIN
 
         low, high = super().band(f, wi, wo, n_dot_l, p, constants)
         tol = constants.D * EPS
@@ -279,7 +278,6 @@ class AshikhminShirley(MaterialModel):
         to 1) and off the peak for nu, nv up to 1e6 along t, b and the diagonal; Schlick's cosine
         rounding above 1 (l = v); v.h -> 0 (l, v grazing and nearly opposite); max(n.l, n.v) at
         grazing; n.v <= 0; rho_s = 0 and 1, rho_d = 0."""
-        from ..stability import Case, generic_cases
 
         e_one = 4 * np.pi  # a point light at 1 m: E = 1 W/m^2
         light = _unit(30.0, 0.0)

@@ -16,11 +16,15 @@ q          scalar  >= 0        1       exponent (q = 0: lobe 1 where h is define
 """
 import numpy as np
 
-from ..reference import BLINN_HALF_FLOOR, blinn_delta, blinn_lobe, half_cosine
-from .fresnel import FresnelSlot, fresnel_band, fresnel_factor
-from .lambert import Lambert
-from .model import GlslFile, MaterialModel, MaterialSum, Properties
-from .phong import _KS, _Q, _dot, lobe_oracle
+from glphong.twin.functions import BLINN_HALF_FLOOR, blinn_delta, blinn_lobe, half_cosine
+from glphong.materials.fresnel import FresnelSlot, fresnel_band, fresnel_factor
+from glphong.materials.lambert import Lambert
+from glphong.materials.model import GlslFile, MaterialModel, MaterialSum, Properties
+from glphong.materials.phong import _KS, _Q, _dot, lobe_oracle
+from glphong.materials.cases import generic_cases, lobe_cases
+from glphong.materials.fresnel import fresnel_oracle
+from glphong.twin.band import EPS, lobe_band
+from glphong.twin.functions import safe_normalize
 
 __all__ = ["BlinnLobe", "BlinnPhong", "blinn_delta", "blinn_lobe", "half_cosine", "BLINN_HALF_FLOOR", "blinn_lobe_band"]
 
@@ -40,8 +44,6 @@ def blinn_lobe_band(f, wi, wo, p, constants):
     f_low, f_high : (N, 3) ndarray
         The Fresnel factor's interval.
     """
-    from ..reference import safe_normalize
-    from ..tolerances import EPS, lobe_band
 
     tol = constants.D * EPS
     ok_h, h_dir, h_len = safe_normalize(wi + wo)
@@ -90,7 +92,6 @@ class BlinnLobe(MaterialModel):
         length = mpmath.sqrt(sum(x * x for x in s))
         if not (sum(a * b for a, b in zip(f.n, wo)) > 0 and length > 0):
             return [mpmath.mpf(0)] * 3
-        from .fresnel import fresnel_oracle
 
         lobe = lobe_oracle(sum(a * b / length for a, b in zip(f.n, s)), p.q)
         fresnel = fresnel_oracle(p, sum(a * b / length for a, b in zip(wi, s)))
@@ -102,8 +103,6 @@ class BlinnLobe(MaterialModel):
 
     @classmethod
     def stability_cases(cls):
-        from ..stability import generic_cases, lobe_cases
-
         return generic_cases("blinn", BlinnPhong(0.2, 0.5, 100.0)) + lobe_cases("blinn", BlinnPhong)
 
 

@@ -87,9 +87,12 @@ m = 1), so `CookTorrance` conserves energy when ``rho_d + max F <= 1``; the 1982
 """
 import numpy as np
 
-from .diffuse import Diffuse
-from .fresnel import DielectricFresnel, FresnelSlot, SchlickFresnel, fresnel_factor
-from .model import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.materials.diffuse import Diffuse
+from glphong.materials.fresnel import DielectricFresnel, FresnelSlot, SchlickFresnel, fresnel_factor
+from glphong.materials.model import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
+from glphong.materials.fresnel import fresnel_oracle
+from glphong.twin.functions import safe_normalize
 
 __all__ = ["CookTorranceLobe", "CookTorrance", "cook_torrance_geometry", "cook_torrance_beckmann",
            "cook_torrance_masking", "COOK_TORRANCE_EXP_LIMIT", "COOK_TORRANCE_FORM_RATIO"]
@@ -131,7 +134,6 @@ def cook_torrance_geometry(n, wi, wo, n_dot_l):
         ``n.v``; ``n.h = (n.l + n.v)/|l + v|``; ``h.l = |l + v|/2``; ``tan^2(theta_h) = delta (2 - delta)
         / (n.h)^2`` with ``delta = |h - n|^2 / 2``.  1, 1, 1 and 0 where not valid.
     """
-    from ..reference import safe_normalize
 
     ok, h, h_len = safe_normalize(wi + wo)
     dtype = h.dtype
@@ -229,8 +231,6 @@ class CookTorranceLobe(MaterialModel):
         cos^4 in the denominator, 1/((n.l)(n.v)) formed): 0 where n.v <= 0 or l = -v."""
         import mpmath
 
-        from .fresnel import fresnel_oracle
-
         dot = lambda a, b: sum(x * y for x, y in zip(a, b))  # noqa: E731
         n_dot_v = dot(f.n, wo)
         s = [a + b for a, b in zip(wi, wo)]
@@ -288,7 +288,6 @@ class CookTorrance(MaterialSum):
 def _stability_cases():
     """Generic geometry plus the extremes of Cook-Torrance: grazing view (1/((n.l)(n.v))), grazing half
     vectors (Beckmann's tan^2 and exp), small m at the peak, v.h near 0, Schlick at c rounding above 1."""
-    from ..stability import Case, _mirror_eye, _unit, generic_cases
 
     e_one = 4 * np.pi  # a point light at 1 m: E = 1 W/m^2
     light = _unit(30.0)

@@ -14,7 +14,9 @@ rho_d      rgb     [0, 1]      1       diffuse albedo (kd = rho_d / pi)
 """
 import numpy as np
 
-from .model import GlslFile, MaterialModel, Param, Properties
+from glphong.materials.model import GlslFile, MaterialModel, Param, Properties
+from glphong.materials.cases import generic_cases
+from glphong.twin.band import EPS
 
 __all__ = ["Diffuse", "diffuse", "RHO_D"]
 
@@ -52,7 +54,6 @@ class Diffuse(MaterialModel):
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
         """``rho_d / pi [max(n.l - D eps, 0), n.l + D eps]`` widened by 2 eps (the constant and the product)."""
-        from ..tolerances import EPS
 
         tol = constants.D * EPS
         return (diffuse(p.rho_d, np.maximum(n_dot_l - tol, 0.0)) * (1 - 2 * EPS),
@@ -69,6 +70,4 @@ class Diffuse(MaterialModel):
 
     @classmethod
     def stability_cases(cls):
-        from ..stability import generic_cases
-
         return generic_cases("diffuse", cls(0.6))

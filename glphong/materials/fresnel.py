@@ -22,7 +22,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .model import Param
+from glphong.materials.params import Param
+from glphong.twin.band import EPS
+from glphong.twin.functions import fresnel_dielectric, fresnel_schlick
 
 __all__ = ["Fresnel", "SchlickFresnel", "DielectricFresnel", "FresnelSlot", "fresnel_factor", "FRESNEL_PARAMS",
            "fresnel_oracle", "fresnel_band", "fresnel_uniform_values"]
@@ -149,7 +151,6 @@ def fresnel_factor(p, c):
     c : (...) ndarray
         The cosine the model states.
     """
-    from ..reference import fresnel_dielectric, fresnel_schlick
 
     c = np.asarray(c)
     form = int(p.fresnel_form)
@@ -185,7 +186,6 @@ def fresnel_band(p, c, tol):
     Both forms are non-increasing in ``c`` on [0, 1], so the ends are ``F(c + tol)`` and ``F(c - tol)``,
     widened by 16 eps relative (the power, the square root and the divisions).
     """
-    from ..tolerances import EPS
 
     c = np.asarray(c, dtype=np.float64)
     low = fresnel_factor(p, np.clip(c + tol, 0, 1))

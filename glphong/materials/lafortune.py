@@ -93,8 +93,11 @@ the lobe's scale made explicit as the issue specifies):
 """
 import numpy as np
 
-from .diffuse import Diffuse
-from .model import GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.materials.diffuse import Diffuse
+from glphong.materials.model import GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
+from glphong.twin.band import EPS, FLT_MAX, lobe_band
+from glphong.twin.functions import log_one_minus, safe_normalize
 
 __all__ = ["LafortuneLobes", "Lafortune", "lafortune_local", "lafortune_log", "lafortune_lobe",
            "LAFORTUNE_MAX_LOBES"]
@@ -191,7 +194,6 @@ def lafortune_local(f, d):
 def lafortune_log(m):
     """``ln m`` for ``m > 0``, to a few ulp relative (lafortune_lobes.glsl): ``log_one_minus(1 - m)`` on
     [0.5, 1], ``-log_one_minus((m - 1)/m)`` on (1, 2], ``log(m)`` elsewhere."""
-    from ..reference import log_one_minus
 
     m = np.asarray(m)
     dtype = m.dtype if m.dtype.kind == "f" else np.dtype(np.float64)
@@ -206,7 +208,6 @@ def lafortune_log(m):
 
 def _lobe_parts(l, v, c):
     """The generalised chord form's pieces: ``(m, ok, u, delta)`` (see `lafortune_lobe`)."""
-    from ..reference import safe_normalize
 
     dtype = np.result_type(l, v)
     c = np.asarray(c, dtype=dtype)
@@ -243,7 +244,6 @@ def lafortune_lobe(l, v, c, q):
         ``exp(clip(q (ln m + ln(1 - u)/2 + ln(1 - delta)), -104, 88))``; 1 for ``q = 0``; 0 where
         ``x <= 0`` or ``C o l = 0``.
     """
-    from ..reference import log_one_minus
 
     m, ok, u, delta = _lobe_parts(l, v, c)
     dtype = delta.dtype
@@ -258,8 +258,6 @@ def lafortune_lobe(l, v, c, q):
 
 def _lobe_band(l, v, c, q, constants):
     """Interval of float32 values of one lobe consistent with the float64 twin (see `LafortuneLobes.band`)."""
-    from ..reference import safe_normalize
-    from ..tolerances import EPS, lobe_band
 
     if q == 0:
         one = np.ones(len(l))
@@ -383,7 +381,6 @@ class LafortuneLobes(MaterialModel):
         Model-specific because the generic default does not perturb ``C`` and cannot see the rounding of
         ``ln m`` and ``ln(1 - u)`` where they cancel (an off-specular peak with ``|C o l| = 1``).  For
         ``|Cx| = |Cy| = |Cz|`` it is the Phong lobe band (``u = 0``)."""
-        from ..tolerances import EPS, FLT_MAX
 
         tol = constants.D * EPS
         l = lafortune_local(f, wi)
@@ -491,7 +488,6 @@ def _peak_eye(c, light):
 
 def lafortune_cases(label):
     """The stability cases of the Lafortune lobes (list of `glphong.stability.Case`); normal +z, tangent +x."""
-    from ..stability import Case, _mirror_eye, _unit, generic_cases
 
     e_one = 4 * np.pi  # a point light at 1 m: E = 1 W/m^2
     light = _unit(30.0)

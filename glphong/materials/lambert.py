@@ -12,7 +12,9 @@ kd         rgb     >= 0        1/sr    diffuse BRDF value k_d
 """
 import numpy as np
 
-from .model import GlslFile, MaterialModel, Param, Properties
+from glphong.materials.model import GlslFile, MaterialModel, Param, Properties
+from glphong.materials.cases import generic_cases
+from glphong.twin.band import EPS
 
 __all__ = ["Lambert", "lambert"]
 
@@ -48,7 +50,6 @@ class Lambert(MaterialModel):
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
         """``k_d [max(n.l - D eps, 0), n.l + D eps]``: the dot product's absolute error (docs/design.md section 4)."""
-        from ..tolerances import EPS
 
         tol = constants.D * EPS
         return lambert(p.kd, np.maximum(n_dot_l - tol, 0.0)), lambert(p.kd, np.maximum(n_dot_l + tol, 0.0))
@@ -62,6 +63,4 @@ class Lambert(MaterialModel):
 
     @classmethod
     def stability_cases(cls):
-        from ..stability import generic_cases
-
         return generic_cases("lambert", cls(0.2))

@@ -48,10 +48,12 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import merl
-from ..reference import atan2_first_quadrant, frame_from_tangent, safe_normalize
-from .model import Choice, GlslFile, MaterialModel, Properties
-from .table import Table, TableData
+from glphong.core import merl
+from glphong.twin.functions import atan2_first_quadrant, frame_from_tangent, safe_normalize
+from glphong.materials.model import Choice, GlslFile, MaterialModel, Properties
+from glphong.materials.table import Table, TableData
+from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
+from glphong.twin.band import EPS
 
 __all__ = ["MeasuredBRDF", "measured_brdf_coordinates", "measured_brdf_fetch", "measured_brdf_nearest",
            "measured_brdf_trilinear"]
@@ -231,7 +233,6 @@ class MeasuredBRDF(MaterialModel):
         bin interiors) inside it, where a piecewise multilinear function has its extremes.  An azimuth
         box of one bin or more spans the whole period.  Trilinear sums are widened by ``A eps``.
         """
-        from ..tolerances import EPS
 
         e = 4 * constants.D * EPS
         x = measured_brdf_coordinates(f.n, wi, wo)
@@ -319,7 +320,6 @@ class MeasuredBRDF(MaterialModel):
         """The generic geometry, and the peak of a sharp tabulated lobe (q = 1e4; ``theta_h`` from 0 to 5e-4
         rad, where ``acos`` of n.h resolves nothing below 3.5e-4 rad: x_h moves by up to 1.3 bins) with
         both lookups."""
-        from ..stability import Case, _mirror_eye, _unit, generic_cases
 
         cases = generic_cases(cls.name, cls.example())
         light = _unit(30.0)

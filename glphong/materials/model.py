@@ -19,568 +19,21 @@ models use exactly this mechanism; a definition is checked when its class is cre
 missing twin, a GLSL function of the wrong name or signature, a parameter without a range or a
 name that clashes fails there, with a message saying what is wrong.
 """
-import functools
-import hashlib
-import inspect
-import keyword
-import re
-import sys
-from dataclasses import dataclass
-from pathlib import Path
-
 import numpy as np
 
-from .. import _validate
-from .table import Table, TableData
+from glphong.core import validate as _validate
+from glphong.materials.definition_checks import check_definition
+from glphong.materials.params import (MATERIAL_KEYWORDS, Choice, GlslFile, MaterialDefinitionError, Param, ParamValues,
+                                      Properties, ShadingFrame)
+from glphong.materials.registry import _REGISTRY, _is_builtin, model_named, model_source, register, registered_models
+from glphong.materials.table import Table, TableData
+from glphong.materials.cases import generic_cases
+from glphong.materials.fresnel import FRESNEL_PARAMS, fresnel_uniform_values
+from glphong.materials.surface import SurfaceInput
+from glphong.twin.band import EPS
 
 __all__ = ["Param", "Choice", "Table", "TableData", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
            "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
-
-#: parameter kinds and their GLSL types
-KINDS = {"scalar": "float", "rgb": "vec3"}
-#: what a model may ask for beyond the normal and the light direction
-NEEDS = ("view", "tangent", "uv")
-#: library chunks (glsl/<name>.glsl) a model may use besides common.glsl, which is always there
-LIBRARY_CHUNKS = ("lobe", "fresnel", "angle")
-#: names a model may not take: GLSL prefixes and uniforms of the shading loop and the library
-RESERVED_NAMES = frozenset({
-    "material", "shade", "common", "lights", "light", "point", "unattenuated", "directional", "ambient",
-    "eye", "model", "normal", "view", "use", "ka", "safe", "lobe", "srgb", "encode", "mesh", "uber", "naive",
-    "frame", "gl", "object", "exposure", "radiance", "fullscreen", "fresnel"})
-#: material-level keywords every material takes
-MATERIAL_KEYWORDS = ("ka", "two_sided")
-_GLSL_KEYWORDS = frozenset("""attribute const uniform varying layout centroid flat smooth noperspective break continue
-do for while switch case default if else in out inout float int void bool true false invariant discard return mat2
-mat3 mat4 vec2 vec3 vec4 ivec2 ivec3 ivec4 bvec2 bvec3 bvec4 uint uvec2 uvec3 uvec4 lowp mediump highp precision
-sampler2D struct common partition active asm class union enum typedef template this packed goto inline noinline
-volatile public static extern external interface long short double half fixed unsigned superp input output
-filter sizeof cast namespace using""".split())
-_IDENT = re.compile(r"^[a-z][a-z0-9_]*$")
-
-
-class MaterialDefinitionError(TypeError):
-    """A `MaterialModel` or `MaterialSum` definition is incomplete or inconsistent."""
-
-
-# --------------------------------------------------------------------------- parameters
-def _check_argument_name(kind, name):
-    """A `Param` or `Table` name: a lowercase identifier, not a GLSL or Python keyword, not a material keyword."""
-    if not isinstance(name, str) or not _IDENT.match(name) or name in _GLSL_KEYWORDS or keyword.iskeyword(name):
-        raise MaterialDefinitionError(f"{kind} name must be a lowercase identifier such as 'kd' (got {name!r})")
-    if name in MATERIAL_KEYWORDS:
-        raise MaterialDefinitionError(f"{kind} {name!r}: the name is a keyword every material takes "
-                                      f"({', '.join(MATERIAL_KEYWORDS)}); choose another")
-
-
-@dataclass(frozen=True)
-class Param:
-    """One parameter of a material model.
-
-    Parameters
-    ----------
-    name : str
-        Python keyword and GLSL suffix: the uniform is ``u_<model>_<name>``.
-    kind : {'scalar', 'rgb'}
-        A float, or an RGB triple (a scalar broadcasts to the three channels).
-    low, high : float, optional
-        The valid range; at least one must be given (pass ``low=-numpy.inf`` explicitly for a
-        parameter with no lower bound).  Values must also be finite and representable in float32.
-    default : float or (3,) array_like, optional
-        Value when the parameter is not passed; without one the parameter is required.
-    unit : str
-        Physical unit, for documentation (``'1/sr'``, ``'rad'``, ``''`` for dimensionless).
-    doc : str
-        One line of documentation.
-    low_inclusive, high_inclusive : bool
-        Whether the ends of the range are allowed values.
-    textureable : bool
-        The parameter also takes a `glphong.materials.surface.SurfaceInput` (a texture, vertex
-        colours or both, `glphong.Texture`, `glphong.VertexColors`): its value then varies over the
-        surface, and the model's GLSL reads ``u_<model>_<name>`` unchanged (glphong sets it per fragment
-        before the response is called).  rgb parameters only.
-    """
-
-    name: str
-    kind: str
-    low: float = None
-    high: float = None
-    default: object = None
-    unit: str = ""
-    doc: str = ""
-    low_inclusive: bool = True
-    high_inclusive: bool = True
-    textureable: bool = False
-
-    def __post_init__(self):
-        _check_argument_name("Param", self.name)
-        if self.kind not in KINDS:
-            raise MaterialDefinitionError(f"Param {self.name!r}: kind must be one of {', '.join(map(repr, KINDS))} "
-                                          f"(got {self.kind!r})")
-        if self.textureable and self.kind != "rgb":
-            raise MaterialDefinitionError(f"Param {self.name!r}: only rgb parameters can be textureable (a texture "
-                                          "gives rgb per fragment)")
-        if self.low is None and self.high is None:
-            raise MaterialDefinitionError(
-                f"Param {self.name!r} has no range: give low= and/or high= (for example low=0.0); "
-                "pass low=-numpy.inf explicitly for a parameter without bounds")
-        low = -np.inf if self.low is None else float(self.low)
-        high = np.inf if self.high is None else float(self.high)
-        if np.isnan(low) or np.isnan(high) or not low < high:
-            raise MaterialDefinitionError(f"Param {self.name!r}: low must be below high (got {self.low!r}, {self.high!r})")
-        object.__setattr__(self, "low", low)
-        object.__setattr__(self, "high", high)
-        if self.default is not None:
-            try:
-                object.__setattr__(self, "default", self.validate(self.default))
-            except (TypeError, ValueError) as exc:
-                raise MaterialDefinitionError(f"Param {self.name!r}: default is not a valid value: {exc}") from None
-
-    @property
-    def glsl_type(self):
-        """``'float'`` or ``'vec3'``."""
-        return KINDS[self.kind]
-
-    @property
-    def interval(self):
-        """The valid range as text, e.g. ``'[0, 2]'``."""
-        return (f"{'[' if self.low_inclusive else '('}{self.low:g}, {self.high:g}"
-                f"{']' if self.high_inclusive else ')'}")
-
-    def validate(self, value):
-        """``value`` checked against kind and range: a float, or a tuple of 3 floats for 'rgb'.
-
-        Raises
-        ------
-        TypeError, ValueError
-            Naming the parameter and its valid range.
-        """
-        from .surface import SurfaceInput
-
-        if isinstance(value, SurfaceInput):
-            return self._validate_surface_input(value)
-        low = max(self.low, -_validate.FLT_MAX)
-        high = min(self.high, _validate.FLT_MAX)
-        low_inclusive = self.low_inclusive or self.low < -_validate.FLT_MAX
-        high_inclusive = self.high_inclusive or self.high > _validate.FLT_MAX
-        if self.kind == "rgb":
-            return _validate.rgb(self.name, value, low=low, high=high, low_inclusive=low_inclusive,
-                                 high_inclusive=high_inclusive)
-        return _validate.scalar(self.name, value, low=low, high=high, low_inclusive=low_inclusive,
-                                high_inclusive=high_inclusive)
-
-    def _validate_surface_input(self, value):
-        """A `SurfaceInput` given to this parameter: allowed where textureable, its values over any surface
-        (texels times ``scale``; vertex colours in [0, 1]) within the range."""
-        if not self.textureable:
-            raise TypeError(f"{self.name} takes a constant ({self.kind} in {self.interval}), not a texture or vertex "
-                            "colours: the model does not declare it textureable")
-        low, high = value.value_range()
-        below = self.low > -np.inf and (np.any(low < self.low) or not self.low_inclusive and np.any(low == self.low))
-        above = self.high < np.inf and (np.any(high > self.high) or not self.high_inclusive and np.any(high == self.high))
-        if below or above:
-            raise ValueError(f"{self.name} must be in {self.interval} everywhere; {value!r} spans "
-                             f"[{float(np.min(low)):g}, {float(np.max(high)):g}] (texels times scale"
-                             f"{', vertex colours in [0, 1]' if value.vertex_colors else ''})")
-        return value
-
-    def example(self):
-        """A representative valid value: the default, else 0.5 moved into the range."""
-        if self.default is not None:
-            return self.default
-        x = min(max(0.5, self.low), self.high)
-        if x == self.low and not self.low_inclusive or x == self.high and not self.high_inclusive:
-            x = self.low + 0.5 * (self.high - self.low) if np.isfinite(self.high - self.low) else \
-                (self.low + 1.0 if np.isfinite(self.low) else self.high - 1.0)
-        return self.validate(x)
-
-
-@dataclass(frozen=True)
-class Choice:
-    """A structural option of a material model: which form of its formula the program compiles.
-
-    Parameters
-    ----------
-    name : str
-        Python keyword; the define is ``<MODEL>_<NAME>`` (upper-cased), its value the index of the
-        chosen value in `values` (so the GLSL reads ``#if COOK_TORRANCE_LOBE_FORM == 1``).
-    values : tuple of str
-        The allowed values, in index order.
-    default : str
-    doc : str
-    """
-
-    name: str
-    values: tuple
-    default: str
-    doc: str = ""
-
-    def __post_init__(self):
-        if not isinstance(self.name, str) or not _IDENT.match(self.name) or keyword.iskeyword(self.name):
-            raise MaterialDefinitionError(f"Choice name must be a lowercase identifier (got {self.name!r})")
-        if not isinstance(self.values, tuple) or not self.values or not all(isinstance(v, str) for v in self.values):
-            raise MaterialDefinitionError(f"Choice {self.name!r}: values must be a non-empty tuple of str")
-        if self.default not in self.values:
-            raise MaterialDefinitionError(f"Choice {self.name!r}: default {self.default!r} is not one of {self.values}")
-
-    @property
-    def interval(self):
-        return " or ".join(map(repr, self.values))
-
-    def validate(self, value):
-        """``value`` if it is one of `values`, else ValueError naming them."""
-        if not isinstance(value, str) or value not in self.values:
-            raise ValueError(f"{self.name} must be {self.interval} (got {value!r})")
-        return value
-
-    def define(self, value):
-        """``(NAME, index)`` of the chosen value."""
-        return self.name.upper(), str(self.values.index(value))
-
-
-@dataclass(frozen=True)
-class Properties:
-    """What a model declares about its BRDF, for the analysis to check (docs/design.md section 8).
-
-    Attributes
-    ----------
-    reciprocal, isotropic : bool or None
-        ``f_r(wi, wo) = f_r(wo, wi)``; invariance under rotation about the normal.  None: not declared.
-    energy_conserving : bool or None
-        Directional albedo at most 1 for every incident direction, under `condition`.
-    condition : str
-        When energy conservation holds, e.g. ``'pi kd + ks (q + 2)/(2 pi) <= 1'``; '' for always/never.
-    non_negative : bool or None
-    """
-
-    reciprocal: bool = None
-    isotropic: bool = None
-    energy_conserving: bool = None
-    condition: str = ""
-    non_negative: bool = True
-
-
-class ParamValues:
-    """The float32 parameter values the GPU was given, as attributes (``p.kd``, ``p.q``).
-
-    rgb parameters are ``(3,)`` arrays, scalars ``()`` arrays, in the dtype of the computation
-    (float64 in the reference: exactly the float32 values).
-    """
-
-    def __init__(self, values):
-        self.__dict__.update(values)
-
-    def __repr__(self):
-        return "ParamValues(" + ", ".join(f"{k}={np.asarray(v).tolist()}" for k, v in self.__dict__.items()) + ")"
-
-
-@dataclass(frozen=True)
-class ShadingFrame:
-    """The twin's ``ShadingFrame`` (common.glsl): the local frame at each shading point.
-
-    Attributes
-    ----------
-    n : (N, 3) ndarray
-        Unit normal (flipped toward the viewer on back faces when two-sided).
-    t, b : (N, 3) ndarray or None
-        Unit tangent and bitangent, ``(t, b, n)`` right-handed up to the mesh's handedness sign;
-        None unless a term needs ``'tangent'``.
-    uv : (N, 2) ndarray or None
-        Texture coordinates; None unless a term needs ``'uv'`` or a parameter is textured.
-    inputs : dict of str to (N, 3) ndarray or None
-        The twin's per-fragment values of surface inputs by uniform name (``u_<model>_<param>``: in GLSL
-        the globals `material_inputs` sets); None where no parameter varies.
-    input_bounds : dict of str to ((N, 3), (N, 3)) or None
-        Their intervals for the tolerance band (`glphong.tolerances.input_bounds`).
-    """
-
-    n: np.ndarray
-    t: np.ndarray = None
-    b: np.ndarray = None
-    uv: np.ndarray = None
-    inputs: dict = None
-    input_bounds: dict = None
-
-    def select(self, mask):
-        """The frame at the points where ``mask`` is true."""
-        pick = lambda a: None if a is None else a[mask]  # noqa: E731
-        inputs = None if self.inputs is None else {k: v[mask] for k, v in self.inputs.items()}
-        bounds = None if self.input_bounds is None else \
-            {k: (lo[mask], hi[mask]) for k, (lo, hi) in self.input_bounds.items()}
-        return ShadingFrame(self.n[mask], pick(self.t), pick(self.b), pick(self.uv), inputs, bounds)
-
-
-
-# --------------------------------------------------------------------------- GLSL sources
-@dataclass(frozen=True)
-class GlslFile:
-    """A built-in model's GLSL file, relative to glphong's shader folder (``glsl/``).
-
-    Read through the same root as every chunk, so ``GLPHONG_GLSL_DIR`` (a working copy of the
-    shaders) applies to model chunks too.  A model's GLSL is read when its class is defined (the
-    definition is checked then), library chunks when first used: set ``GLPHONG_GLSL_DIR`` before
-    importing glphong.
-    """
-
-    path: str
-
-
-_REGISTRY = {}
-_SOURCES = {}
-
-
-def registered_models():
-    """Every defined `MaterialModel` subclass, built-in and user, sorted by name (tuple)."""
-    return tuple(_REGISTRY[name] for name in sorted(_REGISTRY))
-
-
-def model_named(name):
-    """The `MaterialModel` subclass registered as ``name``.
-
-    Raises
-    ------
-    KeyError
-        No model has that name.
-    """
-    try:
-        return _REGISTRY[name]
-    except KeyError:
-        raise KeyError(f"no material model is named {name!r} (defined: {', '.join(sorted(_REGISTRY))})") from None
-
-
-def _is_builtin(cls):
-    return cls.__module__.startswith("glphong.")
-
-
-def _strip_comments(text):
-    text = re.sub(r"/\*.*?\*/", lambda m: "\n" * m.group(0).count("\n"), text, flags=re.S)
-    return re.sub(r"//[^\n]*", "", text)
-
-
-def _resolve_source(cls):
-    """``(text, label, first_line)`` of a model's GLSL: label names the file or the class, and
-    ``first_line`` is the line of the text's first line in that file (1 for .glsl files)."""
-    glsl = cls.__dict__.get("glsl", cls.glsl)
-    if isinstance(glsl, GlslFile):
-        from ..programs import glsl_root
-
-        path = glsl_root().joinpath(*glsl.path.split("/"))  # a Traversable: one part at a time
-        try:
-            return path.read_text(encoding="utf-8"), glsl.path, 1
-        except OSError as exc:
-            raise MaterialDefinitionError(
-                f"{cls.__qualname__}: cannot read its GLSL {glsl.path!r} from the shader folder {glsl_root()} "
-                f"({exc.strerror}); GLPHONG_GLSL_DIR, when set, must name a full copy of glphong's glsl/ folder, "
-                "and be set before glphong is imported") from None
-    if isinstance(glsl, Path) or (isinstance(glsl, str) and "\n" not in glsl and glsl.strip().endswith(".glsl")):
-        path = Path(glsl)
-        if not path.is_absolute():
-            module = sys.modules.get(cls.__module__)
-            base = Path(getattr(module, "__file__", None) or ".").resolve().parent
-            path = base / path
-        if not path.is_file():
-            raise MaterialDefinitionError(f"{cls.__qualname__}.glsl names the file {str(path)!r}, which does not exist")
-        return path.read_text(encoding="utf-8"), str(path), 1
-    if not isinstance(glsl, str):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl must be GLSL source text or the path of a .glsl file "
-                                      f"(got {type(glsl).__name__})")
-    label, first = f"{cls.__qualname__}.glsl (material {cls.__dict__.get('name', cls.name)!r})", 1
-    try:  # where the inline string starts in the Python file, so compile errors name that file and line
-        lines, start = inspect.getsourcelines(cls)
-        file = inspect.getsourcefile(cls)
-        for i, line in enumerate(lines):
-            if re.match(r"\s*glsl\s*=\s*[rR]?(\"\"\"|''')", line):
-                label, first = f"{file}", start + i
-                break
-    except (OSError, TypeError):
-        pass
-    return glsl, label, first
-
-
-_BY_HASH = {}
-
-
-def model_source(cls):
-    """``(text, label, first_line, source_hash)`` of a model's GLSL (cached per class).
-
-    The hash covers everything the model's chunk is made of: its uniform declarations (from
-    `params`), the library chunks it uses and its text, so an edited definition is another program.
-    """
-    cached = _SOURCES.get(cls)
-    if cached is None:
-        text, label, first = _resolve_source(cls)
-        whole = "\n".join([cls.uniform_declarations(), " ".join(cls.uses), text])
-        digest = hashlib.sha256(whole.encode("utf-8")).hexdigest()[:12]
-        cached = _SOURCES[cls] = (text, label, first, digest)
-        _BY_HASH[(cls.name, digest)] = cls
-    return cached
-
-
-def model_for_key(name, source_hash):
-    """The model class a program key's term was made from (by name and source hash): a class that was
-    redefined since (a re-run notebook cell) still builds its own programs."""
-    cls = _BY_HASH.get((name, source_hash))
-    if cls is None:
-        cls = model_named(name)
-        if cls.source_hash() != source_hash:
-            raise KeyError(f"no definition of the material model {name!r} has source hash {source_hash}")
-    return cls
-
-
-def _check_glsl(cls, text):
-    """The definition-time checks of a model's GLSL text."""
-    code = _strip_comments(text)
-    name = cls.name
-    wanted = f"vec3 {name}_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)"
-    pattern = rf"\bvec3\s+{name}_response\s*\(\s*ShadingFrame\s+\w+\s*,\s*vec3\s+\w+\s*,\s*vec3\s+\w+\s*,\s*float\s+\w+\s*\)"
-    if not re.search(pattern, code):
-        found = re.search(rf"\b\w+\s+{name}_response\s*\([^)]*\)", code)
-        functions = sorted(set(re.findall(r"\b(?:vec3|float|bool|vec2|vec4|void)\s+([A-Za-z_]\w*)\s*\(", code)))
-        raise MaterialDefinitionError(
-            f"{cls.__qualname__}.glsl must define `{wanted}` (name = {name!r} gives the prefix); "
-            + (f"found `{found.group(0)}`" if found else
-               f"found no {name}_response (functions defined: {', '.join(functions) or 'none'})"))
-    read = set(re.findall(rf"\bu_{name}_([A-Za-z_]\w*)", code))
-    declared = {p.name for p in cls.uniform_params()} | {t.name for t in cls.tables}
-    if read - declared:
-        raise MaterialDefinitionError(
-            f"{cls.__qualname__}.glsl reads {', '.join(f'u_{name}_{x}' for x in sorted(read - declared))}, "
-            f"which no Param or Table declares (params and tables: {', '.join(sorted(declared)) or 'none'})")
-    # the Fresnel slot's uniforms and the ambient parameter are read by generated code
-    unread = declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]} - {cls.ambient}
-    if unread:
-        raise MaterialDefinitionError(
-            f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(unread))}: "
-            "every Param and Table is a uniform the response must use (or remove it)")
-    if re.search(rf"\buniform\s+\w+\s+u_{name}_", code):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl declares its own u_{name}_* uniforms: glphong "
-                                      "declares them from params; remove the declarations")
-    calls = re.search(rf"\b{name}_fresnel\s*\(", code)
-    if cls.fresnel_slot is not None and not calls:
-        raise MaterialDefinitionError(f"{cls.__qualname__} has a fresnel_slot, so its GLSL must call "
-                                      f"{name}_fresnel(c) (generated by glphong) with the cosine {cls.fresnel_slot.cosine}")
-    if cls.fresnel_slot is None and calls:
-        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl calls {name}_fresnel, which glphong generates only "
-                                      "for a model with fresnel_slot = FresnelSlot(...)")
-    _check_needs(cls, code)
-    _check_namespace(cls, code)
-
-
-def _function_body(code, name):
-    """``(parameter names, body text)`` of GLSL function ``name`` in ``code``."""
-    m = re.search(rf"\b{name}\s*\(([^)]*)\)\s*\{{", code)
-    depth, i = 1, m.end()
-    while depth and i < len(code):
-        depth += {"{": 1, "}": -1}.get(code[i], 0)
-        i += 1
-    return [p.split()[-1] for p in m.group(1).split(",")], code[m.end():i]
-
-
-def _check_needs(cls, code):
-    """The response must not read what `needs` does not declare: ``wo`` without 'view', ``f.t``/``f.b``
-    without 'tangent', ``f.uv`` without 'uv' (they would be 0, or set by another term's needs)."""
-    (frame, _, wo, _), body = _function_body(code, f"{cls.name}_response")
-    missing = []
-    if "view" not in cls.needs and re.search(rf"\b{wo}\b", body):
-        missing.append(f"'view' (it reads {wo})")
-    if "tangent" not in cls.needs and re.search(rf"\b{frame}\s*\.\s*[tb]\b", body):
-        missing.append(f"'tangent' (it reads {frame}.t or {frame}.b)")
-    if "uv" not in cls.needs and re.search(rf"\b{frame}\s*\.\s*uv\b", body):
-        missing.append(f"'uv' (it reads {frame}.uv)")
-    if missing:
-        raise MaterialDefinitionError(f"{cls.__qualname__}.needs must include {' and '.join(missing)}: what a model "
-                                      "does not declare is not computed for it")
-
-
-def _top_level_names(code):
-    """Functions, constants and structs a GLSL text defines at file scope."""
-    names, depth, start = set(), 0, 0
-    for i, c in enumerate(code + "\n"):
-        if c == "{":
-            if depth == 0:
-                names.update(re.findall(r"\b([A-Za-z_]\w*)\s*\([^()]*\)\s*$", code[start:i]))
-                names.update(re.findall(r"\bstruct\s+([A-Za-z_]\w*)\s*$", code[start:i]))
-            depth += 1
-        elif c == "}":
-            depth -= 1
-            start = i + 1
-        elif c == ";" and depth == 0:
-            names.update(re.findall(r"\bconst\s+\w+\s+([A-Za-z_]\w*)\s*=", code[start:i]))
-            start = i + 1
-    return names
-
-
-def _generated_names(cls):
-    """The uniform and switch names glphong generates for a model."""
-    names = {cls.uniform_name(p.name) for p in cls.uniform_params() + cls.tables}
-    names |= {cls.uniform_name(f"{p.name}_{suffix}") for p in cls.params if p.textureable for suffix in ("scale", "texture")}
-    names |= {f"u_use_{cls.name}", f"u_use_{cls.name}_ambient"}
-    return names | ({f"{cls.name}_fresnel"} if cls.fresnel_slot is not None else set())
-
-
-@functools.lru_cache(maxsize=1)
-def _library_names():
-    """What the library chunks define at file scope (read once: the shader folder is fixed at import)."""
-    from ..programs import chunk_source
-
-    names = {"material_emission", "material_response", "shade_point"}
-    for chunk in ("common", "lights") + LIBRARY_CHUNKS + ("shade", "srgb"):
-        names |= _top_level_names(_strip_comments(chunk_source(chunk)))
-    return frozenset(names)
-
-
-_MODEL_NAMES = {}
-
-
-def _model_names(cls):
-    """What a registered model's GLSL defines at file scope, once per definition (name and source hash)."""
-    key = (cls.name, cls.source_hash())
-    names = _MODEL_NAMES.get(key)
-    if names is None:
-        names = _MODEL_NAMES[key] = frozenset(_top_level_names(_strip_comments(cls.source())))
-    return names
-
-
-def _check_namespace(cls, code):
-    """What a model defines must not collide with the library or another model (they share a program)."""
-    own = _top_level_names(code)
-    clash = own & _library_names()
-    if clash:
-        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl defines {', '.join(sorted(clash))}, which glphong's "
-                                      f"library chunks define; prefix your functions with {cls.name}_")
-    for other in registered_models():
-        if other.name == cls.name:
-            continue
-        theirs = _model_names(other)
-        both = own & theirs
-        if both:
-            raise MaterialDefinitionError(
-                f"{cls.__qualname__}.glsl defines {', '.join(sorted(both))}, which the model {other.name!r} also "
-                f"defines (both can be in one program): prefix your functions with {cls.name}_")
-        generated = _generated_names(cls) & (_generated_names(other) | theirs)
-        if generated:
-            raise MaterialDefinitionError(
-                f"{cls.__qualname__}: its generated uniforms {', '.join(sorted(generated))} collide with the model "
-                f"{other.name!r}'s names; rename the model or the parameter")
-
-
-_TWIN_ARGS = ("f", "wi", "wo", "n_dot_l", "p")
-
-
-def _check_twin(cls):
-    response = cls.__dict__.get("response")
-    if response is None or response is MaterialModel.response:
-        raise MaterialDefinitionError(
-            f"{cls.__qualname__} defines no numpy twin: add `def response(self, f, wi, wo, n_dot_l, p)` "
-            "returning f_r (n.wi) [1/sr] as an (N, 3) array, the same formulation as its GLSL")
-    try:
-        params = list(inspect.signature(response).parameters.values())[1:]
-    except (TypeError, ValueError):
-        return
-    positional = [p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
-    if len(positional) != len(_TWIN_ARGS) and not any(p.kind == p.VAR_POSITIONAL for p in params):
-        raise MaterialDefinitionError(
-            f"{cls.__qualname__}.response must take (self, {', '.join(_TWIN_ARGS)}) "
-            f"(got ({', '.join(['self'] + [p.name for p in params])}))")
 
 
 # --------------------------------------------------------------------------- materials
@@ -816,10 +269,8 @@ class MaterialModel(Material):
                     f"{cls.__qualname__}: the name {cls.name!r} is taken by "
                     f"{'the built-in ' if _is_builtin(existing) else ''}{existing.__module__}.{existing.__qualname__}; "
                     "choose another name")
-        _check_definition(cls)
-        if existing is not None:
-            _SOURCES.pop(existing, None)  # a re-run of the same definition (a notebook cell) replaces it
-        _REGISTRY[cls.name] = cls
+        check_definition(cls, MaterialModel)
+        register(cls)  # a re-run of the same definition (a notebook cell) replaces it
 
     def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
         if type(self).name is None:
@@ -840,7 +291,6 @@ class MaterialModel(Material):
         ``fresnel_ior`` where the model has a `fresnel_slot` (tuple)."""
         if cls.fresnel_slot is None:
             return cls.params
-        from .fresnel import FRESNEL_PARAMS
 
         return cls.params + FRESNEL_PARAMS
 
@@ -853,8 +303,6 @@ class MaterialModel(Material):
         """The value of the uniform ``u_<model>_<name>`` (a param, or the Fresnel factor's: no param may
         start with ``fresnel_``)."""
         if self.fresnel_slot is not None and name.startswith("fresnel_"):
-            from .fresnel import fresnel_uniform_values
-
             return fresnel_uniform_values(self.fresnel)[name]
         return getattr(self, name)
 
@@ -946,7 +394,6 @@ class MaterialModel(Material):
 
     def surface_inputs(self):
         """The parameters given a `SurfaceInput` (a texture or vertex colours), by name (dict)."""
-        from .surface import SurfaceInput
 
         return {p.name: getattr(self, p.name) for p in self.params if isinstance(getattr(self, p.name), SurfaceInput)}
 
@@ -1013,7 +460,6 @@ class MaterialModel(Material):
         accepts 0 as well); a band must bound the response over ``(0, n.l + D eps]``.  The default
         evaluates the twin at ``max(n.l, tiny)`` there.
         """
-        from ..tolerances import EPS
 
         tiny = np.finfo(np.float64).tiny
         n_dot_l = np.maximum(n_dot_l, tiny)
@@ -1080,7 +526,6 @@ class MaterialModel(Material):
     @classmethod
     def stability_cases(cls):
         """The model's extreme cases for `glphong.stability` (default: generic geometry, see there)."""
-        from ..stability import generic_cases
 
         return generic_cases(cls.name, cls.example())
 
@@ -1091,66 +536,6 @@ def _perpendiculars(v):
     a = np.cross(v, helper)
     a = a / np.linalg.norm(a, axis=-1, keepdims=True)
     return a, np.cross(v, a)
-
-
-def _check_definition(cls):
-    """Definition-time checks of a `MaterialModel` subclass (raises MaterialDefinitionError)."""
-    name = cls.name
-    if not isinstance(name, str) or not _IDENT.match(name) or "__" in name or name.endswith("_"):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.name must be a lowercase GLSL identifier such as "
-                                      f"'minnaert' (got {name!r})")
-    if name in RESERVED_NAMES or name in _GLSL_KEYWORDS or name.startswith("gl_"):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.name {name!r} is reserved by glphong's shading code "
-                                      "or GLSL; choose another")
-    params = cls.params
-    if not isinstance(params, tuple) or not all(isinstance(p, Param) for p in params):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.params must be a tuple of glphong.materials.Param")
-    if not isinstance(cls.tables, tuple) or not all(isinstance(t, Table) for t in cls.tables):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.tables must be a tuple of glphong.materials.Table")
-    names = [p.name for p in params]
-    if len(set(names)) != len(names):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.params repeats a name ({names})")
-    shadowing = sorted(set(names + [t.name for t in cls.tables]) & set(dir(MaterialModel)))
-    if shadowing:
-        raise MaterialDefinitionError(f"{cls.__qualname__}.params: {', '.join(shadowing)} would shadow a "
-                                      "MaterialModel attribute; choose other parameter names")
-    if not isinstance(cls.needs, tuple) or not set(cls.needs) <= set(NEEDS):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.needs must be a tuple of {', '.join(map(repr, NEEDS))} "
-                                      f"(got {cls.needs!r})")
-    if not isinstance(cls.uses, tuple) or not set(cls.uses) <= set(LIBRARY_CHUNKS):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.uses must be a tuple of library chunks "
-                                      f"{', '.join(map(repr, LIBRARY_CHUNKS))} (got {cls.uses!r})")
-    rgb = {p.name for p in params if p.kind == "rgb"}
-    if cls.ambient is not None and cls.ambient not in rgb:
-        raise MaterialDefinitionError(f"{cls.__qualname__}.ambient must be None or the name of an rgb Param "
-                                      f"({', '.join(sorted(rgb)) or 'none'}) (got {cls.ambient!r})")
-    if not set(cls.vanishes_with) <= set(names):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.vanishes_with names {sorted(set(cls.vanishes_with) - set(names))}, "
-                                      "which are not params")
-    if not isinstance(cls.properties, Properties):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.properties must be a glphong.materials.Properties")
-    if not isinstance(cls.choices, tuple) or not all(isinstance(c, Choice) for c in cls.choices):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.choices must be a tuple of glphong.materials.Choice")
-    from .fresnel import FresnelSlot
-
-    if cls.fresnel_slot is not None and not isinstance(cls.fresnel_slot, FresnelSlot):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.fresnel_slot must be None or a "
-                                      f"glphong.materials.FresnelSlot (got {cls.fresnel_slot!r})")
-    arguments = [a.name for a in cls.arguments()]
-    if len(set(arguments)) != len(arguments) or any(n.startswith("fresnel_") for n in names):
-        raise MaterialDefinitionError(f"{cls.__qualname__}: params, choices and fresnel must have distinct names, "
-                                      f"and no param may start with fresnel_ (got {arguments})")
-    scale = cls.ambient_scale
-    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0 < scale < np.inf:
-        raise MaterialDefinitionError(f"{cls.__qualname__}.ambient_scale must be a positive finite float "
-                                      f"(the answer to L_a is ambient_scale * <ambient param> * L_a; got {scale!r})")
-    if cls.glsl is None:
-        raise MaterialDefinitionError(f"{cls.__qualname__} has no glsl: set glsl to the GLSL source of "
-                                      f"`vec3 {name}_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)` "
-                                      "or to the path of a .glsl file")
-    _check_twin(cls)
-    _SOURCES.pop(cls, None)
-    _check_glsl(cls, model_source(cls)[0])
 
 
 class MaterialSum(Material):

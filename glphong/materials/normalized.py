@@ -82,12 +82,15 @@ and accepted by the bands.
 """
 import numpy as np
 
-from ..reference import blinn_lobe, half_cosine, phong_delta, phong_lobe
-from .blinn import blinn_lobe_band
-from .diffuse import Diffuse
-from .fresnel import FresnelSlot, fresnel_band, fresnel_factor
-from .model import GlslFile, MaterialModel, MaterialSum, Param, Properties
-from .phong import lobe_oracle
+from glphong.twin.functions import blinn_lobe, half_cosine, phong_delta, phong_lobe
+from glphong.materials.blinn import blinn_lobe_band
+from glphong.materials.diffuse import Diffuse
+from glphong.materials.fresnel import FresnelSlot, fresnel_band, fresnel_factor
+from glphong.materials.model import GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.materials.phong import lobe_oracle
+from glphong.materials.cases import Case, generic_cases, lobe_cases
+from glphong.materials.fresnel import DielectricFresnel, SchlickFresnel, fresnel_oracle
+from glphong.twin.band import EPS, FLT_MIN, lobe_band
 
 __all__ = ["NormalizedPhongLobe", "NormalizedPhong", "NormalizedBlinnLobe", "NormalizedBlinnPhong",
            "normalized_phong_lobe_norm", "normalized_blinn_lobe_norm", "Q_MAX"]
@@ -137,7 +140,6 @@ def normalized_blinn_lobe_norm(q):
 def _scaled_band(p, norm, lobe_low, lobe_high, n_dot_l, f_low, f_high, constants):
     """``rho_s F (norm lobe) (n.l)`` bounds: the lobe's band times the constant widened by
     `_NORM_ULPS` eps, ``n.l`` known to ``+- D eps``, the Fresnel band; 0 below FLT_MIN (flush)."""
-    from ..tolerances import EPS, FLT_MIN
 
     tol = constants.D * EPS
     norm = np.asarray(norm, dtype=np.float64)
@@ -183,7 +185,6 @@ class NormalizedPhongLobe(MaterialModel):
 
         The generic default does not fit: it neither follows the chord's q-amplified sensitivity at
         the peak of a 1e7 lobe the way `lobe_band` does, nor accepts the flush to 0 of a lobe below FLT_MIN."""
-        from ..tolerances import EPS, lobe_band
 
         low, high = lobe_band(phong_delta(f.n, wi, wo), p.q, 1.0, constants)
         f_low, f_high = fresnel_band(p, n_dot_l, constants.D * EPS)
@@ -193,8 +194,6 @@ class NormalizedPhongLobe(MaterialModel):
     def oracle(self, f, wi, wo, n_dot_l, p):
         """``rho_s F(n.l) (q + 2)/(2 pi) max(v.r, 0)^q (n.l)`` in mpmath, ``v.r`` from ``r = 2 (n.l) n - l``."""
         import mpmath
-
-        from .fresnel import fresnel_oracle
 
         v_dot_r = sum(v * (2 * n_dot_l * a - b) for v, a, b in zip(wo, f.n, wi))
         norm = (p.q + 2) / (2 * mpmath.pi)
@@ -209,7 +208,6 @@ class NormalizedPhongLobe(MaterialModel):
     def stability_cases(cls):
         """Generic geometry, the exponent sweep q = 0 to 1e7 at, near and in the tail of the peak, and
         the Fresnel factor at grazing incidence at the peak (`_fresnel_cases`)."""
-        from ..stability import generic_cases, lobe_cases
 
         return (generic_cases("normalized_phong", NormalizedPhong(0.2, 0.5, 100.0))
                 + lobe_cases("normalized_phong", NormalizedPhong)
@@ -283,8 +281,6 @@ class NormalizedBlinnLobe(MaterialModel):
         ``n.v <= 0`` or ``l + v = 0``."""
         import mpmath
 
-        from .fresnel import fresnel_oracle
-
         s = [a + b for a, b in zip(wi, wo)]
         length = mpmath.sqrt(sum(x * x for x in s))
         if not (sum(a * b for a, b in zip(f.n, wo)) > 0 and length > 0):
@@ -303,7 +299,6 @@ class NormalizedBlinnLobe(MaterialModel):
     def stability_cases(cls):
         """Generic geometry, the exponent sweep q = 0 to 1e7 at, near and in the tail of the peak, and
         the Fresnel factor at grazing incidence at the peak (`_fresnel_cases`)."""
-        from ..stability import generic_cases, lobe_cases
 
         return (generic_cases("normalized_blinn", NormalizedBlinnPhong(0.2, 0.5, 100.0))
                 + lobe_cases("normalized_blinn", NormalizedBlinnPhong)
@@ -339,8 +334,6 @@ def _fresnel_cases(label, material_class, q=1e3):
         Called as ``material_class(rho_d, rho_s, q, fresnel)``.
     q : float
     """
-    from ..stability import Case
-    from .fresnel import DielectricFresnel, SchlickFresnel
 
     cases = []
     for fresnel in (SchlickFresnel(0.04), DielectricFresnel(1.5)):

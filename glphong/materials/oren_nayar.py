@@ -83,8 +83,11 @@ Where common implementations differ from the paper (glphong follows the paper, d
 """
 import numpy as np
 
-from ..reference import atan2_first_quadrant
-from .model import Choice, GlslFile, MaterialModel, Param, Properties
+from glphong.twin.functions import atan2_first_quadrant
+from glphong.materials.model import Choice, GlslFile, MaterialModel, Param, Properties
+from glphong.materials.cases import Case, generic_cases
+from glphong.twin.band import EPS
+from glphong.twin.functions import safe_normalize
 
 __all__ = ["OrenNayar", "oren_nayar_tangential", "oren_nayar_cos_phi", "oren_nayar_tan_beta",
            "oren_nayar_full", "oren_nayar_qualitative", "RHO", "SIGMA"]
@@ -108,7 +111,6 @@ def _dot(a, b):
 def oren_nayar_tangential(n, w):
     """``sin(theta) = |w - (n.w) n|`` (clamped to 1) and the unit tangential direction (0 where it
     vanishes), by `safe_normalize` (oren_nayar.glsl): (..., 3) -> ((...), (..., 3))."""
-    from ..reference import safe_normalize
 
     _, direction, length = safe_normalize(w - _dot(n, w)[..., None] * n)
     return np.minimum(length, 1).astype(direction.dtype), direction
@@ -251,7 +253,6 @@ class OrenNayar(MaterialModel):
         grazing geometry for large sigma (the response crosses 0 above sigma = 0.664 rad), where
         a band relative to the result alone is too narrow.  The qualitative form's summands are
         non-negative: the widening is then ``A eps`` of the value, inside the generic band's own."""
-        from ..tolerances import EPS
 
         low, high = super().band(f, wi, wo, n_dot_l, p, constants)
         n_dot_l = np.maximum(n_dot_l, np.finfo(np.float64).tiny)
@@ -313,7 +314,6 @@ class OrenNayar(MaterialModel):
         """The generic geometry for both forms, and the model's own limits: l = n and v = n (undefined
         azimuth), l and v near n, both grazing in retro (c = 1), forward (c = -1) and crossed (c = 0)
         azimuth, grazing light under a steep view and the reverse, and sigma at 0 and pi/2."""
-        from ..stability import Case, generic_cases
 
         e_one = 4 * np.pi  # a point light at 1 m: E = 1 W/m^2
 

@@ -17,10 +17,13 @@ q          scalar  >= 0        1       exponent (q = 0: lobe 1, the 0^0 := 1 con
 """
 import numpy as np
 
-from ..reference import phong_delta, phong_lobe
-from .fresnel import FresnelSlot, fresnel_band, fresnel_factor
-from .lambert import Lambert
-from .model import GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.twin.functions import phong_delta, phong_lobe
+from glphong.materials.fresnel import FresnelSlot, fresnel_band, fresnel_factor
+from glphong.materials.lambert import Lambert
+from glphong.materials.model import GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.materials.cases import generic_cases, lobe_cases
+from glphong.materials.fresnel import fresnel_oracle
+from glphong.twin.band import EPS, lobe_band
 
 __all__ = ["PhongLobe", "Phong", "phong_delta", "phong_lobe"]
 
@@ -69,15 +72,12 @@ class PhongLobe(MaterialModel):
     def band(self, f, wi, wo, n_dot_l, p, constants):
         """``k_s`` times `glphong.tolerances.lobe_band` of the Phong delta (docs/design.md section 4), times the
         Fresnel band at ``n.l +- D eps``."""
-        from ..tolerances import EPS, lobe_band
 
         low, high = lobe_band(phong_delta(f.n, wi, wo), p.q, 1.0, constants)
         f_low, f_high = fresnel_band(p, n_dot_l, constants.D * EPS)
         return p.ks * f_low * low[..., None], p.ks * f_high * high[..., None]
 
     def oracle(self, f, wi, wo, n_dot_l, p):
-        from .fresnel import fresnel_oracle
-
         c = sum(v * (2 * n_dot_l * a - b) for v, a, b in zip(wo, f.n, wi))
         lobe = lobe_oracle(c, p.q)
         return [k * F * lobe for k, F in zip(p.ks, fresnel_oracle(p, n_dot_l))]
@@ -88,8 +88,6 @@ class PhongLobe(MaterialModel):
 
     @classmethod
     def stability_cases(cls):
-        from ..stability import generic_cases, lobe_cases
-
         return generic_cases("phong", Phong(0.2, 0.5, 100.0)) + lobe_cases("phong", Phong)
 
 

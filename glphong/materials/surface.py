@@ -31,7 +31,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import _validate
+from glphong.core import validate as _validate
+from glphong.core.filesafety import LIMITS, decode_image, read_bytes
+from glphong.core.imaging import encode_srgb8, srgb_decode
+from glphong.twin.band import EPS
 
 __all__ = ["SurfaceInput", "Texture", "VertexColors", "TextureImage", "surface_texture", "surface_texture_band",
            "WRAPS", "FILTERS", "MAX_TEXTURE_SIZE"]
@@ -46,7 +49,6 @@ MAX_TEXTURE_SIZE = 16384
 
 def _decode(array, srgb):
     """Linear float64 rgb (H, W, 3) of an image array (H, W), (H, W, 1..4)."""
-    from ..imaging import srgb_decode
 
     a = np.asarray(array)
     if a.ndim == 2:
@@ -128,7 +130,6 @@ class TextureImage:
         source = None
         if isinstance(image, (str, Path)):
             source = str(image)
-            from ..filesafety import LIMITS, decode_image, read_bytes
 
             # the caller chose this file: any format Pillow reads, sides checked from the header before decoding
             budget = LIMITS.replace(image_pixels=MAX_TEXTURE_SIZE * MAX_TEXTURE_SIZE)
@@ -198,7 +199,6 @@ class TextureImage:
         ValueError
             The source was not 8-bit (16-bit and float images cannot be re-encoded losslessly in 8 bits).
         """
-        from ..imaging import encode_srgb8
 
         base = self.levels[0][::-1].astype(np.float64)
         if self.encoding == "srgb8":
@@ -383,7 +383,6 @@ def surface_texture_band(image, uv, lod, constants):
     their magnitude, and a filter's weights are non-negative and sum to 1, so it also lies between
     the smallest and the largest of them.  ``T = constants.T``.
     """
-    from ..tolerances import EPS
 
     value, low, high = _sample(image, uv, lod)
     ulps = constants.A * EPS * np.maximum(np.abs(low), np.abs(high))

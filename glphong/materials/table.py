@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+from glphong.materials.params import MaterialDefinitionError, _check_argument_name
 
 __all__ = ["Table", "TableData", "uniform_as"]
 
@@ -130,8 +131,6 @@ class Table:
     doc: str = ""
 
     def __post_init__(self):
-        from .model import MaterialDefinitionError, _check_argument_name
-
         _check_argument_name("Table", self.name)
         shape = tuple(self.shape) if isinstance(self.shape, (tuple, list)) else None
         if shape is None or len(shape) not in SAMPLERS or not all(

@@ -75,8 +75,11 @@ Where the papers and common implementations differ (glphong follows the papers, 
 """
 import numpy as np
 
-from .diffuse import Diffuse
-from .model import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.materials.diffuse import Diffuse
+from glphong.materials.model import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.materials.cases import Case, generic_cases
+from glphong.twin.band import EPS
+from glphong.twin.functions import safe_normalize
 
 __all__ = ["WardLobe", "Ward", "ward_half", "ward_exponent", "ward_lobe_value", "WARD_HALF_FLOOR", "WARD_COS_FLOOR",
            "WARD_EXPONENT_MAX", "WARD_NORMALIZATIONS"]
@@ -117,7 +120,6 @@ def ward_half(wi, wo):
     h_len : (...) ndarray
         ``|l + v|``.
     """
-    from ..reference import safe_normalize
 
     ok, h, h_len = safe_normalize(wi + wo)
     return ok & (h_len > WARD_HALF_FLOOR), h, h_len
@@ -223,8 +225,6 @@ class WardLobe(MaterialModel):
 
         The product is widened by ``A eps`` for the remaining products and quotients.
         """
-        from ..reference import safe_normalize
-        from ..tolerances import EPS
 
         A, B, C, D = constants.A, constants.B, constants.C, constants.D
         tol = D * EPS
@@ -315,7 +315,6 @@ class WardLobe(MaterialModel):
         n.v = 1e-6 (exp(-e) below FLT_MIN, the value above it: the split exponential), small alpha
         (1e-3, isotropic and with alpha_y = 0.1) at, near and in the tail of the peak, the bounded form
         with alpha = 1 and h 80 degrees off n, and l almost -v (|l + v| = 2e-7: h undefined, 0)."""
-        from ..stability import Case, generic_cases
 
         e_one = 4 * np.pi  # a point light at 1 m with E = 1 W/m^2
         cases = []

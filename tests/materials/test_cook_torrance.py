@@ -49,11 +49,11 @@ import pytest
 
 import glphong
 import glphong.primitives
-from glphong.key import program_key
+from glphong.shaders.key import program_key
 from glphong.materials import (CookTorrance, CookTorranceLobe, DielectricFresnel, Diffuse, SchlickFresnel,
                                ShadingFrame)
 from glphong.materials.cook_torrance import COOK_TORRANCE_FORM_RATIO, cook_torrance_beckmann
-from glphong.stability import cases_for, run_stability
+from glphong.checks.stability import cases_for, run_stability
 from glphong.testing import assert_render_matches, direction, direction_sets, evaluate, frame_around, rotate_toward
 
 EPS = 2.0 ** -24

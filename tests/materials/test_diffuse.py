@@ -20,7 +20,7 @@ import pytest
 
 import glphong
 import glphong.primitives
-from glphong.key import program_key
+from glphong.shaders.key import program_key
 from glphong.materials import Diffuse, Lambert
 from glphong.testing import assert_render_matches, direction, evaluate
 

@@ -59,10 +59,10 @@ import pytest
 
 import glphong
 import glphong.primitives
-from glphong.key import program_key, response_key
+from glphong.shaders.key import program_key, response_key
 from glphong.materials import Diffuse, Lafortune, LafortuneLobes, PhongLobe
 from glphong.materials.lafortune import LAFORTUNE_MAX_LOBES
-from glphong.programs import assemble, effective_source
+from glphong.shaders.assembly import assemble, effective_source
 from glphong.testing import assert_render_matches, evaluate, float32_units
 
 EPS = 2.0 ** -24
@@ -473,7 +473,7 @@ def test_constructors_and_round_trips():
     assert eval(repr(m), {"Lafortune": Lafortune}) == m
     assert Lafortune(0.2, m.lobes, ka=0.01) == m
     assert Lafortune(0.2, m.lobes) != m and Lafortune(0.2, m.lobes[:1], ka=0.01) != m
-    from glphong.stability import _with_ka
+    from glphong.checks.stability import _with_ka
 
     assert _with_ka(m, 0.5).ka == (0.5,) * 3 and _with_ka(m, 0.5).lobes == m.lobes
     single = LafortuneLobes([(0.3, 0.5, 0.5, 0.5, 2.0)], two_sided=False)
@@ -550,7 +550,7 @@ def test_program_key_defines_and_uniform_names():
 
 # --------------------------------------------------------------------------- stability
 def test_stability_cases(glphong_backend):
-    from glphong.stability import cases_for, run_stability
+    from glphong.checks.stability import cases_for, run_stability
 
     cases = cases_for(LafortuneLobes)
     assert len(cases) == 25

@@ -25,7 +25,8 @@ import numpy as np
 import pytest
 
 import glphong
-from glphong import merl, primitives
+from glphong import primitives
+from glphong import merl
 from glphong.materials import MeasuredBRDF
 from glphong.materials.measured import measured_brdf_coordinates
 from glphong.testing import TwinMismatch
@@ -111,7 +112,7 @@ def test_the_band_catches_a_wrong_bin(glphong_backend, tabulated):
 def _assert_in_band(material, wi, wo, gpu):
     """`assert_twin_matches`' judgement on given GPU values (the tool's check, at these pairs)."""
     from glphong.testing import _inputs, _twin, response_key
-    from glphong.tolerances import BAND, EPS
+    from glphong.checks.tolerances import BAND, EPS
 
     wi, wo, normal, tangent, uv = _inputs(material, wi, wo, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0), None)
     key = response_key(material)
@@ -272,7 +273,7 @@ def test_cli_brdf_and_plots_of_a_measured_file(tmp_path, capsys):
     """``glphong brdf`` and ``glphong plot`` take a measured material by its file, like any other."""
     import json
 
-    from glphong.cli import main
+    from glphong.tools.cli import main
 
     path = tmp_path / "lambert.binary"
     merl.write_merl(path, np.full(merl.SHAPE + (3,), 0.2))

@@ -49,11 +49,11 @@ import pytest
 
 import glphong
 import glphong.primitives
-from glphong import probe
+from glphong.checks import probe
 from glphong.materials import (DielectricFresnel, Diffuse, NormalizedBlinnLobe, NormalizedBlinnPhong,
                                NormalizedPhong, NormalizedPhongLobe, SchlickFresnel, ShadingFrame)
 from glphong.materials.normalized import normalized_blinn_lobe_norm
-from glphong.stability import cases_for
+from glphong.checks.stability import cases_for
 from glphong.testing import (assert_render_matches, cosine_power_interval, direction, direction_sets, evaluate,
                              float32_units, frame_around, rotate_toward)
 

@@ -49,7 +49,7 @@ import pytest
 import glphong
 import glphong.primitives
 from glphong.materials import Diffuse, OrenNayar, Properties, ShadingFrame
-from glphong.stability import cases_for
+from glphong.checks.stability import cases_for
 from glphong.testing import (assert_render_matches, direction, direction_sets, evaluate, float32_units, frame_around,
                              rotate_toward)
 

@@ -1,0 +1,105 @@
+"""Module paths of glphong 0.1.0 that moved into subpackages: they keep working for one release.
+
+`install` registers the `PUBLIC` paths in ``sys.modules`` and puts a finder on ``sys.meta_path`` that answers an old path (``import glphong.stability``,
+``from glphong.key import ProgramKey``) with the module at its new path (the very same module object,
+so every name, private ones included, is there), warning once per path with a `DeprecationWarning`
+that names the new one.  `PUBLIC` paths are documented API that now live in a subpackage
+(``glphong.imaging`` is ``glphong.core.imaging``): they answer without a warning.  The changelog
+lists every move.
+"""
+import importlib
+import importlib.abc
+import importlib.util
+import sys
+import warnings
+
+__all__ = ["MOVED", "PUBLIC", "install", "target_of"]
+
+#: deprecated old path -> new path (removed in the release after next)
+MOVED = {
+    "glphong._validate": "glphong.core.validate",
+    "glphong.timing": "glphong.core.timing",
+    "glphong.tolerances": "glphong.checks.tolerances",
+    "glphong.stability": "glphong.checks.stability",
+    "glphong.probe": "glphong.checks.probe",
+    "glphong.raycast": "glphong.checks.raycast",
+    "glphong.key": "glphong.shaders.key",
+    "glphong.programs": "glphong.gpu.programs",
+    "glphong.camera": "glphong.scene.camera",
+    "glphong.lights": "glphong.scene.lights",
+    "glphong.geometry": "glphong.scene.geometry",
+    "glphong.culling": "glphong.scene.culling",
+    "glphong.contexts": "glphong.gpu.contexts",
+    "glphong.textures": "glphong.gpu.textures",
+    "glphong.renderer": "glphong.gpu.renderer",
+    "glphong.describe": "glphong.gpu.describe",
+    "glphong.comparisons": "glphong.analysis.comparisons",
+    "glphong.plots": "glphong.analysis.plots",
+    "glphong.gallery": "glphong.analysis.gallery",
+    "glphong.figures": "glphong.analysis.figures",
+    "glphong.loaders": "glphong.formats",
+    "glphong.gltf_data": "glphong.formats.gltf_data",
+    "glphong.gltf_validate": "glphong.formats.gltf_validate",
+    "glphong.gltf_export": "glphong.formats.gltf_export",
+    "glphong.obj_reader": "glphong.formats.obj",
+    "glphong.cli": "glphong.tools.cli",
+    "glphong.bench": "glphong.tools.bench",
+    "glphong.speed": "glphong.tools.speed",
+    "glphong.expressions": "glphong.tools.expressions",
+}
+#: documented old path -> new path, answered without a warning
+PUBLIC = {
+    "glphong.imaging": "glphong.core.imaging",
+    "glphong.radiometry": "glphong.core.radiometry",
+    "glphong.filesafety": "glphong.core.filesafety",
+    "glphong.primitives": "glphong.scene.primitives",
+    "glphong.reference": "glphong.checks.reference",
+}
+
+
+def target_of(name):
+    """The new path of old module path ``name``, or None."""
+    return MOVED.get(name) or PUBLIC.get(name)
+
+
+class _Alias(importlib.abc.Loader):
+    """Loads an old path as the module at its new path."""
+
+    def __init__(self, target):
+        self.target = target
+
+    def create_module(self, spec):
+        return importlib.import_module(self.target)
+
+    def exec_module(self, module):
+        """Nothing to run: the module at the new path is already executed."""
+
+
+class _MovedFinder(importlib.abc.MetaPathFinder):
+    """Finds the old module paths of `MOVED` and `PUBLIC`."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        new = target_of(fullname)
+        if new is None:
+            return None
+        if fullname in MOVED:
+            warnings.warn(f"{fullname} moved to {new}; the old path goes in the release after next "
+                          "(see the changelog)", DeprecationWarning, stacklevel=_caller_level())
+        return importlib.util.spec_from_loader(fullname, _Alias(new))
+
+
+def _caller_level():
+    """The stack level of the import statement that asked (past importlib's frames)."""
+    frame, level = sys._getframe(1), 1
+    while frame is not None and frame.f_code.co_filename.startswith("<frozen importlib"):
+        frame, level = frame.f_back, level + 1
+    return level + 1
+
+
+def install():
+    """Register the `PUBLIC` paths and put the finder on ``sys.meta_path``, once (``import glphong`` does
+    this, after importing the modules the public paths name)."""
+    for old, new in PUBLIC.items():
+        sys.modules.setdefault(old, importlib.import_module(new))
+    if not any(isinstance(finder, _MovedFinder) for finder in sys.meta_path):
+        sys.meta_path.insert(0, _MovedFinder())

@@ -1,0 +1,463 @@
+"""Benchmark adapters: a hand-written moderngl floor and a pyrender conversion.
+
+`HandWrittenRenderer`
+    The minimal moderngl program that draws a glphong scene with glphong's own generated
+    GLSL: every one-time step (compilation, uploads, uniform packing) happens in
+    `HandWrittenRenderer.prepare`, and `HandWrittenRenderer.render` only binds, writes
+    precomputed uniform bytes, draws and reads back.  Its frame time is the floor that
+    glphong's per-frame overhead (key computation, strict uniform binding, validation) is
+    measured against.  ``shader='textbook'`` draws with the naive formulation instead.
+
+`to_pyrender`, `PyrenderRenderer`
+    A glphong `Scene` as a ``pyrender.Scene``, for speed and quality comparisons with a
+    widely used rasteriser.  pyrender is optional: it is imported only inside these
+    functions, and ``import glphong`` never imports it (nor PyOpenGL).
+
+The pyrender conversion is approximate where the models differ (pyrender shades a
+metallic-roughness microfacet BRDF, not Phong or Blinn):
+
+- albedo: ``baseColorFactor = clip(pi kd, 0, 1)`` (a Lambertian BRDF ``kd`` is albedo / pi);
+  ``metallicFactor = 0``.  pyrender's diffuse term is ``(1 - F) 0.96 rho / pi``, not ``kd``.
+- glossiness: the exponent maps to pyrender's perceptual roughness by the Blinn-Beckmann
+  correspondence ``alpha = sqrt(2 / (q_blinn + 2))`` and pyrender's ``alpha = roughness**2``,
+  so ``roughness = (2 / (q_blinn + 2)) ** 0.25`` with ``q_blinn = q`` for `BlinnPhong` and
+  ``q_blinn = 4 q`` for `Phong` (the usual Phong-to-Blinn exponent rule); see
+  `pyrender_roughness`.  ``ks`` has no counterpart: pyrender's dielectric specular is
+  fixed by ``F0 = 0.04``.  pyrender clamps roughness below at 0.04.
+- ``ka`` (a radiance added to every pixel) becomes ``emissiveFactor = sqrt(ka)``: pyrender
+  0.1.45's fragment shader multiplies the emissive factor in twice.
+- point lights: ``I = Phi / (4 pi)`` (docs/design.md section 2) as ``color * intensity`` with
+  ``color = Phi / max(Phi)`` and ``intensity = max(Phi) / (4 pi)``.
+- directional lights: ``intensity = max(E)``, ``color = E / max(E)``, shining along the
+  node's -Z axis, which the pose points along the light's direction.
+- `UnattenuatedPointLight` has no pyrender equivalent (pyrender always divides by ``d^2``).
+- ambient ``L_a`` becomes ``ambient_light = L_a / pi``: pyrender adds
+  ``baseColor * ambient_light = pi kd * ambient_light``, glphong adds ``kd L_a``.
+- ``doubleSided`` is False (pyrender's default: it culls back faces) unless ``double_sided=True``
+  (every triangle drawn, as glphong's ``culling='off'``).
+
+pyrender's output is not radiance: it is clamped to [0, 1], encoded with ``x ** (1/2.2)``
+and quantised to 8 bits.  On EGL it draws into a 4x multisampled framebuffer object (the
+sample count is hard-coded); on OSMesa it draws into the context's single-sampled default
+framebuffer, so there is no antialiasing.
+"""
+import importlib
+import os
+import sys
+from dataclasses import replace
+
+import moderngl
+import numpy as np
+
+from glphong.gpu.contexts import create_context
+from glphong.scene.lights import DirectionalLight, PointLight, UnattenuatedPointLight
+from glphong.shaders.assembly import assemble
+from glphong.scene.camera import IntrinsicsCamera, OrthographicCamera
+from glphong.scene.scene import Scene
+
+__all__ = ["HandWrittenRenderer", "PyrenderRenderer", "to_pyrender", "pyrender_roughness", "import_pyrender",
+           "SHADERS", "PYRENDER_PLATFORMS"]
+
+#: shader variants of `HandWrittenRenderer`
+SHADERS = ("glphong", "textbook")
+
+#: pyrender platforms `PyrenderRenderer` supports (values of ``PYOPENGL_PLATFORM``)
+PYRENDER_PLATFORMS = ("egl", "osmesa")
+
+#: MSAA sample count pyrender 0.1.45 hard-codes for its framebuffer-object path (EGL)
+PYRENDER_SAMPLES = 4
+
+
+class HandWrittenRenderer:
+    """The fastest honest moderngl rendering of a glphong scene: the floor of glphong's overhead.
+
+    Parameters
+    ----------
+    width, height : int
+        Image size in pixels.
+    backend : {'egl', 'osmesa', 'auto'}
+        Passed to `glphong.contexts.create_context`; the renderer owns the context.
+    shader : {'glphong', 'textbook'}
+        'glphong': the stable programs glphong draws with.  'textbook': the same keys with
+        ``formulation='naive'`` (the textbook GLSL), the floor of a naive implementation.
+
+    Notes
+    -----
+    `prepare` does every one-time step; `render` only makes the context current, binds and
+    clears the target, enables the depth test, then per object writes the precomputed
+    uniform bytes and draws, and reads the float32 target back.  The scene is captured at
+    `prepare`: later changes to it are not seen until `prepare` is called again.
+    """
+
+    def __init__(self, width, height, backend="egl", shader="glphong"):
+        if shader not in SHADERS:
+            raise ValueError(f"shader must be one of {', '.join(map(repr, SHADERS))} (got {shader!r})")
+        self.width = int(width)
+        self.height = int(height)
+        self.shader = shader
+        self.context = create_context(backend)
+        self._mgl = self.context.mgl
+        self._programs = {}
+        self._buffers = []
+        self._vaos = []
+        self._draws = ()
+        self._fbo = None
+
+    @property
+    def backend(self):
+        """Name of the OpenGL backend in use ('egl' or 'osmesa')."""
+        return self.context.backend
+
+    def key(self, scene, obj):
+        """The `ProgramKey` this renderer draws ``obj`` with."""
+        key = scene.program_key(obj)
+        return replace(key, formulation="naive") if self.shader == "textbook" else key
+
+    def prepare(self, scene):
+        """Compile, upload and pack everything ``scene`` needs; replaces a previous scene."""
+        if self.context is None:
+            raise RuntimeError("this HandWrittenRenderer has been released")
+        aspect = self.width / self.height
+        with self.context:
+            self._release_scene()
+            mgl = self._mgl
+            colour = mgl.renderbuffer((self.width, self.height), 4, dtype="f4")
+            self._fbo = mgl.framebuffer([colour], mgl.depth_renderbuffer((self.width, self.height)))
+            mgl.disable(moderngl.CULL_FACE)
+            meshes, draws = {}, []
+            for index, obj in enumerate(scene.objects):
+                key = self.key(scene, obj)
+                program = self._programs.get(key)
+                if program is None:
+                    defines, generated = key.defines(), key.generated_chunks()
+                    program = self._programs[key] = mgl.program(
+                        vertex_shader=assemble(key.vertex_chunks(), defines, generated),
+                        fragment_shader=assemble(key.fragment_chunks(), defines, generated))
+                mesh = meshes.get(id(obj.mesh))
+                if mesh is None:
+                    mesh = meshes[id(obj.mesh)] = {"indices": mgl.buffer(obj.mesh.indices.tobytes())}
+                    self._buffers.append(mesh["indices"])
+                content = []
+                for name, source, fmt in (("in_position", "positions", "3f"), ("in_normal", "normals", "3f"),
+                                          ("in_tangent", "tangents", "4f"), ("in_uv", "uvs", "2f")):
+                    if name in key.attributes() and name in program:
+                        if source not in mesh:
+                            mesh[source] = mgl.buffer(getattr(obj.mesh, source).tobytes())
+                            self._buffers.append(mesh[source])
+                        content.append((mesh[source], fmt, name))
+                vao = mgl.vertex_array(program, content, mesh["indices"], index_element_size=4)
+                self._vaos.append(vao)
+                uniforms = []
+                for name, value in scene.uniform_values(index, key, aspect).items():
+                    if program.get(name, None) is None:
+                        if key.formulation == "naive":
+                            continue  # the compiler removed an input the naive program never reads
+                        raise KeyError(f"program {key.describe()!r} has no uniform {name!r}")
+                    uniform = program[name]
+                    data = np.asarray(value, dtype=np.float32)
+                    if data.ndim == 2 and data.shape[0] == data.shape[1] and uniform.dimension == data.size:
+                        data = data.T  # row-major matrix -> GL column-major
+                    uniforms.append((uniform, np.ascontiguousarray(data).tobytes()))
+                draws.append((tuple(uniforms), vao))
+            self._draws = tuple(draws)
+        return self
+
+    def render(self):
+        """Draw the prepared scene; return its radiance, (H, W, 3) float32, row 0 at the top."""
+        fbo = self._fbo
+        if fbo is None:
+            raise RuntimeError("call prepare(scene) first (or this HandWrittenRenderer has been released)")
+        with self.context:
+            fbo.use()
+            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+            self._mgl.enable(moderngl.DEPTH_TEST)
+            for uniforms, vao in self._draws:
+                for uniform, data in uniforms:
+                    uniform.write(data)
+                vao.render()
+            rgba = np.frombuffer(fbo.read(components=4, dtype="f4"), dtype=np.float32)
+        return np.ascontiguousarray(rgba.reshape(self.height, self.width, 4)[::-1, :, :3])
+
+    def _release_scene(self):
+        for vao in self._vaos:
+            vao.release()
+        for buffer in self._buffers:
+            buffer.release()
+        for program in self._programs.values():
+            program.release()
+        if self._fbo is not None:
+            self.context.release_framebuffer(self._fbo)
+        self._programs, self._buffers, self._vaos, self._draws, self._fbo = {}, [], [], (), None
+
+    def release(self):
+        """Release every GL object and the context; idempotent."""
+        if self.context is None:
+            return
+        with self.context:
+            self._release_scene()
+        self.context.release()
+        self.context = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.release()
+
+    def __repr__(self):
+        state = "released" if self.context is None else self.backend
+        return f"HandWrittenRenderer({self.width}x{self.height}, shader={self.shader!r}, {state})"
+
+
+# --------------------------------------------------------------------------- pyrender
+
+
+def _loaded_pyopengl_platform():
+    """The platform PyOpenGL was loaded with in this process ('egl', 'osmesa', other), or None."""
+    module = sys.modules.get("OpenGL.platform")
+    platform = getattr(module, "PLATFORM", None)
+    if platform is None:
+        return None
+    name = type(platform).__name__.lower()
+    for known in PYRENDER_PLATFORMS:
+        if name.startswith(known):
+            return known
+    return name.removesuffix("platform")
+
+
+def import_pyrender(platform):
+    """Import pyrender on ``platform`` ('egl' or 'osmesa') and return the module.
+
+    PyOpenGL reads ``PYOPENGL_PLATFORM`` once, when it is first imported, so this sets the
+    variable before the first import.
+
+    Raises
+    ------
+    ValueError
+        ``platform`` is not one of `PYRENDER_PLATFORMS`.
+    RuntimeError
+        PyOpenGL (hence pyrender) was already imported in this process on another platform.
+    ImportError
+        pyrender is not installed (``pip install glphong[pyrender]``, then
+        ``pip install --no-deps PyOpenGL==3.1.10``).
+    """
+    if platform not in PYRENDER_PLATFORMS:
+        raise ValueError(f"platform must be one of {', '.join(map(repr, PYRENDER_PLATFORMS))} (got {platform!r})")
+    loaded = _loaded_pyopengl_platform()
+    if loaded is not None and loaded != platform:
+        raise RuntimeError(
+            f"PyOpenGL (and pyrender) already use the {loaded!r} platform in this process; PYOPENGL_PLATFORM "
+            f"is read once, at the first import, so pyrender on {platform!r} needs a new process")
+    os.environ["PYOPENGL_PLATFORM"] = platform
+    return importlib.import_module("pyrender")
+
+
+def pyrender_base_color(material):
+    """pyrender base colour (an albedo, RGB) for a glphong material: the sum of ``pbr_base_color()`` over
+    its non-vanishing terms that define one (Lambert: ``pi k_d``), 0 where none does."""
+    values = [np.asarray(term.pbr_base_color(), dtype=np.float64) for term in material.components
+              if hasattr(term, "pbr_base_color") and not term.vanishes()]
+    return np.sum(values, axis=0) if values else np.zeros(3)
+
+
+def pyrender_roughness(material):
+    """pyrender perceptual roughness for a glphong material (a rough, documented mapping).
+
+    The smallest ``pbr_roughness()`` of the material's non-vanishing terms that define one, 1.0
+    when none does.  The lobe models define ``(2 / (q_blinn + 2)) ** 0.25`` with ``q_blinn = q``
+    for the Blinn lobe and ``4 q`` for the Phong lobe.  Derivation: a Blinn lobe of exponent q
+    resembles a Beckmann/GGX lobe of ``alpha = sqrt(2 / (q + 2))``, and pyrender uses
+    ``alpha = roughness**2``.
+    """
+    values = [term.pbr_roughness() for term in material.components
+              if hasattr(term, "pbr_roughness") and not term.vanishes()]
+    return min(values) if values else 1.0
+
+
+def _pyrender_material(pyrender, material, double_sided=False):
+    ka = np.asarray(material.ka, dtype=np.float64)
+    return pyrender.MetallicRoughnessMaterial(
+        baseColorFactor=np.append(np.clip(pyrender_base_color(material), 0.0, 1.0), 1.0),
+        metallicFactor=0.0,
+        roughnessFactor=pyrender_roughness(material),
+        emissiveFactor=np.sqrt(ka),  # pyrender 0.1.45 squares the emissive factor
+        doubleSided=bool(double_sided),
+    )
+
+
+def _colour_and_scale(values):
+    """``(values / max, max)`` as float64; colour (1, 1, 1) for an all-zero value."""
+    values = np.asarray(values, dtype=np.float64)
+    peak = float(values.max())
+    return (values / peak if peak > 0.0 else np.ones(3)), peak
+
+
+def _directional_pose(direction):
+    """A rotation whose -Z axis is ``direction`` (a unit vector)."""
+    z = -np.asarray(direction, dtype=np.float64)
+    helper = np.array([0.0, 1.0, 0.0]) if abs(z[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x)
+    pose = np.eye(4)
+    pose[:3, 0], pose[:3, 1], pose[:3, 2] = x, np.cross(z, x), z
+    return pose
+
+
+def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=None, double_sided=False):
+    """Convert a glphong `Scene` to a ``pyrender.Scene`` (see the module notes for the mapping).
+
+    Parameters
+    ----------
+    scene : glphong.Scene
+    samples : int
+        MSAA samples; must be 4, the count pyrender 0.1.45 hard-codes (on EGL; its OSMesa
+        path draws single-sampled).  Kept so callers state what they compare against.
+    aspect_ratio : float, optional
+        The camera's width / height; None (default) uses the viewport's at render time.
+    platform : {'egl', 'osmesa'}, optional
+        Import pyrender on this platform (see `import_pyrender`); None imports it as is
+        (PyOpenGL then picks its platform from the environment, GLX by default).
+    double_sided : bool
+        pyrender's ``doubleSided`` on every material: False (pyrender's default) culls back faces.
+
+    Returns
+    -------
+    pyrender.Scene
+        Background (0, 0, 0, 0); one mesh node per object, one camera node, one light node
+        per light.
+
+    Raises
+    ------
+    ValueError
+        The scene has an `UnattenuatedPointLight`, or ``samples`` is not 4.
+    """
+
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a glphong.Scene (got {type(scene).__name__})")
+    if samples != PYRENDER_SAMPLES:
+        raise ValueError(f"pyrender 0.1.45 always renders with {PYRENDER_SAMPLES}x MSAA (EGL) "
+                         f"or none (OSMesa); samples={samples!r} cannot be honoured")
+    for light in scene.lights:
+        if isinstance(light, UnattenuatedPointLight):
+            raise ValueError(f"UnattenuatedPointLight at {light.position} has no pyrender equivalent "
+                             "(pyrender point lights always fall off as 1/d^2)")
+    pyrender = import_pyrender(platform) if platform is not None else importlib.import_module("pyrender")
+    ambient = np.zeros(3) if scene.ambient is None else np.asarray(scene.ambient.radiance) / np.pi
+    out = pyrender.Scene(bg_color=np.zeros(4), ambient_light=ambient)
+    for obj in scene.objects:
+        primitive = pyrender.Primitive(positions=obj.mesh.positions, normals=obj.mesh.normals,
+                                       indices=obj.mesh.indices,
+                                       material=_pyrender_material(pyrender, obj.material, double_sided))
+        out.add(pyrender.Mesh([primitive], name=obj.name), pose=obj.pose, name=obj.name)
+    camera = scene.camera
+
+    if isinstance(camera, OrthographicCamera):
+        if aspect_ratio is None:
+            raise ValueError("an OrthographicCamera needs aspect_ratio (its xmag is ymag * width / height)")
+        out.add(pyrender.OrthographicCamera(xmag=camera.ymag * aspect_ratio, ymag=camera.ymag, znear=camera.znear,
+                                            zfar=camera.zfar), pose=camera.pose)
+    elif isinstance(camera, IntrinsicsCamera):  # pyrender measures the principal point from the corner
+        out.add(pyrender.IntrinsicsCamera(camera.fx, camera.fy, camera.cx + 0.5, camera.cy + 0.5, znear=camera.znear,
+                                          zfar=camera.zfar), pose=camera.pose)
+    else:
+        out.add(pyrender.PerspectiveCamera(yfov=camera.yfov, znear=camera.znear, zfar=camera.zfar,
+                                           aspectRatio=aspect_ratio), pose=camera.pose)
+    for light in scene.lights:
+        if isinstance(light, PointLight):
+            colour, peak = _colour_and_scale(light.power)
+            pose = np.eye(4)
+            pose[:3, 3] = light.position
+            out.add(pyrender.PointLight(color=colour, intensity=peak / (4.0 * np.pi)), pose=pose)
+        elif isinstance(light, DirectionalLight):
+            colour, peak = _colour_and_scale(light.irradiance)
+            out.add(pyrender.DirectionalLight(color=colour, intensity=peak), pose=_directional_pose(light.direction))
+        else:  # pragma: no cover - Scene admits no other light kinds
+            raise ValueError(f"{type(light).__name__} has no pyrender equivalent")
+    return out
+
+
+class PyrenderRenderer:
+    """pyrender's ``OffscreenRenderer`` drawing a converted glphong scene.
+
+    Parameters
+    ----------
+    width, height : int
+        Image size in pixels.
+    platform : {'egl', 'osmesa'}
+        ``PYOPENGL_PLATFORM``; set before pyrender is first imported.  Only one platform can
+        be used per process.
+    double_sided : bool
+        Draw every triangle (pyrender's ``doubleSided``); False (default) is pyrender's default,
+        which culls back faces.
+
+    Attributes
+    ----------
+    samples : int
+        MSAA samples pyrender actually uses: 4 on EGL, 1 on OSMesa (no framebuffer objects).
+
+    Raises
+    ------
+    RuntimeError
+        pyrender (PyOpenGL) was already imported with another platform.
+    ImportError
+        pyrender is not installed.
+    """
+
+    def __init__(self, width, height, platform="egl", double_sided=False):
+        self._pyrender = import_pyrender(platform)
+        self.double_sided = bool(double_sided)
+        self.width = int(width)
+        self.height = int(height)
+        self.platform = platform
+        self.samples = PYRENDER_SAMPLES if platform == "egl" else 1
+        self.scene = None
+        os.environ["PYOPENGL_PLATFORM"] = platform  # pyrender picks its context class from it at construction
+        self._renderer = self._pyrender.OffscreenRenderer(self.width, self.height)
+
+    def prepare(self, scene):
+        """Convert ``scene`` once (`to_pyrender`); returns self."""
+        self.scene = to_pyrender(scene, aspect_ratio=self.width / self.height, platform=self.platform,
+                                 double_sided=self.double_sided)
+        return self
+
+    def render(self):
+        """Render the prepared scene: (H, W, 3) uint8, gamma 1/2.2 encoded, row 0 at the top."""
+        if self._renderer is None:
+            raise RuntimeError("this PyrenderRenderer has been released")
+        colour, _depth = self._renderer.render(self.scene)
+        return colour
+
+    def release(self):
+        """Delete pyrender's renderer and its context; idempotent.
+
+        On EGL this does not call ``OffscreenRenderer.delete``: pyrender's EGL platform then
+        calls ``eglTerminate`` on the device's display, which Mesa shares with every other
+        EGL context on that device in the process (glphong's and moderngl's included) and so
+        destroys them all.  Here pyrender's GL objects are deleted and only its own EGL
+        context is destroyed (this reaches into pyrender 0.1.45's private attributes).
+        """
+        offscreen, self._renderer = self._renderer, None
+        if offscreen is None:
+            return
+        if self.platform != "egl":
+            offscreen.delete()
+            return
+        from OpenGL.EGL import EGL_NO_CONTEXT, EGL_NO_SURFACE, eglDestroyContext, eglMakeCurrent
+
+        platform = offscreen._platform
+        platform.make_current()
+        offscreen._renderer.delete()
+        eglMakeCurrent(platform._egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT)
+        eglDestroyContext(platform._egl_display, platform._egl_context)
+        platform._egl_context = platform._egl_display = None
+        offscreen._renderer = offscreen._platform = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.release()
+
+    def __repr__(self):
+        state = "released" if self._renderer is None else self.platform
+        return f"PyrenderRenderer({self.width}x{self.height}, {state})"

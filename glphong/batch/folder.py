@@ -1,0 +1,306 @@
+"""The folder of a batch: its lock, its manifest claimed atomically, its frames journal, the frames on disk.
+
+`_BatchFolder` claims ``out_dir`` for a running batch; the `glphong.batch` docstring says what
+``manifest.json``, ``frames.jsonl`` and ``.lock`` are for.  Every file of the folder is opened without
+following a symbolic link, and a link or a file that is not regular is refused (`BatchError`).
+"""
+import errno
+import hashlib
+import json
+import os
+import stat
+import tempfile
+from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # Windows: no advisory locks, see _lock_folder
+    fcntl = None
+
+__all__ = ["BatchError"]
+
+MANIFEST = "manifest.json"
+JOURNAL = "frames.jsonl"
+LOCK = ".lock"
+_JOURNAL_LINE_LIMIT = 4096  # bytes; a longer line is no record of ours
+_NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
+_CLOEXEC = getattr(os, "O_CLOEXEC", 0)
+_NONBLOCK = getattr(os, "O_NONBLOCK", 0)  # a FIFO put in a file's place does not hang its open
+
+
+class BatchError(RuntimeError):
+    """A batch cannot run as asked: another batch's frames or a running batch in the folder, files the batch
+    cannot trust (a symbolic link, frames without a manifest), a spec that cannot be pickled."""
+
+
+def _frame_name(index, fmt):
+    return f"frame_{index:06d}.{fmt}"
+
+
+def _file_digest(fd):
+    """``(size, sha256)`` of the open file ``fd`` read from its start: its size in bytes and hex digest."""
+    digest = hashlib.sha256()
+    size = 0
+    os.lseek(fd, 0, os.SEEK_SET)
+    while block := os.read(fd, 1 << 20):
+        digest.update(block)
+        size += len(block)
+    return size, digest.hexdigest()
+
+
+def _regular_or_missing(path, what):
+    """``os.lstat(path)``, or None where ``path`` does not exist; `BatchError` where it is a symbolic link or
+    not a regular file (``what`` says what it should be)."""
+    try:
+        info = os.lstat(path)
+    except FileNotFoundError:
+        return None
+    if stat.S_ISLNK(info.st_mode):
+        raise BatchError(f"{path} ({what}) is a symbolic link: a batch writes and trusts only its own files; "
+                         "remove it or use another out_dir")
+    if not stat.S_ISREG(info.st_mode):
+        raise BatchError(f"{path} ({what}) is not a regular file; remove it or use another out_dir")
+    return info
+
+
+def _open_regular(path, flags, what, mode=0o666):
+    """``os.open`` without following a symbolic link; `BatchError` for a link or a file that is not regular."""
+    try:
+        fd = os.open(path, flags | _NOFOLLOW | _CLOEXEC | _NONBLOCK, mode)
+    except OSError as exc:
+        if exc.errno in (errno.ELOOP, errno.EMLINK) or os.path.islink(path):
+            _regular_or_missing(path, what)  # raises, naming the link
+        if exc.errno in (errno.EISDIR, errno.ENXIO):
+            raise BatchError(f"{path} ({what}) is not a regular file; remove it or use another out_dir") from None
+        raise
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise BatchError(f"{path} ({what}) is not a regular file; remove it or use another out_dir")
+    return fd
+
+
+def _lock_folder(out):
+    """Lock ``out/.lock`` for this batch (exclusive, non-blocking ``flock``) and return its descriptor, to be
+    closed at the end; `BatchError` where another batch holds it.  Where ``fcntl`` is missing (Windows) the
+    file is opened and nothing is locked."""
+    path = out / LOCK
+    fd = _open_regular(path, os.O_RDWR | os.O_CREAT, "the batch lock")
+    if fcntl is None:
+        return fd
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except OSError as exc:
+        os.close(fd)
+        if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+            raise BatchError(f"another batch is running in {out} (it holds {path}): wait for it to finish "
+                             "or use another out_dir") from None
+        raise
+    return fd
+
+
+def _write_temporary(folder, text):
+    """A new file in ``folder`` holding ``text`` (UTF-8); its path."""
+    handle, temporary = tempfile.mkstemp(dir=folder, prefix=".partial-", suffix=".json")
+    with open(handle, "w", encoding="utf-8") as stream:
+        stream.write(text)
+    return temporary
+
+
+def _create_exclusive(path, text):
+    """Create ``path`` holding ``text`` atomically, whole or not at all; `FileExistsError` where it exists.
+
+    A temporary file is hard-linked to ``path`` (which fails where ``path`` exists, a symbolic link
+    included); where the file system has no hard links, ``O_CREAT | O_EXCL`` does the claiming.
+    """
+    temporary = _write_temporary(path.parent, text)
+    try:
+        os.link(temporary, path)
+        return
+    except FileExistsError:
+        raise
+    except OSError as exc:
+        if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.ENOSYS, errno.EXDEV):
+            raise
+    finally:
+        os.remove(temporary)
+    fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | _NOFOLLOW | _CLOEXEC, 0o666)
+    with open(fd, "w", encoding="utf-8") as stream:
+        stream.write(text)
+
+
+def _replace_atomically(path, text):
+    """Replace ``path`` by a file holding ``text`` (a temporary file renamed over it)."""
+    temporary = _write_temporary(path.parent, text)
+    try:
+        os.replace(temporary, path)
+    finally:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+
+
+def _read_manifest(path, limit):
+    """The manifest at ``path`` as a dict; `BatchError` for a link, a file over ``limit`` bytes, or one that
+    is not a JSON object (none of them is a manifest of this batch)."""
+    fd = _open_regular(path, os.O_RDONLY, "the batch manifest")
+    with open(fd, "rb") as stream:
+        data = stream.read(limit + 1)
+    try:
+        manifest = json.loads(data) if len(data) <= limit else None
+    except ValueError:
+        manifest = None
+    if not isinstance(manifest, dict):
+        raise BatchError(f"{path} is not a glphong batch manifest: remove it or use another out_dir")
+    return manifest
+
+
+def _foreign_file(out):
+    """The name of a frame file or journal in ``out`` (the folder has no manifest), or None."""
+    with os.scandir(out) as entries:
+        return next((e.name for e in entries if e.name.startswith("frame_") or e.name == JOURNAL), None)
+
+
+def _claim_manifest(out, batch):
+    """Create ``out/manifest.json`` for ``batch``, or compare ``batch`` with the one there; the manifest kept
+    (with the GL renderer where a run named it).  `BatchError` for another batch, or frames without one."""
+    path = out / MANIFEST
+    if _regular_or_missing(path, "the batch manifest") is None:
+        foreign = _foreign_file(out)
+        if foreign is not None:
+            raise BatchError(f"{out} holds {foreign} but no {MANIFEST}: files of an unknown batch are not "
+                             "adopted; remove them or use another out_dir")
+        try:
+            _create_exclusive(path, json.dumps(batch, indent=1))
+            return dict(batch)
+        except FileExistsError:
+            pass  # a batch that does not lock (another host, an older glphong) claimed it first: compare
+    previous = _read_manifest(path, 65536 + 64 * len(batch["specs"]))
+    stored = {k: v for k, v in previous.items() if k != "renderer"}
+    if stored != batch:
+        differ = sorted(k for k in set(batch) | set(stored) if stored.get(k) != batch.get(k))
+        raise BatchError(f"{out} holds another batch (its {', '.join(differ)} differ): glphong never mixes two "
+                         "batches in one folder; use another out_dir or remove it")
+    return previous
+
+
+def _parse_record(line, count):
+    """``(index, size, sha256)`` from a journal line, or None for a line that is not a record of a frame
+    below ``count`` (a line cut short by a crash, say)."""
+    try:
+        record = json.loads(line)
+        index, size, sha256 = record["index"], record["size"], record["sha256"]
+    except (ValueError, TypeError, KeyError):
+        return None
+    if (type(index) is not int or type(size) is not int or not 0 <= index < count or size < 0
+            or not isinstance(sha256, str) or len(sha256) != 64):
+        return None
+    return index, size, sha256
+
+
+def _read_journal(path, count):
+    """The last record of each frame in the journal at ``path``: ``{index: (size, sha256)}``."""
+    if _regular_or_missing(path, "the frame journal") is None:
+        return {}
+    records = {}
+    with open(_open_regular(path, os.O_RDONLY, "the frame journal"), "rb") as stream:
+        while line := stream.readline(_JOURNAL_LINE_LIMIT):
+            if not line.endswith(b"\n"):  # over the limit (skip the rest of it) or cut short at the end
+                while line and not line.endswith(b"\n"):
+                    line = stream.readline(_JOURNAL_LINE_LIMIT)
+                continue
+            record = _parse_record(line, count)
+            if record is not None:
+                records[record[0]] = record[1:]
+    return records
+
+
+def _frame_matches(path, record):
+    """Whether the frame file at ``path`` (a regular file) has the ``(size, sha256)`` of its record."""
+    fd = _open_regular(path, os.O_RDONLY, "a frame")
+    try:
+        return os.fstat(fd).st_size == record[0] and _file_digest(fd) == record
+    finally:
+        os.close(fd)
+
+
+def _trusted_frames(paths, records):
+    """``{index: (size, sha256)}`` of the frames on disk that match their journal record; `BatchError` for a
+    frame path that is a symbolic link or not a regular file."""
+    trusted = {}
+    for index, path in enumerate(paths):
+        if _regular_or_missing(path, "a frame") is None:
+            continue
+        record = records.get(index)
+        if record is not None and _frame_matches(path, record):
+            trusted[index] = record
+    return trusted
+
+
+def _record_line(index, size, sha256):
+    """The journal line of a frame: ``{"index", "size", "sha256"}`` and a newline."""
+    return json.dumps({"index": index, "size": size, "sha256": sha256}) + "\n"
+
+
+class _BatchFolder:
+    """``out_dir`` claimed by a running batch: its lock held, its manifest created or compared, its journal
+    open for appending, and the frames done so far.
+
+    Parameters
+    ----------
+    out : pathlib.Path
+        The folder (it exists).
+    batch : dict
+        The manifest of this batch, without the GL renderer.
+    paths : list of str
+        The frame paths, in spec order.
+    """
+
+    def __init__(self, out, batch, paths):
+        self.out, self.batch, self.paths = out, batch, paths
+        self.lock = self.journal = None
+        self.manifest, self.done = None, {}
+
+    def __enter__(self):
+        self.lock = _lock_folder(self.out)
+        try:
+            self.manifest = _claim_manifest(self.out, self.batch)
+            _remove_partials(self.out)  # the lock is ours: no writer of this folder is left
+            journal = self.out / JOURNAL
+            self.done = _trusted_frames(self.paths, _read_journal(journal, len(self.paths)))
+            _replace_atomically(journal, "".join(_record_line(i, *r) for i, r in sorted(self.done.items())))
+            self.journal = _open_regular(journal, os.O_WRONLY | os.O_APPEND, "the frame journal")
+        except BaseException:
+            self.__exit__(None, None, None)
+            raise
+        return self
+
+    def __exit__(self, *exc_info):
+        for fd in (self.journal, self.lock):
+            if fd is not None:
+                os.close(fd)
+        self.journal = self.lock = None
+
+    @property
+    def missing(self):
+        """The indices of the frames not done, ascending."""
+        return [i for i in range(len(self.paths)) if i not in self.done]
+
+    def record(self, records):
+        """Journal the frames ``records`` (``(index, size, sha256)`` each, as a worker returned them)."""
+        for index, size, sha256 in records:
+            os.write(self.journal, _record_line(index, size, sha256).encode())
+            self.done[index] = (size, sha256)
+
+    def name_renderer(self, renderer_name):
+        """Add the GL renderer to the manifest (an atomic replace) where it has none."""
+        if renderer_name is not None and "renderer" not in self.manifest:
+            self.manifest = self.manifest | {"renderer": renderer_name}
+            _replace_atomically(self.out / MANIFEST, json.dumps(self.manifest, indent=1))
+
+
+def _remove_partials(out):
+    """Remove the temporary files of writers that died (``.partial-*``; a frame is renamed when whole)."""
+    for leftover in Path(out).glob(".partial-*"):
+        try:
+            leftover.unlink()
+        except OSError:
+            pass

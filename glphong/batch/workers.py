@@ -1,0 +1,140 @@
+"""The workers of a batch: the 'spawn' pool, the worker-side `_render_chunk`, a local Dask cluster.
+
+The pool's initializer (`_init_worker`) makes each worker die with its parent, by ``PR_SET_PDEATHSIG`` on
+Linux and a watchdog thread everywhere; `_render_chunk` renders frames in a worker with the renderer it
+keeps and writes each atomically; `_local_dask` starts the local Dask cluster of ``executor='dask'``.
+
+Functions the pool runs (`_init_worker`, `_render_chunk`) are top-level functions of this module: a
+'spawn' worker unpickles them by their module path.
+"""
+import ctypes
+import multiprocessing
+import os
+import signal
+import sys
+import tempfile
+import threading
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+import numpy as np
+from glphong.batch.folder import _CLOEXEC, _NOFOLLOW, _file_digest, _frame_name
+from glphong.gpu.renderer import Renderer
+
+_PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
+_PARENT_POLL_S = 0.5
+
+_WORKER = {}
+
+
+def _set_threads(threads):
+    """llvmpipe's rasterizer threads per worker, before the worker's first context."""
+    if threads:
+        os.environ.setdefault("LP_NUM_THREADS", str(threads))
+
+
+def _init_worker(threads, parent_pid):
+    """Pool worker initialiser: `_set_threads`, then `_die_with_parent`.
+
+    Parameters
+    ----------
+    threads : int
+        ``LP_NUM_THREADS`` for this worker (0: leave it).
+    parent_pid : int
+        The pid of the process that started the pool.
+    """
+    _set_threads(threads)
+    _die_with_parent(parent_pid)
+
+
+def _die_with_parent(parent_pid):
+    """End this process when ``parent_pid``, its parent, dies: ``PR_SET_PDEATHSIG`` on Linux, a check for a
+    parent that died before that, and a daemon thread polling ``os.getppid()`` everywhere."""
+    if sys.platform.startswith("linux"):
+        _request_death_signal()
+    if os.getppid() != parent_pid:
+        os._exit(1)  # the parent died before the death signal was asked for: nobody will collect our work
+    threading.Thread(target=_watch_parent, args=(parent_pid,), name="glphong-parent-watch", daemon=True).start()
+
+
+def _request_death_signal():
+    """Ask the Linux kernel to ``SIGKILL`` this process when its parent dies; False where it cannot."""
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def _watch_parent(parent_pid, interval=_PARENT_POLL_S):
+    """Poll every ``interval`` seconds; exit the process at once when the parent is no longer ``parent_pid``
+    (an orphan is adopted by init or a subreaper)."""
+    while os.getppid() == parent_pid:
+        time.sleep(interval)
+    os._exit(1)
+
+
+def _spawn_pool(workers):
+    """A 'spawn' `ProcessPoolExecutor` of ``workers`` processes that die with this one."""
+    threads = max(1, (os.cpu_count() or 1) // workers)
+    return ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn"),
+                               initializer=_init_worker, initargs=(threads, os.getpid()))
+
+
+def _local_dask(workers):
+    """``((client, cluster), executor)``: a local Dask cluster of ``workers`` single-threaded processes."""
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise ImportError("executor='dask' needs dask.distributed: pip install 'glphong[dask]'") from None
+    threads = max(1, (os.cpu_count() or 1) // workers)
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                           env={"LP_NUM_THREADS": str(threads)})
+    client = Client(cluster)
+    return (client, cluster), client.get_executor()
+
+
+def _write_frame(frame, final, out_dir, fmt):
+    """Write ``frame`` to ``final`` through a temporary file renamed when whole; ``(size, sha256)`` of it."""
+    handle, temporary = tempfile.mkstemp(dir=out_dir, prefix=".partial-", suffix=f".{fmt}")
+    os.close(handle)
+    try:
+        if fmt == "npy":
+            np.save(temporary, np.ascontiguousarray(frame.radiance, dtype=np.float32))
+        else:
+            frame.save_png(temporary)
+        handle = os.open(temporary, os.O_RDONLY | _NOFOLLOW | _CLOEXEC)
+        try:
+            written = _file_digest(handle)
+        finally:
+            os.close(handle)
+        os.replace(temporary, final)
+    finally:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+    return written
+
+
+def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options):
+    """In a worker: render ``items`` (``(index, spec)`` pairs) with the worker's renderer and write each frame
+    atomically.
+
+    Returns
+    -------
+    records : list of tuple
+        ``(index, size, sha256)`` of each frame written: its size in bytes and the file's hex SHA-256.
+    renderer_name : str
+        The worker's GL renderer.
+    """
+
+    key = (width, height, tuple(sorted(options.items())))
+    renderer = _WORKER.get(key)
+    if renderer is None or renderer.context is None:
+        renderer = _WORKER[key] = Renderer(width, height, **options)
+    records = []
+    for index, spec in items:
+        frame = renderer.render(scene_fn(spec))
+        size, sha256 = _write_frame(frame, Path(out_dir) / _frame_name(index, fmt), out_dir, fmt)
+        records.append((index, size, sha256))
+    return records, renderer.context.renderer_name

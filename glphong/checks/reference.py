@@ -1,0 +1,302 @@
+"""The numpy twin of the GLSL shaders (docs/design.md sections 1 and 3).
+
+Every GLSL function of the library chunks (common, lights, lobe, fresnel, shade and the generated
+material chunk) has a twin here with the same name, the same argument order and the same
+formulation; a model's functions live with its definition (``glphong.materials.<model>``, its
+``response`` method the twin of ``<model>_response``).  Only the arithmetic is done in the dtype
+of the inputs (float64 for the reference, float32 to study the GPU's formulation on the CPU).
+Conventions of the mirror:
+
+- vectors are arrays of shape ``(..., 3)``, scalars per point of shape ``(...)``;
+- a GLSL function with ``out`` parameters returns ``(return value, *outs)``;
+- uniforms the GLSL reads from globals are passed as the trailing ``uniforms``
+  dictionary (the very float32 values the GPU was given), the ``key`` and the ``material``
+  (whose terms' twins the generated material chunk calls).
+
+`shade` is the image-level entry: it shades a G-buffer, fragment for fragment.
+"""
+import numpy as np
+
+from glphong.materials.surface import surface_texture, surface_texture_band
+from glphong.materials.table import uniform_as
+from glphong.twin.band import BAND, EPS
+from glphong.twin.functions import (BLINN_HALF_FLOOR, FLT_MAX, FRAME_PARALLEL_LIMIT, ShadingFrame, _dot,  # noqa: F401
+                                    atan2_first_quadrant, blinn_delta, blinn_lobe, frame_from_tangent, fresnel_dielectric,
+                                    fresnel_schlick, half_cosine, light_term, lobe_from_delta, log_one_minus,
+                                    phong_delta, phong_lobe, point_irradiance, safe_normalize, shading_frame)
+from glphong.materials import registered_models
+
+__all__ = [
+    "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus", "lobe_from_delta",
+    "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
+    "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
+    "shade_inputs", "shade", "input_bounds",
+]
+
+def __getattr__(name):
+    """A model's twin function by name (``reference.lambert``): each lives with its model in
+    ``glphong.materials.<module>``; this finds it in the modules of the registered models."""
+    import sys
+
+    for model in registered_models():
+        module = sys.modules.get(model.__module__)
+        if name in getattr(module, "__all__", ()):
+            return getattr(module, name)
+    raise AttributeError(f"module 'glphong.reference' has no attribute {name!r}")
+
+
+def incident_light(position, key, uniforms):
+    """Direction and irradiance of every light at each point: the head of shade.glsl's loops.
+
+    Parameters
+    ----------
+    position : (N, 3) ndarray
+        World-space points [m].
+    key : glphong.key.ProgramKey
+    uniforms : dict of str to ndarray
+        The program's uniforms, in the dtype of the computation.
+
+    Returns
+    -------
+    list of (valid, wi, irradiance)
+        Per light, in shader order: ``valid`` (N,) bool (the direction normalised),
+        ``wi`` (N, 3) unit vector toward the light, ``irradiance`` (N, 3) E [W/m^2].
+    """
+    out = []
+    for j in range(key.num_point_lights):
+        valid, wi, d = safe_normalize(uniforms["u_point_position"][j] - position)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            out.append((valid, wi, point_irradiance(uniforms["u_point_intensity"][j], d)))
+    for j in range(key.num_unattenuated_lights):
+        valid, wi, _ = safe_normalize(uniforms["u_unattenuated_position"][j] - position)
+        out.append((valid, wi, np.broadcast_to(uniforms["u_unattenuated_radiance"][j], position.shape)))
+    for j in range(key.num_directional_lights):
+        wi = np.broadcast_to(uniforms["u_directional_direction"][j], position.shape)
+        out.append((np.ones(len(position), bool), wi, np.broadcast_to(uniforms["u_directional_irradiance"][j], position.shape)))
+    return out
+
+
+def _terms(material):
+    return {term.name: term for term in material.components}
+
+
+def material_emission(key, uniforms, shape, dtype, material=None, inputs=None):
+    """``k_a + sum_terms k L_a`` (the generated material chunk's ``material_emission``), broadcast to ``shape``;
+    ``inputs`` the per-fragment values of surface inputs (`material_inputs`), where the key has them."""
+    radiance = np.zeros(shape, dtype)
+    if key.has_ka:
+        radiance = radiance + uniforms["u_ka"]
+    for term in key.terms:
+        if term.ambient:
+            scale = np.float32(term.ambient_scale).astype(dtype)
+            name = f"u_{term.name}_{term.ambient_param}"
+            k = inputs[name] if inputs is not None and name in inputs else uniforms[name]
+            radiance = radiance + k * (scale * uniforms["u_ambient"])
+    return radiance
+
+
+def material_inputs(uv, color, lod, key, uniforms, sample=None):
+    """The surface inputs of the generated material chunk's ``material_inputs(uv, color)``:
+    ``u_<model>_<param> = scale * surface_texture(texture, uv) * color``.
+
+    Parameters
+    ----------
+    uv : (N, 2) ndarray or None
+    color : (N, 3) ndarray or None
+        The interpolated vertex colour (the G-buffer's), where an input reads it.
+    lod : (N, 4) ndarray or None
+        The level of detail of each textured input, in `ProgramKey.textured_inputs` order.
+    key : glphong.key.ProgramKey
+    uniforms : dict
+        The program's uniforms (``u_<model>_<param>_scale`` and ``_texture``).
+    sample : callable, optional
+        ``sample(image, uv, lod)`` in place of `surface_texture`; it may return ``(k, N, 3)`` (several
+        arrays that the products broadcast over: `glphong.tolerances.input_bounds` passes the value and
+        its interval from one sampling).
+
+    Returns
+    -------
+    dict of str to (N, 3) (or (k, N, 3)) float64 ndarray
+        By uniform name; empty where the key has no surface input.
+    """
+    sample = surface_texture if sample is None else sample
+    out = {}
+    textured = list(key.textured_inputs)
+    for term, param, mode in key.inputs:
+        name = f"u_{term}_{param}"
+        value = np.asarray(uniforms[f"{name}_scale"], dtype=np.float64)
+        if "texture" in mode:
+            value = value * sample(uniforms[f"{name}_texture"], uv, lod[:, textured.index((term, param))])
+        if "vertex" in mode:
+            value = value * color
+        n = len(uv) if uv is not None else len(color)
+        out[name] = np.broadcast_to(value, np.broadcast_shapes(np.shape(value), (n, 3)))
+    return out
+
+
+def input_bounds(uv, color, lod, key, u, band=BAND):
+    """The surface inputs ``scale * T(uv) * C`` (`glphong.reference.material_inputs`) and the intervals the
+    GPU's values lie in, from one sampling of each texture.
+
+    The texture value's interval is `glphong.materials.surface.surface_texture_band`; scale and
+    colour are exact float32 inputs (>= 0), so the products carry the interval's ends, and the two
+    float32 products add ``2 eps`` relative.
+
+    Returns
+    -------
+    values : dict of str to (N, 3) float64 ndarray
+    bounds : dict of str to (low, high)
+        Both by uniform name.
+    """
+    stacked = material_inputs(uv, color, lod, key, u,
+                                  sample=lambda image, at, level: np.stack(surface_texture_band(image, at, level, band)))
+    values, bounds = {}, {}
+    for name, v in stacked.items():
+        value, low, high = v if v.ndim == 3 else (v, v, v)  # (value, low, high), or exact (no texture)
+        values[name], bounds[name] = value, (low * (1 - 2 * EPS), high * (1 + 2 * EPS))
+    return values, bounds
+
+
+def material_response(f, wi, wo, n_dot_l, key, uniforms, material):
+    """Sum of the lit terms' twins (the generated material chunk's ``material_response``); (N, 3)."""
+    terms = _terms(material)
+    out = np.zeros(np.shape(wi), np.result_type(f.n, wi))
+    for term_key in key.lit_terms:  # a term that does not need the view gets v = 0, as in the GLSL
+        term = terms[term_key.name]
+        p = term.values_from_uniforms(uniforms, dtype=out.dtype, inputs=f.inputs)
+        view = wo if "view" in term.needs else np.zeros_like(wi)
+        out = out + term.response(f, wi, view, n_dot_l, p)
+    return out
+
+
+def view_direction(position, n_valid, eye, key):
+    """The head of shade.glsl's light loops: ``v`` where a lobe needs it, and which points are lit.
+
+    Returns
+    -------
+    wo : (N, 3) ndarray
+        Unit vectors toward the viewer, ``normalize(e - w x)`` of the homogeneous eye ``(e, w)`` (0 where no
+        lit term needs the view: not computed).
+    lit : (N,) bool ndarray
+        Valid normal and, where the view is needed, a valid view direction.
+    """
+    if not key.needs_view:
+        return np.zeros_like(position), n_valid
+    eye = np.asarray(eye)
+    if eye.shape[-1] == 3:  # a camera centre: the homogeneous eye (e, 1)
+        ok_v, wo, _ = safe_normalize(eye - position)
+    else:
+        ok_v, wo, _ = safe_normalize(eye[:3] - position * eye[3])
+    return wo, n_valid & ok_v
+
+
+def shade_point(position, n, n_valid, eye, key, uniforms, material):
+    """E6 at each point (shade.glsl's ``shade_point``).
+
+    Parameters
+    ----------
+    position : (N, 3) ndarray
+        World-space points [m].
+    n : (N, 3) ndarray or ShadingFrame
+        Unit normals, or the whole shading frame (needed where a term reads t, b or uv).
+    n_valid : (N,) bool ndarray
+        False where the normal was zero or not finite: emission terms only.
+    eye : (4,) or (3,) ndarray or None
+        The homogeneous eye ``(e, w)`` (`glphong.Camera.eye`), or a camera centre ``e`` (``w = 1``);
+        None where the key needs no view vector.
+    key, uniforms
+        As in `incident_light`.
+    material : glphong.materials.Material
+        The material whose terms' twins are summed.
+
+    Returns
+    -------
+    (N, 3) ndarray
+        Radiance [W/(m^2 sr)].
+    """
+    f = n if hasattr(n, "n") else shading_frame(np.asarray(n), key=key)
+    radiance = material_emission(key, uniforms, position.shape, position.dtype, material, f.inputs)
+    if key.num_lights == 0:
+        return radiance
+    wo, lit = view_direction(position, n_valid, eye, key)
+    for valid, wi, irradiance in incident_light(position, key, uniforms):
+        n_dot_l = _dot(f.n, wi)
+        gate = lit & valid & (n_dot_l > 0)
+        term = np.zeros_like(radiance)
+        if gate.any():
+            g = f.select(gate)
+            with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
+                term[gate] = light_term(material_response(g, wi[gate], wo[gate], n_dot_l[gate], key, uniforms, material),
+                                        irradiance[gate])
+        radiance = radiance + term
+    return radiance
+
+
+# --------------------------------------------------------------------------- mesh_fragment.glsl
+def shade_inputs(scene, gbuffer, dtype=np.float64, band=None):
+    """Per object, the fragments it covers and the inputs its program shaded them with.
+
+    ``band`` (`glphong.tolerances.BandConstants`): also the intervals of the surface inputs
+    (``f.input_bounds``), for the tolerance band.
+
+    Yields
+    ------
+    selection : (H, W) bool ndarray
+        The object's pixels.
+    obj : glphong.SceneObject
+    key : glphong.key.ProgramKey
+        Its radiance-program key.
+    uniforms : dict of str to ndarray
+        The uniforms the GPU was given, cast to ``dtype``.
+    position : (N, 3) ndarray
+    f : ShadingFrame
+        The G-buffer normal renormalised (mesh_fragment.glsl), and the frame built from the
+        G-buffer's tangent and uv where the key reads them (`shading_frame`), with the surface
+        inputs from the G-buffer's uv, vertex colour and levels of detail (`material_inputs`).
+    n_valid : (N,) bool ndarray
+    """
+    height, width = gbuffer.mask.shape
+    for index, obj in enumerate(scene.objects):
+        selection = gbuffer.object_index == index
+        if not selection.any():
+            continue
+        key = scene.program_key(obj)
+        uniforms = {k: uniform_as(v, dtype) for k, v in scene.uniform_values(index, key, width / height).items()}
+        position = gbuffer.position[selection].astype(dtype)
+        n_valid, n, _ = safe_normalize(gbuffer.normal[selection].astype(dtype))
+        tangent = gbuffer.tangent[selection].astype(dtype) if key.has_tangent else None
+        uv = gbuffer.uv[selection].astype(dtype) if key.has_uv else None
+        f = shading_frame(n, tangent, uv, key)
+        if key.inputs:
+            color = gbuffer.color[selection].astype(np.float64) if key.has_color else None
+            lod = gbuffer.lod[selection].astype(np.float64) if key.textured_inputs else None
+            uv64 = None if uv is None else gbuffer.uv[selection].astype(np.float64)
+            bounds = None
+            if band is None:
+                inputs = material_inputs(uv64, color, lod, key, uniforms)
+            else:  # the values and their intervals from one sampling of each texture
+                inputs, bounds = input_bounds(uv64, color, lod, key, uniforms, band)
+            f = type(f)(f.n, f.t, f.b, f.uv, {k: v.astype(dtype) for k, v in inputs.items()}, bounds)
+        yield selection, obj, key, uniforms, position, f, n_valid
+
+
+def shade(scene, gbuffer, dtype=np.float64):
+    """Shade a G-buffer with the twin, fragment for fragment.
+
+    Parameters
+    ----------
+    scene : glphong.Scene
+    gbuffer : glphong.GBuffer
+        From ``Renderer.gbuffer(scene)`` at the same image size.
+    dtype : numpy dtype
+        float64 (the reference) or float32 (the GPU's formulation on the CPU).
+
+    Returns
+    -------
+    (H, W, 3) ndarray of ``dtype``
+        Radiance [W/(m^2 sr)], 0 where not covered.
+    """
+    out = np.zeros(gbuffer.position.shape, dtype)
+    for selection, obj, key, uniforms, position, f, n_valid in shade_inputs(scene, gbuffer, dtype):
+        out[selection] = shade_point(position, f, n_valid, uniforms.get("u_eye"), key, uniforms, obj.material)
+    return out

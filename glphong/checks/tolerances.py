@@ -1,0 +1,156 @@
+"""The tolerance band GPU float32 results are held to against the float64 twin (docs/design.md section 4).
+
+With ``eps = 2^-24`` (float32 unit roundoff) and the constants below, the band
+around the twin's value of each term is:
+
+- Lambert: ``k_d E [max(n.l - D eps, 0), n.l + D eps] (1 +- A eps)``.
+- Lobe: the chord ``c = sqrt(2 delta)`` widened by ``+-C eps`` (for Blinn scaled by
+  ``max(1, 2/|l + v|)``, the conditioning of the half vector), mapped through
+  ``(1 - c^2/2)^q``, then widened by ``(1 +- eps (A + B lambda))``, ``lambda = -ln(lobe)``
+  (`lobe_band`; the lobe models' ``band`` methods apply it).
+- Other models: their own ``band`` method, or the generic one of
+  `glphong.materials.MaterialModel.band` (the twin's sensitivity to a few ulps of its inputs).
+- Gates: where ``|n.l| <= D eps`` (Blinn: also ``|n.v| <= D eps``, or ``|l + v|`` within
+  a factor 4 of its floor) either outcome of the gate is accepted.
+- Ambient terms: ``(1 +- A eps)``.  The sum over terms widens by ``(1 +- m eps)`` for m terms.
+- Results below FLT_MIN may be flushed: the lower bound is 0 there; above FLT_MAX the
+  upper bound is +inf.
+
+The constants and the lobe's band are `glphong.twin.band` (re-exported here); this module holds the
+band of a whole image, term by term.
+"""
+import numpy as np
+
+from glphong.checks import reference as ref
+from glphong.checks.reference import input_bounds  # noqa: F401 - re-exported
+from glphong.twin.band import BAND, EPS, FLT_MAX, FLT_MIN, BandConstants, lobe_band  # noqa: F401 - re-exported
+
+__all__ = ["EPS", "FLT_MIN", "FLT_MAX", "BandConstants", "BAND", "lobe_band", "response_band", "point_band",
+           "radiance_band", "input_bounds"]
+
+
+def _input_ends(f):
+    """``(low, high)``: the surface inputs at the two ends of their intervals (None, None without inputs)."""
+    if not f.inputs:
+        return None, None
+    bounds = f.input_bounds
+    if bounds is None:  # no intervals asked for: the values themselves
+        return f.inputs, f.inputs
+    return {k: lo for k, (lo, _) in bounds.items()}, {k: hi for k, (_, hi) in bounds.items()}
+
+
+def point_band(key, u, position, n, n_valid, material, band=BAND):
+    """Interval the GPU's ``shade_point()`` must return at given points.
+
+    Each lit term contributes its own band (`glphong.materials.MaterialModel.band`: the model's
+    derived band, or the generic one from the twin's sensitivity), times the irradiance widened
+    by ``(1 +- A eps)``.  Where ``|n.l| <= D eps`` either side of the light gate is accepted: there
+    the lower bound is 0 and a term's band is asked at its (possibly non-positive) ``n.l``, which it
+    must bound over ``(0, n.l + D eps]``.
+
+    Parameters
+    ----------
+    key : glphong.key.ProgramKey
+    u : dict of str to ndarray
+        The program's uniforms as float64.
+    position : (N, 3) float64 ndarray
+    n : (N, 3) float64 ndarray or ShadingFrame
+        Unit normals (as `glphong.reference.safe_normalize` returns them), or the shading frame.
+    n_valid : (N,) bool ndarray
+    material : glphong.materials.Material
+    band : BandConstants
+
+    Returns
+    -------
+    low, high : (N, 3) float64 ndarray
+    """
+    f = n if hasattr(n, "n") else ref.shading_frame(np.asarray(n), key=key)
+    low_inputs, high_inputs = _input_ends(f)
+    lo = ref.material_emission(key, u, position.shape, np.float64, inputs=low_inputs) * (1 - band.A * EPS)
+    hi = ref.material_emission(key, u, position.shape, np.float64, inputs=high_inputs) * (1 + band.A * EPS)
+    terms = int(key.has_ka) + sum(1 for t in key.terms if t.ambient)
+    if key.num_lights:
+        wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
+        tol = band.D * EPS
+        for valid, wi, irradiance in ref.incident_light(position, key, u):
+            terms += 1
+            n_dot_l = ref._dot(f.n, wi)
+            certain = (lit & valid & (n_dot_l > tol))[..., None]
+            possible = lit & valid & (n_dot_l > -tol)
+            f_lo = np.zeros_like(position)
+            f_hi = np.zeros_like(position)
+            if possible.any():
+                f_lo[possible], f_hi[possible] = response_band(key, u, f.select(possible), wi[possible],
+                                                               wo[possible], n_dot_l[possible], material, band)
+            with np.errstate(over="ignore", invalid="ignore"):
+                # an irradiance below FLT_MIN may be flushed to 0 on the GPU, and the term with it
+                e_lo = np.where(irradiance < FLT_MIN, 0.0, irradiance)
+                t_lo = np.nan_to_num(ref.light_term(f_lo, e_lo) * (1 - band.A * EPS), nan=0.0)
+                t_hi = np.nan_to_num(ref.light_term(f_hi, irradiance) * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
+            lo = lo + np.where(certain, t_lo, 0.0)
+            hi = hi + np.where(possible[..., None], t_hi, 0.0)
+    low = lo * (1 - terms * EPS)
+    high = hi * (1 + terms * EPS)
+    return np.where(low < FLT_MIN, 0.0, low), np.where(high > FLT_MAX, np.inf, high)
+
+
+def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
+    """Interval of the GLSL ``material_response()``: the sum of the lit terms' bands.
+
+    Parameters
+    ----------
+    key : glphong.key.ProgramKey
+    u : dict of str to ndarray
+        Uniforms as float64 (the terms' parameters are read from them).
+    f : ShadingFrame
+    wi, wo : (N, 3) float64 ndarray
+    n_dot_l : (N,) float64 ndarray
+        May be down to ``-D eps`` where the light gate is uncertain.
+    material : glphong.materials.Material
+    band : BandConstants
+
+    Returns
+    -------
+    low, high : (N, 3) float64 ndarray
+        Widened by ``(1 -+ m eps)`` for the sum of m terms.
+    """
+    models = {term.name: term for term in material.components}
+    low = np.zeros(np.shape(wi))
+    high = np.zeros(np.shape(wi))
+    for term_key in key.lit_terms:
+        term = models[term_key.name]
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            if term.surface_inputs():  # the band at both ends of the inputs' intervals (first order inside)
+                ends = [term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u, inputs=inputs), band)
+                        for inputs in _input_ends(f)]
+                t_lo, t_hi = np.minimum(ends[0][0], ends[1][0]), np.maximum(ends[0][1], ends[1][1])
+            else:
+                t_lo, t_hi = term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u), band)
+        # a term's float32 result below FLT_MIN in magnitude may be flushed to 0 (e.g. ks * lobe with
+        # the lobe just above FLT_MIN): the band then reaches 0
+        t_lo = np.where((t_lo > 0) & (t_lo < FLT_MIN), 0.0, t_lo)
+        t_hi = np.where((t_hi < 0) & (t_hi > -FLT_MIN), 0.0, t_hi)
+        low, high = low + t_lo, high + t_hi
+    m = max(len(key.lit_terms) - 1, 0)
+    return low * (1 - m * EPS), high * (1 + m * EPS)
+
+
+def radiance_band(scene, gbuffer, band=BAND):
+    """Per-pixel interval the GPU's radiance must lie in (`point_band` on every covered pixel).
+
+    Parameters
+    ----------
+    scene : glphong.Scene
+    gbuffer : glphong.GBuffer
+    band : BandConstants
+
+    Returns
+    -------
+    low, high : (H, W, 3) float64 ndarray
+        0 where not covered.
+    """
+    low = np.zeros(gbuffer.position.shape)
+    high = np.zeros(gbuffer.position.shape)
+    for selection, obj, key, u, position, f, n_valid in ref.shade_inputs(scene, gbuffer, band=band):
+        low[selection], high[selection] = point_band(key, u, position, f, n_valid, obj.material, band)
+    return low, high

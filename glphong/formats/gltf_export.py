@@ -1,0 +1,222 @@
+"""Writing a `glphong.Scene` as glTF 2.0 (``.glb`` or ``.gltf``), so that `glphong.load_scene` reads it back.
+
+What is written:
+- every object as a node (its pose as the node ``matrix``) with a mesh of its `MeshData` (positions,
+  normals, ``TEXCOORD_0`` with v flipped to glTF's top-left origin, ``COLOR_0`` as linear floats, given
+  tangents as ``TANGENT``; one glTF mesh per distinct MeshData);
+- every material as a glTF metallic-roughness material for other viewers (``baseColorFactor`` from the
+  diffuse albedo ``rho_d``/``rho``, or ``pi kd`` clipped to 1, its texture as ``baseColorTexture``;
+  metallic 0, roughness 1: an approximation) and, exactly, in the material's
+  ``extras: {"glphong": ...}`` (`glphong.materials.as_json`), which `load_scene` prefers;
+- textures as PNG images (8-bit sources, re-encoded losslessly) with their samplers;
+- the camera (perspective: ``yfov``, ``znear``, ``zfar``; orthographic: ``ymag``; an `IntrinsicsCamera`'s
+  principal point is not representable: written as its perspective frustum, with a warning);
+- point and directional lights (``KHR_lights_punctual``) in radiometric units (W/sr, W/m^2), declared in
+  the asset's ``extras: {"glphong": {"light_units": "radiometric"}}`` together with the ambient light,
+  which glTF has no place for.  `UnattenuatedPointLight` has no glTF equivalent: skipped, with a warning.
+"""
+import base64
+import json
+import struct
+import warnings
+from io import BytesIO
+from pathlib import Path
+
+import numpy as np
+from glphong.materials import SurfaceInput
+from glphong.materials.as_json import material_to_json
+from glphong.scene.camera import IntrinsicsCamera, OrthographicCamera
+from glphong.scene.scene import Scene
+
+__all__ = ["save_gltf"]
+
+_FLOAT, _UINT = 5126, 5125
+_ARRAY_BUFFER, _ELEMENT_ARRAY_BUFFER = 34962, 34963
+_REPEAT, _CLAMP = 10497, 33071
+_LINEAR, _LINEAR_MIPMAP_LINEAR = 9729, 9987
+
+
+class _Builder:
+    """The JSON document and the one binary buffer of a glTF file being written."""
+
+    def __init__(self):
+        self.doc = {"asset": {"version": "2.0", "generator": "glphong"}, "buffers": [], "bufferViews": [],
+                    "accessors": []}
+        self.data = bytearray()
+
+    def view(self, payload, target=None):
+        while len(self.data) % 4:
+            self.data.append(0)
+        view = {"buffer": 0, "byteOffset": len(self.data), "byteLength": len(payload)}
+        if target is not None:
+            view["target"] = target
+        self.data += payload
+        self.doc["bufferViews"].append(view)
+        return len(self.doc["bufferViews"]) - 1
+
+    def accessor(self, array, kind, target=_ARRAY_BUFFER, bounds=False):
+        array = np.ascontiguousarray(array)
+        component = _UINT if array.dtype == np.uint32 else _FLOAT
+        accessor = {"bufferView": self.view(array.tobytes(), target), "componentType": component,
+                    "count": int(array.shape[0]), "type": kind}
+        if bounds:
+            accessor["min"] = [float(v) for v in array.min(axis=0)]
+            accessor["max"] = [float(v) for v in array.max(axis=0)]
+        self.doc["accessors"].append(accessor)
+        return len(self.doc["accessors"]) - 1
+
+    def append(self, field, entry):
+        self.doc.setdefault(field, []).append(entry)
+        return len(self.doc[field]) - 1
+
+
+def _mesh(builder, mesh, material_index):
+    attributes = {"POSITION": builder.accessor(mesh.positions, "VEC3", bounds=True),
+                  "NORMAL": builder.accessor(mesh.normals, "VEC3")}
+    if mesh.uvs is not None:
+        uv = np.array(mesh.uvs, dtype=np.float32)
+        uv[:, 1] = 1.0 - uv[:, 1]  # glTF's v runs down from the image's top-left corner
+        attributes["TEXCOORD_0"] = builder.accessor(uv, "VEC2")
+    if mesh.colors is not None:
+        attributes["COLOR_0"] = builder.accessor(mesh.colors, "VEC3")
+    if mesh._tangents is not None:
+        attributes["TANGENT"] = builder.accessor(mesh._tangents, "VEC4")
+    indices = builder.accessor(mesh.indices.reshape(-1), "SCALAR", _ELEMENT_ARRAY_BUFFER)
+    return {"primitives": [{"attributes": attributes, "indices": indices, "material": material_index}]}
+
+
+def _texture(builder, image, cache):
+    from PIL import Image
+
+    if image.digest in cache:
+        return cache[image.digest]
+    png = BytesIO()
+    Image.fromarray(image.pixels8()).save(png, format="PNG")
+    source = builder.append("images", {"bufferView": builder.view(png.getvalue()), "mimeType": "image/png"})
+    sampler = builder.append("samplers", {
+        "wrapS": _REPEAT if image.wrap == "repeat" else _CLAMP, "wrapT": _REPEAT if image.wrap == "repeat" else _CLAMP,
+        "magFilter": _LINEAR, "minFilter": _LINEAR_MIPMAP_LINEAR if image.filter == "trilinear" else _LINEAR})
+    index = cache[image.digest] = builder.append("textures", {"source": source, "sampler": sampler})
+    return index
+
+
+def _base_color(material):
+    """``(baseColorFactor rgb, TextureImage or None)`` of the PBR approximation (see the module)."""
+
+    for term in material.components:
+        for name, scale in (("rho_d", 1.0), ("rho", 1.0), ("kd", np.pi)):
+            value = getattr(term, name, None) if name in {p.name for p in term.params} else None
+            if value is None:
+                continue
+            if isinstance(value, SurfaceInput):
+                return np.clip(np.asarray(value.scale) * scale, 0, 1), value.texture
+            return np.clip(np.asarray(value) * scale, 0, 1), None
+    return np.full(3, 0.5), None
+
+
+def _material(builder, material, cache):
+    stored = material_to_json(material, texture_index=lambda image: _texture(builder, image, cache))
+    base, texture = _base_color(material)
+    pbr = {"baseColorFactor": [float(c) for c in base] + [1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}
+    if texture is not None:
+        pbr["baseColorTexture"] = {"index": _texture(builder, texture, cache)}
+    name = f"{type(material).__name__}{len(builder.doc.get('materials', []))}"  # unique: readers key materials by name
+    return {"name": name, "pbrMetallicRoughness": pbr, "extras": {"glphong": stored},
+            "doubleSided": bool(material.two_sided)}
+
+
+def _column_major(matrix):
+    return [float(v) for v in np.asarray(matrix, dtype=np.float64).T.ravel()]
+
+
+def _camera(camera):
+    if isinstance(camera, OrthographicCamera):
+        return {"type": "orthographic", "orthographic": {"xmag": float(camera.ymag), "ymag": float(camera.ymag),
+                                                         "znear": float(camera.znear), "zfar": float(camera.zfar)}}
+    if isinstance(camera, IntrinsicsCamera):
+        warnings.warn("an IntrinsicsCamera's principal point has no glTF equivalent: written as a centred "
+                      "perspective camera of the same vertical field of view", stacklevel=3)
+    return {"type": "perspective", "perspective": {"yfov": float(camera.yfov), "znear": float(camera.znear),
+                                                   "zfar": float(camera.zfar)}}
+
+
+def _light_node(builder, light, index):
+    values = np.asarray(light.intensity if light.kind == "point" else light.irradiance, dtype=np.float64)
+    peak = float(values.max())
+    entry = {"type": light.kind, "color": [float(c) for c in (values / peak if peak > 0 else np.ones(3))],
+             "intensity": peak}
+    lights = builder.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})["lights"]
+    lights.append(entry)
+    pose = np.eye(4)
+    if light.kind == "point":
+        pose[:3, 3] = light.position
+    else:  # the node's -z axis is the direction the light travels in
+        z = -np.asarray(light.direction)
+        x = np.cross((0.0, 1.0, 0.0) if abs(z[1]) < 0.9 else (1.0, 0.0, 0.0), z)
+        x /= np.linalg.norm(x)
+        pose[:3, :3] = np.stack([x, np.cross(z, x), z], axis=1)
+    return {"name": f"light{index}", "matrix": _column_major(pose),
+            "extensions": {"KHR_lights_punctual": {"light": len(lights) - 1}}}
+
+
+def save_gltf(scene, path):
+    """Write ``scene`` to ``path`` (``.glb``: binary; ``.gltf``: JSON with the buffer as a data URI).
+
+    Parameters
+    ----------
+    scene : glphong.Scene
+    path : str or path-like
+
+    Returns
+    -------
+    pathlib.Path
+
+    Raises
+    ------
+    ValueError
+        Another suffix, a material with a table argument, or a texture made from a 16-bit or float image
+        (PNG at 8 bits cannot hold it exactly).
+    """
+
+    if not isinstance(scene, Scene):
+        raise TypeError(f"scene must be a glphong.Scene (got {type(scene).__name__})")
+    path = Path(path)
+    if path.suffix.lower() not in (".glb", ".gltf"):
+        raise ValueError(f"{path}: save_gltf writes .glb or .gltf files (got {path.suffix or 'no suffix'!r})")
+    builder = _Builder()
+    doc = builder.doc
+    nodes, meshes, materials, textures = [], {}, {}, {}
+    for obj in scene.objects:
+        if obj.material not in materials:
+            materials[obj.material] = builder.append("materials", _material(builder, obj.material, textures))
+        key = (id(obj.mesh), materials[obj.material])
+        if key not in meshes:
+            meshes[key] = builder.append("meshes", _mesh(builder, obj.mesh, materials[obj.material]))
+        nodes.append({"name": obj.name, "mesh": meshes[key], "matrix": _column_major(obj.pose)})
+    doc["cameras"] = [_camera(scene.camera)]
+    nodes.append({"name": "camera", "camera": 0, "matrix": _column_major(scene.camera.pose)})
+    for index, light in enumerate(scene.lights):
+        if light.kind == "unattenuated":
+            warnings.warn(f"light {index}: an UnattenuatedPointLight has no glTF equivalent; not written", stacklevel=2)
+            continue
+        nodes.append(_light_node(builder, light, index))
+    if "extensions" in doc:
+        doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    doc["nodes"] = nodes
+    doc["scenes"] = [{"nodes": list(range(len(nodes)))}]
+    doc["scene"] = 0
+    doc["asset"]["extras"] = {"glphong": {"light_units": "radiometric",
+                                          "ambient": None if scene.ambient is None else list(scene.ambient.radiance)}}
+    while len(builder.data) % 4:
+        builder.data.append(0)
+    doc["buffers"] = [{"byteLength": len(builder.data)}]
+    if path.suffix.lower() == ".gltf":
+        doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64.b64encode(builder.data).decode()
+        path.write_text(json.dumps(doc), encoding="utf-8")
+        return path
+    text = json.dumps(doc).encode("utf-8")
+    text += b" " * (-len(text) % 4)
+    body = struct.pack("<II", len(text), 0x4E4F534A) + text + struct.pack("<II", len(builder.data), 0x004E4942) + \
+        bytes(builder.data)
+    path.write_bytes(struct.pack("<III", 0x46546C67, 2, 12 + len(body)) + body)
+    return path

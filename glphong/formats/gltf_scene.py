@@ -1,0 +1,231 @@
+"""A glTF 2.0 file as a glphong scene: its camera and ``KHR_lights_punctual`` lights (`gltf_view`), its
+materials (the glphong material stored in ``extras``, `material_from_extras`, else the metallic-roughness
+approximation `gltf_material`) and its primitives (`glphong.formats.gltf_data`).
+"""
+import warnings
+
+import numpy as np
+
+from glphong.core.filesafety import SceneFileError
+from glphong.core.radiometry import LUMENS_PER_WATT, power_from_intensity
+from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, read_gltf_primitives, texture_sampling
+from glphong.materials import Material, Texture, TextureImage, VertexColors
+from glphong.materials.cook_torrance import CookTorrance
+from glphong.materials.fresnel import SchlickFresnel
+from glphong.formats.overrides import chosen_material
+from glphong.materials.as_json import material_from_json
+from glphong.scene.camera import OrthographicCamera, PerspectiveCamera
+from glphong.scene.from_trimesh import _trimesh_material, default_view, empty_scene, with_default_view
+from glphong.scene.lights import AmbientLight, DirectionalLight, PointLight
+from glphong.scene.scene import Scene
+
+__all__ = ["read_gltf_json", "gltf_view", "gltf_material", "material_from_extras", "load_gltf"]
+
+
+def read_gltf_json(path, limits=None):
+    """The validated JSON document of a ``.gltf`` file, or of a ``.glb`` file's first chunk (dict;
+    `glphong.gltf_data.GltfFile`).
+
+    Raises
+    ------
+    glphong.filesafety.SceneFileError
+        Anything wrong with the file, with its JSON path.
+    """
+
+    return GltfFile(path, limits).document
+
+
+def _glphong_extras(document):
+    """What glphong stored in the asset's ``extras`` (`glphong.gltf_export`), or {}."""
+    extras = document.get("asset", {}).get("extras", {})
+    stored = extras.get("glphong") if isinstance(extras, dict) else None
+    return stored if isinstance(stored, dict) else {}
+
+
+def material_from_extras(entry, gltf, where=""):
+    """The glphong material stored in a glTF material's ``extras: {"glphong": ...}``
+    (`glphong.materials.as_json`), or None where there is none.
+
+    Parameters
+    ----------
+    entry : dict
+        The JSON ``materials`` entry.
+    gltf : glphong.gltf_data.GltfFile
+    where : str
+        The entry's JSON path (for errors).
+
+    Raises
+    ------
+    glphong.filesafety.SceneFileError
+        A stored material that cannot be made (an unknown class, a table, a value its class refuses).
+    """
+    extras = entry.get("extras", {})
+    stored = extras.get("glphong") if isinstance(extras, dict) else None
+    if stored is None:
+        return None
+
+    def textures(index, wrap, filter, srgb):
+        textures_count = len(gltf.document.get("textures", []))
+        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index < textures_count:
+            raise ValueError(f"texture index {index!r:.20} is not one of the file's {textures_count} textures")
+        pixels = read_gltf_image(gltf, index)
+        if pixels is None:
+            raise ValueError(f"texture {index} has no image glphong decodes")
+        return TextureImage(pixels, srgb=srgb, wrap=wrap, filter=filter)
+
+    try:
+        return material_from_json(stored, textures)
+    except SceneFileError:
+        raise
+    except (TypeError, ValueError, KeyError, AttributeError) as exc:
+        raise SceneFileError(gltf.path, f"stores a glphong material that cannot be made: {exc}"[:400],
+                             f"{where}.extras.glphong") from None
+
+
+def gltf_view(document, camera_name=None, light_units=None, source=""):
+    """The camera and lights of a glTF document: ``(camera or None, [lights])``.
+
+    The camera is the node camera named ``camera_name`` (by the camera's or its node's name) or the first
+    one; ``yfov``, ``znear`` and ``zfar`` are read as written (an infinite ``zfar``: ``1e6 znear``),
+    orthographic ``ymag`` too.  ``KHR_lights_punctual`` point and directional lights need ``light_units``:
+    ``'photometric'`` (the glTF specification: point intensity in candela, directional illuminance in lux;
+    ``Phi = 4 pi I color / 683``, ``E = lux color / 683``) or ``'radiometric'`` (intensity taken as W/sr and
+    W/m^2).  Spot lights are refused (glphong has point and directional lights).
+    """
+
+    nodes = document.get("nodes", [])
+    worlds = node_matrices(document)
+    cameras = document.get("cameras", [])
+    camera = None
+    for index, node in enumerate(nodes):
+        if "camera" not in node or index not in worlds:
+            continue
+        spec = cameras[node["camera"]]
+        if camera_name is not None and camera_name not in (spec.get("name"), node.get("name")):
+            continue
+        pose = worlds[index].copy()
+        pose[:3, :3] /= np.linalg.norm(pose[:3, :3], axis=0)  # a camera node's scale does not apply
+        if spec.get("type") == "orthographic":
+            o = spec["orthographic"]
+            camera = OrthographicCamera(o["ymag"], pose=pose, znear=max(o.get("znear", 0.0), 1e-6), zfar=o["zfar"])
+        else:
+            p = spec["perspective"]
+            camera = PerspectiveCamera(p["yfov"], pose=pose, znear=p["znear"], zfar=p.get("zfar", 1e6 * p["znear"]))
+        break
+    if camera_name is not None and camera is None:
+        names = [c.get("name") for c in cameras]
+        raise ValueError(f"{source}: no camera named {camera_name!r} (cameras: {names})")
+    definitions = document.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
+    lights = []
+    for index, node in enumerate(nodes):
+        reference = node.get("extensions", {}).get("KHR_lights_punctual")
+        if reference is None or index not in worlds:
+            continue
+        light = definitions[reference["light"]]
+        kind = light.get("type")
+        if kind == "spot":
+            raise ValueError(f"{source}: light {light.get('name', reference['light'])!r} is a spot light: glphong has "
+                             "point and directional lights only")
+        if light_units is None:  # a file may declare them (glphong.gltf_export writes radiometric lights)
+            light_units = _glphong_extras(document).get("light_units")
+        if light_units not in ("photometric", "radiometric"):
+            raise ValueError(f"{source} has KHR_lights_punctual lights: say what their intensities are with "
+                             "light_units='photometric' (candela and lux, as the glTF specification says) or "
+                             "'radiometric' (W/sr and W/m^2)")
+        scale = (1.0 / LUMENS_PER_WATT if light_units == "photometric" else 1.0) * light.get("intensity", 1.0)
+        colour = np.asarray(light.get("color", (1.0, 1.0, 1.0)), dtype=np.float64) * scale
+        world = worlds[index]
+        if kind == "point":
+            lights.append(PointLight(tuple(world[:3, 3]), tuple(power_from_intensity(colour))))
+        elif kind == "directional":
+            lights.append(DirectionalLight(tuple(-world[:3, 2]), tuple(colour)))
+        else:
+            raise ValueError(f"{source}: light type {kind!r} is not one glphong knows")
+    return camera, lights
+
+
+def gltf_material(entry, base_color_texture=None, vertex_colors=False):
+    """glphong's approximation of a glTF metallic-roughness material (JSON ``materials`` entry): Cook-Torrance
+    with Beckmann slope ``m = roughness^2`` (glTF's GGX ``alpha``, at least 1e-3), diffuse albedo
+    ``baseColor (1 - metallic)`` and Schlick's Fresnel with ``f0 = 0.04 (1 - metallic) + baseColorFactor metallic``.
+    The lobes differ (Beckmann against GGX, no coupling of diffuse and specular): an approximation.
+
+    ``baseColor`` is ``baseColorFactor`` times the base-colour texture (``base_color_texture``, an image
+    array, sRGB, or a `glphong.materials.TextureImage`) times the mesh's ``COLOR_0`` (``vertex_colors``), as glTF defines it; the texture and the
+    colours vary the diffuse albedo only (the metallic-roughness texture is not read)."""
+
+    pbr = entry.get("pbrMetallicRoughness", {})
+    base = np.clip(np.asarray(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3], dtype=np.float64), 0.0, 1.0)
+    metallic = min(float(pbr.get("metallicFactor", 1.0)), 1.0)  # factors above 1 (validated >= 0) are clamped
+    roughness = min(float(pbr.get("roughnessFactor", 1.0)), 1.0)
+    f0 = 0.04 * (1 - metallic) + base * metallic
+    rho_d = tuple(base * (1 - metallic))
+    if base_color_texture is not None:
+        rho_d = Texture(base_color_texture, scale=rho_d, srgb=True, vertex_colors=vertex_colors)
+    elif vertex_colors:
+        rho_d = VertexColors(scale=rho_d)
+    return CookTorrance(rho_d, max(roughness * roughness, 1e-3), fresnel=SchlickFresnel(tuple(np.clip(f0, 0.0, 1.0))))
+
+
+def _gltf_object_material(gltf, entries, materials, made, name, mesh, index):
+    """The material of one glTF primitive: the user's, the stored glphong one, or `gltf_material`."""
+
+    entry = entries[index] if index is not None else None
+    material_name = entry.get("name") if entry is not None else None
+    if callable(materials):
+        chosen = chosen_material(materials, material_name or name, entry)
+    else:
+        chosen = next((chosen_material(materials, k, entry) for k in (material_name, name)
+                       if k is not None and materials and k in materials), None)
+    if chosen is not None:
+        return chosen
+    if entry is None:
+        return _trimesh_material(None)
+    textured = "baseColorTexture" in entry.get("pbrMetallicRoughness", {}) and mesh.uvs is not None
+    key = (index, textured, mesh.colors is not None)
+    if key not in made:
+        stored = material_from_extras(entry, gltf, f"materials[{index}]")
+        if stored is None:
+            texture = None
+            if textured:
+                reference = entry["pbrMetallicRoughness"]["baseColorTexture"]["index"]
+                pixels = read_gltf_image(gltf, reference)
+                if pixels is not None:
+                    wrap, filter_ = texture_sampling(gltf.document, reference)
+                    texture = TextureImage(pixels, srgb=True, wrap=wrap, filter=filter_)
+            stored = gltf_material(entry, texture, mesh.colors is not None)
+        made[key] = stored
+    return made[key]
+
+
+def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name, allow_outside, limits):
+    """A glTF file's scene: its own arrays (`glphong.gltf_data`), nodes in file order, materials from the
+    user's ``materials``, else the stored glphong material (``extras``), else `gltf_material`."""
+
+    gltf = GltfFile(path, limits, allow_outside)
+    document = gltf.document
+    file_camera, file_lights = gltf_view(document, camera_name, light_units, str(path))
+    written = _glphong_extras(document)
+    if lights is None and (file_lights or written):
+        lights = file_lights
+    if ambient is None and isinstance(written.get("ambient"), (int, float, list)):
+        try:
+            ambient = AmbientLight(tuple(written["ambient"]) if isinstance(written["ambient"], list) else written["ambient"])
+        except (TypeError, ValueError) as exc:
+            raise SceneFileError(path, f"the stored ambient light cannot be made: {exc}", "asset.extras.glphong.ambient") \
+                from None
+    chosen_camera = camera if camera is not None else file_camera
+    scene = empty_scene(Scene, chosen_camera, lights, ambient)
+    entries, made = document.get("materials", []), {}
+    for name, mesh, world, index in read_gltf_primitives(gltf):
+        scene.add(mesh, _gltf_object_material(gltf, entries, materials, made, name, mesh, index), pose=world, name=name)
+    if lights is None:  # a file without lights is not drawn black by accident
+        _, view_lights, view_ambient = default_view(scene)
+        warnings.warn(f"{path} has no lights: glphong adds its default point light and ambient light (give "
+                      "lights=[] to keep the scene dark)", stacklevel=3)
+        for light in view_lights:
+            scene.add_light(light)
+        if ambient is None:
+            scene.ambient = view_ambient
+        lights = list(view_lights)
+    return with_default_view(scene, chosen_camera, lights, ambient)

@@ -1,0 +1,621 @@
+"""Headless OpenGL contexts on Mesa's EGL or OSMesa drivers.
+
+`create_context` opens an offscreen OpenGL core-profile context through EGL
+(``moderngl``'s standalone EGL backend) or through OSMesa (``libOSMesa``
+loaded with :mod:`ctypes`) and wraps it in a `GLContext`.  Rendering goes
+into framebuffer objects created on ``GLContext.mgl``; neither backend has a
+usable default framebuffer.
+
+Several contexts, of either backend, may live in one process.  Make a context
+current with ``with ctx:`` before issuing GL calls on it; ``with`` blocks nest,
+and leaving an inner block makes the enclosing block's context current again.
+
+One module of about 600 lines on purpose: the two backends share one context pool (recycling), one
+fork guard and one notion of "current", whose invariants hold only if a single module owns them.
+"""
+
+import atexit
+import ctypes
+import ctypes.util
+import functools
+import os
+import threading
+
+import moderngl
+
+__all__ = [
+    "BACKENDS",
+    "SYSTEM_PACKAGES",
+    "BackendUnavailableError",
+    "EGLDisplayTerminatedError",
+    "GLContext",
+    "available_backends",
+    "create_context",
+    "egl_device_count",
+]
+
+BACKENDS = ("egl", "osmesa")
+"""Backends in the order ``backend="auto"`` tries them."""
+
+SYSTEM_PACKAGES = {
+    "egl": "libegl1 libegl-mesa0 libgl1-mesa-dri",
+    "osmesa": "libosmesa6",
+}
+"""Debian/Ubuntu packages providing each backend."""
+
+_ENV_BACKEND = "GLPHONG_BACKEND"
+
+# OSMesa constants, from GL/osmesa.h and GL/gl.h.
+_OSMESA_FORMAT = 0x22
+_OSMESA_RGBA = 0x1908
+_OSMESA_DEPTH_BITS = 0x30
+_OSMESA_PROFILE = 0x33
+_OSMESA_CORE_PROFILE = 0x34
+_OSMESA_CONTEXT_MAJOR_VERSION = 0x36
+_OSMESA_CONTEXT_MINOR_VERSION = 0x37
+_GL_UNSIGNED_BYTE = 0x1401
+_OSMESA_VERSIONS = ((4, 5), (3, 3))
+
+_entered = threading.local()
+
+
+class BackendUnavailableError(RuntimeError):
+    """No OpenGL context could be created on the requested backend(s)."""
+
+
+class ForkedProcessError(RuntimeError):
+    """OpenGL used in a process forked from one that had already used OpenGL (it would hang)."""
+
+
+class EGLDisplayTerminatedError(RuntimeError):
+    """An EGL context can no longer be made current: its display was terminated (``eglTerminate``)."""
+
+
+_EGL_TERMINATED = (
+    "this EGL context can no longer be made current: the EGL display it lives on was terminated "
+    "(eglTerminate). Mesa gives every EGL context on a device one display, and pyrender's "
+    "OffscreenRenderer.delete() on EGL (also when the garbage collector drops one) terminates it, "
+    "taking the contexts of every other library in the process with it; glphong's drew nothing from "
+    "then on (moderngl says 'cannot create texture' or returns garbage). Make a new glphong.Renderer "
+    "(a fresh context re-initialises the display), keep pyrender's renderer alive while glphong's are "
+    "in use, or release it with glphong.comparisons.PyrenderRenderer.release, which does not terminate it")
+
+
+@functools.lru_cache(maxsize=1)
+def _egl_current_context():
+    """libEGL's ``eglGetCurrentContext`` (ctypes), or None where libEGL cannot be loaded."""
+    name = ctypes.util.find_library("EGL")
+    if name is None:
+        return None
+    try:
+        function = ctypes.CDLL(name).eglGetCurrentContext
+    except (OSError, AttributeError):
+        return None
+    function.restype = ctypes.c_void_p
+    return function
+
+
+#: the process that first tried to make a context (llvmpipe starts its rasterizer threads then)
+_GL_PID = None
+#: recycled contexts per backend (`GLContext.recycle`), reused by `create_context`
+_POOL = {}
+_POOL_LOCK = threading.Lock()
+POOL_SIZE = 4
+
+
+@atexit.register
+def _destroy_pool():
+    with _POOL_LOCK:
+        waiting = [ctx for contexts in _POOL.values() for ctx in contexts]
+        _POOL.clear()
+    for ctx in waiting:
+        try:
+            ctx.release()
+        except Exception:  # noqa: BLE001 - interpreter shutdown
+            pass
+
+
+def _reuse(backend, require, device=0):
+    """A recycled context of ``backend`` (on EGL ``device``) at least as new as ``require``, or None."""
+    with _POOL_LOCK:
+        waiting = _POOL.get(backend, [])
+        for i, ctx in enumerate(waiting):
+            if ctx.version_code >= require and ctx.device == device:
+                return waiting.pop(i)
+    return None
+
+
+_GL_THREADLESS = False
+
+
+def _note_gl_use():
+    """Record that this process has made a context (and whether llvmpipe runs without threads)."""
+    global _GL_PID, _GL_THREADLESS
+    if _GL_PID is None:
+        _GL_PID = os.getpid()
+        _GL_THREADLESS = os.environ.get("LP_NUM_THREADS") == "0"  # Mesa reads it at the first context
+
+
+def check_not_forked():
+    """Raise `ForkedProcessError` in a process forked after its parent used OpenGL.
+
+    llvmpipe's rasterizer threads are not copied by ``fork``: a context made or used in such a child
+    waits for them forever (in the first read-back).  ``LP_NUM_THREADS=0`` (no rasterizer threads)
+    avoids it, and is honoured.
+    """
+    if _GL_PID is not None and _GL_PID != os.getpid() and not _GL_THREADLESS:
+        raise ForkedProcessError(
+            f"this process was forked from process {_GL_PID}, which had already made an OpenGL context: "
+            "Mesa's llvmpipe rasterizer threads do not survive fork, and OpenGL here would hang. Start worker "
+            "processes with multiprocessing's 'spawn' or 'forkserver' method "
+            "(multiprocessing.get_context('spawn')), or make every context in the workers and none before "
+            "forking; setting LP_NUM_THREADS=0 before the parent makes its first context also avoids the "
+            "hang, at a speed cost")
+
+
+def _entered_stack():
+    """Return this thread's stack of entered `GLContext` objects."""
+    if not hasattr(_entered, "stack"):
+        _entered.stack = []
+    return _entered.stack
+
+
+class GLContext:
+    """An offscreen OpenGL context.
+
+    Normally obtained from `create_context`.
+
+    Parameters
+    ----------
+    backend : str
+        Name of the backend that created the context, one of `BACKENDS`.
+    mgl : moderngl.Context
+        The wrapped context.  It must be current when the `GLContext` is
+        constructed.
+    on_release : callable, optional
+        Called without arguments once, after ``mgl`` is released, to free
+        native resources that moderngl does not own.
+
+    Attributes
+    ----------
+    backend : str
+        Name of the backend that created the context.
+    mgl : moderngl.Context
+        The wrapped moderngl context; create GL objects on it.
+    renderer_name : str
+        The ``GL_RENDERER`` string, e.g. ``"llvmpipe (LLVM 15.0.6, 256 bits)"``.
+    version_code : int
+        OpenGL version as reported by moderngl, e.g. ``450`` for 4.5.
+    """
+
+    def __init__(self, backend, mgl, on_release=None, device=0):
+        self.backend = backend
+        self.device = device
+        self.mgl = mgl
+        self.renderer_name = mgl.info["GL_RENDERER"]
+        self.version_code = mgl.version_code
+        self._on_release = on_release
+        self._released = False
+        self._idle_framebuffer = None
+
+    def __enter__(self):
+        """Make this context current on the calling thread."""
+        check_not_forked()
+        self._make_current()
+        _entered_stack().append(self)
+        return self
+
+    def __exit__(self, *exc_info):
+        """Leave the context, restoring the enclosing ``with`` block's one."""
+        stack = _entered_stack()
+        stack.pop()
+        self.mgl.__exit__(*exc_info)
+        if stack:
+            stack[-1]._make_current()
+
+    def _make_current(self):
+        # EGL skips eglMakeCurrent for a context it already considers current,
+        # although an OSMesa context may have taken over the GL dispatch that
+        # both drivers share through libglapi since; leaving first forces a
+        # real switch.  Leaving an OSMesa context does nothing.
+        self.mgl.__exit__(None, None, None)
+        self.mgl.__enter__()
+        if self.backend == "egl" and self.alive is False:
+            raise EGLDisplayTerminatedError(_EGL_TERMINATED)
+
+    @property
+    def alive(self):
+        """For an EGL context just made current: whether EGL made it current (False once its display was
+        terminated, `EGLDisplayTerminatedError`); None where that cannot be asked (OSMesa, no libEGL)."""
+        current = _egl_current_context() if self.backend == "egl" else None
+        return None if current is None else bool(current())
+
+    def detach(self):
+        """Leave the context current on no thread, so that any thread may enter it next (EGL allows a
+        context to be current on one thread only; an OSMesa context needs nothing)."""
+        if self.backend == "egl" and not self._released:
+            self.mgl.__enter__()
+            self.mgl.__exit__(None, None, None)  # leaving moderngl's binding releases it from this thread
+
+    def bind_idle_framebuffer(self):
+        """Bind a 1x1 framebuffer owned by this context; call with the context entered.
+
+        A complete framebuffer must be bound for any draw call, transform feedback
+        included (standalone EGL contexts have none), and a framebuffer about to be
+        released must not stay bound: moderngl rebinds the previously bound one when
+        it creates the next, and binding a deleted name is GL_INVALID_OPERATION.
+        """
+        if self._idle_framebuffer is None:
+            self._idle_framebuffer = self.mgl.framebuffer([self.mgl.renderbuffer((1, 1))])
+        self._idle_framebuffer.use()
+
+    def release_framebuffer(self, fbo):
+        """Release a framebuffer and its attachments; call with the context entered.
+
+        The idle framebuffer is bound first, so the released one does not stay bound (see
+        `bind_idle_framebuffer`).
+        """
+        self.bind_idle_framebuffer()
+        for attachment in (*fbo.color_attachments, fbo.depth_attachment):
+            if attachment is not None:
+                attachment.release()
+        fbo.release()
+
+    def release(self):
+        """Destroy the context.  Calling it again does nothing."""
+        if self._released:
+            return
+        self._released = True
+        if self._idle_framebuffer is not None:
+            with self:
+                self.release_framebuffer(self._idle_framebuffer)
+            self._idle_framebuffer = None
+        self.mgl.release()
+        if self._on_release is not None:
+            self._on_release()
+
+    def recycle(self):
+        """Hand the context back for reuse by a later `create_context` of its backend instead of destroying
+        it; the caller must have released every GL object it made on it.
+
+        Making and destroying a context costs memory the driver never returns (measured with plain
+        moderngl on Mesa's EGL: about 0.05 MB per context), so a loop that makes renderers would grow
+        without bound; recycled contexts keep it flat.  At most `POOL_SIZE` contexts per backend wait
+        for reuse; beyond that, and at exit, they are destroyed.
+        """
+        if self._released:
+            return
+        try:
+            with self:
+                _ = self.mgl.error  # reading the flag clears it: the next user starts clean
+            self.detach()
+        except Exception:  # noqa: BLE001 - a broken context is destroyed, not recycled
+            self.release()
+            return
+        with _POOL_LOCK:
+            waiting = _POOL.setdefault(self.backend, [])
+            if len(waiting) < POOL_SIZE and os.getpid() == _GL_PID:
+                waiting.append(self)
+                return
+        self.release()
+
+    def check_error(self, where):
+        """Raise if the GL error flag of the current context is set.
+
+        Parameters
+        ----------
+        where : str
+            Description of the preceding operation, used in the message.
+
+        Raises
+        ------
+        RuntimeError
+            If ``glGetError`` reports an error (which it also clears).
+        """
+        err = self.mgl.error
+        if err != "GL_NO_ERROR":
+            raise RuntimeError(f"GL error {err} after {where}")
+
+    def __repr__(self):
+        state = ", released" if self._released else ""
+        return (
+            f"GLContext(backend={self.backend!r}, renderer={self.renderer_name!r}, "
+            f"version_code={self.version_code}{state})"
+        )
+
+
+class _OSMesaLoader:
+    """moderngl loader and make-current hooks for one OSMesa context."""
+
+    def __init__(self, lib, handle):
+        self._lib = lib
+        self._handle = handle
+        # OSMesa needs a colour buffer to make a context current; all
+        # rendering goes to framebuffer objects, so one pixel suffices.
+        self._buffer = (ctypes.c_ubyte * 4)()
+
+    def make_current(self):
+        """Make the context current; return whether OSMesa accepted it."""
+        return bool(
+            self._lib.OSMesaMakeCurrent(self._handle, self._buffer, _GL_UNSIGNED_BYTE, 1, 1)
+        )
+
+    def load_opengl_function(self, name):
+        """Return the address of GL function ``name``, 0 if it is missing."""
+        return self._lib.OSMesaGetProcAddress(name.encode()) or 0
+
+    def destroy(self):
+        """Destroy the OSMesa context."""
+        self._lib.OSMesaDestroyContext(self._handle)
+
+    def __enter__(self):
+        self.make_current()
+
+    def __exit__(self, *exc_info):
+        pass
+
+    def release(self):
+        pass
+
+
+@functools.cache
+def _osmesa_library():
+    """Load libOSMesa and declare the signatures used here."""
+    errors = []
+    for name in (ctypes.util.find_library("OSMesa"), "libOSMesa.so.8", "libOSMesa.so"):
+        if name is None:
+            continue
+        try:
+            lib = ctypes.CDLL(name)
+            break
+        except OSError as exc:
+            errors.append(str(exc))
+    else:
+        raise OSError("libOSMesa not found: " + "; ".join(errors))
+    lib.OSMesaCreateContextAttribs.restype = ctypes.c_void_p
+    lib.OSMesaCreateContextAttribs.argtypes = [ctypes.POINTER(ctypes.c_int), ctypes.c_void_p]
+    lib.OSMesaMakeCurrent.restype = ctypes.c_ubyte
+    lib.OSMesaMakeCurrent.argtypes = [
+        ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint, ctypes.c_int, ctypes.c_int
+    ]
+    lib.OSMesaGetProcAddress.restype = ctypes.c_void_p
+    lib.OSMesaGetProcAddress.argtypes = [ctypes.c_char_p]
+    lib.OSMesaDestroyContext.restype = None
+    lib.OSMesaDestroyContext.argtypes = [ctypes.c_void_p]
+    return lib
+
+
+def _create_egl(require, device=0):
+    # moderngl itself rejects a context older than ``require``.
+    mgl = moderngl.create_context(standalone=True, backend="egl", require=require, device_index=device)
+    return GLContext("egl", mgl, device=device)
+
+
+def egl_device_count():
+    """The number of EGL devices (``eglQueryDevicesEXT``), or None where libEGL or the extension is missing."""
+    name = ctypes.util.find_library("EGL")
+    if name is None:
+        return None
+    try:
+        egl = ctypes.CDLL(name)
+        egl.eglGetProcAddress.restype = ctypes.c_void_p
+        egl.eglGetProcAddress.argtypes = [ctypes.c_char_p]
+        address = egl.eglGetProcAddress(b"eglQueryDevicesEXT")
+    except (OSError, AttributeError):
+        return None
+    if not address:
+        return None
+    query = ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_int, ctypes.POINTER(ctypes.c_void_p),
+                             ctypes.POINTER(ctypes.c_int))(address)
+    count = ctypes.c_int(0)
+    return count.value if query(0, None, ctypes.byref(count)) else None
+
+
+def _create_osmesa(require):
+    lib = _osmesa_library()
+    for major, minor in _OSMESA_VERSIONS:
+        attribs = (ctypes.c_int * 11)(
+            _OSMESA_FORMAT, _OSMESA_RGBA,
+            _OSMESA_DEPTH_BITS, 24,
+            _OSMESA_PROFILE, _OSMESA_CORE_PROFILE,
+            _OSMESA_CONTEXT_MAJOR_VERSION, major,
+            _OSMESA_CONTEXT_MINOR_VERSION, minor,
+            0,
+        )
+        handle = lib.OSMesaCreateContextAttribs(attribs, None)
+        if handle:
+            break
+    else:
+        raise RuntimeError("OSMesaCreateContextAttribs failed for OpenGL 4.5 and 3.3 core")
+    loader = _OSMesaLoader(lib, handle)
+    try:
+        if not loader.make_current():
+            raise RuntimeError("OSMesaMakeCurrent failed")
+        moderngl.init_context(loader)
+        mgl = moderngl.get_context()
+    except BaseException:
+        loader.destroy()
+        raise
+    ctx = GLContext("osmesa", mgl, on_release=loader.destroy)
+    if ctx.version_code < require:
+        ctx.release()
+        raise RuntimeError(f"got OpenGL {ctx.version_code}, need {require}")
+    return ctx
+
+
+_CREATORS = {"egl": _create_egl, "osmesa": _create_osmesa}
+
+
+def _try_create(backend, require, device=0):
+    """Return ``(context, None)``, or ``(None, reason)`` if creation failed.
+
+    The context current before the call stays current if it was entered.
+    """
+    check_not_forked()
+    reused = _reuse(backend, require, device)
+    while reused is not None:
+        try:
+            reused._make_current()  # as a new context is: current (unless a with block restores another below)
+            return reused, None
+        except EGLDisplayTerminatedError:  # a recycled context whose display was terminated since: drop it
+            reused._released = True
+            reused = _reuse(backend, require, device)
+    try:
+        context = _create_egl(require, device) if backend == "egl" else _CREATORS[backend](require)
+        _note_gl_use()
+        return context, None
+    except Exception as exc:
+        return None, str(exc) or type(exc).__name__
+    finally:
+        stack = _entered_stack()
+        if stack:
+            stack[-1]._make_current()
+
+
+def _install_hint(backend):
+    return f"Debian/Ubuntu: apt-get install {SYSTEM_PACKAGES[backend]}"
+
+
+def create_context(backend="auto", require=330, device=None):
+    """Create an offscreen OpenGL core-profile context.
+
+    A context a released `glphong.Renderer` recycled (`GLContext.recycle`) is reused when one of the
+    backend is waiting.  The new context is current unless called inside another context's ``with``
+    block, which then stays current; `GLContext.detach` leaves it current on no thread (for use
+    from other threads, as `glphong.Renderer` does).  In a process forked after its parent made a
+    context, `ForkedProcessError` is raised instead of hanging (see `check_not_forked`).
+
+    Parameters
+    ----------
+    backend : {"auto", "egl", "osmesa"}, optional
+        Driver interface to use.  ``"auto"`` uses the backend named by the
+        ``GLPHONG_BACKEND`` environment variable if that is set and not
+        empty, otherwise the first of `BACKENDS` that works.
+    require : int, optional
+        Minimum OpenGL version, as ``major * 100 + minor * 10``.
+    device : int, optional
+        The EGL device (GPU) index, as ``eglQueryDevicesEXT`` lists them (default 0); EGL only.
+
+    Returns
+    -------
+    GLContext
+        The new context.  Call its `GLContext.release` when done.
+
+    Raises
+    ------
+    ValueError
+        If ``backend`` or ``GLPHONG_BACKEND`` names no known backend, or ``device`` is not an index of
+        this machine's EGL devices (the message gives their number).
+    BackendUnavailableError
+        If no context could be created; the message gives the reason for
+        each backend tried and the system packages that provide it.
+    """
+    if backend not in ("auto", *BACKENDS):
+        raise ValueError(
+            f"backend must be one of 'auto', {', '.join(map(repr, BACKENDS))}; got {backend!r}"
+        )
+    origin = ""
+    if backend == "auto" and os.environ.get(_ENV_BACKEND):
+        backend = os.environ[_ENV_BACKEND].strip().lower()
+        if backend not in BACKENDS:
+            raise ValueError(
+                f"environment variable {_ENV_BACKEND} must be one of "
+                f"{', '.join(map(repr, BACKENDS))}; got {os.environ[_ENV_BACKEND]!r}"
+            )
+        origin = f" (chosen by {_ENV_BACKEND})"
+    if device is not None:
+        if backend == "auto":
+            backend = "egl"
+        if backend != "egl":
+            raise ValueError(f"device selects an EGL device: it needs backend 'egl' or 'auto' (got {backend!r})")
+        count = egl_device_count()
+        if isinstance(device, bool) or not isinstance(device, int) or device < 0 or (count is not None and device >= count):
+            raise ValueError(f"device must be an EGL device index from 0 to {'?' if count is None else count - 1} "
+                             f"(this machine has {'an unknown number of' if count is None else count} EGL device(s); "
+                             f"got {device!r})")
+    device = device or 0
+    if backend != "auto":
+        ctx, reason = _try_create(backend, require, device)
+        if ctx is None:
+            raise BackendUnavailableError(
+                f"OpenGL backend {backend!r}{origin} is unavailable: {reason}. "
+                f"{_install_hint(backend)}"
+            )
+        return ctx
+    failures = []
+    for name in BACKENDS:
+        ctx, reason = _try_create(name, require)
+        if ctx is not None:
+            return ctx
+        failures.append(f"  {name}: {reason} ({_install_hint(name)})")
+    raise BackendUnavailableError(
+        f"no OpenGL {require} backend is available; tried:\n" + "\n".join(failures)
+    )
+
+
+def available_backends():
+    """Report which backends can create an OpenGL 3.3 context.
+
+    Each backend is probed by creating and releasing a context.
+
+    Returns
+    -------
+    dict of str to str or None
+        For each name in `BACKENDS`, None if it works, else the reason it
+        does not.
+    """
+    report = {}
+    for name in BACKENDS:
+        ctx, report[name] = _try_create(name, 330)
+        if ctx is not None:
+            ctx.release()
+    return report
+
+
+class _CurrentContextLoader:
+    """moderngl loader for a context some other library created and made current.
+
+    Entering and leaving do nothing: the owner keeps the context current.
+    """
+
+    def __init__(self, get_proc_address):
+        self._get_proc_address = get_proc_address
+
+    def load_opengl_function(self, name):
+        return self._get_proc_address(name.encode()) or 0
+
+    def __enter__(self):
+        pass
+
+    def __exit__(self, *exc_info):
+        pass
+
+    def release(self):
+        pass
+
+
+def attach_current(platform):
+    """Wrap the OpenGL context another library made current (e.g. pyrender's), without owning it.
+
+    Parameters
+    ----------
+    platform : {'egl', 'osmesa'}
+        How the current context was created; GL functions are loaded with
+        ``eglGetProcAddress`` or ``OSMesaGetProcAddress``.
+
+    Returns
+    -------
+    moderngl.Context
+        Valid while the owner keeps that context current; releasing it is the owner's job.
+    """
+    if platform == "egl":
+        name = ctypes.util.find_library("EGL") or "libEGL.so.1"
+        get_proc_address = ctypes.CDLL(name).eglGetProcAddress
+        get_proc_address.restype = ctypes.c_void_p
+        get_proc_address.argtypes = [ctypes.c_char_p]
+    elif platform == "osmesa":
+        get_proc_address = _osmesa_library().OSMesaGetProcAddress
+    else:
+        raise ValueError(f"platform must be 'egl' or 'osmesa' (got {platform!r})")
+    moderngl.init_context(_CurrentContextLoader(get_proc_address))
+    return moderngl.get_context()

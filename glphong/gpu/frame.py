@@ -1,0 +1,107 @@
+"""What a render returns: a `Frame` (linear float32 radiance, coverage, optional depth and normals) and
+the `GBuffer` of per-pixel shader inputs that the twin shades.
+"""
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from glphong.core import validate as _validate
+from glphong.core.imaging import encode_srgb8, png_bytes, save_npy, save_png
+
+__all__ = ["Frame", "GBuffer"]
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A rendered image.
+
+    Attributes
+    ----------
+    radiance : (H, W, 3) float32 ndarray
+        Linear radiance [W/(m^2 sr)], row 0 at the top, never clamped.  With multisampling
+        or supersampling, pixels on silhouettes hold the coverage-weighted average (the
+        background counts as 0).  A writable view into the one RGBA readback (GL's bottom-up
+        rows flipped by a negative stride; no copy is made): ``numpy.ascontiguousarray`` gives
+        C order where a consumer needs it.
+    mask : (H, W) bool ndarray
+        Pixels covered by geometry (any sample).
+    coverage : (H, W) float32 ndarray
+        Fraction of the pixel's samples covered by geometry (0 or 1 with one sample).
+    depth : (H, W) float32 ndarray or None
+        With ``render(scene, depth=True)``: linear depth [m], the distance of the surface point at
+        the pixel centre from the camera along its viewing axis (view-space ``-z``; not the distance
+        to the eye), 0 where no geometry covers the centre.  One sample per pixel at the output size,
+        whatever ``samples`` and ``supersample`` are.
+    normal : (H, W, 3) float32 ndarray or None
+        With ``render(scene, normals=True)``: the world-space unit shading normal at the pixel centre
+        (interpolated, renormalised, flipped toward the viewer on the back faces of two-sided
+        materials, as shaded), 0 where not covered or where the normal is zero or not finite.
+    exposure : float
+        The linear exposure a notebook shows the frame at (``_repr_png_``: Jupyter displays a `Frame`
+        as a PNG of ``to_srgb8(exposure)``, the exact sRGB curve); 1 unless given (`with_exposure`).
+    """
+
+    radiance: np.ndarray
+    mask: np.ndarray
+    coverage: np.ndarray = None
+    depth: np.ndarray = None
+    normal: np.ndarray = None
+    exposure: float = 1.0
+
+    def with_exposure(self, exposure):
+        """The same frame (arrays shared, not copied) shown at ``exposure`` in a notebook."""
+        return replace(self, exposure=_validate.scalar("exposure", exposure, low_inclusive=False))
+
+    def _repr_png_(self):
+        """PNG bytes of the frame at ``self.exposure`` (exact sRGB curve): how Jupyter shows a Frame."""
+        return png_bytes(self.radiance, self.exposure)
+
+    def to_srgb8(self, exposure=1.0):
+        """8-bit sRGB image, (H, W, 3) uint8 (see `glphong.imaging.encode_srgb8`)."""
+        return encode_srgb8(self.radiance, exposure)
+
+    def save_png(self, path, exposure=1.0, compress_level=1):
+        """Tone-map with ``exposure``, encode with the exact sRGB curve, write a PNG (`glphong.imaging.save_png`)."""
+        save_png(path, self.radiance, exposure, compress_level)
+
+    def save_npy(self, path):
+        """Write the raw float32 radiance ``(H, W, 3)`` as ``.npy``."""
+        save_npy(path, self.radiance)
+
+
+@dataclass(frozen=True)
+class GBuffer:
+    """The per-pixel inputs the shader used.
+
+    Attributes
+    ----------
+    position : (H, W, 3) float32 ndarray
+        World-space surface point [m] (0 where not covered).
+    normal : (H, W, 3) float32 ndarray
+        World-space unit normal after renormalisation and the two-sided flip; 0 where
+        the interpolated normal was zero or not finite (ambient-only pixels).
+    object_index : (H, W) int ndarray
+        Index into ``scene.objects``, -1 where not covered.
+    mask : (H, W) bool ndarray
+        Pixels covered by geometry.
+    tangent : (H, W, 4) float32 ndarray or None
+        The interpolated world-space tangent (handedness in w) the frame was built from, where a
+        drawn term needs ``'tangent'``; else None.
+    uv : (H, W, 2) float32 ndarray or None
+        The interpolated texture coordinates, where a drawn term needs ``'uv'`` or a parameter is
+        textured; else None.
+    color : (H, W, 3) float32 ndarray or None
+        The interpolated linear vertex colour, where a parameter takes vertex colours; else None.
+    lod : (H, W, 4) float32 ndarray or None
+        Per pixel, the level of detail the GPU used for each texture of the object's material, in the
+        order of `glphong.key.ProgramKey.textured_inputs` (0 beyond), where a parameter is textured.
+    """
+
+    position: np.ndarray
+    normal: np.ndarray
+    object_index: np.ndarray
+    mask: np.ndarray
+    tangent: np.ndarray = None
+    uv: np.ndarray = None
+    color: np.ndarray = None
+    lod: np.ndarray = None

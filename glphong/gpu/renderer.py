@@ -1,0 +1,545 @@
+"""Offscreen rendering: scene -> program keys -> cached programs -> float32 images.
+
+One render: for each object, the scene gives its `ProgramKey`; the cache gives the
+program; the scene gives the uniforms, bound strictly; only the vertex attributes
+the program reads are bound; the draw goes to an RGBA32F target that is read back
+as float32 with row 0 at the top.
+"""
+import functools
+import threading
+import warnings
+import weakref
+from dataclasses import dataclass, replace
+
+import moderngl
+import numpy as np
+
+from glphong.core import validate as _validate
+from glphong.gpu.frame import Frame, GBuffer
+from glphong.gpu.resources import ORPHANS, ORPHANS_LOCK, MeshBuffers, release_orphans, release_resources, release_targets
+from glphong.gpu.contexts import check_not_forked, create_context
+from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
+from glphong.shaders.key import FORMULATIONS, GBUFFER_PLANES, EncodeKey, uber_key
+from glphong.gpu.programs import ProgramCache
+from glphong.scene.scene import Scene
+
+__all__ = ["Renderer", "Frame", "GBuffer"]
+
+
+@dataclass(eq=False)
+class _ObjectEntry:
+    """What a renderer draws one scene object with (see `Renderer._draw_list`)."""
+
+    state: tuple
+    index: int
+    key: object
+    program: object
+    pack: tuple
+    vertex_array: object
+    mirrored: bool
+    sphere: tuple = None  # ((x, y, z), radius) in the world where the mesh's back faces may be culled
+    checked: object = None
+
+
+def _available_memory():
+    """``MemAvailable`` of /proc/meminfo [bytes] (llvmpipe's render targets live in host memory), or None."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
+
+
+def _one_call_at_a_time(method):
+    """Run a Renderer method under its lock: a renderer is usable from any thread, one call at a time.
+
+    The fork check comes first (a lock copied by fork while held would hang the child), then the GL
+    objects of renderers the garbage collector found unreleased are released (`ORPHANS`)."""
+    @functools.wraps(method)
+    def locked(self, *args, **kwargs):
+        check_not_forked()
+        release_orphans()
+        with self._lock:
+            return method(self, *args, **kwargs)
+    return locked
+
+
+class Renderer:
+    """Offscreen renderer of glphong scenes.
+
+    Threads: a renderer may be used from any thread; its calls are serialised by a lock (two threads
+    rendering at once take turns), and its context is current only inside a call.  Processes: a
+    renderer cannot cross ``fork``; in a child forked after any context was made, it raises
+    `glphong.contexts.ForkedProcessError` (use the 'spawn' or 'forkserver' start methods).
+
+    Parameters
+    ----------
+    width, height : int
+        Image size in pixels, 1 to 16384.
+    backend : {'auto', 'egl', 'osmesa'}
+        OpenGL backend (see `glphong.contexts.create_context`).
+    shading : {'pixel', 'vertex'}
+        'pixel' (default): the model is evaluated per fragment.  'vertex': per vertex and
+        interpolated (Gouraud): cheaper, and wrong inside triangles where the radiance is not
+        linear (highlights smaller than a triangle vanish).
+    samples : {1, 2, 4, 8}
+        Multisample anti-aliasing samples per pixel (silhouettes only; shading stays one
+        evaluation per pixel and triangle).  At most the context's GL_MAX_SAMPLES (4 on llvmpipe).
+    supersample : int
+        Render at ``supersample`` times the size in each direction and box-filter down
+        (anti-aliases shading too), 1 to 8.
+    formulation : {'stable', 'naive'}
+        'stable' (default): docs/design.md section 3.  'naive': the textbook float32 formulation,
+        for measuring what stability costs and buys; not for real use.
+    culling : {'auto', 'off'}
+        'auto' (default): cull the back faces of an object where they cannot be seen (a closed,
+        outward-wound mesh wholly between the near and far planes; `glphong.culling`), which
+        changes no pixel but a silhouette pixel where a back triangle ties with the front one in
+        depth (there the front face shows).  'off': draw every triangle.
+    device : int, optional
+        The EGL device (GPU) to render on, an index of ``eglQueryDevicesEXT``'s list (default 0; EGL
+        only; `glphong.contexts.egl_device_count` says how many there are).  A batch passes it through
+        (``render_many(..., device=1)``).
+    specialise : bool
+        True (default): one program per distinct `ProgramKey`, containing only what the
+        object needs.  False: every object drawn with the uber-shader (every built-in term,
+        the scene's own terms and up to 8 lights per kind compiled in, switched by uniforms),
+        for measuring what specialisation buys.
+
+    Examples
+    --------
+    >>> with glphong.Renderer(256, 256) as r:            # doctest: +SKIP
+    ...     frame = r.render(scene)
+    """
+
+    def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
+                 formulation="stable", specialise=True, culling="auto", device=None):
+        self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
+        self.samples = _validate.choice("samples", _validate.positive_int("samples", samples, 1, 8), (1, 2, 4, 8))
+        self.supersample = _validate.positive_int("supersample", supersample, 1, 8)
+        self._size = self._check_size(width, height)
+        self.formulation = _validate.choice("formulation", formulation, FORMULATIONS)
+        self.culling = _validate.choice("culling", culling, ("auto", "off"))
+        if not isinstance(specialise, (bool, np.bool_)):
+            raise TypeError(f"specialise must be a bool, True or False (got {specialise!r})")
+        self.specialise = bool(specialise)
+        self.context = None
+        self._lock = threading.RLock()
+        check_not_forked()
+        release_orphans()
+        context = create_context(backend, device=device)
+        try:
+            with context:
+                info = context.mgl.info
+                self._max_size = min(info["GL_MAX_TEXTURE_SIZE"], info["GL_MAX_RENDERBUFFER_SIZE"],
+                                     *info["GL_MAX_VIEWPORT_DIMS"])
+                max_samples = context.mgl.max_samples
+            if self.samples > max_samples:
+                raise ValueError(f"samples must be at most this context's GL_MAX_SAMPLES = {max_samples} "
+                                 f"({context.renderer_name}) (got {self.samples})")
+            self._check_limits(self._size, context.renderer_name)
+        except BaseException:
+            context.release()
+            raise
+        context.detach()  # current only inside a call, on whichever thread makes it
+        self.context = context
+        self._mgl = context.mgl
+        self.programs = ProgramCache(self._mgl)
+        self._meshes = {}
+        self._targets = {}
+        self._entries = weakref.WeakKeyDictionary()  # SceneObject -> {output: _ObjectEntry}
+
+    def render_target_bytes(self, size=None):
+        """Memory the render targets and one float32 readback need at ``size`` (default the current one) [bytes].
+
+        Radiance target RGBA32F plus depth at the internal (supersampled) size, times the samples, a
+        resolve target when multisampling, the 8-bit display target and depth times the samples and
+        its resolve, the G-buffer (up to four RGBA32F planes and depth) at the output size, and the
+        float32 readback of the internal size.
+        """
+        w, h = size or self._size
+        internal = w * h * self.supersample ** 2
+        samples = self.samples
+        radiance = internal * (16 + 4) * samples + (internal * 16 if samples > 1 else 0)
+        display = w * h * (4 + 4) * samples + w * h * 4  # render_srgb8's 8-bit target and its resolve
+        return radiance + display + w * h * (4 * 16 + 4) + internal * 16
+
+    def _check_limits(self, size, renderer_name):
+        """The size against the context's limits and the memory it needs, before any work starts."""
+        internal = (size[0] * self.supersample, size[1] * self.supersample)
+        if max(internal) > self._max_size:
+            raise ValueError(f"width and height times supersample must be at most this context's largest "
+                             f"render target, {self._max_size} pixels ({renderer_name}) (got {internal[0]}x{internal[1]})")
+        needed = self.render_target_bytes(size)
+        available = _available_memory()
+        if available is not None and needed > 0.8 * available:
+            raise ValueError(f"a {size[0]}x{size[1]} renderer (supersample {self.supersample}, samples {self.samples}) "
+                             f"needs about {needed / 2**30:.1f} GiB for its render targets and readback; this machine "
+                             f"has {available / 2**30:.1f} GiB available (at most 80% of it may be used)")
+
+    def _check_size(self, width, height):
+        size = (_validate.positive_int("width", width, 1, 16384), _validate.positive_int("height", height, 1, 16384))
+        if max(size) * self.supersample > 16384:
+            raise ValueError(f"width and height times supersample must be at most 16384 "
+                             f"(got {size[0]}x{size[1]} x {self.supersample})")
+        return size
+
+    @property
+    def width(self):
+        """Image width in pixels."""
+        return self._size[0]
+
+    @property
+    def height(self):
+        """Image height in pixels."""
+        return self._size[1]
+
+    @property
+    def backend(self):
+        """Name of the OpenGL backend in use ('egl' or 'osmesa')."""
+        if self.context is None:
+            raise RuntimeError("this Renderer has been released: it has no backend any more")
+        return self.context.backend
+
+    @property
+    def _internal_size(self):
+        return (self.width * self.supersample, self.height * self.supersample)
+
+    @_one_call_at_a_time
+    def resize(self, width, height):
+        """Change the image size; the render targets are rebuilt on next use."""
+        if self.context is None:
+            raise RuntimeError("this Renderer has been released")
+        size = self._check_size(width, height)
+        self._check_limits(size, self.context.renderer_name)
+        if size != self._size:
+            with self.context:
+                self.release_targets()
+            self._size = size
+
+    @_one_call_at_a_time
+    def render(self, scene, depth=False, normals=False):
+        """Render the scene's shaded radiance (linear float32).
+
+        Parameters
+        ----------
+        scene : Scene
+        depth, normals : bool
+            Also return linear depth [m] and world-space normals (`Frame.depth`, `Frame.normal`), from
+            one G-buffer pass at the output size.
+
+        Returns
+        -------
+        Frame
+        """
+        self._check_scene(scene)
+        for name, flag in (("depth", depth), ("normals", normals)):
+            if not isinstance(flag, (bool, np.bool_)):
+                raise TypeError(f"{name} must be a bool, True or False (got {flag!r})")
+        geometry = self.gbuffer(scene) if depth or normals else None  # the lock is re-entrant
+        with self.context:
+            fbo = self._draw_radiance(scene)
+            rgba = self._read(fbo, self._internal_size, components=4)
+            self.context.check_error("rendering radiance")
+        s = self.supersample
+        if s > 1:
+            rgba = rgba.reshape(self.height, s, self.width, s, 4).mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
+        # views of the one readback (rows flipped by strides): no copy after the driver's
+        coverage = rgba[..., 3]
+        extra = {}
+        if depth:
+            camera = scene.camera
+            forward = -camera.pose[:3, 2]
+            along = np.einsum("ijk,k->ij", geometry.position - camera.pose[:3, 3], forward)
+            extra["depth"] = np.where(geometry.mask, along, 0.0).astype(np.float32)
+        if normals:
+            extra["normal"] = geometry.normal
+        return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, **extra)
+
+    @_one_call_at_a_time
+    def render_srgb8(self, scene, exposure=1.0, resolve="display"):
+        """Render and encode on the GPU: exposure, exact sRGB curve, 8 bits; only 8-bit RGB is read back.
+
+        Parameters
+        ----------
+        scene : Scene
+        exposure : float
+            Linear scale applied before encoding, > 0.
+        resolve : {'display', 'linear'}
+            'display' (default): each fragment is shaded, exposed and encoded in the shading pass
+            (OUTPUT_DISPLAY) into an 8-bit target, multisampled where ``samples > 1``, whose
+            silhouette samples are averaged as display values, as pyrender and most real-time
+            renderers do.  'linear': the linear float image is resolved (and box-filtered where
+            ``supersample > 1``, which always takes this path) first and encoded by a separate pass
+            (encode.glsl).  Interior pixels are the same either way; silhouette pixels of a
+            multisampled image differ (the average of encoded values against the encoded average).
+            'display' needs per-pixel shading, no supersampling and specialised programs; with any
+            other option the linear path runs.  Measured: 'display' saves the float target's clear,
+            resolve and readback (see README).
+
+        Returns
+        -------
+        (H, W, 3) uint8 ndarray
+            Row 0 at the top.
+        """
+        self._check_scene(scene)
+        exposure = _validate.scalar("exposure", exposure, low=0.0, low_inclusive=False)
+        resolve = _validate.choice("resolve", resolve, ("display", "linear"))
+        with self.context:
+            if resolve == "display" and self.supersample == 1 and self.shading == "pixel" and self.specialise:
+                target = self._target("display")
+                self._draw(scene, "display", target, {"u_exposure": exposure})
+                if self.samples > 1:
+                    resolved = self._target("srgb8")
+                    self._mgl.copy_framebuffer(resolved, target)
+                    target = resolved
+                rgb = self._read(target, self._size, components=3, dtype="f1")
+                self.context.check_error("rendering display values")
+                return rgb
+            texture = self._draw_radiance(scene).color_attachments[0]
+            out = self._target("srgb8")
+            out.use()
+            program = self.programs.get(EncodeKey(self.supersample))
+            texture.use(location=0)
+            program.bind({"u_radiance": 0, "u_exposure": exposure})
+            self._mgl.disable(moderngl.DEPTH_TEST)
+            self._fullscreen(program).render(moderngl.TRIANGLES, vertices=3)
+            rgb = self._read(out, self._size, components=3, dtype="f1")  # 'f1': normalised bytes
+            self.context.check_error("encoding sRGB")
+        return rgb
+
+    @_one_call_at_a_time
+    def gbuffer(self, scene):
+        """Render the per-pixel shading inputs of the scene (one sample per pixel, output size).
+
+        Returns
+        -------
+        GBuffer
+        """
+        self._check_scene(scene)
+        needs = scene.gbuffer_needs()
+        extras = [n for n in GBUFFER_PLANES if n in needs]
+        with self.context:
+            fbo = self._target(("gbuffer", *extras))
+            self._draw(scene, "gbuffer", fbo)
+            planes = [self._read(fbo, self._size, components=4, attachment=i) for i in range(2 + len(extras))]
+            self.context.check_error("rendering the G-buffer")
+        position, normal = planes[:2]
+        extra = dict(zip(extras, planes[2:]))
+        mask = position[..., 3] > 0.0
+        object_index = np.where(mask, np.rint(position[..., 3]).astype(np.int64) - 1, -1)
+        return GBuffer(position=np.ascontiguousarray(position[..., :3]), normal=np.ascontiguousarray(normal[..., :3]),
+                       object_index=object_index, mask=mask,
+                       tangent=np.ascontiguousarray(extra["tangent"]) if "tangent" in extra else None,
+                       uv=np.ascontiguousarray(extra["uv"][..., :2]) if "uv" in extra else None,
+                       color=np.ascontiguousarray(extra["color"][..., :3]) if "color" in extra else None,
+                       lod=np.ascontiguousarray(extra["lod"]) if "lod" in extra else None)
+
+    def program_key(self, scene, obj, output="radiance"):
+        """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading)."""
+        per_vertex = output == "radiance" and self.shading == "vertex"
+        if output == "radiance" and not self.specialise:
+            return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex)
+        key = scene.program_key(obj, output)
+        if per_vertex and key.textured_inputs:
+            raise ValueError(f"object {obj.name!r}: {', '.join(f'{t}.{p}' for t, p in key.textured_inputs)} "
+                             "are textured, which needs per-pixel shading (a vertex has no texture footprint): "
+                             "use Renderer(shading='pixel')")
+        if key.formulation != self.formulation or key.shade_per_vertex != per_vertex:
+            key = replace(key, formulation=self.formulation, shade_per_vertex=per_vertex)
+        return key
+
+    def _check_scene(self, scene):
+        if not isinstance(scene, Scene):
+            raise TypeError(f"scene must be a glphong.Scene (got {type(scene).__name__})")
+        if self.context is None:
+            raise RuntimeError("this Renderer has been released")
+
+    def _draw_radiance(self, scene):
+        """Draw the radiance; returns the single-sample framebuffer whose color is a texture."""
+        target = self._target("radiance")
+        self._draw(scene, "radiance", target)
+        if self.samples == 1:
+            return target
+        resolved = self._target("resolve")
+        self._mgl.copy_framebuffer(resolved, target)
+        return resolved
+
+    def _draw(self, scene, output, fbo, frame_values=None):
+        aspect = self.width / self.height
+        self._purge_dead_meshes()
+        fbo.use()
+        fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
+        self._mgl.enable(moderngl.DEPTH_TEST)
+        self._mgl.disable(moderngl.CULL_FACE)
+        camera = scene.camera
+        eye = tuple(camera.pose[:3, 3])
+        forward = tuple(-camera.pose[:3, 2])
+        near, far = camera.znear, camera.zfar
+        mirrored = culled = False
+        for program, frame_pack, entry in self._draw_list(scene, output, aspect, frame_values):
+            program.write(frame_pack)
+            program.write(entry.pack)
+            if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
+                mirrored = entry.mirrored
+                self._mgl.front_face = "cw" if mirrored else "ccw"
+            cull = entry.sphere is not None and view_allows_culling(*entry.sphere, eye, forward, near, far)
+            if cull != culled:
+                culled = cull
+                (self._mgl.enable if cull else self._mgl.disable)(moderngl.CULL_FACE)
+            entry.vertex_array.render(moderngl.TRIANGLES)
+        self._mgl.front_face = "ccw"
+        self._mgl.disable(moderngl.CULL_FACE)
+
+    def _draw_list(self, scene, output, aspect, frame_values=None):
+        """``(program, frame pack, object entry)`` per object, in order.
+
+        Per frame, the uniforms every object shares (camera, lights) are packed once per program key;
+        per object, its key, program, vertex array and packed uniforms (pose, normal matrix, material)
+        are made once and kept (`_ObjectEntry`) while the scene's lights, ambient light and the object's
+        index are what they were: objects, materials and poses are immutable.  The uber-shader's key is
+        the scene's, the same for every object (made once per frame).  ``frame_values`` are uniforms the
+        call adds to every program's frame pack (the display programs' ``u_exposure``)."""
+        drop = self.formulation == "naive"
+        state = (output, tuple(scene.light_counts().values()), scene.ambient_radiance, self.formulation,
+                 self.shading, self.specialise, self.culling)
+        shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
+        frame_packs = {}
+        entries = self._entries
+        for index, obj in enumerate(scene.objects):
+            per_object = entries.get(obj)
+            if per_object is None:
+                per_object = entries[obj] = {}
+            entry = per_object.get(output)
+            if shared is not None or entry is None or entry.state != state or entry.index != index:
+                key = shared or self.program_key(scene, obj, output)
+                program = self.programs.get(key)
+                values = scene.uniform_values(index, key, aspect) if shared is not None else \
+                    scene.object_uniform_values(index, key)
+                vao = self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program)
+                sphere = world_sphere(obj.mesh, obj.pose) if self.culling == "auto" and closed_outward(obj.mesh)[0] else None
+                entry = _ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
+                                     None if sphere is None else (tuple(sphere[0]), sphere[1]))
+                if shared is None:
+                    per_object[output] = entry
+            frame = frame_packs.get(entry.program)
+            if frame is None:
+                values = {} if shared is not None else scene.frame_uniform_values(entry.key, aspect)
+                pack = entry.program.pack(values | (frame_values or {}), drop)
+                frame = frame_packs[entry.program] = (pack, tuple(name for name, _, _ in pack))
+            if entry.checked != frame[1]:  # strict: every active uniform set, checked once per entry
+                entry.program.check_complete(frame[0], entry.pack)
+                entry.checked = frame[1]
+            yield entry.program, frame[0], entry
+
+    @staticmethod
+    def _read(fbo, size, components, attachment=0, dtype="f4"):
+        """The attachment as a new writable (H, W, components) array, row 0 at the top (a view with a
+        negative row stride: GL's rows run bottom-up), read straight into it."""
+        data = np.empty((size[1], size[0], components), np.float32 if dtype == "f4" else np.uint8)
+        fbo.read_into(data, components=components, attachment=attachment, dtype=dtype)
+        return data[::-1]
+
+    def _fullscreen(self, program):
+        vao = self._targets.get(("fullscreen", program.key))
+        if vao is None:
+            vao = self._targets[("fullscreen", program.key)] = self._mgl.vertex_array(program.gl_program, [])
+        return vao
+
+    def _target(self, name):
+        fbo = self._targets.get(name)
+        if fbo is not None:
+            return fbo
+        try:
+            fbo = self._targets[name] = self._make_target(name)
+        except moderngl.Error as exc:
+            raise RuntimeError(f"the driver could not make a {self._internal_size[0]}x{self._internal_size[1]} "
+                               f"render target ({self.context.renderer_name}: {exc}); it needs about "
+                               f"{self.render_target_bytes() / 2**30:.2f} GiB with the G-buffer and readback: "
+                               "use a smaller size, supersample or samples") from None
+        return fbo
+
+    def _make_target(self, name):
+        mgl = self._mgl
+        if isinstance(name, tuple) and name[0] == "gbuffer":
+            colors = [mgl.renderbuffer(self._size, 4, dtype="f4") for _ in range(len(name) + 1)]
+            fbo = mgl.framebuffer(colors, mgl.depth_renderbuffer(self._size))
+        elif name == "radiance" and self.samples > 1:
+            fbo = mgl.framebuffer([mgl.renderbuffer(self._internal_size, 4, samples=self.samples, dtype="f4")],
+                                  mgl.depth_renderbuffer(self._internal_size, samples=self.samples))
+        elif name == "display":  # 8-bit display values, multisampled like the radiance target
+            fbo = mgl.framebuffer([mgl.renderbuffer(self._size, 4, samples=self.samples if self.samples > 1 else 0)],
+                                  mgl.depth_renderbuffer(self._size, samples=self.samples if self.samples > 1 else 0))
+        elif name in ("radiance", "resolve"):
+            texture = mgl.texture(self._internal_size, 4, dtype="f4")
+            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            depth = mgl.depth_renderbuffer(self._internal_size) if name == "radiance" else None
+            fbo = mgl.framebuffer([texture], depth)
+        else:  # srgb8
+            fbo = mgl.framebuffer([mgl.renderbuffer(self._size, 4)])
+        return fbo
+
+    def _mesh_buffers(self, mesh):
+        entry = self._meshes.get(id(mesh))
+        if entry is None or entry.owner() is not mesh:
+            if entry is not None:
+                entry.release()
+            entry = self._meshes[id(mesh)] = MeshBuffers(self._mgl, mesh)
+        return entry
+
+    def _purge_dead_meshes(self):
+        for mesh_id in [k for k, e in self._meshes.items() if e.owner() is None]:
+            self._meshes.pop(mesh_id).release()
+
+    def release_targets(self):
+        release_targets(self.context, self._targets)
+
+    def gl_object_count(self):
+        """Number of GL objects this renderer holds (programs, textures, buffers, vertex arrays, targets)."""
+        meshes = sum(1 + len(e.buffers) + len(e.vertex_arrays) for e in self._meshes.values())
+        targets = sum(1 if name[0] == "fullscreen" else
+                      1 + len(f.color_attachments) + (f.depth_attachment is not None)
+                      for name, f in self._targets.items())
+        return len(self.programs) + len(self.programs.textures) + meshes + targets
+
+    @_one_call_at_a_time
+    def release(self):
+        """Release every GL object and the context; idempotent."""
+        if self.context is None:
+            return
+        self._entries.clear()
+        release_resources(self.context, self._meshes, self._targets, self.programs)
+        self.context = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.release()
+
+    def __del__(self):
+        # dropped without release(): moderngl never frees GL objects on garbage collection, so hand them
+        # to the next glphong call (GL work here could run inside someone else's draw), and say so the way
+        # an unclosed file does
+        if getattr(self, "context", None) is None:
+            return
+        state = (self.context, self._meshes, self._targets, self.programs)
+        self.context = None
+        with ORPHANS_LOCK:
+            ORPHANS.append(functools.partial(release_resources, *state))
+        try:
+            warnings.warn("a glphong.Renderer was never released: its GL objects are released at the next "
+                          "glphong call (call release() or use 'with glphong.Renderer(...) as r:')",
+                          ResourceWarning, stacklevel=2)
+        except Exception:  # noqa: BLE001 - warnings turned into errors must not keep the resources
+            pass
+
+    def __repr__(self):
+        state = "released" if self.context is None else self.backend
+        options = "".join([f", shading={self.shading!r}" if self.shading != "pixel" else "",
+                           f", samples={self.samples}" if self.samples > 1 else "",
+                           f", supersample={self.supersample}" if self.supersample > 1 else ""])
+        return f"Renderer({self.width}x{self.height}, {state}{options})"

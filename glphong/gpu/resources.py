@@ -1,0 +1,107 @@
+"""The GL objects a renderer owns, and their release: a mesh's buffers and vertex arrays
+(`MeshBuffers`, uploaded per attribute on first use), and the release of everything a renderer made,
+also for renderers the garbage collector found unreleased (`ORPHANS`, released at the next glphong call
+or at exit: the collector may run anywhere, inside pyrender's draw or on another thread, where GL work
+is unsafe).
+"""
+import atexit
+import threading
+import weakref
+
+import numpy as np
+
+from glphong.gpu.contexts import EGLDisplayTerminatedError
+
+__all__ = ["MeshBuffers", "release_resources", "release_targets", "release_orphans", "ORPHANS", "ORPHANS_LOCK"]
+
+
+class MeshBuffers:
+    """GPU buffers of one MeshData and its vertex arrays per program.
+
+    A vertex attribute is uploaded the first time a program that reads it draws the mesh:
+    a scene whose programs never read normals (no lights) never uploads them.
+    """
+
+    #: attribute -> (MeshData attribute, moderngl format)
+    _SOURCES = {"in_position": ("positions", "3f"), "in_normal": ("normals", "3f"), "in_tangent": ("tangents", "4f"),
+                "in_uv": ("uvs", "2f"), "in_color": ("colors", "3f")}
+
+    def __init__(self, mgl, mesh):
+        self.owner = weakref.ref(mesh)
+        self.buffers = {}
+        self.index_buffer = mgl.buffer(mesh.indices.tobytes())
+        self.vertex_arrays = {}
+
+    #: what a mesh without tangents or UVs supplies to a program that reads them for another object's
+    #: sake (the G-buffer, the uber-shader): tangent 0 (the shader then uses the basis around n), uv 0
+    _DEFAULTS = {"in_tangent": (0.0, 0.0, 0.0, 1.0), "in_uv": (0.0, 0.0), "in_color": (1.0, 1.0, 1.0)}
+
+    def buffer(self, mgl, name):
+        if name not in self.buffers:
+            mesh = self.owner()
+            data = getattr(mesh, self._SOURCES[name][0])
+            if data is None:
+                data = np.tile(np.float32(self._DEFAULTS[name]), (len(mesh.positions), 1))
+            self.buffers[name] = mgl.buffer(np.ascontiguousarray(data, dtype=np.float32).tobytes())
+        return self.buffers[name]
+
+    def vertex_array(self, mgl, program):
+        vao = self.vertex_arrays.get(program.key)
+        if vao is None:
+            # only what the linked program reads: a declared need its GLSL never reads is compiled out
+            content = [(self.buffer(mgl, name), self._SOURCES[name][1], name) for name in program.key.attributes()
+                       if name in program.gl_program]
+            vao = self.vertex_arrays[program.key] = mgl.vertex_array(
+                program.gl_program, content, self.index_buffer, index_element_size=4)
+        return vao
+
+    def release(self):
+        for vao in self.vertex_arrays.values():
+            vao.release()
+        for buf in (*self.buffers.values(), self.index_buffer):
+            buf.release()
+
+
+#: the resources of renderers dropped without release(), released at the next glphong call: the
+#: garbage collector may run anywhere (inside pyrender's draw, on another thread), where GL work is unsafe
+ORPHANS = []
+ORPHANS_LOCK = threading.Lock()
+
+
+def release_targets(context, targets):
+    """Release a renderer's framebuffers and full-screen vertex arrays (context entered)."""
+    for name, obj in targets.items():
+        if name[0] == "fullscreen":  # a full-screen vertex array
+            obj.release()
+        else:
+            context.release_framebuffer(obj)
+    targets.clear()
+
+
+def release_resources(context, meshes, targets, programs):
+    """Release every GL object of a renderer, then recycle its context (`Renderer.release` and the
+    orphans of renderers dropped without it).  A context whose EGL display was terminated has lost its
+    objects already: it is only marked released."""
+    try:
+        with context:
+            for entry in meshes.values():
+                entry.release()
+            meshes.clear()
+            release_targets(context, targets)
+            programs.release()
+    except EGLDisplayTerminatedError:
+        context._released = True
+        return
+    context.recycle()  # every GL object is released: the context may serve another renderer
+
+
+@atexit.register
+def release_orphans():
+    with ORPHANS_LOCK:
+        orphans = ORPHANS[:]
+        ORPHANS.clear()
+    for release in orphans:
+        try:
+            release()
+        except Exception:  # noqa: BLE001 - a context the driver lost cannot be released further
+            pass

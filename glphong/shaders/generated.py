@@ -1,0 +1,94 @@
+"""The GLSL chunks generated from a program key: the material chunk that sums a material's terms
+(`material_chunk`, label ``generated:material``) and a textured G-buffer program's levels of detail
+(`lod_chunk`, label ``generated:levels_of_detail``).  Generated text, never text substitution: the
+rest of a program is the shipped chunk files.
+"""
+import numpy as np
+
+from glphong.materials.registry import model_named, model_source
+
+__all__ = ["MATERIAL_CHUNK", "LOD_CHUNK", "LIGHT_KINDS", "material_chunk", "lod_chunk", "model_chunk_label"]
+
+#: the light kinds, in the order of the shader's loops
+LIGHT_KINDS = ("point", "unattenuated", "directional")
+#: the label of the generated material chunk
+MATERIAL_CHUNK = "generated:material"
+#: the label of the generated levels-of-detail chunk of a textured G-buffer program
+LOD_CHUNK = "generated:levels_of_detail"
+
+
+def model_chunk_label(name):
+    """Where a model's GLSL comes from, for messages (its file, or its class)."""
+
+    return model_source(model_named(name))[1]
+
+
+def _switch(key, flag, statement):
+    return f"    if (SWITCH({flag})) {statement}" if key.uber else f"    {statement}"
+
+
+def _glsl_float(value):
+    """A GLSL float literal that reads back as ``value`` rounded to float32 (a Python float's repr always
+    has a '.' or an exponent)."""
+    return repr(float(np.float32(value)))
+
+
+def material_chunk(key):
+    """The generated GLSL that sums the key's terms (label ``generated:material``).
+
+    ``material_emission() = k_a + sum_terms k_term L_a`` and
+    ``material_response(f, wi, wo, n_dot_l) = sum_lit_terms <model>_response(f, wi, wo, n_dot_l)``;
+    in the uber-shader every term is behind a ``SWITCH(u_use_<model>)`` uniform flag.
+    """
+    lines = ["// material (generated from the program key) -- the material as a sum of its terms (docs/design.md section 8):",
+             "//   material_emission() = k_a + sum_terms k L_a                          [W/(m^2 sr)]",
+             "//   material_response(f, wi, wo, n_dot_l) = sum_terms <model>_response    [1/sr], times cos"]
+    if key.uber:
+        lines += ["uniform float u_use_ka;"] + [f"uniform float u_use_{t.name};" for t in key.lit_terms]
+        lines += [f"uniform float u_use_{t.name}_ambient;" for t in key.terms if t.ambient]
+        lines += [f"uniform float u_{kind}_count;" for kind in LIGHT_KINDS]
+    if key.has_ka:
+        lines.append("uniform vec3 u_ka;                 // k_a [W/(m^2 sr)]")
+    if key.has_ambient:
+        lines.append("uniform vec3 u_ambient;            // L_a [W/m^2]")
+    lines += ["", "vec3 material_emission()", "{", "    vec3 radiance = vec3(0.0);"]
+    if key.has_ka:
+        lines.append(_switch(key, "u_use_ka", "radiance += u_ka;"))
+    for t in key.terms:
+        if t.ambient:
+            scaled = "u_ambient" if t.ambient_scale == 1.0 else f"({_glsl_float(t.ambient_scale)} * u_ambient)"
+            lines.append(_switch(key, f"u_use_{t.name}_ambient", f"radiance += u_{t.name}_{t.ambient_param} * {scaled};"))
+    lines += ["    return radiance;", "}", "",
+              "vec3 material_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)", "{",
+              "    vec3 response = vec3(0.0);"]
+    for t in key.lit_terms:  # a term that does not need the view gets v = 0, whatever the others need
+        view = "wo" if "view" in t.needs else "vec3(0.0)"
+        lines.append(_switch(key, f"u_use_{t.name}", f"response += {t.name}_response(f, wi, {view}, n_dot_l);"))
+    lines += ["    return response;", "}"]
+    if key.inputs:
+        lines += ["", "// surface inputs (glsl/surface.glsl): u_<model>_<param> = scale * texture(uv) * vertex colour"]
+        for term, param, mode in key.inputs:
+            lines.append(f"uniform vec3 u_{term}_{param}_scale;")
+            if "texture" in mode:
+                lines.append(f"uniform sampler2D u_{term}_{param}_texture;")
+        lines += ["", "void material_inputs(vec2 uv, vec3 color)", "{"]
+        for term, param, mode in key.inputs:
+            factors = [f"u_{term}_{param}_scale"]
+            factors += [f"surface_texture(u_{term}_{param}_texture, uv)"] if "texture" in mode else []
+            factors += ["color"] if "vertex" in mode else []
+            lines.append(f"    u_{term}_{param} = {' * '.join(factors)};")
+        lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def lod_chunk(key):
+    """The generated GLSL of a G-buffer program with textures (label ``generated:levels_of_detail``): one
+    sampler per textured input of the object's material, ``u_lod_texture<i>``, and
+    ``gbuffer_levels_of_detail(uv)``, their ``surface_texture_lod`` in x, y, z, w (0 beyond)."""
+    lines = ["// levels of detail (generated from the program key): what texture() used for each of the object's",
+             "// textures, in ProgramKey.textured_inputs order; the twin blends the same levels (surface.glsl)"]
+    lines += [f"uniform sampler2D u_lod_texture{i};" for i in range(key.lod_textures)]
+    lines += ["", "vec4 gbuffer_levels_of_detail(vec2 uv)", "{", "    vec4 lod = vec4(0.0);"]
+    lines += [f"    lod.{'xyzw'[i]} = surface_texture_lod(u_lod_texture{i}, uv);" for i in range(key.lod_textures)]
+    lines += ["    return lod;", "}"]
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,536 @@
+"""Program keys: the one source of truth for what a GLSL program contains (docs/design.md sections 5 and 8).
+
+A `ProgramKey` is frozen and hashable.  It is the program-cache key, and it alone generates
+the ``#define`` lines, the list of chunks a program is assembled from, the generated material
+chunk (the sum of the material's terms), the vertex attributes and what `describe` lists as left
+out.  A material's terms enter as `TermKey` (model name, a hash of its GLSL, what it needs, whether
+it is in the light loop and whether it answers ``L_a``): terms a material does not have or whose
+parameters make them vanish, light kinds a scene lacks and vertex attributes nobody reads are
+left out of the source.  Nothing here knows any model by name; the numpy twin reads the same key.
+"""
+from dataclasses import dataclass, fields
+
+from glphong.materials.model import registered_models, surface_define
+from glphong.materials.params import LIBRARY_CHUNKS
+from glphong.shaders.generated import (LIGHT_KINDS, LOD_CHUNK, MATERIAL_CHUNK, lod_chunk, material_chunk,  # noqa: F401
+                                       model_chunk_label)
+
+__all__ = ["ProgramKey", "TermKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "response_key", "UBER_MAX_LIGHTS",
+           "material_chunk", "LIGHT_KINDS"]
+
+#: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
+UBER_MAX_LIGHTS = 8
+
+OUTPUTS = ("radiance", "gbuffer", "points", "display", "response")
+FORMULATIONS = ("stable", "naive")
+#: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed)
+GBUFFER_PLANES = ("tangent", "uv", "color", "lod")
+#: how a surface input is made (``<MODEL>_<PARAM>_INPUT`` is the mode's index plus 1)
+INPUT_MODES = ("texture", "vertex", "texture*vertex")
+#: textured parameters per material (one G-buffer plane of levels of detail)
+MAX_TEXTURED_INPUTS = 4
+
+
+@dataclass(frozen=True)
+class TermKey:
+    """One term of a program's material.
+
+    Attributes
+    ----------
+    name : str
+        The model's name (its GLSL prefix).
+    source_hash : str
+        Hash of the model's GLSL: an edited definition is a different program.
+    needs : tuple of str
+        What the model reads besides n and l ('view', 'tangent', 'uv').
+    lit : bool
+        Evaluated in the light loop.
+    ambient : bool
+        Answers the ambient light ``L_a`` (``k L_a``).
+    uses : tuple of str
+        Library chunks its GLSL calls.
+    defines : tuple of (str, str)
+        The instance's structural defines.
+    ambient_param : str or None
+        The rgb parameter of its ``k L_a`` answer.
+    ambient_scale : float
+        The answer is ``ambient_scale * k * L_a`` (``1/pi`` for an albedo ``rho``: ``rho/pi L_a``).
+    inputs : tuple of (str, str)
+        The parameters the program sets per fragment (surface inputs, glsl/surface.glsl) and how:
+        ``(param, mode)`` with mode ``'texture'``, ``'vertex'`` or ``'texture*vertex'``.
+    """
+
+    name: str
+    source_hash: str
+    needs: tuple = ()
+    lit: bool = True
+    ambient: bool = False
+    uses: tuple = ()
+    defines: tuple = ()
+    ambient_param: str = None
+    ambient_scale: float = 1.0
+    inputs: tuple = ()
+
+    @property
+    def chunk(self):
+        """Chunk label of the model's GLSL, ``model:<name>@<source hash>``: the program is built from the
+        very definition the material was made of."""
+        return f"model:{self.name}@{self.source_hash}"
+
+    def describe(self):
+        flags = [f for f, on in (("lit", self.lit), ("ambient", self.ambient)) if on]
+        flags += [f"{param}={mode}" for param, mode in self.inputs]
+        return f"{self.name}[{','.join(flags)}]"
+
+
+@dataclass(frozen=True)
+class ProgramKey:
+    """What one program contains.
+
+    Attributes
+    ----------
+    output : {'radiance', 'gbuffer', 'points', 'display'}
+        Shaded radiance, the G-buffer of shading inputs, radiance at arbitrary points
+        (a vertex-only program whose ``shade_point()`` result is captured by transform feedback), or
+        display values (exposure and sRGB applied after shading) for pyrender's 8-bit framebuffer,
+        or the material's response at given direction pairs (transform feedback, `glphong.testing`).
+    terms : tuple of TermKey
+        The material's terms that the program evaluates (lit, or answering ``L_a``), in order.
+    has_ka : bool
+        The constant term ``k_a``.
+    num_point_lights, num_unattenuated_lights, num_directional_lights : int
+        Compile-time light counts per kind.
+    has_normal : bool
+        Whether the program reads the normal attribute (not needed without lights).
+    has_tangent, has_uv : bool
+        Whether it reads the tangent (vec4, handedness in w) and uv attributes.  For a G-buffer
+        program: whether it writes them.
+    two_sided : bool
+        Flip the normal on back faces.
+    formulation : {'stable', 'naive'}
+        The stable float32 formulation of docs/design.md section 3, or the textbook one (``normalize``,
+        ``d*d``, ``pow(dot(v, r), q)``, through the ``NAIVE`` define every chunk may honour) kept
+        only to show why the stable one exists.
+    uber : bool
+        The uber-shader: its terms (every built-in one and the scene's own) and `UBER_MAX_LIGHTS`
+        lights of each kind compiled in and switched by uniforms.  Kept to measure what
+        specialisation buys.
+    shade_per_vertex : bool
+        Gouraud shading: ``shade_point()`` runs in the vertex stage and its radiance is interpolated.
+    has_color : bool
+        Whether it reads the vertex-colour attribute (a surface input with vertex colours; for a
+        G-buffer program: whether it writes the interpolated colour).
+    has_lod : bool
+        G-buffer programs only: whether the G-buffer has the level-of-detail plane (the scene has a
+        textured parameter).
+    lod_textures : int
+        G-buffer programs only: how many textures' levels of detail it writes there (``textureQueryLOD``,
+        one per textured surface input of the object's material, at most 4; the rest are 0).
+    attribute_locations : tuple of (str, int)
+        Where the tangent, uv and colour attributes are bound, where not at glphong's own locations
+        (tangent 2, uv 3, colour 5): pyrender packs a primitive's attributes in order, so its uv is at 2
+        when the primitive has no tangents (`glphong.integrations.pyrender`).
+    """
+
+    output: str = "radiance"
+    terms: tuple = ()
+    has_ka: bool = False
+    num_point_lights: int = 0
+    num_unattenuated_lights: int = 0
+    num_directional_lights: int = 0
+    has_normal: bool = True
+    has_tangent: bool = False
+    has_uv: bool = False
+    two_sided: bool = True
+    formulation: str = "stable"
+    uber: bool = False
+    shade_per_vertex: bool = False
+    has_color: bool = False
+    has_lod: bool = False
+    lod_textures: int = 0
+    attribute_locations: tuple = ()
+
+    def __post_init__(self):
+        if self.output not in OUTPUTS or self.formulation not in FORMULATIONS or \
+                not all(isinstance(t, TermKey) for t in self.terms):
+            raise ValueError(f"invalid ProgramKey {self}")
+
+    @property
+    def lit_terms(self):
+        """Terms in the light loop (tuple of TermKey)."""
+        return tuple(t for t in self.terms if t.lit)
+
+    @property
+    def has_ambient(self):
+        """True when a term answers ``L_a`` (the program reads ``u_ambient``)."""
+        return any(t.ambient for t in self.terms)
+
+    @property
+    def needs_view(self):
+        """True when the program needs the eye position: a lit term reads v, or per-vertex
+        two-sided shading turns the normal toward the eye."""
+        return (self.num_lights > 0 and any("view" in t.needs for t in self.lit_terms)) or \
+            (self.shade_per_vertex and self.two_sided and self.has_normal)
+
+    @property
+    def inputs(self):
+        """``(term, param, mode)`` of every surface input the program computes (tuple)."""
+        return tuple((t.name, param, mode) for t in self.terms for param, mode in t.inputs)
+
+    @property
+    def textured_inputs(self):
+        """``(term, param)`` of the surface inputs that sample a texture, in sampler order (tuple)."""
+        return tuple((t, p) for t, p, mode in self.inputs if "texture" in mode)
+
+    @property
+    def num_lights(self):
+        """Total number of lights the program loops over."""
+        return self.num_point_lights + self.num_unattenuated_lights + self.num_directional_lights
+
+    def attributes(self):
+        """Vertex attributes the program reads, in binding order."""
+        names = ["in_position"]
+        names += ["in_normal"] if self.has_normal else []
+        names += ["in_tangent"] if self.has_tangent else []
+        names += ["in_uv"] if self.has_uv else []
+        names += ["in_color"] if self.has_color else []
+        return tuple(names)
+
+    def extensions(self):
+        """``#extension`` lines of the program: ``textureQueryLOD`` for a G-buffer that writes levels of detail."""
+        return ("GL_ARB_texture_query_lod : require",) if self.lod_textures else ()
+
+    def gbuffer_planes(self):
+        """The extra G-buffer planes a G-buffer program writes, in attachment order (tuple of str)."""
+        return tuple(name for name in GBUFFER_PLANES if getattr(self, f"has_{name}"))
+
+    def defines(self):
+        """The generated ``#define`` lines as (name, value) pairs."""
+        b = lambda flag: "1" if flag else "0"  # noqa: E731
+        out = [
+            ("OUTPUT_GBUFFER", b(self.output == "gbuffer")),
+            ("OUTPUT_DISPLAY", b(self.output == "display")),
+            ("HAS_NORMAL", b(self.has_normal)),
+            ("HAS_TANGENT", b(self.has_tangent)),
+            ("HAS_UV", b(self.has_uv)),
+            ("HAS_COLOR", b(self.has_color)),
+            ("HAS_INPUTS", b(bool(self.inputs))),
+            ("HAS_LOD", b(self.has_lod)),
+            *((f"{name.upper()}_LOCATION", str(where)) for name, where in
+              ({"tangent": 2, "uv": 3, "color": 5} | dict(self.attribute_locations)).items()),
+            ("NUM_LOD_TEXTURES", str(self.lod_textures)),
+            ("TWO_SIDED", b(self.two_sided)),
+            ("RUNTIME_SWITCHES", b(self.uber)),
+            ("SHADE_PER_VERTEX", b(self.shade_per_vertex)),
+            ("NAIVE", b(self.formulation == "naive")),
+            # SWITCH(u_flag): a float uniform flag in the uber-shader, the constant true otherwise
+            ("SWITCH(flag)", "((flag) > 0.5)" if self.uber else "true"),
+        ]
+        if self.output == "gbuffer":  # extra planes follow position and normal, packed in this order
+            out += [(f"GBUFFER_{name.upper()}_LOCATION", str(2 + i)) for i, name in enumerate(self.gbuffer_planes())]
+        if self.output != "gbuffer":
+            out.append(("NEEDS_VIEW", b(self.needs_view)))
+            for kind in LIGHT_KINDS:
+                size = getattr(self, f"num_{kind}_lights")
+                out.append((f"NUM_{kind.upper()}_LIGHTS", str(size)))
+                out.append((f"{kind.upper()}_LIGHT_COUNT", f"int(u_{kind}_count)" if self.uber else str(size)))
+            for term in self.terms:  # a model's structural defines, prefixed with its name
+                out += [(f"{term.name.upper()}_{name}", value) for name, value in term.defines]
+                out += [(surface_define(term.name, param), str(INPUT_MODES.index(mode) + 1)) for param, mode in term.inputs]
+        return out
+
+    def library_chunks(self):
+        """Library chunks the terms use, in first-use order."""
+        return tuple(dict.fromkeys(c for t in self.terms for c in t.uses))
+
+    def shading_chunks(self):
+        """Chunks that define ``shade_point()`` and what it calls: only those the key needs."""
+        chunks = ["common"]
+        if self.num_point_lights:
+            chunks.append("lights")
+        chunks += self.library_chunks()
+        chunks += ["surface"] if self.textured_inputs else []
+        chunks += [t.chunk for t in self.terms]
+        chunks += [MATERIAL_CHUNK, "shade"]
+        return tuple(chunks)
+
+    def vertex_chunks(self):
+        """Chunks of the vertex stage, in order."""
+        if self.output == "response":
+            return ("common",) + self.library_chunks() + tuple(t.chunk for t in self.terms) + \
+                (MATERIAL_CHUNK, "response_points")
+        if self.output == "points":
+            return self.shading_chunks() + ("shade_points",)
+        if self.shade_per_vertex:
+            return self.shading_chunks() + ("mesh_vertex",)
+        return ("mesh_vertex",)
+
+    def fragment_chunks(self):
+        """Chunks of the fragment stage, in order (none for 'points' and 'response')."""
+        if self.output in ("points", "response"):
+            return ()
+        if self.output == "gbuffer":
+            return ("common", "surface", LOD_CHUNK, "mesh_fragment") if self.lod_textures else ("common", "mesh_fragment")
+        if self.shade_per_vertex:
+            return ("mesh_fragment",)
+        if self.output == "display":
+            return self.shading_chunks() + ("srgb", "mesh_fragment")
+        return self.shading_chunks() + ("mesh_fragment",)
+
+    def generated_chunks(self):
+        """Text of the chunks generated from the key (label -> GLSL)."""
+        if self.output == "gbuffer":
+            return {LOD_CHUNK: lod_chunk(self)} if self.lod_textures else {}
+        return {MATERIAL_CHUNK: material_chunk(self)}
+
+    def varyings(self):
+        """Transform-feedback outputs of a 'points' or 'response' program."""
+        return {"points": ("out_radiance",), "response": ("out_response",)}.get(self.output, ())
+
+    def left_out(self, absent_terms=()):
+        """What this program does not contain, one readable line per item (list of str).
+
+        Parameters
+        ----------
+        absent_terms : sequence of (MaterialModel subclass, str)
+            Terms of the drawn materials that the key leaves out, with the reason.
+        """
+        if self.output == "gbuffer":
+            return ["all shading code and lights (the G-buffer program writes the shading inputs only)",
+                    "radiance output"] + [f"{name} output (no drawn term needs it)" for name in GBUFFER_PLANES
+                                          if name not in self.gbuffer_planes()]
+        if self.uber:
+            return ["nothing: the uber-shader compiles every built-in term and the scene's own and switches at run time"]
+        out = []
+        for model, reason in absent_terms:
+            params = ", ".join(model.uniform_name(p.name) for p in model.params + model.tables)
+            out.append(f"term {model.name}: {model_chunk_label(model.name)}{', ' + params if params else ''} ({reason})")
+        used = set(self.library_chunks())
+
+        for chunk in LIBRARY_CHUNKS:
+            if chunk not in used:
+                out.append(f"library chunk {chunk}.glsl (no term of this program calls it)")
+        if not self.needs_view:
+            out.append("view vector v = normalize(eye - x) and u_eye (no lit term reads it)")
+        if not self.has_ka:
+            out.append("constant term k_a (ka = 0)")
+        if not self.has_ambient:
+            out.append("ambient light L_a and u_ambient (no AmbientLight, or no term answers it)")
+        for kind in LIGHT_KINDS:
+            if not getattr(self, f"num_{kind}_lights"):
+                extra = " and lights.glsl" if kind == "point" else ""
+                out.append(f"{kind}-light loop, its uniform arrays{extra} (no {kind} light reaches this material)")
+        if not self.has_normal:
+            out.append("normal attribute, its upload and the normal matrix (nothing reads a normal)")
+        if not self.two_sided:
+            out.append("two-sided normal flip")
+        if not self.has_tangent:
+            out.append("tangent attribute and the tangent frame (no lit term needs 'tangent')")
+        if not self.has_uv:
+            out.append("uv attribute (no lit term needs 'uv', no parameter is textured)")
+        if not self.has_color:
+            out.append("vertex-colour attribute (no parameter takes vertex colours)")
+        if not self.textured_inputs:
+            out.append("surface.glsl, texture samplers and material_inputs() (no parameter is textured)")
+        out.append("G-buffer outputs (they exist only in the G-buffer program)")
+        return out
+
+    def describe(self):
+        """One line naming every field that is set, e.g. ``radiance terms=lambert[lit]+phong_lobe[lit] num_point_lights=2``."""
+        if self.uber:
+            return (f"{self.output} uber (terms {'+'.join(t.name for t in self.terms) or 'none'}, "
+                    f"{UBER_MAX_LIGHTS} lights per kind, switched by uniforms)"
+                    f"{'' if self.formulation == 'stable' else ' formulation=' + self.formulation}")
+        parts = [self.output]
+        for f in fields(self):
+            v = getattr(self, f.name)
+            if f.name == "terms":
+                if v:
+                    parts.append("terms=" + "+".join(t.describe() for t in v))
+            elif f.name != "output" and v not in (False, 0, None, "stable"):
+                parts.append(f.name if v is True else f"{f.name}={v}")
+        return " ".join(parts)
+
+
+def _ambient_present(ambient_radiance):
+    return ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance)
+
+
+def _term_key(term, lit, ambient, uber=False):
+    surface = term.surface_inputs()
+    inputs = tuple((p.name, surface[p.name].mode) for p in term.params
+                   if p.name in surface and (lit or (ambient and p.name == term.ambient)))
+    return TermKey(term.name, term.source_hash(), tuple(term.needs), lit=lit, ambient=ambient,
+                   uses=term.library_uses(uber), defines=term.structural_defines(uber), ambient_param=term.ambient,
+                   ambient_scale=float(term.ambient_scale), inputs=inputs)
+
+
+def term_keys(material, lit, ambient_present):
+    """The `TermKey` of each term of ``material`` that a program evaluates."""
+    out = []
+    for term in material.components:
+        if term.vanishes():
+            continue
+        answers = ambient_present and term.answers_ambient()
+        if lit or answers:
+            out.append(_term_key(term, lit=lit, ambient=answers))
+    return tuple(out)
+
+
+def response_key(material):
+    """The key of a program that evaluates ``material``'s response at direction pairs (`glphong.testing`):
+    every term that does not vanish, in the light loop's place, no light, no emission."""
+    terms = tuple(t for t in term_keys(material, True, False))
+    _refuse_surface_inputs(terms, "glphong.testing evaluates a material's response at given directions, with "
+                                  "constant parameters")
+    needs = {n for t in terms for n in t.needs}
+    return ProgramKey(output="response", terms=terms, has_normal=True, has_tangent="tangent" in needs,
+                      has_uv="uv" in needs, two_sided=False)
+
+
+def program_key(material, light_counts, ambient_radiance, output="radiance", gbuffer_needs=None):
+    """The program key of one material in a scene.
+
+    Parameters
+    ----------
+    material : glphong.materials.Material
+    light_counts : dict of str to int
+        Number of lights per kind ('point', 'unattenuated', 'directional').
+    ambient_radiance : tuple of 3 float or None
+        The scene's ``L_a``.
+    output : {'radiance', 'gbuffer', 'points', 'display'}
+    gbuffer_needs : set of str, optional
+        For 'gbuffer': the extra outputs ('tangent', 'uv') the scene's G-buffer carries.
+
+    Returns
+    -------
+    ProgramKey
+    """
+    if output == "gbuffer":
+        textured = program_key(material, light_counts, ambient_radiance).textured_inputs
+        if len(textured) > MAX_TEXTURED_INPUTS:
+            raise ValueError(f"a material may texture at most {MAX_TEXTURED_INPUTS} parameters (the G-buffer holds one "
+                             f"level of detail per texture); {type(material).__name__} textures {len(textured)}")
+        return gbuffer_key(material, gbuffer_needs or (), len(textured))
+    # lights matter only to a material with a term that reflects them
+    lit = sum(light_counts.values()) > 0 and any(not t.vanishes() for t in material.components)
+    terms = term_keys(material, lit, _ambient_present(ambient_radiance))
+    needs = {n for t in terms if t.lit for n in t.needs}
+    modes = [mode for t in terms for _, mode in t.inputs]
+    if output == "points":
+        _refuse_surface_inputs(terms, "shading at given points has no texture coordinates or vertex colours")
+    count = lambda kind: light_counts.get(kind, 0) if lit else 0  # noqa: E731
+    return ProgramKey(
+        output=output,
+        terms=terms,
+        has_ka=any(c > 0.0 for c in material.ka),
+        num_point_lights=count("point"),
+        num_unattenuated_lights=count("unattenuated"),
+        num_directional_lights=count("directional"),
+        has_normal=lit,
+        has_tangent="tangent" in needs,
+        has_uv="uv" in needs or any("texture" in m for m in modes),
+        two_sided=material.two_sided and lit,
+        has_color=any("vertex" in m for m in modes),
+    )
+
+
+def _refuse_surface_inputs(terms, why):
+    inputs = [f"{t.name}.{param}" for t in terms for param, _ in t.inputs]
+    if inputs:
+        raise ValueError(f"{', '.join(inputs)} vary over the surface (a texture or vertex colours), but {why}: "
+                         "give the material constant parameters")
+
+
+_UBER_BUILTINS = {}
+
+
+def _uber_builtins():
+    """Example instances of the models the uber-shader always holds (those that declare ``in_uber = True``:
+    the lecture's Lambert, Phong and Blinn lobes; they need no more than the view and have no structural
+    defines), computed once per state of the registry.  Every other model joins it only where a scene has it:
+    each term costs every fragment its switch (benchmarks/specialisation.py, a Lambert sphere and floor at
+    1024x1024 on EGL: 2.34x the specialised program with the lecture's three terms, 4.2x with the normalised
+    lobes, the albedo diffuse term and the Fresnel switch compiled in too)."""
+
+    models = registered_models()
+    cached = _UBER_BUILTINS.get(models)
+    if cached is None:
+        examples = [m.example() for m in models if m.in_uber and set(m.needs) <= {"view"}]
+        cached = _UBER_BUILTINS[models] = [e for e in examples if not e.structural_defines()]
+    return cached
+
+
+def uber_key(materials, output="radiance", formulation="stable", shade_per_vertex=False):
+    """The uber-shader's key: every built-in model that needs no more than the view vector, every
+    term of ``materials``, and `UBER_MAX_LIGHTS` lights of each kind, switched at run time by uniforms.
+
+    Parameters
+    ----------
+    materials : sequence of glphong.materials.Material
+        The materials drawn with it (a scene's); their terms are all compiled in.
+    """
+    terms = {}
+    drawn = [term for material in materials for term in material.components]
+    textured = [f"{t.name}.{name}" for t in drawn for name in t.surface_inputs()]
+    if textured:
+        raise ValueError(f"the uber-shader holds constant parameters only, but {', '.join(textured)} vary over the "
+                         "surface (a texture or vertex colours): render it with specialise=True")
+    # a model's Fresnel form is a run-time switch, compiled only where one of the scene's terms has one
+    # (computing F for every fragment and light would cost the lecture's models whatever the scene)
+    with_fresnel = {t.name for t in drawn if getattr(t, "fresnel", None) is not None}
+    for term in _uber_builtins() + drawn:
+        key = _term_key(term, lit=True, ambient=term.ambient is not None, uber=term.name in with_fresnel)
+        known = terms.setdefault(term.name, key)
+        if known != key:
+            raise ValueError(f"the uber-shader holds one variant of each model, but the scene has two of "
+                             f"{term.name!r} (defines {known.defines} and {key.defines}, or two definitions): "
+                             "render it with specialise=True")
+    needs = {n for t in terms.values() for n in t.needs}
+    return ProgramKey(output=output, terms=tuple(terms[name] for name in sorted(terms)), has_ka=True,
+                      num_point_lights=UBER_MAX_LIGHTS, num_unattenuated_lights=UBER_MAX_LIGHTS,
+                      num_directional_lights=UBER_MAX_LIGHTS, has_normal=True, has_tangent="tangent" in needs,
+                      has_uv="uv" in needs, two_sided=True, formulation=formulation, uber=True,
+                      shade_per_vertex=shade_per_vertex)
+
+
+@dataclass(frozen=True)
+class EncodeKey:
+    """Key of the 8-bit output pass (encode.glsl): box filter of ``supersample``^2 texels,
+    exposure, exact sRGB curve."""
+
+    supersample: int = 1
+
+    def defines(self):
+        """The generated ``#define`` lines."""
+        return [("SUPERSAMPLE", str(self.supersample))]
+
+    def vertex_chunks(self):
+        return ("fullscreen_vertex",)
+
+    def fragment_chunks(self):
+        return ("srgb", "encode")
+
+    def generated_chunks(self):
+        return {}
+
+    def varyings(self):
+        return ()
+
+    def attributes(self):
+        return ()
+
+    def describe(self):
+        return f"encode srgb8 supersample={self.supersample}"
+
+    def extensions(self):
+        return ()
+
+
+def gbuffer_key(material, needs=(), lod_textures=0):
+    """The G-buffer-program key of one material: its two-sided flag, the scene's extra G-buffer outputs
+    ``needs`` ('tangent', 'uv', 'color', 'lod') and the number of its textures whose level of detail it
+    writes."""
+    return ProgramKey(output="gbuffer", has_normal=True, two_sided=material.two_sided,
+                      has_tangent="tangent" in needs, has_uv="uv" in needs, has_color="color" in needs,
+                      has_lod="lod" in needs, lod_textures=lod_textures)

@@ -1,0 +1,3 @@
+"""The command line (`cli`, `expressions`) and the benchmarks (`bench`, `speed`): glphong's users, not
+its core.
+"""

@@ -1,0 +1,303 @@
+"""The numpy twin of glphong's GLSL library chunks (docs/design.md sections 1 and 3).
+
+Every function of the library chunks common, lights, lobe, fresnel and angle has its twin here with the
+same name, the same argument order and the same formulation; only the arithmetic's dtype differs
+(float64 for the reference, float32 to study the GPU's formulation on the CPU).  Conventions:
+
+- vectors are arrays of shape ``(..., 3)``, scalars per point of shape ``(...)``;
+- a GLSL function with ``out`` parameters returns ``(return value, *outs)``.
+
+A material model's twin (its ``response``) is written with these; the image-level twin, which shades a
+whole G-buffer, is `glphong.checks.reference`.
+"""
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = [
+    "ShadingFrame", "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus",
+    "lobe_from_delta", "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
+    "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "light_term", "FLT_MAX", "FRAME_PARALLEL_LIMIT",
+]
+
+
+@dataclass(frozen=True)
+class ShadingFrame:
+    """The twin's ``ShadingFrame`` (common.glsl): the local frame at each shading point.
+
+    Attributes
+    ----------
+    n : (N, 3) ndarray
+        Unit normal (flipped toward the viewer on back faces when two-sided).
+    t, b : (N, 3) ndarray or None
+        Unit tangent and bitangent, ``(t, b, n)`` right-handed up to the mesh's handedness sign;
+        None unless a term needs ``'tangent'``.
+    uv : (N, 2) ndarray or None
+        Texture coordinates; None unless a term needs ``'uv'`` or a parameter is textured.
+    inputs : dict of str to (N, 3) ndarray or None
+        The twin's per-fragment values of surface inputs by uniform name (``u_<model>_<param>``: in GLSL
+        the globals `material_inputs` sets); None where no parameter varies.
+    input_bounds : dict of str to ((N, 3), (N, 3)) or None
+        Their intervals for the tolerance band (`glphong.tolerances.input_bounds`).
+    """
+
+    n: np.ndarray
+    t: np.ndarray = None
+    b: np.ndarray = None
+    uv: np.ndarray = None
+    inputs: dict = None
+    input_bounds: dict = None
+
+    def select(self, mask):
+        """The frame at the points where ``mask`` is true."""
+        pick = lambda a: None if a is None else a[mask]  # noqa: E731
+        inputs = None if self.inputs is None else {k: v[mask] for k, v in self.inputs.items()}
+        bounds = None if self.input_bounds is None else \
+            {k: (lo[mask], hi[mask]) for k, (lo, hi) in self.input_bounds.items()}
+        return ShadingFrame(self.n[mask], pick(self.t), pick(self.b), pick(self.uv), inputs, bounds)
+
+
+#: common.glsl FLT_MAX: vectors with a larger (or NaN) component do not normalise
+FLT_MAX = float(np.finfo(np.float32).max)
+#: common.glsl FRAME_PARALLEL_LIMIT (2^-10): a tangent whose part across n is at most this times its
+#: part along n counts as parallel to n in `frame_from_tangent`
+FRAME_PARALLEL_LIMIT = 2.0 ** -10
+
+
+def _dot(a, b):
+    return np.sum(a * b, axis=-1)
+
+
+# --------------------------------------------------------------------------- common.glsl
+def safe_normalize(x):
+    """Scaled normalisation (common.glsl).
+
+    Parameters
+    ----------
+    x : (..., 3) ndarray
+
+    Returns
+    -------
+    valid : (...) bool ndarray
+        ``0 < max|x_i| <= FLT_MAX`` (false for zero, NaN or Inf vectors).
+    x_hat : (..., 3) ndarray
+        ``x / |x|``, 0 where not valid.
+    length : (...) ndarray
+        ``|x|`` computed as ``s sqrt((x/s).(x/s))``, 0 where not valid.
+    """
+    x = np.asarray(x)
+    s = np.max(np.abs(x), axis=-1)
+    valid = (s > 0) & (s <= FLT_MAX)
+    s_safe = np.where(valid, s, 1).astype(x.dtype)[..., None]
+    with np.errstate(invalid="ignore", over="ignore"):
+        y = np.where(valid[..., None], x / s_safe, 0).astype(x.dtype)
+        yy = np.where(valid, _dot(y, y), 1).astype(x.dtype)
+        length = np.where(valid, s_safe[..., 0] * np.sqrt(yy), 0).astype(x.dtype)
+        x_hat = (y * (1 / np.sqrt(yy))[..., None]).astype(x.dtype)  # y * inversesqrt(y.y), as in GLSL
+    return valid, x_hat, length
+
+
+def frame_from_tangent(n, tangent):
+    """The tangent and bitangent of the shading frame (common.glsl).
+
+    Parameters
+    ----------
+    n : (N, 3) ndarray
+        Unit normals.
+    tangent : (N, 4) ndarray
+        Interpolated tangents, handedness in w.
+
+    Returns
+    -------
+    t, b : (N, 3) ndarray
+        ``t = normalize(tangent.xyz - (n.tangent.xyz) n)``; where that is zero or not finite, or
+        the tangent is parallel to n (``|projection| <= FRAME_PARALLEL_LIMIT |n.tangent.xyz|``), the
+        tangent of Duff et al.'s orthonormal basis around n; ``b = sign(w) cross(n, t)``.
+    """
+    n = np.asarray(n)
+    tangent = np.asarray(tangent, dtype=n.dtype)
+    xyz = tangent[..., :3]
+    along = _dot(n, xyz)
+    projected, t, length = safe_normalize(xyz - along[..., None] * n)
+    projected = projected & (length > FRAME_PARALLEL_LIMIT * np.abs(along))
+    s = np.where(n[..., 2] >= 0, 1.0, -1.0).astype(n.dtype)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        a = -1.0 / (s + n[..., 2])
+        fallback = np.stack([1.0 + s * n[..., 0] * n[..., 0] * a, s * n[..., 0] * n[..., 1] * a, -s * n[..., 0]], axis=-1)
+    t = np.where(projected[..., None], t, fallback).astype(n.dtype)
+    b = (np.where(tangent[..., 3] < 0, -1.0, 1.0)[..., None] * np.cross(n, t)).astype(n.dtype)
+    return t, b
+
+
+def shading_frame(n, tangent=None, uv=None, key=None):
+    """The `ShadingFrame` of shading points (common.glsl ``shading_frame``): ``t``, ``b`` from
+    `frame_from_tangent` where ``key.has_tangent``; ``uv`` where ``key.has_uv``."""
+    if key is not None and key.has_tangent:
+        t, b = frame_from_tangent(n, tangent)
+        return ShadingFrame(n, t, b, uv if key.has_uv else None)
+    return ShadingFrame(n, None, None, uv if key is not None and key.has_uv else None)
+
+
+# --------------------------------------------------------------------------- lights.glsl
+def point_irradiance(intensity, d):
+    """E1 as ``min((I / d) / d, FLT_MAX)`` (lights.glsl).
+
+    Parameters
+    ----------
+    intensity : (..., 3) ndarray
+        ``Phi / (4 pi)`` [W/sr].
+    d : (...) ndarray
+        Distance [m], > 0.
+
+    Returns
+    -------
+    (..., 3) ndarray
+        Irradiance [W/m^2].
+    """
+    d = np.asarray(d)[..., None]
+    with np.errstate(over="ignore", under="ignore"):
+        return np.minimum((intensity / d) / d, FLT_MAX)
+
+
+# --------------------------------------------------------------------------- lobe.glsl
+def _series_terms(dtype):
+    """Terms of the artanh series: 8 in float32, exactly as lobe.glsl; in float64, as many as
+    sigma <= 1/3 needs to reach its precision (16)."""
+    if np.dtype(dtype) == np.float32:
+        return 8
+    eps = np.finfo(dtype).eps
+    k = 0
+    while (1.0 / 9.0) ** k / (2 * k + 1) > eps / 4:
+        k += 1
+    return k
+
+
+def log_one_minus(delta):
+    """``ln(1 - delta)`` for ``0 <= delta < 1`` (lobe.glsl).
+
+    ``-2 artanh(delta / (2 - delta))`` by its odd series for ``delta < 1/2`` (8 terms in
+    float32 as in the GLSL, as many as float64 needs otherwise), ``log(1 - delta)`` above.
+    """
+    delta = np.asarray(delta)
+    dtype = delta.dtype if delta.dtype.kind == "f" else np.float64
+    delta = delta.astype(dtype)
+    small = delta < 0.5
+    with np.errstate(divide="ignore", invalid="ignore"):
+        two_sigma = np.where(small, (2 * delta) / (2 - delta), 0).astype(dtype)
+        t = (0.25 * (two_sigma * two_sigma)).astype(dtype)
+        series = np.zeros_like(two_sigma)
+        for k in reversed(range(_series_terms(dtype))):
+            series = (series * t + dtype.type(1.0) / dtype.type(2 * k + 1)).astype(dtype)
+        direct = np.log(np.where(small, 0.5, 1 - delta)).astype(dtype)
+    return np.where(small, -two_sigma * series, direct).astype(dtype)
+
+
+def lobe_from_delta(delta, q):
+    """``(1 - delta)^q``, stable for q up to FLT_MAX (lobe.glsl).
+
+    Returns 1 for q == 0, 0 for delta >= 1, else ``exp(max(q ln(1 - delta), -104))``; ``q`` a scalar or
+    an array broadcasting with ``delta`` (a per-point exponent).
+    """
+    delta = np.asarray(delta)
+    dtype = delta.dtype if delta.dtype.kind == "f" else np.float64
+    q = np.asarray(q, dtype=dtype)
+    inside = delta < 1
+    with np.errstate(over="ignore", invalid="ignore"):
+        value = np.exp(np.maximum(q * log_one_minus(np.where(inside, delta, 0)), dtype.type(-104)))
+    value = np.where(inside, value, 0)
+    return np.where(q == 0, 1, value).astype(dtype)
+
+
+def phong_delta(n, wi, wo):
+    """``|r - v|^2 / 2`` with ``r = 2 (n.l) n - l`` (lobe.glsl); unit (..., 3) inputs -> (...)."""
+    r = 2 * _dot(n, wi)[..., None] * n - wi
+    e = r - wo
+    return 0.5 * _dot(e, e)
+
+
+def phong_lobe(n, wi, wo, q):
+    """``max(v.r, 0)^q`` = `lobe_from_delta` of `phong_delta` (lobe.glsl); (...)."""
+    return lobe_from_delta(phong_delta(n, wi, wo), q)
+
+
+#: lobe.glsl BLINN_HALF_FLOOR = 2^-20: |l + v| at or below it gives a zero Blinn lobe
+BLINN_HALF_FLOOR = 2.0 ** -20
+
+
+def blinn_delta(n, wi, wo):
+    """Blinn's ``delta = |h - n|^2 / 2`` (lobe.glsl).
+
+    Returns
+    -------
+    valid : (...) bool ndarray
+        ``n.v > 0`` and ``|l + v| > BLINN_HALF_FLOOR``.
+    delta : (...) ndarray
+        ``|h - n|^2 / 2``; 2 where not valid.
+    """
+    ok_h, h, h_len = safe_normalize(wi + wo)
+    valid = (_dot(n, wo) > 0) & ok_h & (h_len > BLINN_HALF_FLOOR)
+    e = h - n
+    return valid, np.where(valid, 0.5 * _dot(e, e), 2).astype(e.dtype)
+
+
+def blinn_lobe(n, wi, wo, q):
+    """``max(n.h, 0)^q``, 0 where `blinn_delta` is not valid (lobe.glsl); (...)."""
+    valid, delta = blinn_delta(n, wi, wo)
+    return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype)
+
+
+def half_cosine(wi, wo):
+    """``h.l`` with ``h = (l + v)/|l + v|``, 0 where ``l + v`` does not normalise (lobe.glsl); (...)."""
+    ok, h, _ = safe_normalize(wi + wo)
+    return np.where(ok, _dot(h, wi), 0).astype(h.dtype)
+
+
+# --------------------------------------------------------------------------- fresnel.glsl
+def fresnel_schlick(f0, c):
+    """Schlick's ``f0 + (1 - f0)(1 - c)^5`` with ``c`` clamped to [0, 1] (fresnel.glsl).
+
+    f0 (3,) in [0, 1], c (...) -> (..., 3), dimensionless.
+    """
+    c = np.asarray(c)
+    m = np.clip(1 - c, 0, 1)
+    m2 = m * m
+    return f0 + (1 - f0) * (m2 * m2 * m)[..., None]
+
+
+def fresnel_dielectric(ior, c):
+    """The exact unpolarised dielectric reflectance (fresnel.glsl): ior () > 0, c (...) -> (...).
+
+    ``(g - c)^2 / (2 (g + c)^2) (1 + (c (g + c) - 1)^2 / (c (g - c) + 1)^2)``, ``g^2 = ior^2 + c^2 - 1``,
+    with ``g - c = (ior^2 - 1)/(g + c)``; 1 under total internal reflection and at ``c = 0``.
+    """
+    c = np.clip(np.asarray(c), 0, 1)
+    dtype = c.dtype if c.dtype.kind == "f" else np.float64
+    ior = np.asarray(ior, dtype)
+    a = (ior - 1) * (ior + 1)
+    g2 = a + c * c
+    g = np.sqrt(np.maximum(g2, 0))
+    g_plus_c = g + c
+    safe = np.maximum(g_plus_c, dtype.type(1e-30))
+    with np.errstate(over="ignore", invalid="ignore"):
+        ratio = (a / safe) / safe
+        g_minus_c = a / safe
+        q = (c * g_plus_c - 1) / (c * g_minus_c + 1)
+        f = 0.5 * (ratio * ratio) * (1 + q * q)
+    return np.where((g2 < 0) | (g_plus_c <= 0), 1, np.minimum(f, 1)).astype(dtype)
+
+
+# --------------------------------------------------------------------------- angle.glsl
+def atan2_first_quadrant(y, x):
+    """``atan(y / x)`` [rad] in [0, pi/2] for ``y, x >= 0``, 0 where both are 0 (angle.glsl): exact here
+    (``numpy.arctan2``); the GLSL evaluates Cephes' atanf polynomial, good to 3 ulp (GLSL's own atan
+    is not: 2e-5 relative measured on llvmpipe).  (...) -> (...)."""
+    return np.arctan2(y, x)
+
+
+# --------------------------------------------------------------------------- shade.glsl
+
+
+def light_term(response, irradiance):
+    """``response * E``, exactly 0 where ``E = 0`` (shade.glsl): an overflowed response never makes NaN."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        return np.where(irradiance == 0, 0.0, response * irradiance).astype(np.result_type(response, irradiance))

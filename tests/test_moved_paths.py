@@ -1,0 +1,59 @@
+"""The module paths of glphong 0.1.0 keep working for one release (`glphong._moved`): an old path imports the
+module at its new path, the very same object (private names included), with one `DeprecationWarning` that names
+the new path; the documented public paths answer without a warning.  Each runs in a fresh interpreter, since an
+import happens once per process.
+"""
+import subprocess
+import sys
+
+import pytest
+
+from glphong import _moved
+
+CHECK = r"""
+import importlib, sys, warnings
+old, new = sys.argv[1], sys.argv[2]
+import glphong
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    module = importlib.import_module(old)
+assert module is importlib.import_module(new), (module, new)
+deprecations = [str(w.message) for w in caught if issubclass(w.category, DeprecationWarning)]
+print(len(deprecations), deprecations[0] if deprecations else "")
+"""
+
+
+def _import(old, new):
+    result = subprocess.run([sys.executable, "-c", CHECK, old, new], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr[-2000:]
+    count, _, message = result.stdout.strip().partition(" ")
+    return int(count), message
+
+
+@pytest.mark.parametrize("old", ["glphong.stability", "glphong.key", "glphong.loaders", "glphong.cli"])
+def test_an_old_path_is_the_new_module_with_a_warning(old):
+    count, message = _import(old, _moved.MOVED[old])
+    assert count == 1 and f"{old} moved to {_moved.MOVED[old]}" in message
+
+
+@pytest.mark.parametrize("old", sorted(_moved.PUBLIC))
+def test_public_paths_answer_without_a_warning(old):
+    assert _import(old, _moved.PUBLIC[old]) == (0, "")
+
+
+def test_from_import_of_an_old_path_and_private_names():
+    code = ("import warnings; warnings.simplefilter('error', DeprecationWarning)\n"
+            "try:\n    from glphong.stability import _mirror_eye\nexcept DeprecationWarning as w:\n    print('warned', w)\n"
+            "warnings.simplefilter('ignore')\nfrom glphong.stability import _mirror_eye, case_scene\n"
+            "from glphong.tolerances import EPS, lobe_band\nimport glphong\nprint(callable(glphong.verify), EPS)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.splitlines()[0].startswith("warned glphong.stability moved to glphong.checks.stability")
+    assert out.stdout.splitlines()[-1] == f"True {2.0 ** -24}"
+
+
+def test_every_moved_target_exists():
+    import importlib
+
+    for new in list(_moved.MOVED.values()) + list(_moved.PUBLIC.values()):
+        importlib.import_module(new)
