@@ -88,7 +88,7 @@ def main(out="custom_material.png"):
         print(f"render cross-check: {report}")
         renderer.render(scene).save_png(out, exposure=1.0)
     print(f"wrote {out}")
-    print(glphong.format_descriptions(glphong.gpu.describe(scene))[:600], "...")
+    print(glphong.format_descriptions(glphong.describe(scene))[:600], "...")
     try:
         import pyrender  # noqa: F401
     except ImportError:

@@ -12,6 +12,7 @@ Typical use::
         report = glphong.verify(scene, r)
 """
 from glphong import _moved, materials
+from glphong.analysis import tabulate as _tabulate  # noqa: F401 - registers MeasuredBRDF.from_model's tabulator
 from glphong.checks import reference
 from glphong.core import filesafety, imaging, radiometry
 from glphong.core.version import __version__

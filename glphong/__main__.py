@@ -1,4 +1,4 @@
-"""``python -m glphong``: see `glphong.cli`."""
+"""``python -m glphong``: see `glphong.tools.cli`."""
 import sys
 
 from glphong.tools.cli import main

@@ -4,7 +4,10 @@
 ``from glphong.key import ProgramKey``) with the module at its new path (the very same module object,
 so every name, private ones included, is there), warning once per path with a `DeprecationWarning`
 that names the new one.  `PUBLIC` paths are documented API that now live in a subpackage
-(``glphong.imaging`` is ``glphong.core.imaging``): they answer without a warning.  The changelog
+(``glphong.imaging`` is ``glphong.core.imaging``): they are registered in ``sys.modules`` when glphong is
+imported and answer without a warning.  Registering them first also keeps ``glphong.verify`` the function:
+an import that loads a submodule sets it as an attribute of its package, one found in ``sys.modules``
+does not.  The changelog
 lists every move.
 """
 import importlib
@@ -54,6 +57,7 @@ PUBLIC = {
     "glphong.filesafety": "glphong.core.filesafety",
     "glphong.primitives": "glphong.scene.primitives",
     "glphong.reference": "glphong.checks.reference",
+    "glphong.verify": "glphong.checks.verify",
 }
 
 

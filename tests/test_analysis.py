@@ -5,7 +5,7 @@ import json
 import numpy as np
 import pytest
 
-from glphong import analysis
+from glphong.analysis import questions as analysis
 from glphong.analysis import albedo, format_properties, properties
 from glphong.tools.cli import main
 from glphong.materials import (CookTorrance, Diffuse, Lambert, NormalizedBlinnPhong, NormalizedPhong, OrenNayar, Phong,

@@ -75,14 +75,14 @@ import pytest
 import glphong
 import glphong.materials
 from glphong import analysis
-from glphong.key import program_key, response_key
+from glphong.shaders.key import program_key, response_key
 from glphong.materials import (AshikhminShirley, BlinnLobe, CookTorrance, CookTorranceLobe, DielectricFresnel, Diffuse,
                                Lafortune, LafortuneLobes, Lambert, MaterialModel, MaterialSum, MeasuredBRDF, MtlPhong,
                                NormalizedBlinnLobe, NormalizedBlinnPhong, NormalizedPhong, NormalizedPhongLobe,
                                OrenNayar, PhongLobe, SchlickFresnel, WardLobe, registered_models)
 from glphong.materials.model import MATERIAL_KEYWORDS, NEEDS
-from glphong.programs import assemble
-from glphong.stability import cases_for, run_stability
+from glphong.gpu.programs import assemble
+from glphong.checks.stability import cases_for, run_stability
 from glphong.testing import assert_twin_matches, direction_sets, evaluate
 
 EPS = 2.0 ** -24

@@ -122,3 +122,10 @@ def test_every_module_is_in_a_layer():
     packages = {p.parent.name for p in PACKAGE.glob("*/__init__.py")} - {"glsl"}
     missing = sorted(p for p in packages if f"glphong.{p}" not in config)
     assert missing == []
+
+
+def test_every_package_is_installed():
+    """setup.cfg lists its packages by name: a subpackage missing there would be missing from the wheel."""
+    listed = (ROOT / "setup.cfg").read_text(encoding="utf-8").split("packages =", 1)[1].split("package_dir", 1)[0].split()
+    folders = sorted(_module_name(p.parent / "__init__.py") for p in PACKAGE.rglob("__init__.py"))
+    assert sorted(set(folders) - set(listed)) == []

@@ -353,6 +353,7 @@ def test_true_overflow_gives_inf_with_warning():
 
 def test_public_api():
     assert set(rad.__all__) == {
+        "LUMENS_PER_WATT",
         "PLANCK",
         "SPEED_OF_LIGHT",
         "photon_energy",

@@ -220,16 +220,16 @@ def test_uniform_binding_is_strict(renderer):
 
 
 def test_compile_error_names_chunk_file_and_line(renderer, monkeypatch):
-    from glphong.gpu import programs
+    from glphong.shaders import assembly
 
-    original = programs.chunk_source
+    original = assembly.chunk_source
 
     def broken(name):
         text = original(name)
         return text.replace("vec3 radiance = material_emission();", "vec3 radiance = material_emission()  // no ;") \
             if name == "shade" else text
 
-    monkeypatch.setattr(programs, "chunk_source", broken)
+    monkeypatch.setattr(assembly, "chunk_source", broken)
     key = program_key(glphong.Lambert(0.3), {"directional": 1}, None)
     with renderer.context, pytest.raises(ShaderCompileError) as caught:
         Program(renderer.context.mgl, key)

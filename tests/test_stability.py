@@ -12,7 +12,7 @@ from glphong import reference as ref
 from glphong.shaders.key import program_key
 from glphong.checks.probe import shade_points
 from glphong.gpu.programs import ProgramCache
-from glphong.checks.stability import CASES, case_scene, oracle, run_stability
+from glphong.checks.stability import CASES, case_inputs, case_scene, oracle, run_stability
 from glphong.checks.tolerances import FLT_MAX, FLT_MIN, point_band
 
 
@@ -31,7 +31,7 @@ def test_float64_twin_agrees_with_the_mpmath_oracle():
     reads the constructors: to one float32 rounding of the inputs."""
     checked = 0
     for case in CASES:
-        key, uniforms = case.inputs()
+        key, uniforms = case_inputs(case)
         u64 = {k: v.astype(np.float64) for k, v in uniforms.items()}
         n_valid, n, _ = ref.safe_normalize(np.asarray([case.normal], dtype=np.float32).astype(np.float64))
         frame = ref.shading_frame(n, np.asarray([case.tangent], dtype=np.float32).astype(np.float64),
@@ -75,7 +75,7 @@ def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, unif
     (the twin and the band, reading the same uniforms, would follow it) fails its cases."""
     from glphong.checks import stability
 
-    original = stability.Case.inputs
+    original = stability.case_inputs
 
     def miswired(case, scene=None):
         key, uniforms = original(case, scene)
@@ -84,7 +84,7 @@ def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, unif
                 uniforms[name] = uniforms[name] * np.float32(1.01)
         return key, uniforms
 
-    monkeypatch.setattr(stability.Case, "inputs", miswired)
+    monkeypatch.setattr(stability, "case_inputs", miswired)
     cases = [c for c in CASES if c.name in ("phong q=1000 near", "blinn q=1 peak", "phong q=1 peak",
                                             "lambert grazing light n.l=0.01", "blinn q=1000 near")]
     report = run_stability(context=session_gl, cases=cases)

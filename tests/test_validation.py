@@ -789,7 +789,7 @@ def test_resize_after_release_names_the_problem(make_renderer):
 
 
 def test_float32_twin_uses_the_glsl_series_length():
-    from glphong import reference
+    from glphong.twin import functions as ref_functions
 
-    assert reference._series_terms(np.float32) == 8  # lobe.glsl sums 8 terms
-    assert reference._series_terms(np.float64) == 16
+    assert ref_functions._series_terms(np.float32) == 8  # lobe.glsl sums 8 terms
+    assert ref_functions._series_terms(np.float64) == 16

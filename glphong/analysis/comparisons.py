@@ -76,7 +76,7 @@ class HandWrittenRenderer:
     width, height : int
         Image size in pixels.
     backend : {'egl', 'osmesa', 'auto'}
-        Passed to `glphong.contexts.create_context`; the renderer owns the context.
+        Passed to `glphong.gpu.contexts.create_context`; the renderer owns the context.
     shader : {'glphong', 'textbook'}
         'glphong': the stable programs glphong draws with.  'textbook': the same keys with
         ``formulation='naive'`` (the textbook GLSL), the floor of a naive implementation.

@@ -114,7 +114,7 @@ def plot_albedo(materials, path, theta_i=None):
 
 
 def plot_gallery(path, theta_i=np.radians(45.0), columns=4):
-    """One polar lobe panel per entry of `glphong.gallery.GALLERY` at ``theta_i``; returns the curves by label."""
+    """One polar lobe panel per entry of `glphong.analysis.gallery.GALLERY` at ``theta_i``; returns the curves by label."""
 
     entries = []
     for label, factory in GALLERY:

@@ -3,6 +3,7 @@ import numpy as np
 
 from glphong.analysis.questions import f_r
 from glphong.core.merl import SHAPE, bin_directions
+from glphong.materials.measured import register_tabulator
 
 __all__ = ["tabulate"]
 
@@ -25,3 +26,6 @@ def tabulate(material, chunk=200_000):
         rows = idx[start:start + chunk]
         out[rows] = f_r(material, wi[rows], wo[rows])
     return out.reshape(SHAPE + (3,))
+
+
+register_tabulator(tabulate)  # MeasuredBRDF.from_model tabulates through here

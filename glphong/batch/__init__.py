@@ -38,7 +38,7 @@ journal or lock that is a symbolic link or not a regular file.
 Workers
 -------
 The default executor is a ``concurrent.futures.ProcessPoolExecutor`` started with 'spawn' (a forked child
-of a process that made a context would hang: `glphong.contexts.ForkedProcessError`), one renderer per
+of a process that made a context would hang: `glphong.gpu.contexts.ForkedProcessError`), one renderer per
 worker made on first use and kept, and ``LP_NUM_THREADS`` set in each worker before its first context so
 that the workers do not oversubscribe the cores.  Each worker ends when the process that started it dies,
 even by ``SIGKILL``: on Linux it asks the kernel for ``SIGKILL`` at its parent's death

@@ -144,7 +144,7 @@ def evaluate(gl, name, **inputs):
 
     Parameters
     ----------
-    gl : glphong.contexts.GLContext
+    gl : glphong.gpu.contexts.GLContext
     name : str
         A key of `signatures()`: a library or model chunk function.
     **inputs : array_like
@@ -198,10 +198,10 @@ def shade_points(gl, programs, key, uniforms, positions, normals, drop_unused=Fa
 
     Parameters
     ----------
-    gl : glphong.contexts.GLContext
-    programs : glphong.programs.ProgramCache
+    gl : glphong.gpu.contexts.GLContext
+    programs : glphong.gpu.programs.ProgramCache
         Cache of ``gl``'s programs.
-    key : glphong.key.ProgramKey
+    key : glphong.shaders.key.ProgramKey
         With ``output='points'``.
     uniforms : dict of str to array_like
         Exactly the program's active uniforms (strict binding).

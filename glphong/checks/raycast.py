@@ -224,7 +224,7 @@ class AnalyticObject:
 
     def __post_init__(self):
         if not isinstance(self.shape, (Sphere, Plane)):
-            raise TypeError(f"shape must be a glphong.raycast.Sphere or Plane (got {type(self.shape).__name__})")
+            raise TypeError(f"shape must be a glphong.checks.raycast.Sphere or Plane (got {type(self.shape).__name__})")
         if not isinstance(self.material, Material):
             raise TypeError(f"material must be a glphong material (got {type(self.material).__name__})")
 
@@ -307,7 +307,7 @@ def render_reference(camera, objects, lights=(), ambient=None, width=256, height
         raise ValueError("objects must hold at least one AnalyticObject")
     for k, obj in enumerate(objects):
         if not isinstance(obj, AnalyticObject):
-            raise TypeError(f"objects[{k}] must be a glphong.raycast.AnalyticObject (got {type(obj).__name__})")
+            raise TypeError(f"objects[{k}] must be a glphong.checks.raycast.AnalyticObject (got {type(obj).__name__})")
     width = _validate.positive_int("width", width)
     height = _validate.positive_int("height", height)
     n = _validate.positive_int("samples_per_axis", samples_per_axis, high=1024)
@@ -404,7 +404,7 @@ def compare_to_reference(image, image_mask, reference, relative_floor=1e-6):
         ``background_pixels`` counts the rest.
     """
     if not isinstance(reference, RayCastImage):
-        raise TypeError(f"reference must be a glphong.raycast.RayCastImage (got {type(reference).__name__})")
+        raise TypeError(f"reference must be a glphong.checks.raycast.RayCastImage (got {type(reference).__name__})")
     relative_floor = _validate.scalar("relative_floor", relative_floor)
     ref = reference.radiance
     img = np.asarray(image, dtype=np.float64)

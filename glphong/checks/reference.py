@@ -52,7 +52,7 @@ def incident_light(position, key, uniforms):
     ----------
     position : (N, 3) ndarray
         World-space points [m].
-    key : glphong.key.ProgramKey
+    key : glphong.shaders.key.ProgramKey
     uniforms : dict of str to ndarray
         The program's uniforms, in the dtype of the computation.
 
@@ -106,12 +106,12 @@ def material_inputs(uv, color, lod, key, uniforms, sample=None):
         The interpolated vertex colour (the G-buffer's), where an input reads it.
     lod : (N, 4) ndarray or None
         The level of detail of each textured input, in `ProgramKey.textured_inputs` order.
-    key : glphong.key.ProgramKey
+    key : glphong.shaders.key.ProgramKey
     uniforms : dict
         The program's uniforms (``u_<model>_<param>_scale`` and ``_texture``).
     sample : callable, optional
         ``sample(image, uv, lod)`` in place of `surface_texture`; it may return ``(k, N, 3)`` (several
-        arrays that the products broadcast over: `glphong.tolerances.input_bounds` passes the value and
+        arrays that the products broadcast over: `glphong.checks.tolerances.input_bounds` passes the value and
         its interval from one sampling).
 
     Returns
@@ -236,7 +236,7 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
 def shade_inputs(scene, gbuffer, dtype=np.float64, band=None):
     """Per object, the fragments it covers and the inputs its program shaded them with.
 
-    ``band`` (`glphong.tolerances.BandConstants`): also the intervals of the surface inputs
+    ``band`` (`glphong.checks.tolerances.BandConstants`): also the intervals of the surface inputs
     (``f.input_bounds``), for the tolerance band.
 
     Yields
@@ -244,7 +244,7 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None):
     selection : (H, W) bool ndarray
         The object's pixels.
     obj : glphong.SceneObject
-    key : glphong.key.ProgramKey
+    key : glphong.shaders.key.ProgramKey
         Its radiance-program key.
     uniforms : dict of str to ndarray
         The uniforms the GPU was given, cast to ``dtype``.

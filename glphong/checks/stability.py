@@ -7,7 +7,7 @@ parameters (rounded to float32, the documented input precision, so float64 round
 the expectation; never from the uniforms).  The GPU evaluates the real GLSL ``shade_point()`` at
 that point through a 'points' program; the float64 twin evaluates its mirror.  Inside the valid
 range the GPU passes when it lies within the tolerance band's widths of the oracle (the band of
-`glphong.tolerances`, computed around the twin, moved onto the oracle's value) and is neither NaN
+`glphong.checks.tolerances`, computed around the twin, moved onto the oracle's value) and is neither NaN
 nor Inf; outside it, the documented float32 behaviour (flush to 0, saturation) is what the twin
 mirrors, and the GPU is judged in the band around the twin.
 
@@ -318,7 +318,7 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
     formulation : {'stable', 'naive'}
         The shader formulation to evaluate ('naive': the textbook ``pow(dot(v, r), q)`` one).
     cases : sequence of Case
-    context : glphong.contexts.GLContext, optional
+    context : glphong.gpu.contexts.GLContext, optional
         Use this context instead of creating one.
 
     Returns

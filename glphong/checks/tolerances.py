@@ -50,7 +50,7 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
 
     Parameters
     ----------
-    key : glphong.key.ProgramKey
+    key : glphong.shaders.key.ProgramKey
     u : dict of str to ndarray
         The program's uniforms as float64.
     position : (N, 3) float64 ndarray
@@ -99,7 +99,7 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
 
     Parameters
     ----------
-    key : glphong.key.ProgramKey
+    key : glphong.shaders.key.ProgramKey
     u : dict of str to ndarray
         Uniforms as float64 (the terms' parameters are read from them).
     f : ShadingFrame

@@ -135,7 +135,7 @@ def verify(scene, renderer, band=BAND):
     ----------
     scene : glphong.Scene
     renderer : glphong.Renderer
-    band : glphong.tolerances.BandConstants
+    band : glphong.checks.tolerances.BandConstants
 
     Returns
     -------
@@ -153,7 +153,7 @@ def verify(scene, renderer, band=BAND):
         raise TypeError(f"renderer must be a glphong.Renderer (got {type(renderer).__name__})")
     if renderer.shading != "pixel" or renderer.samples != 1 or renderer.supersample != 1:
         raise ValueError("verify needs a Renderer with shading='pixel', samples=1 and supersample=1 "
-                         f"(got {renderer!r}); compare other options with glphong.raycast instead")
+                         f"(got {renderer!r}); compare other options with glphong.checks.raycast instead")
     with renderer._lock:  # one call: no resize from another thread between the two passes
         frame = renderer.render(scene)
         gbuffer = renderer.gbuffer(scene)

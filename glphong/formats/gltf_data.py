@@ -1,13 +1,13 @@
 """The binary data of a glTF 2.0 file, read exactly and safely: accessors, mesh primitives and images.
 
 `GltfFile` reads a ``.gltf`` or ``.glb`` file (a regular file within `glphong.filesafety.Limits`), parses
-its JSON, validates the whole document before any data is touched (`glphong.gltf_validate`), and refuses
+its JSON, validates the whole document before any data is touched (`glphong.formats.gltf_validate`), and refuses
 the required extensions it cannot honour.  Buffers and images named by ``uri`` are read only from inside
 the file's folder (`glphong.filesafety.resolve_reference`; ``allow_outside=True`` lifts that), ``data:``
 URIs are decoded from base64, and every byte range is checked before it is read.
 
 `read_gltf_primitives` returns every primitive of every node reachable from the file's scene as a
-`glphong.geometry.MeshData` with the file's own arrays: ``POSITION``, ``NORMAL`` (smooth normals where
+`glphong.scene.geometry.MeshData` with the file's own arrays: ``POSITION``, ``NORMAL`` (smooth normals where
 absent), ``TEXCOORD_0`` (v flipped once, in float64, from glTF's top-left origin to glphong's
 bottom-left), ``TANGENT``, ``COLOR_0`` (linear; normalised integers scaled to [0, 1]) and the indices.
 Nothing is merged or reordered, so a file written by `glphong.save_gltf` reads back the very arrays it
@@ -131,7 +131,7 @@ class GltfFile:
     Raises
     ------
     SceneFileError
-        Anything wrong with the file (`glphong.gltf_validate`), or a required extension glphong cannot
+        Anything wrong with the file (`glphong.formats.gltf_validate`), or a required extension glphong cannot
         honour (named).
     """
 
@@ -281,7 +281,7 @@ def node_matrices(document):
     """World matrices of every node reachable from the default scene, by node index.
 
     The hierarchy is walked iteratively (a legal chain thousands of nodes deep loads); the document is
-    validated (`glphong.gltf_validate`), so it is a forest and each node is reached once.  Without a
+    validated (`glphong.formats.gltf_validate`), so it is a forest and each node is reached once.  Without a
     ``scenes`` array, every node without a parent is a root.
     """
     nodes = document.get("nodes", [])

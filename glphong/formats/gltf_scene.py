@@ -24,7 +24,7 @@ __all__ = ["read_gltf_json", "gltf_view", "gltf_material", "material_from_extras
 
 def read_gltf_json(path, limits=None):
     """The validated JSON document of a ``.gltf`` file, or of a ``.glb`` file's first chunk (dict;
-    `glphong.gltf_data.GltfFile`).
+    `glphong.formats.gltf_data.GltfFile`).
 
     Raises
     ------
@@ -36,7 +36,7 @@ def read_gltf_json(path, limits=None):
 
 
 def _glphong_extras(document):
-    """What glphong stored in the asset's ``extras`` (`glphong.gltf_export`), or {}."""
+    """What glphong stored in the asset's ``extras`` (`glphong.formats.gltf_export`), or {}."""
     extras = document.get("asset", {}).get("extras", {})
     stored = extras.get("glphong") if isinstance(extras, dict) else None
     return stored if isinstance(stored, dict) else {}
@@ -50,7 +50,7 @@ def material_from_extras(entry, gltf, where=""):
     ----------
     entry : dict
         The JSON ``materials`` entry.
-    gltf : glphong.gltf_data.GltfFile
+    gltf : glphong.formats.gltf_data.GltfFile
     where : str
         The entry's JSON path (for errors).
 
@@ -126,7 +126,7 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
         if kind == "spot":
             raise ValueError(f"{source}: light {light.get('name', reference['light'])!r} is a spot light: glphong has "
                              "point and directional lights only")
-        if light_units is None:  # a file may declare them (glphong.gltf_export writes radiometric lights)
+        if light_units is None:  # a file may declare them (glphong.formats.gltf_export writes radiometric lights)
             light_units = _glphong_extras(document).get("light_units")
         if light_units not in ("photometric", "radiometric"):
             raise ValueError(f"{source} has KHR_lights_punctual lights: say what their intensities are with "
@@ -199,7 +199,7 @@ def _gltf_object_material(gltf, entries, materials, made, name, mesh, index):
 
 
 def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name, allow_outside, limits):
-    """A glTF file's scene: its own arrays (`glphong.gltf_data`), nodes in file order, materials from the
+    """A glTF file's scene: its own arrays (`glphong.formats.gltf_data`), nodes in file order, materials from the
     user's ``materials``, else the stored glphong material (``extras``), else `gltf_material`."""
 
     gltf = GltfFile(path, limits, allow_outside)

@@ -11,7 +11,7 @@ naming the node.  Each error is a `glphong.filesafety.SceneFileError` naming the
 (``accessors[3].byteStride``), what was found and what was expected.
 
 glTF 1.0 documents are refused as such; the ``extensionsRequired`` list is returned to the reader, which
-refuses the required extensions it cannot honour (`glphong.gltf_data`).
+refuses the required extensions it cannot honour (`glphong.formats.gltf_data`).
 """
 import math
 import numbers

@@ -78,7 +78,7 @@ _EGL_TERMINATED = (
     "taking the contexts of every other library in the process with it; glphong's drew nothing from "
     "then on (moderngl says 'cannot create texture' or returns garbage). Make a new glphong.Renderer "
     "(a fresh context re-initialises the display), keep pyrender's renderer alive while glphong's are "
-    "in use, or release it with glphong.comparisons.PyrenderRenderer.release, which does not terminate it")
+    "in use, or release it with glphong.analysis.comparisons.PyrenderRenderer.release, which does not terminate it")
 
 
 @functools.lru_cache(maxsize=1)

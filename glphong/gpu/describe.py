@@ -17,7 +17,7 @@ class ProgramDescription:
 
     Attributes
     ----------
-    key : glphong.key.ProgramKey
+    key : glphong.shaders.key.ProgramKey
     objects : tuple of str
         Names of the objects drawn with it.
     vertex_chunks, fragment_chunks : tuple of str
@@ -29,7 +29,7 @@ class ProgramDescription:
     vertex_source, fragment_source : str
         The generated sources, as compiled.
     culling : tuple of str
-        Per drawn object, whether its back faces are culled and why (`glphong.culling`).
+        Per drawn object, whether its back faces are culled and why (`glphong.scene.culling`).
     """
 
     key: object

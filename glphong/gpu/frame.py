@@ -94,7 +94,7 @@ class GBuffer:
         The interpolated linear vertex colour, where a parameter takes vertex colours; else None.
     lod : (H, W, 4) float32 ndarray or None
         Per pixel, the level of detail the GPU used for each texture of the object's material, in the
-        order of `glphong.key.ProgramKey.textured_inputs` (0 beyond), where a parameter is textured.
+        order of `glphong.shaders.key.ProgramKey.textured_inputs` (0 beyond), where a parameter is textured.
     """
 
     position: np.ndarray

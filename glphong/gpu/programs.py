@@ -33,8 +33,8 @@ class Program:
     Parameters
     ----------
     mgl : moderngl.Context
-    key : glphong.key.ProgramKey
-    textures : glphong.textures.TextureStore, optional
+    key : glphong.shaders.key.ProgramKey
+    textures : glphong.gpu.textures.TextureStore, optional
         Where the textures of `TableData` uniform values are uploaded (the cache's store).
     """
 
@@ -172,7 +172,7 @@ class ProgramCache:
 
     Attributes
     ----------
-    textures : glphong.textures.TextureStore
+    textures : glphong.gpu.textures.TextureStore
         The tables the programs' samplers have read, uploaded once each.
     hits, misses : int
         Cache statistics since creation.

@@ -73,14 +73,14 @@ class Renderer:
     Threads: a renderer may be used from any thread; its calls are serialised by a lock (two threads
     rendering at once take turns), and its context is current only inside a call.  Processes: a
     renderer cannot cross ``fork``; in a child forked after any context was made, it raises
-    `glphong.contexts.ForkedProcessError` (use the 'spawn' or 'forkserver' start methods).
+    `glphong.gpu.contexts.ForkedProcessError` (use the 'spawn' or 'forkserver' start methods).
 
     Parameters
     ----------
     width, height : int
         Image size in pixels, 1 to 16384.
     backend : {'auto', 'egl', 'osmesa'}
-        OpenGL backend (see `glphong.contexts.create_context`).
+        OpenGL backend (see `glphong.gpu.contexts.create_context`).
     shading : {'pixel', 'vertex'}
         'pixel' (default): the model is evaluated per fragment.  'vertex': per vertex and
         interpolated (Gouraud): cheaper, and wrong inside triangles where the radiance is not
@@ -96,12 +96,12 @@ class Renderer:
         for measuring what stability costs and buys; not for real use.
     culling : {'auto', 'off'}
         'auto' (default): cull the back faces of an object where they cannot be seen (a closed,
-        outward-wound mesh wholly between the near and far planes; `glphong.culling`), which
+        outward-wound mesh wholly between the near and far planes; `glphong.scene.culling`), which
         changes no pixel but a silhouette pixel where a back triangle ties with the front one in
         depth (there the front face shows).  'off': draw every triangle.
     device : int, optional
         The EGL device (GPU) to render on, an index of ``eglQueryDevicesEXT``'s list (default 0; EGL
-        only; `glphong.contexts.egl_device_count` says how many there are).  A batch passes it through
+        only; `glphong.gpu.contexts.egl_device_count` says how many there are).  A batch passes it through
         (``render_many(..., device=1)``).
     specialise : bool
         True (default): one program per distinct `ProgramKey`, containing only what the

@@ -1,6 +1,6 @@
 """The textures of one GL context: each `TableData` a drawn program reads, uploaded once.
 
-A `TextureStore` belongs to a `glphong.programs.ProgramCache` (one per context) and is released with
+A `TextureStore` belongs to a `glphong.gpu.programs.ProgramCache` (one per context) and is released with
 it.  A table is uploaded the first time a program that samples it is bound (`Program.bind`), never
 before: a scene whose drawn objects read no table uploads nothing.  Entries are keyed by the table's
 content hash and hold it weakly: a table no material holds any more is released at the next upload.

@@ -32,7 +32,7 @@ __all__ = ["BlinnLobe", "BlinnPhong", "blinn_delta", "blinn_lobe", "half_cosine"
 def blinn_lobe_band(f, wi, wo, p, constants):
     """Band of the Blinn lobe ``max(n.h, 0)^q`` and of its Fresnel factor ``F(h.l)``.
 
-    The lobe band of the Blinn delta (`glphong.tolerances.lobe_band`), its chord widening scaled by the
+    The lobe band of the Blinn delta (`glphong.checks.tolerances.lobe_band`), its chord widening scaled by the
     half vector's conditioning ``max(1, 2/|l + v|)``; near the gates (``|n.v| <= D eps``, ``|l + v|``
     within a factor 4 of its floor) either outcome is accepted; the Fresnel band at ``h.l`` known to
     ``4 D eps max(1, 2/|l + v|)``.

@@ -373,7 +373,7 @@ class LafortuneLobes(MaterialModel):
     def band(self, f, wi, wo, n_dot_l, p, constants):
         """The sum of the lobes' bands times ``n.l +- D eps``, widened by ``(k + 1) eps`` (k lobes).
 
-        Each lobe: the direction part ``(w.v)^n`` is `glphong.tolerances.lobe_band` of ``delta`` with the
+        Each lobe: the direction part ``(w.v)^n`` is `glphong.checks.tolerances.lobe_band` of ``delta`` with the
         chord widening ``C eps`` scaled by the conditioning ``1/sqrt(1 - u)`` of the peak direction ``w``;
         the magnitude ``m^n (1 - u)^(n/2)`` takes ``u`` moved by ``eps (2 D sqrt(u (1 - u)) + A u)`` (an
         angle error ``D eps`` of ``l``, and the rounding of ``u``) and a relative ``B eps n (|ln m| +
@@ -487,7 +487,7 @@ def _peak_eye(c, light):
 
 
 def lafortune_cases(label):
-    """The stability cases of the Lafortune lobes (list of `glphong.stability.Case`); normal +z, tangent +x."""
+    """The stability cases of the Lafortune lobes (list of `glphong.checks.stability.Case`); normal +z, tangent +x."""
 
     e_one = 4 * np.pi  # a point light at 1 m: E = 1 W/m^2
     light = _unit(30.0)

@@ -149,6 +149,17 @@ def _read_table(source):
     return table, int(unmeasured.any(axis=-1).sum())
 
 
+#: the function `MeasuredBRDF.from_model` tabulates a material with (`glphong.analysis.tabulate.tabulate`,
+#: which evaluates the material's twin through layers above the materials, registers itself here when
+#: imported, and ``import glphong`` imports it): the materials never import upward
+_TABULATOR = []
+
+
+def register_tabulator(function):
+    """Make ``function(material) -> (90, 90, 180, 3) table`` the tabulator of `MeasuredBRDF.from_model`."""
+    _TABULATOR[:] = [function]
+
+
 class MeasuredBRDF(MaterialModel):
     """A measured isotropic BRDF in the MERL layout (see the module docstring).
 
@@ -202,9 +213,12 @@ class MeasuredBRDF(MaterialModel):
         -------
         MeasuredBRDF
             Bins whose representative pair has the light or the view below the horizon are unmeasured
-            (`glphong.merl.tabulate`).
+            (`glphong.merl.tabulate`, registered by `glphong.analysis.tabulate`).
         """
-        table = merl.tabulate(material)
+        if not _TABULATOR:
+            raise RuntimeError("MeasuredBRDF.from_model needs glphong.analysis.tabulate, which import glphong "
+                               "loads: import glphong first")
+        table = _TABULATOR[0](material)
         if path is None:
             return cls(table, lookup)
         merl.write_merl(path, table)

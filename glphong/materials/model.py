@@ -23,7 +23,7 @@ import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.materials.definition_checks import check_definition
-from glphong.materials.params import (MATERIAL_KEYWORDS, Choice, GlslFile, MaterialDefinitionError, Param, ParamValues,
+from glphong.materials.params import (MATERIAL_KEYWORDS, NEEDS, Choice, GlslFile, MaterialDefinitionError, Param, ParamValues,
                                       Properties, ShadingFrame)
 from glphong.materials.registry import _REGISTRY, _is_builtin, model_named, model_source, register, registered_models
 from glphong.materials.table import Table, TableData
@@ -79,7 +79,7 @@ class Material:
 
         Parameters
         ----------
-        key : glphong.key.ProgramKey
+        key : glphong.shaders.key.ProgramKey
 
         Returns
         -------
@@ -525,7 +525,7 @@ class MaterialModel(Material):
 
     @classmethod
     def stability_cases(cls):
-        """The model's extreme cases for `glphong.stability` (default: generic geometry, see there)."""
+        """The model's extreme cases for `glphong.checks.stability` (default: generic geometry, see there)."""
 
         return generic_cases(cls.name, cls.example())
 

@@ -179,7 +179,7 @@ class NormalizedPhongLobe(MaterialModel):
         return p.rho_s * fresnel_factor(p, n_dot_l) * s[..., None]
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
-        """The lobe band of the Phong delta (`glphong.tolerances.lobe_band`, docs/design.md section 4) times the
+        """The lobe band of the Phong delta (`glphong.checks.tolerances.lobe_band`, docs/design.md section 4) times the
         normalisation (widened by a few eps), ``n.l +- D eps`` and the Fresnel band at ``n.l +- D eps``;
         0 where the lower end is below FLT_MIN.
 
@@ -320,7 +320,7 @@ class NormalizedBlinnPhong(MaterialSum):
 
 
 def _fresnel_cases(label, material_class, q=1e3):
-    """The lobe's peak with a Fresnel factor at grazing incidence (list of `glphong.stability.Case`).
+    """The lobe's peak with a Fresnel factor at grazing incidence (list of `glphong.checks.stability.Case`).
 
     The light at ``n.l = 1e-2`` and ``1e-4`` (a point light at 1 m delivering 1 W/m^2), the eye at its
     mirror direction (the peak of both lobes: ``v = r``, ``h = n``), ``SchlickFresnel(0.04)`` and

@@ -70,7 +70,7 @@ class PhongLobe(MaterialModel):
         return p.ks * fresnel_factor(p, n_dot_l) * phong_lobe(f.n, wi, wo, p.q)[..., None]
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
-        """``k_s`` times `glphong.tolerances.lobe_band` of the Phong delta (docs/design.md section 4), times the
+        """``k_s`` times `glphong.checks.tolerances.lobe_band` of the Phong delta (docs/design.md section 4), times the
         Fresnel band at ``n.l +- D eps``."""
 
         low, high = lobe_band(phong_delta(f.n, wi, wo), p.q, 1.0, constants)

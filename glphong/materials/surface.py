@@ -7,7 +7,7 @@ a `SurfaceInput`, whose value at a fragment is
 
     T(uv)  the texture's linear rgb filtered at the fragment's uv (GLSL ``texture()``: trilinear over
            glphong's own mip pyramid, or bilinear), 1 without a texture;
-    C      the mesh's interpolated linear vertex colour (`glphong.geometry.MeshData` ``colors``), 1
+    C      the mesh's interpolated linear vertex colour (`glphong.scene.geometry.MeshData` ``colors``), 1
            unless ``vertex_colors=True``.
 
 `Texture` and `VertexColors` make the two common cases.  Images are decoded on the CPU: 8- and

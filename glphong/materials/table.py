@@ -3,7 +3,7 @@
 A model declares a table the way it declares a parameter (docs/design.md section 8): ``tables = (Table(...),)``.
 glphong then declares the sampler ``uniform sampler<N>D u_<model>_<name>;`` (generated, like a
 parameter's uniform), validates the value a constructor is given (shape, channels, finite), and
-uploads it as a texture the first time a drawn object's program reads it (`glphong.textures`), once
+uploads it as a texture the first time a drawn object's program reads it (`glphong.gpu.textures`), once
 per content per context.  The twin receives the same `TableData` in its ``p`` (``p.<name>.array``,
 the float32 values the texture holds), so both sides look up identical numbers.
 

@@ -212,7 +212,7 @@ class WardLobe(MaterialModel):
         """Interval arithmetic on the stable formulation (the generic band's first-order deviations
         miss the gates and the 1/n.v growth at grazing view).
 
-        With ``eps = 2^-24`` and the constants (A, B, C, D) of `glphong.tolerances`:
+        With ``eps = 2^-24`` and the constants (A, B, C, D) of `glphong.checks.tolerances`:
 
         - the half vector's direction is uncertain by ``delta = C eps max(1, 2/|l + v|) + D eps``
           (the sum l + v carries the inputs' rounding, amplified by ``1/|l + v|``, as for Blinn; D eps

@@ -30,7 +30,7 @@ _CLOSURE = weakref.WeakKeyDictionary()
 
 
 def closed_outward(mesh):
-    """``(bool, reason)``: whether ``mesh`` (a `glphong.geometry.MeshData`) is a closed, consistently and
+    """``(bool, reason)``: whether ``mesh`` (a `glphong.scene.geometry.MeshData`) is a closed, consistently and
     outward wound surface (see the module); cached per mesh.  1M triangles take about a second."""
     cached = _CLOSURE.get(mesh)
     if cached is None:
@@ -98,7 +98,7 @@ def view_allows_culling(centre, radius, eye, forward, znear, zfar):
 
 def culling_decision(obj, camera):
     """``(culled, reason)``: whether a renderer with ``culling='auto'`` culls the back faces of scene object
-    ``obj`` seen by ``camera``, and why (for `glphong.describe`)."""
+    ``obj`` seen by ``camera``, and why (for `glphong.gpu.describe`)."""
     closed, why = closed_outward(obj.mesh)
     if not closed:
         return False, f"drawn: the mesh is not closed and outward wound ({why})"

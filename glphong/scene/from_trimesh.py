@@ -109,7 +109,7 @@ def build_from_trimesh(scene_class, trimesh_scene, camera=None, lights=None, amb
         By geometry name or material name; a callable gets ``(name, geometry)`` and returns a Material
         (or None for the default).
     vertex_colors : {'srgb', 'linear'}
-        The encoding of the meshes' vertex colours (`glphong.geometry.MeshData.from_trimesh`).
+        The encoding of the meshes' vertex colours (`glphong.scene.geometry.MeshData.from_trimesh`).
     """
     import trimesh
 

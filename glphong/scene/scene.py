@@ -136,7 +136,7 @@ class Scene:
             import trimesh
 
             if not isinstance(mesh, trimesh.Trimesh):
-                raise TypeError(f"mesh must be a trimesh.Trimesh or a glphong.geometry.MeshData (got {type(mesh).__name__})")
+                raise TypeError(f"mesh must be a trimesh.Trimesh or a glphong.scene.geometry.MeshData (got {type(mesh).__name__})")
         pose = np.array(_validate.affine_transform("pose", np.eye(4) if pose is None else pose), dtype=np.float64)
         pose.setflags(write=False)
         data = mesh if isinstance(mesh, MeshData) else MeshData.from_trimesh(mesh, smooth=bool(smooth))
@@ -212,7 +212,7 @@ class Scene:
         ----------
         index : int
             Object index in `objects`.
-        key : glphong.key.ProgramKey
+        key : glphong.shaders.key.ProgramKey
         aspect : float
             Image width / height.
 

@@ -2,7 +2,7 @@
 
 A fixed scene family (two spheres on a plane, Phong and Blinn, q from 10 to 1e5, 1 or 8 point
 lights) is rendered by every method at each setting of its accuracy knob.  Each image is
-compared with a converged float64 ray cast of the exact geometry (`glphong.raycast`): relative
+compared with a converged float64 ray cast of the exact geometry (`glphong.checks.raycast`): relative
 RMS, p99 and max error over pixels both cover, silhouette pixels counted apart.  Each method's
 frame time is the median of repeated runs after a warm-up, all in one process.  Outputs: a CSV
 and a JSON of every point, a work-precision diagram (log error against log time, one curve per
@@ -87,7 +87,7 @@ class BenchCase:
         return scene
 
     def analytic_objects(self):
-        """The exact geometry for `glphong.raycast.render_reference`."""
+        """The exact geometry for `glphong.checks.raycast.render_reference`."""
 
         material = self.material()
         objects = [AnalyticObject(Sphere(center, radius), material) for center, radius in SPHERES]

@@ -225,7 +225,7 @@ def _bench(args):
 
 def _material(command, text):
     """The material an expression such as ``"Phong(kd=0.2, ks=0.5, q=20)"`` describes, or None with the reason
-    printed as one line to stderr (`glphong.expressions.parse_material`: parsed, never evaluated)."""
+    printed as one line to stderr (`glphong.tools.expressions.parse_material`: parsed, never evaluated)."""
 
     try:
         return parse_material(text)
@@ -417,7 +417,7 @@ def build_parser():
     bench.add_argument("--quick", action="store_true", help="a tiny configuration (2 scenes, 2 knob values; with "
                        "--speed: small sizes and stand-in meshes)")
     bench.add_argument("--speed", action="store_true", help="frame times on the scene family against the naive "
-                       "floor and pyrender (glphong.speed), instead of the work-precision report")
+                       "floor and pyrender (glphong.tools.speed), instead of the work-precision report")
     bench.add_argument("--out", default="glphong_bench", type=_writable,
                        help="output prefix: PREFIX.csv, PREFIX.json, PREFIX.png")
     bench.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -467,7 +467,7 @@ def _run_command(args):
 
     A `ValueError` (glphong's convention for bad input: a scene file's content, an expression, a
     parameter), an `OSError` (a missing or unreadable file), a `glphong.batch.BatchError` (a worker's
-    failure, reported by the parent) and a `glphong.contexts.BackendUnavailableError` are printed as
+    failure, reported by the parent) and a `glphong.gpu.contexts.BackendUnavailableError` are printed as
     ``glphong <command>: <message>``; Ctrl-C exits with 130.  Anything else is a bug and propagates
     with its traceback.
 

@@ -14,7 +14,7 @@ and size, in one process and in interleaved rounds (each round renders once with
 warm-up, the median frame time and its spread (the 25th to 75th percentile, relative) of:
 
 - ``glphong float``: `Renderer.render`, one sample, linear float32 radiance with coverage;
-- ``naive floor``: `glphong.comparisons.HandWrittenRenderer` with the textbook shader (``pow(dot(v, r),
+- ``naive floor``: `glphong.analysis.comparisons.HandWrittenRenderer` with the textbook shader (``pow(dot(v, r),
   q)``, ``normalize``): the same meshes and a float target, uniforms packed once, no culling;
 - ``glphong 4x 8-bit``: `Renderer.render_srgb8` with 4x MSAA (the display resolve);
 - ``pyrender`` and ``pyrender 2-sided``: pyrender's ``OffscreenRenderer`` at its defaults (4x MSAA on

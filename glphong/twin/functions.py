@@ -38,7 +38,7 @@ class ShadingFrame:
         The twin's per-fragment values of surface inputs by uniform name (``u_<model>_<param>``: in GLSL
         the globals `material_inputs` sets); None where no parameter varies.
     input_bounds : dict of str to ((N, 3), (N, 3)) or None
-        Their intervals for the tolerance band (`glphong.tolerances.input_bounds`).
+        Their intervals for the tolerance band (`glphong.checks.tolerances.input_bounds`).
     """
 
     n: np.ndarray
