@@ -34,7 +34,7 @@ class TableData:
 
     Attributes
     ----------
-    array : (*shape, channels) float32 ndarray
+    array : ``(*shape, channels)`` float32 ndarray
         Read-only.
     digest : str
         First 16 hex digits of the SHA-256 of the shape and bytes.
