@@ -517,3 +517,23 @@ def test_command_line_one_line_errors_and_warnings(tmp_path, run_isolated):
                                                    "default point light and ambient light (give lights=[] to keep the "
                                                    "scene dark)"]
     assert (tmp_path / "a.png").exists()
+
+
+def test_instancing_and_aliasing_cannot_multiply_memory(tmp_path):
+    """Nodes instancing one mesh share one MeshData; accessors aliasing one buffer view are each counted against
+    ``Limits.decoded_bytes`` before they are made."""
+    document, blob = _document(camera=False, lights=False)
+    document["nodes"] = [{"mesh": 0} for _ in range(300)]
+    document["scenes"] = [{"nodes": list(range(300))}]
+    scene = _load(_write(tmp_path, document, blob), lights=[])
+    assert len(scene.objects) == 300 and len({id(o.mesh) for o in scene.objects}) == 1
+    aliased, _ = _document(camera=False, lights=False)
+    aliased["accessors"] += [dict(aliased["accessors"][0]) for _ in range(2000)]
+    aliased["meshes"] = [{"primitives": [{"attributes": {"POSITION": 3 + k, "NORMAL": 1}, "indices": 2}]}
+                         for k in range(2000)]
+    aliased["nodes"] = [{"mesh": k} for k in range(2000)]
+    aliased["scenes"] = [{"nodes": list(range(2000))}]
+    path = _write(tmp_path, aliased, blob, "aliased.gltf")
+    with pytest.raises(SceneFileError, match=r"accessors\[\d+\]: decoding it would take more than 100000 bytes"):
+        _load(path, lights=[], limits=Limits(decoded_bytes=100_000))
+    assert len(_load(path, lights=[]).objects) == 2000  # within the default budget: every alias loads

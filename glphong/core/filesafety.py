@@ -65,14 +65,19 @@ class Limits:
         about 0.5 GB while its mip pyramid is built in float64).
     nodes : int
         Most glTF nodes, meshes, accessors (each); default 1,000,000.
+    decoded_bytes : int
+        Most bytes of arrays and pixels decoded from one scene file, counted at their widest (float64) before
+        they are made [bytes]; default 4 GiB.  Bounds what instancing and aliasing could multiply: many
+        accessors over one buffer view, many meshes over one accessor.
     """
 
     file_bytes: int = 1 << 30
     image_pixels: int = 4096 * 4096
     nodes: int = 1_000_000
+    decoded_bytes: int = 4 << 30
 
     def __post_init__(self):
-        for name in ("file_bytes", "image_pixels", "nodes"):
+        for name in ("file_bytes", "image_pixels", "nodes", "decoded_bytes"):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < 1:
                 raise ValueError(f"Limits.{name} must be an integer >= 1 (got {value!r})")

@@ -144,8 +144,9 @@ class GltfFile:
         self.document = _parse_json(self.path, data)
         validate_gltf(self.path, self.document, self.limits)
         self._check_required()
-        self._buffers = {}
+        self._buffers, self._accessors, self._images, self._meshes = {}, {}, {}, {}
         self._warned = set()
+        self._decoded = 0
 
     def _check_required(self):
         for name in self.document.get("extensionsRequired", []):
@@ -164,6 +165,13 @@ class GltfFile:
         if topic not in self._warned:
             self._warned.add(topic)
             warnings.warn(f"{self.path}: {message}", stacklevel=4)
+
+    def charge(self, nbytes, where):
+        """Count ``nbytes`` of decoded data against ``Limits.decoded_bytes`` before it is made."""
+        self._decoded += int(nbytes)
+        if self._decoded > self.limits.decoded_bytes:
+            raise SceneFileError(self.path, f"decoding it would take more than {self.limits.decoded_bytes} bytes "
+                                 "(glphong.filesafety.Limits.decoded_bytes)", where)
 
     def buffer(self, index):
         """Buffer ``index``'s bytes (at least its ``byteLength``), read once."""
@@ -215,14 +223,17 @@ def _strided(gltf, data, offset, count, element, stride, where):
 
 
 def read_accessor(gltf, index):
-    """Accessor ``index`` as a (count, width) array of its component type (normalised integers as float64
-    in [0, 1] or [-1, 1]; sparse substitutions applied).
+    """Accessor ``index`` as a (count, width) read-only array of its component type (normalised integers as
+    float64 in [0, 1] or [-1, 1]; sparse substitutions applied), decoded once per file and counted against
+    ``Limits.decoded_bytes``.
 
     Raises
     ------
     SceneFileError
         A matrix accessor with padded columns (glphong reads none).
     """
+    if index in gltf._accessors:
+        return gltf._accessors[index]
     accessor = gltf.document["accessors"][index]
     where = f"accessors[{index}]"
     component, kind, count = accessor["componentType"], accessor["type"], accessor["count"]
@@ -230,6 +241,7 @@ def read_accessor(gltf, index):
     width = TYPE_WIDTHS[kind]
     if kind in ("MAT2", "MAT3") and COMPONENT_BYTES[component] < 4:
         raise SceneFileError(gltf.path, "a padded-column matrix accessor, which glphong does not read", where)
+    gltf.charge(count * width * 8, where)  # at its widest: float64 (normalised, or as the mesh converts it)
     row = dtype.itemsize * width
     if "bufferView" in accessor:
         data, stride = gltf.view(accessor["bufferView"])
@@ -241,6 +253,8 @@ def read_accessor(gltf, index):
         values = _apply_sparse(gltf, accessor["sparse"], values, dtype, width, f"{where}.sparse")
     if accessor.get("normalized") and dtype.kind in "ui":
         values = np.maximum(values / float(np.iinfo(dtype).max), -1.0)
+    values.flags.writeable = False  # shared by every primitive that names the accessor
+    gltf._accessors[index] = values
     return values
 
 
@@ -335,6 +349,7 @@ def _draco_primitive(gltf, extension, where):
         mesh = DracoPy.decode(bytes(data))
     except Exception as exc:  # noqa: BLE001 - the decoder's own exception types vary by version
         raise SceneFileError(gltf.path, f"Draco data that cannot be decoded ({type(exc).__name__})", where) from None
+    gltf.charge(8 * (np.asarray(mesh.faces).size + sum(np.asarray(a["data"]).size for a in mesh.attributes)), where)
     out = {"indices": np.asarray(mesh.faces, dtype=np.int64).reshape(-1)}
     for name, unique_id in extension.get("attributes", {}).items():
         attribute = mesh.get_attribute_by_unique_id(unique_id) if isinstance(unique_id, int) else None
@@ -378,8 +393,15 @@ def _primitive_arrays(gltf, primitive, where):
     return positions, indices, {k: _attribute(gltf, primitive, k, where) for k in _ATTRIBUTE_TYPES if k != "POSITION"}
 
 
-def _primitive_mesh(gltf, primitive, where):
-    """The `MeshData` of one primitive, or None (no triangles)."""
+def _primitive_mesh(gltf, primitive, where, key):
+    """The `MeshData` of one primitive, or None (no triangles); made once per file and ``key`` (mesh index,
+    primitive index), so every node that instances a mesh shares its arrays (and the renderer its buffers)."""
+    if key not in gltf._meshes:
+        gltf._meshes[key] = _new_primitive_mesh(gltf, primitive, where)
+    return gltf._meshes[key]
+
+
+def _new_primitive_mesh(gltf, primitive, where):
 
     mode = primitive.get("mode", _TRIANGLES)
     if mode not in (_TRIANGLES, _STRIP, _FAN):
@@ -411,7 +433,7 @@ def _primitive_mesh(gltf, primitive, where):
         normals = trimesh.Trimesh(positions, triangles, process=False).vertex_normals
     uvs = attributes["TEXCOORD_0"]
     if uvs is not None:
-        uvs = uvs.astype(np.float64)
+        uvs = uvs.astype(np.float64)  # a copy: the accessor's array is shared
         uvs[:, 1] = 1.0 - uvs[:, 1]  # glTF's origin is the image's top-left corner
     colors = attributes["COLOR_0"]
     return MeshData(positions, normals, triangles, uvs=uvs, tangents=attributes["TANGENT"],
@@ -443,7 +465,7 @@ def read_gltf_primitives(gltf):
         for k, primitive in enumerate(primitives):
             name = node.get("name") if isinstance(node.get("name"), str) and node.get("name") else f"node{index}"
             name = name if len(primitives) == 1 else f"{name}.{k}"
-            mesh = _primitive_mesh(gltf, primitive, f"meshes[{node['mesh']}].primitives[{k}]")
+            mesh = _primitive_mesh(gltf, primitive, f"meshes[{node['mesh']}].primitives[{k}]", (node["mesh"], k))
             if mesh is not None:
                 out.append((name, mesh, worlds[index], primitive.get("material")))
     return out
@@ -457,15 +479,23 @@ def read_gltf_image(gltf, index):
     image glphong decodes (a KTX2 or WebP source only; warned once).
 
     The image comes from a buffer view, a base64 data URI, or a file inside the document's folder; it is
-    decoded as PNG or JPEG only, after its size was checked against ``Limits.image_pixels``.
+    decoded as PNG or JPEG only, after its size was checked against ``Limits.image_pixels``, once per file.
     """
     texture = gltf.document["textures"][index]
     if "source" not in texture:
         gltf.warn_once("texture source", f"texture {index} has no PNG or JPEG source (only an extension's); drawn "
                        "without it")
         return None
-    where = f"images[{texture['source']}]"
-    image = gltf.document["images"][texture["source"]]
+    if texture["source"] not in gltf._images:
+        gltf._images[texture["source"]] = _decode_gltf_image(gltf, texture["source"])
+    return gltf._images[texture["source"]]
+
+
+def _decode_gltf_image(gltf, source):
+    """The pixels of image ``source`` (see `read_gltf_image`), counted against ``Limits.decoded_bytes`` at the
+    size of the float64 mip pyramid a texture builds from them (4/3 of the base level)."""
+    where = f"images[{source}]"
+    image = gltf.document["images"][source]
     if "bufferView" in image:
         mime = image.get("mimeType")
         if mime not in _IMAGE_TYPES:
@@ -477,7 +507,10 @@ def read_gltf_image(gltf, index):
     else:
         target = resolve_reference(gltf.path, image["uri"], f"{where}.uri", gltf.allow_outside)
         payload = read_bytes(target, gltf.limits, gltf.path, f"{where}.uri")
-    return decode_image(payload, gltf.limits, gltf.path, where, mode="RGB")
+    pixels = decode_image(payload, gltf.limits, gltf.path, where, mode="RGB")
+    gltf.charge(pixels.size * 8 * 4 // 3, where)
+    pixels.flags.writeable = False  # shared by every texture that names the image
+    return pixels
 
 
 def texture_sampling(document, index):
