@@ -129,3 +129,20 @@ def test_every_package_is_installed():
     listed = (ROOT / "setup.cfg").read_text(encoding="utf-8").split("packages =", 1)[1].split("package_dir", 1)[0].split()
     folders = sorted(_module_name(p.parent / "__init__.py") for p in PACKAGE.rglob("__init__.py"))
     assert sorted(set(folders) - set(listed)) == []
+
+
+def test_optional_dependencies_are_imported_only_where_used():
+    """Imports at the top of modules must not pull an optional extra into ``import glphong`` or the command
+    line: with pyrender, matplotlib, tqdm, Dask, DracoPy, pytest and the docs tools unimportable, they import."""
+    code = ("import sys\n"
+            "class Block:\n"
+            "    def find_spec(self, name, path=None, target=None):\n"
+            "        if name.split('.')[0] in ('pyrender', 'matplotlib', 'tqdm', 'distributed', 'dask', 'DracoPy',\n"
+            "                                  'importlinter', 'pytest', 'hypothesis', 'sphinx'):\n"
+            "            raise ImportError('blocked ' + name)\n"
+            "sys.meta_path.insert(0, Block())\n"
+            "import glphong, glphong.tools.cli, glphong.batch, glphong.formats, glphong.analysis\n"
+            "print(sorted(m for m in sys.modules if m.split('.')[0] in ('pyrender', 'matplotlib', 'pytest')))\n")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert result.returncode == 0, result.stderr[-2000:]
+    assert result.stdout.strip() == "[]"

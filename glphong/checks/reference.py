@@ -15,6 +15,8 @@ Conventions of the mirror:
 
 `shade` is the image-level entry: it shades a G-buffer, fragment for fragment.
 """
+import sys
+
 import numpy as np
 
 from glphong.materials.surface import surface_texture, surface_texture_band
@@ -36,8 +38,6 @@ __all__ = [
 def __getattr__(name):
     """A model's twin function by name (``reference.lambert``): each lives with its model in
     ``glphong.materials.<module>``; this finds it in the modules of the registered models."""
-    import sys
-
     for model in registered_models():
         module = sys.modules.get(model.__module__)
         if name in getattr(module, "__all__", ()):

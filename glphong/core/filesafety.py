@@ -23,8 +23,11 @@ import re
 import stat
 import warnings
 from dataclasses import dataclass, replace
+from io import BytesIO
 from pathlib import Path, PurePosixPath, PureWindowsPath
 from urllib.parse import unquote
+
+import numpy as np
 
 __all__ = ["SceneFileError", "Limits", "LIMITS", "resolve_reference", "read_bytes", "read_text", "open_image",
            "decode_image"]
@@ -231,9 +234,7 @@ def open_image(payload, limits=None, source=None, where=None, formats=IMAGE_FORM
     SceneFileError
         Not one of ``formats``, or more than ``limits.image_pixels`` pixels.
     """
-    from io import BytesIO
-
-    from PIL import Image, UnidentifiedImageError
+    from PIL import Image, UnidentifiedImageError  # Pillow loads its plugins on first use: only where an image is read
 
     limits = limits or LIMITS
     try:
@@ -262,7 +263,6 @@ def decode_image(payload, limits=None, source=None, where=None, formats=IMAGE_FO
     SceneFileError
         As `open_image`, or pixel data that cannot be decoded.
     """
-    import numpy as np
     from PIL import Image
 
     image = open_image(payload, limits, source, where, formats)

@@ -6,6 +6,8 @@ default scene to ``phong_examples.png`` in the current directory.
 import argparse
 import sys
 import time
+import warnings
+
 from glphong.analysis import plots
 from glphong.analysis.figures import LIGHT_ANGLES, Q_VALUES, phong_examples, phong_examples_scene
 from glphong.analysis.gallery import render_gallery
@@ -481,9 +483,6 @@ def _run_command(args):
     int
         The exit status.
     """
-
-    import warnings
-
     command = getattr(args, "command", None) or "render"
 
     def one_line_warning(message, category, filename, lineno, file=None, line=None):

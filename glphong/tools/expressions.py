@@ -7,6 +7,7 @@ every size, and builds the material from the checked tree.
 """
 import ast
 import math
+
 from glphong import materials
 from glphong.materials import Material
 from glphong.materials.fresnel import Fresnel
