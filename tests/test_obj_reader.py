@@ -385,3 +385,16 @@ def test_random_valid_files_read_bit_for_bit_as_the_per_corner_reference(tmp_pat
         with warnings.catch_warnings():
             warnings.simplefilter("error")
             _assert_same(read_obj(path), _reference_read_obj(path))
+
+
+def test_one_huge_joined_line_is_bounded_by_the_decoded_budget(tmp_path):
+    """A file of nothing but continued lines is one logical line: its scan would take about 18 bytes a byte, so
+    a line longer than ``Limits.decoded_bytes / 32`` is refused, naming the lines it is among."""
+    from glphong.core.filesafety import Limits, SceneFileError
+    from glphong.formats.obj import read_obj
+
+    path = tmp_path / "joined.obj"
+    path.write_bytes(b"v 0 0 0\nv 1 0 0\nv 0 1 0\n" + b"f 1 2 3 \\\n" * 20000 + b"f 1 2 3\n")
+    with pytest.raises(SceneFileError, match=r"lines from 1: a line \(with its '\\' continuations\) of more than "
+                                             r"3125 bytes"):
+        read_obj(path, Limits(decoded_bytes=100_000))

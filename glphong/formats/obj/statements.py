@@ -17,7 +17,7 @@ import re
 
 import numpy as np
 
-from glphong.core.filesafety import SceneFileError, read_bytes
+from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
 
 #: characters of a line quoted in an error
 QUOTE_CHARS = 80
@@ -93,6 +93,12 @@ def _quote(text):
     return repr(text if len(text) <= QUOTE_CHARS else text[:QUOTE_CHARS] + "...")
 
 
+#: bytes of working memory the scan of one chunk takes per byte of it, at most (measured: about 18 for a file of
+#: nothing but continued lines, 17 for one face line of a million corners); a chunk is CHUNK_BYTES of whole
+#: lines, or one longer line, which `Limits.decoded_bytes` bounds through this factor
+WORKING_BYTES_PER_BYTE = 32
+
+
 def _split_statements(path, limits):
     """Read a file and sort the lines of each keyword of `KEYWORDS` out of it, a chunk of lines at a time.
 
@@ -109,7 +115,12 @@ def _split_statements(path, limits):
     text = _utf8_with_line_feeds(read_bytes(path, limits))
     found = {keyword: ([], []) for keyword in KEYWORDS}  # lists of line numbers and of block pieces
     first_line = 1
+    longest = (limits or LIMITS).decoded_bytes // WORKING_BYTES_PER_BYTE
     for begin, end in _chunks(text, CHUNK_BYTES):
+        if end - begin > longest:
+            raise SceneFileError(path, f"a line (with its '\\' continuations) of more than {longest} bytes: reading it "
+                                 f"would take more than Limits.decoded_bytes ({(limits or LIMITS).decoded_bytes} bytes)",
+                                 f"lines from {first_line}")
         codes = np.frombuffer(text, dtype=np.uint8, count=end - begin, offset=begin)
         first_line = _scan_chunk(codes, first_line, found)
     del text
