@@ -537,3 +537,18 @@ def test_instancing_and_aliasing_cannot_multiply_memory(tmp_path):
     with pytest.raises(SceneFileError, match=r"accessors\[\d+\]: decoding it would take more than 100000 bytes"):
         _load(path, lights=[], limits=Limits(decoded_bytes=100_000))
     assert len(_load(path, lights=[]).objects) == 2000  # within the default budget: every alias loads
+
+
+def test_obj_mtllib_is_read_once_and_named_by_its_line(tmp_path, monkeypatch):
+    import glphong.formats.load as load
+
+    (tmp_path / "a.mtl").write_text("newmtl m\nKd 0.5 0.5 0.5\n")
+    quad = "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nusemtl m\nf 1 2 3\n"
+    (tmp_path / "many.obj").write_text("mtllib a.mtl\n" * 5000 + quad)
+    calls = []
+    real = load.parse_mtl
+    monkeypatch.setattr(load, "parse_mtl", lambda *a, **k: calls.append(a) or real(*a, **k))
+    assert len(glphong.load_scene(tmp_path / "many.obj").objects) == 1 and len(calls) == 1
+    (tmp_path / "late.obj").write_text("# a comment\n\n  mtllib a.mtl ../b.mtl\n" + quad)
+    error = _refused(tmp_path / "late.obj", "leaves the scene file's folder")
+    assert error.where == "line 3"

@@ -9,6 +9,7 @@
 
 Every file, and every file it names, is untrusted (`glphong.filesafety`, docs/files.md).
 """
+import re
 import warnings
 from pathlib import Path
 
@@ -80,15 +81,22 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None, lig
     return _load_obj(path, camera, lights, ambient, materials, allow_outside, limits)
 
 
+#: an OBJ ``mtllib`` statement: its library names, up to a comment or the line's end
+_MTLLIB = re.compile(r"^[ \t]*mtllib[ \t]+([^\r\n#]*)", re.M)
+
+
 def _mtl_libraries(path, text, allow_outside, limits):
-    """The materials of every ``mtllib`` an OBJ file's ``text`` names (each confined to its folder)."""
-    mtl = {}
-    for number, line in enumerate(text.splitlines(), start=1):
-        words = line.split("#", 1)[0].split()
-        if not words or words[0] != "mtllib":
-            continue
-        for name in words[1:]:
-            library = resolve_reference(path, name, f"line {number}", allow_outside, percent_encoded=False)
+    """The materials of every ``mtllib`` an OBJ file's ``text`` names (each confined to its folder, each read
+    once).  The text is searched, not split into lines: memory stays that of the text itself."""
+    mtl, read, line, position = {}, set(), 1, 0
+    for match in _MTLLIB.finditer(text):
+        line += text.count("\n", position, match.start())
+        position = match.start()
+        for name in match.group(1).split():
+            library = resolve_reference(path, name, f"line {line}", allow_outside, percent_encoded=False)
+            if library in read:
+                continue
+            read.add(library)
             if library.exists():
                 mtl.update(parse_mtl(library, limits, allow_outside))
             else:
