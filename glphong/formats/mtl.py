@@ -10,6 +10,7 @@ An MTL file describes the fixed-function Phong its authors saw; each entry becom
 - ``map_Kd`` / ``map_Ks``: textures (sRGB, trilinear, repeat) that ``Kd`` / ``Ks`` multiply, read only from
   inside the MTL file's folder (`glphong.filesafety`).
 """
+import io
 import math
 import warnings
 from pathlib import Path
@@ -47,7 +48,8 @@ def parse_mtl(path, limits=None, allow_outside=False):
         file and line.
     """
     out, current = {}, None
-    for number, raw in enumerate(read_text(path, limits).splitlines(), start=1):
+    # line by line from a stream: a file of a billion empty lines is never a list of a billion strings
+    for number, raw in enumerate(io.StringIO(read_text(path, limits), newline=None), start=1):
         words = raw.split("#", 1)[0].split()
         if not words:
             continue
