@@ -20,7 +20,7 @@ from glphong.scene import primitives
 from glphong.scene.camera import Camera, IntrinsicsCamera, OrthographicCamera, PerspectiveCamera, opencv_pose
 from glphong.gpu.contexts import BackendUnavailableError, available_backends, create_context
 from glphong.gpu.describe import describe, format_descriptions
-from glphong.scene.lights import AmbientLight, DirectionalLight, PointLight, UnattenuatedPointLight
+from glphong.lights import AmbientLight, DirectionalLight, LightModel, PointLight, SpotLight, UnattenuatedPointLight
 from glphong.formats.gltf_export import save_gltf
 from glphong.formats.load import load_scene
 from glphong.materials import Material, MaterialModel, MaterialSum, Param, Texture, VertexColors
@@ -44,10 +44,10 @@ from glphong.checks.verify import VerifyReport, verify
 _moved.install()  # the module paths of 0.1.0 keep working (glphong._moved)
 
 __all__ = [
-    "Camera", "PerspectiveCamera", "IntrinsicsCamera", "OrthographicCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "AmbientLight",
+    "Camera", "PerspectiveCamera", "IntrinsicsCamera", "OrthographicCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "SpotLight", "AmbientLight", "LightModel",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
     "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
     "DielectricFresnel", "Texture", "VertexColors", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
-    "imaging", "materials", "primitives", "radiometry", "reference", "filesafety", "__version__",
+    "imaging", "lights", "materials", "primitives", "radiometry", "reference", "filesafety", "__version__",
 ]

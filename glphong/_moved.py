@@ -29,7 +29,7 @@ MOVED = {
     "glphong.key": "glphong.shaders.key",
     "glphong.programs": "glphong.gpu.programs",
     "glphong.camera": "glphong.scene.camera",
-    "glphong.lights": "glphong.scene.lights",
+    "glphong.scene.lights": "glphong.lights",
     "glphong.geometry": "glphong.scene.geometry",
     "glphong.culling": "glphong.scene.culling",
     "glphong.contexts": "glphong.gpu.contexts",

@@ -11,7 +11,9 @@
 //   perspective arithmetic is unchanged).
 // light_term(response, E) -> response * E, exactly 0 where E = 0 (a response that overflowed to Inf
 //   times an irradiance of 0 would be NaN): a select, no branch.
-// Each light kind is a loop of compile-time length; a kind the scene lacks has no loop at all.
+// The loops over the lights are generated from the key (generated:lights, glphong/shaders/generated.py):
+// one loop of compile-time length per light kind present, calling the kind's <kind>_incident(x, j, wi, E)
+// (glsl/lights/<kind>.glsl, docs/design.md section 12); a kind the scene lacks has no loop and no chunk.
 // Light j contributes nothing unless n.l_j > 0 (and its direction normalises): every light's term is
 // computed and the gate selects it, without a branch.  llvmpipe (and a GPU's SIMD group) runs both sides
 // of a branch under a mask, so an `if`/`continue` saves nothing and costs control flow; written as
@@ -19,22 +21,13 @@
 // six gallery tiles at 1024x1024 (EGL, one run), with bit-identical images on EGL and OSMesa.  A term's response may therefore be
 // computed where n.l <= 0 and discarded: it must not loop forever there, but NaN or Inf is harmless.
 // The view vector v is computed only where a term reads it (NEEDS_VIEW).
-// The uber-shader reads its light counts from uniforms (*_LIGHT_COUNT).
+// The uber-shader reads its light counts from uniforms (<KIND>_LIGHT_COUNT).
 //
-// Key defines read here: NEEDS_VIEW, NUM_{POINT,UNATTENUATED,DIRECTIONAL}_LIGHTS (array sizes) and
-// {POINT,UNATTENUATED,DIRECTIONAL}_LIGHT_COUNT (loop bounds).
+// Key defines read here: NEEDS_VIEW, NUM_LIGHTS (the total over the kinds).
 
-#if NUM_POINT_LIGHTS > 0
-uniform vec3 u_point_position[NUM_POINT_LIGHTS];        // [m]
-uniform vec3 u_point_intensity[NUM_POINT_LIGHTS];       // Phi / (4 pi) [W/sr]
-#endif
-#if NUM_UNATTENUATED_LIGHTS > 0
-uniform vec3 u_unattenuated_position[NUM_UNATTENUATED_LIGHTS];  // [m]
-uniform vec3 u_unattenuated_radiance[NUM_UNATTENUATED_LIGHTS];  // L_i, used as E [W/m^2]
-#endif
-#if NUM_DIRECTIONAL_LIGHTS > 0
-uniform vec3 u_directional_direction[NUM_DIRECTIONAL_LIGHTS];   // unit, toward the light
-uniform vec3 u_directional_irradiance[NUM_DIRECTIONAL_LIGHTS];  // E [W/m^2]
+#if NUM_LIGHTS > 0
+// the loops over the program's light kinds, generated from the key (generated:lights, after this chunk)
+void add_lights(inout vec3 radiance, vec3 position, ShadingFrame f, vec3 wo, bool lit);
 #endif
 
 vec3 light_term(vec3 response, vec3 irradiance)
@@ -45,41 +38,14 @@ vec3 light_term(vec3 response, vec3 irradiance)
 vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec4 eye)
 {
     vec3 radiance = material_emission();
-#if NUM_POINT_LIGHTS > 0 || NUM_UNATTENUATED_LIGHTS > 0 || NUM_DIRECTIONAL_LIGHTS > 0
+#if NUM_LIGHTS > 0
     bool lit = n_valid;
     vec3 wo = vec3(0.0);
 #if NEEDS_VIEW
     float view_distance;
     lit = lit && safe_normalize(eye.xyz - position * eye.w, wo, view_distance);
 #endif
-    vec3 wi;
-    float d;
-    float n_dot_l;
-    bool valid;
-#endif
-#if NUM_POINT_LIGHTS > 0
-    for (int j = 0; j < POINT_LIGHT_COUNT; ++j) {
-        valid = safe_normalize(u_point_position[j] - position, wi, d);
-        n_dot_l = dot(f.n, wi);
-        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), point_irradiance(u_point_intensity[j], d));
-        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);
-    }
-#endif
-#if NUM_UNATTENUATED_LIGHTS > 0
-    for (int j = 0; j < UNATTENUATED_LIGHT_COUNT; ++j) {
-        valid = safe_normalize(u_unattenuated_position[j] - position, wi, d);
-        n_dot_l = dot(f.n, wi);
-        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), u_unattenuated_radiance[j]);
-        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);
-    }
-#endif
-#if NUM_DIRECTIONAL_LIGHTS > 0
-    for (int j = 0; j < DIRECTIONAL_LIGHT_COUNT; ++j) {
-        wi = u_directional_direction[j];
-        n_dot_l = dot(f.n, wi);
-        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), u_directional_irradiance[j]);
-        radiance += (lit && n_dot_l > 0.0) ? term : vec3(0.0);
-    }
+    add_lights(radiance, position, f, wo, lit);
 #endif
     return radiance;
 }

@@ -17,7 +17,7 @@ import glphong
 from glphong import imaging
 from glphong.gpu.contexts import BACKENDS
 from glphong.scene.geometry import MeshData
-from glphong.scene.lights import _MAX_POWER
+from glphong.lights.point import _MAX_POWER
 
 FLT_MAX = float(np.finfo(np.float32).max)
 NAN, INF = float("nan"), float("inf")

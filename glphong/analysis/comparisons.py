@@ -50,7 +50,7 @@ import moderngl
 import numpy as np
 
 from glphong.gpu.contexts import create_context
-from glphong.scene.lights import DirectionalLight, PointLight, UnattenuatedPointLight
+from glphong.lights import UnattenuatedPointLight
 from glphong.shaders.assembly import assemble
 from glphong.scene.camera import IntrinsicsCamera, OrthographicCamera
 from glphong.scene.scene import Scene
@@ -285,24 +285,6 @@ def _pyrender_material(pyrender, material, double_sided=False):
     )
 
 
-def _colour_and_scale(values):
-    """``(values / max, max)`` as float64; colour (1, 1, 1) for an all-zero value."""
-    values = np.asarray(values, dtype=np.float64)
-    peak = float(values.max())
-    return (values / peak if peak > 0.0 else np.ones(3)), peak
-
-
-def _directional_pose(direction):
-    """A rotation whose -Z axis is ``direction`` (a unit vector)."""
-    z = -np.asarray(direction, dtype=np.float64)
-    helper = np.array([0.0, 1.0, 0.0]) if abs(z[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
-    x = np.cross(helper, z)
-    x /= np.linalg.norm(x)
-    pose = np.eye(4)
-    pose[:3, 0], pose[:3, 1], pose[:3, 2] = x, np.cross(z, x), z
-    return pose
-
-
 def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=None, double_sided=False):
     """Convert a glphong `Scene` to a ``pyrender.Scene`` (see the module notes for the mapping).
 
@@ -341,6 +323,8 @@ def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=Non
         if isinstance(light, UnattenuatedPointLight):
             raise ValueError(f"UnattenuatedPointLight at {light.position} has no pyrender equivalent "
                              "(pyrender point lights always fall off as 1/d^2)")
+        if getattr(light, "range", None) is not None:
+            raise ValueError(f"{light!r} has a range, which pyrender ignores: the images would differ")
     pyrender = import_pyrender(platform) if platform is not None else importlib.import_module("pyrender")
     ambient = np.zeros(3) if scene.ambient is None else np.asarray(scene.ambient.radiance) / np.pi
     out = pyrender.Scene(bg_color=np.zeros(4), ambient_light=ambient)
@@ -363,16 +347,10 @@ def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=Non
         out.add(pyrender.PerspectiveCamera(yfov=camera.yfov, znear=camera.znear, zfar=camera.zfar,
                                            aspectRatio=aspect_ratio), pose=camera.pose)
     for light in scene.lights:
-        if isinstance(light, PointLight):
-            colour, peak = _colour_and_scale(light.power)
-            pose = np.eye(4)
-            pose[:3, 3] = light.position
-            out.add(pyrender.PointLight(color=colour, intensity=peak / (4.0 * np.pi)), pose=pose)
-        elif isinstance(light, DirectionalLight):
-            colour, peak = _colour_and_scale(light.irradiance)
-            out.add(pyrender.DirectionalLight(color=colour, intensity=peak), pose=_directional_pose(light.direction))
-        else:  # pragma: no cover - Scene admits no other light kinds
+        made = light.to_pyrender(pyrender)
+        if made is None:
             raise ValueError(f"{type(light).__name__} has no pyrender equivalent")
+        out.add(made[0], pose=made[1])
     return out
 
 

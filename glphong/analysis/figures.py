@@ -11,7 +11,7 @@ import numpy as np
 
 from glphong.scene.camera import PerspectiveCamera
 from glphong.scene.geometry import MeshData
-from glphong.scene.lights import AmbientLight, PointLight
+from glphong.lights import AmbientLight, PointLight
 from glphong.materials.blinn import BlinnPhong
 from glphong.materials.phong import Phong
 from glphong.scene.scene import Scene

@@ -20,7 +20,7 @@ from glphong.core.imaging import encode_srgb8
 from glphong.analysis.tabulate import tabulate
 from glphong.scene import primitives
 from glphong.scene.camera import PerspectiveCamera
-from glphong.scene.lights import AmbientLight, DirectionalLight, PointLight
+from glphong.lights import AmbientLight, DirectionalLight, PointLight
 from glphong.scene.scene import Scene
 
 __all__ = ["GALLERY", "Gallery", "gallery_scene", "render_gallery"]

@@ -13,7 +13,7 @@ from glphong.materials.lambert import Lambert
 from glphong.materials.phong import Phong
 from glphong.scene import primitives
 from glphong.scene.camera import PerspectiveCamera
-from glphong.scene.lights import AmbientLight, PointLight
+from glphong.lights import AmbientLight, PointLight
 from glphong.scene.scene import Scene
 
 __all__ = ["turntable_scene", "orbit_scene"]

@@ -37,7 +37,7 @@ import numpy as np
 from glphong.core import validate as _validate
 from glphong.scene.camera import Camera
 from glphong.scene.geometry import MeshData
-from glphong.scene.lights import AmbientLight
+from glphong.lights import AmbientLight
 from glphong.materials import Material
 from glphong.materials.table import uniform_as
 from glphong.checks.reference import safe_normalize, shade_point

@@ -25,11 +25,13 @@ from glphong.twin.band import BAND, EPS
 from glphong.twin.functions import (BLINN_HALF_FLOOR, FLT_MAX, FRAME_PARALLEL_LIMIT, ShadingFrame, _dot,  # noqa: F401
                                     atan2_first_quadrant, blinn_delta, blinn_lobe, frame_from_tangent, fresnel_dielectric,
                                     fresnel_schlick, half_cosine, light_term, lobe_from_delta, log_one_minus,
-                                    phong_delta, phong_lobe, point_irradiance, safe_normalize, shading_frame)
+                                    phong_delta, phong_lobe, point_irradiance, range_window, safe_normalize,
+                                    shading_frame)
+from glphong.lights import light_for_key
 from glphong.materials import registered_models
 
 __all__ = [
-    "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus", "lobe_from_delta",
+    "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "log_one_minus", "lobe_from_delta",
     "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
     "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
     "shade_inputs", "shade", "input_bounds",
@@ -45,8 +47,9 @@ def __getattr__(name):
     raise AttributeError(f"module 'glphong.reference' has no attribute {name!r}")
 
 
-def incident_light(position, key, uniforms):
-    """Direction and irradiance of every light at each point: the head of shade.glsl's loops.
+def incident_light(position, key, uniforms, band=None):
+    """Direction and irradiance of every light at each point: the generated light loops' heads, each a kind's
+    twin ``incident`` (`glphong.lights.LightModel`), in the key's order.
 
     Parameters
     ----------
@@ -55,24 +58,29 @@ def incident_light(position, key, uniforms):
     key : glphong.shaders.key.ProgramKey
     uniforms : dict of str to ndarray
         The program's uniforms, in the dtype of the computation.
+    band : glphong.twin.band.BandConstants, optional
+        Also return each irradiance's interval (the kind's ``band``).
 
     Returns
     -------
-    list of (valid, wi, irradiance)
-        Per light, in shader order: ``valid`` (N,) bool (the direction normalised),
-        ``wi`` (N, 3) unit vector toward the light, ``irradiance`` (N, 3) E [W/m^2].
+    list of (valid, wi, irradiance), or of (valid, wi, irradiance, (low, high)) with ``band``
+        Per light, in shader order: ``valid`` (N,) bool (the light reaches the point: its direction
+        normalised), ``wi`` (N, 3) unit vector toward the light, ``irradiance`` (N, 3) E [W/m^2].
     """
     out = []
-    for j in range(key.num_point_lights):
-        valid, wi, d = safe_normalize(uniforms["u_point_position"][j] - position)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out.append((valid, wi, point_irradiance(uniforms["u_point_intensity"][j], d)))
-    for j in range(key.num_unattenuated_lights):
-        valid, wi, _ = safe_normalize(uniforms["u_unattenuated_position"][j] - position)
-        out.append((valid, wi, np.broadcast_to(uniforms["u_unattenuated_radiance"][j], position.shape)))
-    for j in range(key.num_directional_lights):
-        wi = np.broadcast_to(uniforms["u_directional_direction"][j], position.shape)
-        out.append((np.ones(len(position), bool), wi, np.broadcast_to(uniforms["u_directional_irradiance"][j], position.shape)))
+    for light_key in key.lights:
+        kind = light_for_key(light_key.name, light_key.source_hash)
+        twin = kind.twin()
+        for j in range(light_key.count):
+            p = kind.values_from_uniforms(uniforms, j, dtype=position.dtype, defines=light_key.defines)
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+                valid, wi, irradiance = twin.incident(position, p)
+                wi = np.broadcast_to(wi, position.shape)
+                irradiance = np.broadcast_to(irradiance, position.shape)
+                if band is None:
+                    out.append((np.broadcast_to(valid, position.shape[:-1]), wi, irradiance))
+                else:
+                    out.append((np.broadcast_to(valid, position.shape[:-1]), wi, irradiance, twin.band(position, p, band)))
     return out
 
 

@@ -18,6 +18,7 @@ to 0, irradiance beyond FLT_MAX saturates at FLT_MAX, and sums beyond FLT_MAX be
 import json
 from dataclasses import asdict, dataclass, field, replace
 
+import mpmath
 import numpy as np
 
 from glphong.checks.tolerances import FLT_MAX, FLT_MIN, point_band
@@ -30,10 +31,9 @@ from glphong.gpu.programs import ProgramCache
 from glphong.materials import ParamValues, ShadingFrame, registered_models
 from glphong.materials.blinn import BlinnPhong
 from glphong.materials.phong import Phong
-from glphong.scene import lights as L
 from glphong.scene.camera import PerspectiveCamera
 from glphong.scene.geometry import MeshData
-from glphong.scene.lights import DirectionalLight, PointLight, UnattenuatedPointLight
+from glphong.lights import AmbientLight, LightModel, light_named, registered_lights
 from glphong.scene.scene import Scene
 from glphong.shaders.key import ProgramKey, TermKey
 
@@ -57,9 +57,8 @@ def case_scene(case):
     eye = np.asarray(case.eye)
     up = (0.0, 1.0, 0.0) if abs(eye[1]) < 0.9 * np.max(np.abs(eye)) else (1.0, 0.0, 0.0)
     camera = PerspectiveCamera.look_at(eye, (0.0, 0.0, 0.0), up=up, znear=1e-30 * np.max(np.abs(eye)) + 1e-37)
-    kinds = {"point": L.PointLight, "unattenuated": L.UnattenuatedPointLight, "directional": L.DirectionalLight}
-    scene = Scene(camera, lights=[kinds[k](w, v) for k, w, v in case.lights],
-                  ambient=None if case.ambient is None else L.AmbientLight(case.ambient))
+    lights = [light if isinstance(light, LightModel) else light_named(light[0])(light[1], light[2]) for light in case.lights]
+    scene = Scene(camera, lights=lights, ambient=None if case.ambient is None else AmbientLight(case.ambient))
     scene.add(MeshData([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 0, 1]] * 3, [[0, 1, 2]],
                        uvs=[case.uv] * 3, tangents=[case.tangent] * 3), case.material)
     return scene
@@ -83,6 +82,9 @@ def _build_cases():
     for model in registered_models():
         if model.__module__.startswith("glphong."):
             cases += cases_for(model)
+    for kind in registered_lights():
+        if kind.__module__.startswith("glphong."):
+            cases += kind.stability_cases()
     light = _unit(30.0)
     grey = lambda x: (x, x, x)  # noqa: E731
     e_one = 4 * np.pi  # a point light at 1 m with E = 1 W/m^2
@@ -164,8 +166,6 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
     (3,) float64 ndarray
         Radiance [W/(m^2 sr)].
     """
-    import mpmath
-
     mp = mpmath.mp
     mp.dps = digits
     f = lambda x: mpmath.mpf(float(np.float32(x)))  # noqa: E731
@@ -197,19 +197,12 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
     n = unit(vec(raw_n))
     eye, w = vec(scene.camera.eye), f(scene.camera.eye[3])  # homogeneous: v = normalize(e - w x)
     v = unit([e - w * p for e, p in zip(eye, x)])
-    four_pi = 4 * mpmath.pi
     frame = _oracle_frame(n, vec(tangent[:3]), float(np.float32(tangent[3])), [f(c) for c in uv[:2]], unit, dot)
     for light in scene.lights:
-        if isinstance(light, PointLight):
-            to_light = [a - b for a, b in zip(vec(light.position), x)]
-            d2 = dot(to_light, to_light)
-            l, e = unit(to_light), [f(phi) / (four_pi * d2) for phi in light.power]
-        elif isinstance(light, UnattenuatedPointLight):
-            l, e = unit([a - b for a, b in zip(vec(light.position), x)]), vec(light.radiance)
-        elif isinstance(light, DirectionalLight):
-            l, e = unit([-mpmath.mpf(c) for c in light.direction]), vec(light.irradiance)
-        else:
-            raise TypeError(f"oracle: unknown light {light!r}")
+        reached = light.oracle(x) if light.oracle is not None else _light_twin_at(light, x)
+        if reached is None:
+            continue
+        l, e = reached
         ndl = dot(n, l)
         if ndl <= 0:
             continue
@@ -236,10 +229,16 @@ def _oracle_frame(n, tangent, handedness, uv, unit, dot):
     return ShadingFrame(n, t, b, uv)
 
 
+def _light_twin_at(light, x):
+    """A light kind's twin at one mpmath point, in float64 (for kinds without an oracle): ``(wi, E)`` or None."""
+    valid, wi, e = light.incident(np.array([[float(c) for c in x]]), light.values())
+    if not valid[0]:
+        return None
+    return [mpmath.mpf(float(c)) for c in np.ravel(wi)[:3]], [mpmath.mpf(float(c)) for c in np.ravel(e)[:3]]
+
+
 def _twin_at(term, n, l, v, ndl, tangent, uv):
     """A term's twin response at one mpmath geometry, in float64 (for models without an oracle)."""
-    import mpmath
-
     as64 = lambda a: np.array([[float(c) for c in a]])  # noqa: E731
     key = ProgramKey(terms=(TermKey(term.name, "", tuple(term.needs)),), has_tangent="tangent" in term.needs,
                      has_uv="uv" in term.needs)

@@ -43,8 +43,8 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
     """Interval the GPU's ``shade_point()`` must return at given points.
 
     Each lit term contributes its own band (`glphong.materials.MaterialModel.band`: the model's
-    derived band, or the generic one from the twin's sensitivity), times the irradiance widened
-    by ``(1 +- A eps)``.  Where ``|n.l| <= D eps`` either side of the light gate is accepted: there
+    derived band, or the generic one from the twin's sensitivity), times the irradiance's interval (the
+    light kind's ``band``, `glphong.lights.LightModel.band`) widened by ``(1 +- A eps)``.  Where ``|n.l| <= D eps`` either side of the light gate is accepted: there
     the lower bound is 0 and a term's band is asked at its (possibly non-positive) ``n.l``, which it
     must bound over ``(0, n.l + D eps]``.
 
@@ -72,7 +72,7 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
     if key.num_lights:
         wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
         tol = band.D * EPS
-        for valid, wi, irradiance in ref.incident_light(position, key, u):
+        for valid, wi, irradiance, (e_low, e_high) in ref.incident_light(position, key, u, band=band):
             terms += 1
             n_dot_l = ref._dot(f.n, wi)
             certain = (lit & valid & (n_dot_l > tol))[..., None]
@@ -84,9 +84,9 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
                                                                wo[possible], n_dot_l[possible], material, band)
             with np.errstate(over="ignore", invalid="ignore"):
                 # an irradiance below FLT_MIN may be flushed to 0 on the GPU, and the term with it
-                e_lo = np.where(irradiance < FLT_MIN, 0.0, irradiance)
+                e_lo = np.where(e_low < FLT_MIN, 0.0, e_low)
                 t_lo = np.nan_to_num(ref.light_term(f_lo, e_lo) * (1 - band.A * EPS), nan=0.0)
-                t_hi = np.nan_to_num(ref.light_term(f_hi, irradiance) * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
+                t_hi = np.nan_to_num(ref.light_term(f_hi, e_high) * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
             lo = lo + np.where(certain, t_lo, 0.0)
             hi = hi + np.where(possible[..., None], t_hi, 0.0)
     low = lo * (1 - terms * EPS)

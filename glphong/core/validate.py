@@ -107,6 +107,14 @@ def vec3(name, value, nonzero=False):
     return tuple(float(c) + 0.0 for c in a)
 
 
+def unit_vec3(name, value):
+    """A non-zero finite 3-vector (`vec3`) normalised to unit length, as a tuple of float: scaled by its
+    largest component first, so that no square overflows or underflows."""
+    d = np.asarray(vec3(name, value, nonzero=True))
+    d = d / np.max(np.abs(d))
+    return tuple(float(c) for c in d / np.linalg.norm(d))
+
+
 def _matrix4(name, value):
     """A finite (4, 4) float64 array with entries representable in float32 and last row (0, 0, 0, 1)."""
     a = real_array(name, value, "a 4x4 array of real numbers")

@@ -11,9 +11,11 @@ What is written:
 - textures as PNG images (8-bit sources, re-encoded losslessly) with their samplers;
 - the camera (perspective: ``yfov``, ``znear``, ``zfar``; orthographic: ``ymag``; an `IntrinsicsCamera`'s
   principal point is not representable: written as its perspective frustum, with a warning);
-- point and directional lights (``KHR_lights_punctual``) in radiometric units (W/sr, W/m^2), declared in
+- point, spot and directional lights (``KHR_lights_punctual``, each kind's ``to_gltf``; ``range`` where given) in
+  radiometric units (W/sr, W/m^2), declared in
   the asset's ``extras: {"glphong": {"light_units": "radiometric"}}`` together with the ambient light,
-  which glTF has no place for.  `UnattenuatedPointLight` has no glTF equivalent: skipped, with a warning.
+  which glTF has no place for.  A kind without a glTF equivalent (`UnattenuatedPointLight`, a user's kind
+  without ``to_gltf``) is skipped, with a warning.
 """
 import base64
 import json
@@ -141,20 +143,9 @@ def _camera(camera):
 
 
 def _light_node(builder, light, index):
-    values = np.asarray(light.intensity if light.kind == "point" else light.irradiance, dtype=np.float64)
-    peak = float(values.max())
-    entry = {"type": light.kind, "color": [float(c) for c in (values / peak if peak > 0 else np.ones(3))],
-             "intensity": peak}
+    entry, pose = light.to_gltf()
     lights = builder.doc.setdefault("extensions", {}).setdefault("KHR_lights_punctual", {"lights": []})["lights"]
     lights.append(entry)
-    pose = np.eye(4)
-    if light.kind == "point":
-        pose[:3, 3] = light.position
-    else:  # the node's -z axis is the direction the light travels in
-        z = -np.asarray(light.direction)
-        x = np.cross((0.0, 1.0, 0.0) if abs(z[1]) < 0.9 else (1.0, 0.0, 0.0), z)
-        x /= np.linalg.norm(x)
-        pose[:3, :3] = np.stack([x, np.cross(z, x), z], axis=1)
     return {"name": f"light{index}", "matrix": _column_major(pose),
             "extensions": {"KHR_lights_punctual": {"light": len(lights) - 1}}}
 
@@ -196,8 +187,8 @@ def save_gltf(scene, path):
     doc["cameras"] = [_camera(scene.camera)]
     nodes.append({"name": "camera", "camera": 0, "matrix": _column_major(scene.camera.pose)})
     for index, light in enumerate(scene.lights):
-        if light.kind == "unattenuated":
-            warnings.warn(f"light {index}: an UnattenuatedPointLight has no glTF equivalent; not written", stacklevel=2)
+        if light.to_gltf() is None:
+            warnings.warn(f"light {index}: a {type(light).__name__} has no glTF equivalent; not written", stacklevel=2)
             continue
         nodes.append(_light_node(builder, light, index))
     if "extensions" in doc:

@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 
 from glphong.core.filesafety import SceneFileError
-from glphong.core.radiometry import LUMENS_PER_WATT, power_from_intensity
+from glphong.core.radiometry import LUMENS_PER_WATT
 from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, read_gltf_primitives, texture_sampling
 from glphong.materials import Material, Texture, TextureImage, VertexColors
 from glphong.materials.cook_torrance import CookTorrance
@@ -16,7 +16,7 @@ from glphong.formats.overrides import chosen_material
 from glphong.materials.as_json import material_from_json
 from glphong.scene.camera import OrthographicCamera, PerspectiveCamera
 from glphong.scene.from_trimesh import _trimesh_material, default_view, empty_scene, with_default_view
-from glphong.scene.lights import AmbientLight, DirectionalLight, PointLight
+from glphong.lights import AmbientLight, registered_lights
 from glphong.scene.scene import Scene
 
 __all__ = ["read_gltf_json", "gltf_view", "gltf_material", "material_from_extras", "load_gltf"]
@@ -88,9 +88,10 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
     The camera is the node camera named ``camera_name`` (by the camera's or its node's name) or the first
     one; ``yfov``, ``znear`` and ``zfar`` are read as written (an infinite ``zfar``: ``1e6 znear``),
     orthographic ``ymag`` too.  ``KHR_lights_punctual`` point and directional lights need ``light_units``:
-    ``'photometric'`` (the glTF specification: point intensity in candela, directional illuminance in lux;
-    ``Phi = 4 pi I color / 683``, ``E = lux color / 683``) or ``'radiometric'`` (intensity taken as W/sr and
-    W/m^2).  Spot lights are refused (glphong has point and directional lights).
+    ``'photometric'`` (the glTF specification: point and spot intensity in candela, directional illuminance in
+    lux; ``I = cd color / 683`` [W/sr], ``E = lux color / 683``) or ``'radiometric'`` (intensity taken as W/sr and
+    W/m^2).  Each light type is read by the light kind whose ``gltf_type`` it is (`glphong.lights.LightModel.from_gltf`):
+    point (with its ``range``), spot (cone angles and ``range``) and directional.
     """
 
     nodes = document.get("nodes", [])
@@ -122,10 +123,7 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
         if reference is None or index not in worlds:
             continue
         light = definitions[reference["light"]]
-        kind = light.get("type")
-        if kind == "spot":
-            raise ValueError(f"{source}: light {light.get('name', reference['light'])!r} is a spot light: glphong has "
-                             "point and directional lights only")
+        kind = _GLTF_KINDS.get(light.get("type"))
         if light_units is None:  # a file may declare them (glphong.formats.gltf_export writes radiometric lights)
             light_units = _glphong_extras(document).get("light_units")
         if light_units not in ("photometric", "radiometric"):
@@ -135,13 +133,20 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
         scale = (1.0 / LUMENS_PER_WATT if light_units == "photometric" else 1.0) * light.get("intensity", 1.0)
         colour = np.asarray(light.get("color", (1.0, 1.0, 1.0)), dtype=np.float64) * scale
         world = worlds[index]
-        if kind == "point":
-            lights.append(PointLight(tuple(world[:3, 3]), tuple(power_from_intensity(colour))))
-        elif kind == "directional":
-            lights.append(DirectionalLight(tuple(-world[:3, 2]), tuple(colour)))
-        else:
-            raise ValueError(f"{source}: light type {kind!r} is not one glphong knows")
+        if kind is None:
+            raise ValueError(f"{source}: light type {light.get('type')!r} is not one glphong knows "
+                             f"({', '.join(sorted(_GLTF_KINDS))})")
+        pose = world.copy()
+        pose[:3, :3] /= np.linalg.norm(pose[:3, :3], axis=0)  # a light node's scale does not apply
+        try:
+            lights.append(kind.from_gltf(colour, light, pose))
+        except (TypeError, ValueError) as exc:
+            raise ValueError(f"{source}: light {light.get('name', reference['light'])!r}: {exc}") from None
     return camera, lights
+
+
+#: KHR_lights_punctual type -> the light kind that reads it
+_GLTF_KINDS = {kind.gltf_type: kind for kind in registered_lights() if kind.gltf_type}
 
 
 def gltf_material(entry, base_color_texture=None, vertex_colors=False):

@@ -342,7 +342,7 @@ class Renderer:
         """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading)."""
         per_vertex = output == "radiance" and self.shading == "vertex"
         if output == "radiance" and not self.specialise:
-            return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex)
+            return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex, scene.lights)
         key = scene.program_key(obj, output)
         if per_vertex and key.textured_inputs:
             raise ValueError(f"object {obj.name!r}: {', '.join(f'{t}.{p}' for t, p in key.textured_inputs)} "
@@ -404,7 +404,7 @@ class Renderer:
         the scene's, the same for every object (made once per frame).  ``frame_values`` are uniforms the
         call adds to every program's frame pack (the display programs' ``u_exposure``)."""
         drop = self.formulation == "naive"
-        state = (output, tuple(scene.light_counts().values()), scene.ambient_radiance, self.formulation,
+        state = (output, scene.light_keys(), scene.ambient_radiance, self.formulation,
                  self.shading, self.specialise, self.culling)
         shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
         frame_packs = {}

@@ -23,8 +23,13 @@ primitive keeps pyrender's shaders.  Lights map with the units of docs/design.md
   so ``Phi = 4 pi I`` (`glphong.PointLight`);
 - ``pyrender.DirectionalLight(color, intensity)``: irradiance ``E = color * intensity`` [W/m^2],
   travelling along the node's -Z axis (`glphong.DirectionalLight`);
-- ``scene.ambient_light``: ``L_a`` (`glphong.AmbientLight`);
-- ``pyrender.SpotLight``: refused with a ValueError (the lecture's models have no cone).
+- ``pyrender.SpotLight(color, intensity, innerConeAngle, outerConeAngle)``: a `glphong.SpotLight` of intensity
+  ``I = color * intensity`` taken as W/sr along the axis (pyrender's shader uses the candela value as the
+  intensity, and KHR_lights_punctual's falloff, as glphong does), pointing along the node's -Z axis;
+- ``scene.ambient_light``: ``L_a`` (`glphong.AmbientLight`).
+
+Each pyrender light class is read by the glphong light kind whose ``pyrender_type`` it is
+(`glphong.lights.LightModel.from_pyrender`).  pyrender ignores a light's range; so does the mapping.
 
 Importing this module imports pyrender, so set ``PYOPENGL_PLATFORM`` first (pyrender reads it once).
 pyrender 0.1.45's OSMesa platform needs PyOpenGL >= 3.1.5 (``pip install --no-deps PyOpenGL==3.1.10``).
@@ -38,7 +43,7 @@ import pyrender
 from pyrender.constants import ProgramFlags, RenderFlags
 from pyrender.renderer import Renderer as _PyrenderRenderer
 
-from glphong.scene import lights as glphong_lights
+from glphong.lights import AmbientLight, registered_lights
 from glphong.core.validate import scalar
 from glphong.scene.camera import PerspectiveCamera
 from glphong.gpu.contexts import attach_current
@@ -96,19 +101,18 @@ def glphong_lights_of(scene):
     lights : list of glphong lights
     ambient : glphong.AmbientLight or None
     """
+    kinds = {kind.pyrender_type: kind for kind in registered_lights() if kind.pyrender_type}
     out = []
     for node in scene.light_nodes:
         light, pose = node.light, scene.get_pose(node)
         value = np.asarray(light.color, dtype=np.float64) * float(light.intensity)
-        if isinstance(light, pyrender.SpotLight):
-            raise ValueError(f"pyrender.SpotLight {node.name or ''!r} cannot light glphong materials: the lecture's "
-                             "models have point and directional lights only; use a PointLight or remove it")
-        if isinstance(light, pyrender.PointLight):
-            out.append(glphong_lights.PointLight(pose[:3, 3], 4.0 * np.pi * value))
-        elif isinstance(light, pyrender.DirectionalLight):
-            out.append(glphong_lights.DirectionalLight(-pose[:3, 2], value))
+        kind = kinds.get(type(light).__name__)
+        if kind is None:
+            raise ValueError(f"pyrender light {node.name or ''!r} is a {type(light).__name__}, which no glphong light "
+                             f"kind maps (mapped: {', '.join(sorted(kinds))})")
+        out.append(kind.from_pyrender(value, light, pose))
     ambient = np.asarray(scene.ambient_light, dtype=np.float64)
-    return out, (glphong_lights.AmbientLight(ambient) if np.any(ambient > 0) else None)
+    return out, (AmbientLight(ambient) if np.any(ambient > 0) else None)
 
 
 def _glphong_camera(scene):

@@ -24,8 +24,9 @@ class Case:
         Raw normal at the origin (renormalised by the shader; may be zero or non-finite).
     eye : tuple of 3 float
         Camera centre [m].
-    lights : tuple of (kind, where, value)
-        ``('point', position, power)``, ``('unattenuated', position, radiance)`` or
+    lights : tuple of glphong.lights.LightModel or of (kind, where, value)
+        Lights, any kind (`glphong.lights.SpotLight(...)`, a user's), or the short form of the kinds made of
+        two values: ``('point', position, power)``, ``('unattenuated', position, radiance)`` or
         ``('directional', direction of travel, irradiance)``.
     ambient : float or None
         ``L_a``.

@@ -148,7 +148,7 @@ def _short(value):
     return f"({', '.join(f'{c:g}' for c in value)})" if isinstance(value, tuple) else f"{value:g}"
 
 
-def _bind_arguments(cls, params, args, kwargs):
+def bind_arguments(cls, params, args, kwargs):
     """Map positional and keyword arguments onto ``params`` (validated values by name).
 
     ``params`` are the constructor's arguments in positional order: `Table`, `Param`, `Choice` and a
@@ -161,7 +161,7 @@ def _bind_arguments(cls, params, args, kwargs):
     for name, value in kwargs.items():
         if name not in names:
             raise TypeError(f"{cls.__name__}() got an unexpected parameter {name!r} "
-                            f"(parameters: {', '.join(names + list(MATERIAL_KEYWORDS))})")
+                            f"(parameters: {', '.join(names + list(getattr(cls, 'keywords', MATERIAL_KEYWORDS)))})")
         if name in given:
             raise TypeError(f"{cls.__name__}() got parameter {name!r} twice")
         given[name] = value
@@ -169,7 +169,7 @@ def _bind_arguments(cls, params, args, kwargs):
     for p in params:
         if p.name in given:
             out[p.name] = p.validate(given[p.name])
-        elif p.default is not None or not isinstance(p, (Param, Table)):
+        elif p.default is not None or getattr(p, "optional", False) or not isinstance(p, (Param, Table)):
             out[p.name] = p.default
         else:
             raise TypeError(f"{cls.__name__}() missing parameter {p.name!r} ({p.kind} in {p.interval}"
@@ -275,7 +275,7 @@ class MaterialModel(Material):
     def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
         if type(self).name is None:
             raise TypeError(f"{type(self).__name__} is not a material model (it has no name)")
-        for name, value in _bind_arguments(type(self), self.arguments(), args, kwargs).items():
+        for name, value in bind_arguments(type(self), self.arguments(), args, kwargs).items():
             object.__setattr__(self, name, value)
         self._set_common(ka, two_sided)
 
@@ -592,7 +592,7 @@ class MaterialSum(Material):
     def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
         if not type(self).terms:
             raise TypeError(f"{type(self).__name__} has no terms")
-        values = _bind_arguments(type(self), self.arguments(), args, kwargs)
+        values = bind_arguments(type(self), self.arguments(), args, kwargs)
         parts = tuple(t(**{a.name: values[a.name] for a in t.arguments()}, two_sided=two_sided) for t in self.terms)
         object.__setattr__(self, "_parts", parts)
         self._set_common(ka, two_sided)

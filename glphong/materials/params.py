@@ -14,11 +14,12 @@ from glphong.core import validate as _validate
 from glphong.twin.functions import ShadingFrame
 from glphong.materials.surface import SurfaceInput
 
-__all__ = ["Param", "Choice", "Properties", "ParamValues", "ShadingFrame", "GlslFile", "MaterialDefinitionError",
+__all__ = ["Param", "Choice", "Properties", "ParamValues", "ShadingFrame", "GlslFile", "DefinitionError", "MaterialDefinitionError",
            "KINDS", "NEEDS", "LIBRARY_CHUNKS", "RESERVED_NAMES", "MATERIAL_KEYWORDS"]
 
-#: parameter kinds and their GLSL types
-KINDS = {"scalar": "float", "rgb": "vec3"}
+#: parameter kinds and their GLSL types: a float, an RGB triple, a point (``vec3``, any finite 3-vector, e.g. a
+#: position [m]) and a direction (any non-zero 3-vector, normalised when validated)
+KINDS = {"scalar": "float", "rgb": "vec3", "vec3": "vec3", "direction": "vec3"}
 #: what a model may ask for beyond the normal and the light direction
 NEEDS = ("view", "tangent", "uv")
 #: library chunks (glsl/<name>.glsl) a model may use besides common.glsl, which is always there
@@ -39,7 +40,11 @@ filter sizeof cast namespace using""".split())
 _IDENT = re.compile(r"^[a-z][a-z0-9_]*$")
 
 
-class MaterialDefinitionError(TypeError):
+class DefinitionError(TypeError):
+    """A definition (a material model, a light kind) is incomplete or inconsistent."""
+
+
+class MaterialDefinitionError(DefinitionError):
     """A `MaterialModel` or `MaterialSum` definition is incomplete or inconsistent."""
 
 
@@ -61,8 +66,9 @@ class Param:
     ----------
     name : str
         Python keyword and GLSL suffix: the uniform is ``u_<model>_<name>``.
-    kind : {'scalar', 'rgb'}
-        A float, or an RGB triple (a scalar broadcasts to the three channels).
+    kind : {'scalar', 'rgb', 'vec3', 'direction'}
+        A float, an RGB triple (a scalar broadcasts to the three channels), a point (any finite 3-vector;
+        give ``low=-numpy.inf``) or a direction (any non-zero 3-vector, stored normalised).
     low, high : float, optional
         The valid range; at least one must be given (pass ``low=-numpy.inf`` explicitly for a
         parameter with no lower bound).  Values must also be finite and representable in float32.
@@ -79,6 +85,9 @@ class Param:
         colours or both, `glphong.Texture`, `glphong.VertexColors`): its value then varies over the
         surface, and the model's GLSL reads ``u_<model>_<name>`` unchanged (glphong sets it per fragment
         before the response is called).  rgb parameters only.
+    optional : bool
+        None is a valid value, and the default (a light's ``range=None``: no range).  The definition
+        says what its uniform holds then (`glphong.lights.LightModel.uniform_value`).
     """
 
     name: str
@@ -91,6 +100,7 @@ class Param:
     low_inclusive: bool = True
     high_inclusive: bool = True
     textureable: bool = False
+    optional: bool = False
 
     def __post_init__(self):
         _check_argument_name("Param", self.name)
@@ -138,6 +148,12 @@ class Param:
 
         if isinstance(value, SurfaceInput):
             return self._validate_surface_input(value)
+        if value is None and self.optional:
+            return None
+        if self.kind == "vec3":
+            return _validate.vec3(self.name, value)
+        if self.kind == "direction":
+            return _validate.unit_vec3(self.name, value)
         low = max(self.low, -_validate.FLT_MAX)
         high = min(self.high, _validate.FLT_MAX)
         low_inclusive = self.low_inclusive or self.low < -_validate.FLT_MAX
@@ -165,8 +181,10 @@ class Param:
 
     def example(self):
         """A representative valid value: the default, else 0.5 moved into the range."""
-        if self.default is not None:
+        if self.default is not None or self.optional:
             return self.default
+        if self.kind in ("vec3", "direction"):
+            return self.validate((0.0, 0.0, 1.0) if self.kind == "vec3" else (0.0, 0.0, -1.0))
         x = min(max(0.5, self.low), self.high)
         if x == self.low and not self.low_inclusive or x == self.high and not self.high_inclusive:
             x = self.low + 0.5 * (self.high - self.low) if np.isfinite(self.high - self.low) else \

@@ -12,7 +12,8 @@ import sys
 from pathlib import Path
 
 from glphong.core.glsl_files import chunk_source, glsl_root
-from glphong.materials.params import LIBRARY_CHUNKS, GlslFile, MaterialDefinitionError
+from glphong.materials.params import LIBRARY_CHUNKS, GlslFile
+from glphong.materials.params import MaterialDefinitionError as _MaterialDefinitionError
 
 __all__ = ["registered_models", "model_named", "model_source", "model_for_key", "register"]
 
@@ -57,8 +58,11 @@ def _strip_comments(text):
 
 
 def _resolve_source(cls):
-    """``(text, label, first_line)`` of a model's GLSL: label names the file or the class, and
-    ``first_line`` is the line of the text's first line in that file (1 for .glsl files)."""
+    """``(text, label, first_line)`` of a definition's GLSL (a material model's, a light kind's): label names
+    the file or the class, and ``first_line`` is the line of the text's first line in that file (1 for .glsl
+    files).  Errors are the definition's own class (``cls.definition_error``, `MaterialDefinitionError` by
+    default)."""
+    MaterialDefinitionError = getattr(cls, "definition_error", _MaterialDefinitionError)  # noqa: N806
     glsl = cls.__dict__.get("glsl", cls.glsl)
     if isinstance(glsl, GlslFile):
         path = glsl_root().joinpath(*glsl.path.split("/"))  # a Traversable: one part at a time
@@ -81,7 +85,7 @@ def _resolve_source(cls):
     if not isinstance(glsl, str):
         raise MaterialDefinitionError(f"{cls.__qualname__}.glsl must be GLSL source text or the path of a .glsl file "
                                       f"(got {type(glsl).__name__})")
-    label, first = f"{cls.__qualname__}.glsl (material {cls.__dict__.get('name', cls.name)!r})", 1
+    label, first = f"{cls.__qualname__}.glsl ({getattr(cls, 'definition_kind', 'material')} {cls.__dict__.get('name', cls.name)!r})", 1
     try:  # where the inline string starts in the Python file, so compile errors name that file and line
         lines, start = inspect.getsourcelines(cls)
         file = inspect.getsourcefile(cls)
@@ -97,20 +101,26 @@ def _resolve_source(cls):
 _BY_HASH = {}
 
 
-def model_source(cls):
-    """``(text, label, first_line, source_hash)`` of a model's GLSL (cached per class).
+def hashed_source(cls, sources, by_hash):
+    """``(text, label, first_line, source_hash)`` of a definition's GLSL, cached in ``sources`` (by class) and
+    ``by_hash`` (class by ``(name, hash)``): the registry's caches of materials or of light kinds.
 
-    The hash covers everything the model's chunk is made of: its uniform declarations (from
+    The hash covers everything the definition's chunk is made of: its uniform declarations (from
     `params`), the library chunks it uses and its text, so an edited definition is another program.
     """
-    cached = _SOURCES.get(cls)
+    cached = sources.get(cls)
     if cached is None:
         text, label, first = _resolve_source(cls)
         whole = "\n".join([cls.uniform_declarations(), " ".join(cls.uses), text])
         digest = hashlib.sha256(whole.encode("utf-8")).hexdigest()[:12]
-        cached = _SOURCES[cls] = (text, label, first, digest)
-        _BY_HASH[(cls.name, digest)] = cls
+        cached = sources[cls] = (text, label, first, digest)
+        by_hash[(cls.name, digest)] = cls
     return cached
+
+
+def model_source(cls):
+    """``(text, label, first_line, source_hash)`` of a model's GLSL (cached per class; `hashed_source`)."""
+    return hashed_source(cls, _SOURCES, _BY_HASH)
 
 
 def model_for_key(name, source_hash):

@@ -23,7 +23,7 @@ from glphong.materials.mtl import MtlPhong
 from glphong.scene.camera import PerspectiveCamera
 from glphong.scene.culling import points_sphere
 from glphong.scene.geometry import MeshData
-from glphong.scene.lights import AmbientLight, PointLight
+from glphong.lights import AmbientLight, PointLight
 
 __all__ = ["build_from_trimesh", "default_view", "scene_bounds", "empty_scene", "with_default_view"]
 

@@ -11,8 +11,8 @@ from glphong.core import validate as _validate
 from glphong.scene.camera import Camera
 from glphong.scene.geometry import MeshData
 from glphong.scene.from_trimesh import build_from_trimesh
-from glphong.shaders.key import GBUFFER_PLANES, program_key
-from glphong.scene.lights import LIGHT_KINDS, AmbientLight
+from glphong.shaders.key import GBUFFER_PLANES, light_keys, program_key
+from glphong.lights import AmbientLight, LightModel, light_named
 from glphong.materials import Material
 from glphong.materials.surface import TextureImage
 from glphong.materials.table import TableData
@@ -21,7 +21,7 @@ from glphong.shaders.key import UBER_MAX_LIGHTS
 
 __all__ = ["Scene", "SceneObject"]
 
-_LIGHT_CLASSES = tuple(cls for cls, _, _ in LIGHT_KINDS.values())
+_LIGHT_WORDS = "glphong lights (PointLight, SpotLight, DirectionalLight, UnattenuatedPointLight or a LightModel of yours)"
 
 
 @dataclass(frozen=True, eq=False)
@@ -62,7 +62,8 @@ class Scene:
     ----------
     camera : Camera
         A `PerspectiveCamera`, `IntrinsicsCamera` or `OrthographicCamera`.
-    lights : sequence of PointLight, UnattenuatedPointLight or DirectionalLight
+    lights : sequence of glphong.lights.LightModel
+        `PointLight`, `SpotLight`, `DirectionalLight`, `UnattenuatedPointLight` or a user's kind.
     ambient : AmbientLight, optional
         The ambient ``L_a`` of the term ``k_d L_a``.
     """
@@ -74,16 +75,15 @@ class Scene:
         if ambient is not None and not isinstance(ambient, AmbientLight):
             raise TypeError(f"ambient must be a glphong.AmbientLight or None (got {type(ambient).__name__})")
         try:
-            light_list = list(lights) if not isinstance(lights, (*_LIGHT_CLASSES, str, bytes)) else None
+            light_list = list(lights) if not isinstance(lights, (LightModel, AmbientLight, str, bytes)) else None
         except TypeError:
             light_list = None
         if light_list is None:
-            raise TypeError("lights must be a sequence of PointLight, UnattenuatedPointLight or DirectionalLight "
+            raise TypeError(f"lights must be a sequence of {_LIGHT_WORDS} "
                             f"(got {type(lights).__name__}; wrap a single light in a list)")
         for i, light in enumerate(light_list):
-            if not isinstance(light, _LIGHT_CLASSES):
-                raise TypeError(f"lights[{i}] must be a PointLight, UnattenuatedPointLight or DirectionalLight "
-                                f"(got {type(light).__name__})")
+            if not isinstance(light, LightModel):
+                raise TypeError(f"lights[{i}] must be one of the {_LIGHT_WORDS} (got {type(light).__name__})")
         self.camera = camera
         self.ambient = ambient
         self._lights = []
@@ -102,9 +102,9 @@ class Scene:
         return tuple(self._objects)
 
     def add_light(self, light):
-        """Add a `PointLight`, `UnattenuatedPointLight` or `DirectionalLight`."""
-        if not isinstance(light, _LIGHT_CLASSES):
-            raise TypeError(f"light must be a PointLight, UnattenuatedPointLight or DirectionalLight (got {type(light).__name__})")
+        """Add a light: any `glphong.lights.LightModel` (`PointLight`, `SpotLight`, ...)."""
+        if not isinstance(light, LightModel):
+            raise TypeError(f"light must be one of the {_LIGHT_WORDS} (got {type(light).__name__})")
         self._lights.append(light)
         return light
 
@@ -151,8 +151,15 @@ class Scene:
         return build_from_trimesh(cls, trimesh_scene, camera, lights, ambient, materials, vertex_colors)
 
     def light_counts(self):
-        """Number of lights per kind, dict of str to int."""
-        return {kind: sum(1 for light in self._lights if light.kind == kind) for kind in LIGHT_KINDS}
+        """Number of lights per kind present, dict of kind name to int, in the shader's loop order."""
+        return {k.name: k.count for k in self.light_keys()}
+
+    def light_keys(self):
+        """The `glphong.shaders.key.LightKey` of each kind present (computed once per state of the lights)."""
+        cached = getattr(self, "_light_keys", None)
+        if cached is None or cached[0] != len(self._lights):
+            cached = self._light_keys = (len(self._lights), light_keys(self._lights))
+        return cached[1]
 
     @property
     def ambient_radiance(self):
@@ -162,7 +169,7 @@ class Scene:
     def program_key(self, obj, output="radiance"):
         """The `ProgramKey` of one of this scene's objects."""
         needs = self.gbuffer_needs() if output == "gbuffer" else None
-        return program_key(obj.material, self.light_counts(), self.ambient_radiance, output, needs)
+        return program_key(obj.material, self.light_keys(), self.ambient_radiance, output, needs)
 
     def gbuffer_needs(self):
         """Extra G-buffer outputs the scene's radiance programs read ('tangent', 'uv', 'color'; 'lod' where a
@@ -173,8 +180,8 @@ class Scene:
         state = (len(self._objects), len(self._lights), self.ambient_radiance)
         cached = getattr(self, "_gbuffer_needs", None)
         if cached is None or cached[0] != state:
-            counts, ambient = self.light_counts(), self.ambient_radiance
-            keys = [program_key(o.material, counts, ambient) for o in self._objects]
+            lights, ambient = self.light_keys(), self.ambient_radiance
+            keys = [program_key(o.material, lights, ambient) for o in self._objects]
             needs = frozenset(n for n in GBUFFER_PLANES if any(
                 k.textured_inputs if n == "lod" else getattr(k, f"has_{n}") for k in keys))
             cached = self._gbuffer_needs = (state, needs)
@@ -186,16 +193,15 @@ class Scene:
         Returns
         -------
         dict of str to ndarray
-            float32 ``(N, 3)`` arrays per present light kind and ``u_ambient`` ``(3,)``.
+            float32 arrays ``u_<kind>_<uniform>``, ``(N, 3)`` or ``(N,)``, of each kind the key loops over
+            (`glphong.lights.LightModel.pack_uniforms`) and ``u_ambient`` ``(3,)``.
         """
-        counts = {"point": key.num_point_lights, "unattenuated": key.num_unattenuated_lights,
-                  "directional": key.num_directional_lights}
         values = {}
-        for kind, (_, where_name, value_name) in LIGHT_KINDS.items():
-            if counts[kind]:
-                rows = [light.uniform_row() for light in self._lights if light.kind == kind]
-                values[where_name] = np.array([r[0] for r in rows], dtype=np.float32)
-                values[value_name] = np.array([r[1] for r in rows], dtype=np.float32)
+        for light_key in key.lights:
+            kind = light_named(light_key.name)
+            mine = [light for light in self._lights if type(light) is kind]
+            if mine:
+                values.update(kind.pack_uniforms(mine, light_key.defines))
         if key.has_ambient:
             values["u_ambient"] = np.asarray(self.ambient_radiance, dtype=np.float32)
         return values
@@ -260,9 +266,7 @@ class Scene:
 
         obj = self._objects[index]
         spec = self.program_key(obj, key.output)
-        counts = {"point": spec.num_point_lights, "unattenuated": spec.num_unattenuated_lights,
-                  "directional": spec.num_directional_lights}
-        if max(self.light_counts().values()) > UBER_MAX_LIGHTS:
+        if max(self.light_counts().values(), default=0) > UBER_MAX_LIGHTS:
             raise ValueError(f"the uber-shader takes at most {UBER_MAX_LIGHTS} lights of each kind "
                              f"(scene has {self.light_counts()})")
         values = self.uniform_values(index, spec, aspect)
@@ -278,13 +282,16 @@ class Scene:
                 values.setdefault(model.uniform_name(p.name), np.zeros(3 if p.kind == "rgb" else (), np.float32))
             for t in model.tables:
                 values.setdefault(model.uniform_name(t.name), TableData.zeros(t.shape, t.channels))
-        for kind, (_, where_name, value_name) in LIGHT_KINDS.items():
-            for name in (where_name, value_name):
-                padded = np.zeros((UBER_MAX_LIGHTS, 3), np.float32)
-                if counts[kind]:
-                    padded[:counts[kind]] = values[name]
+        for light_key in key.lights:  # every uniform of the kinds the uber-shader holds, padded; the count switches
+            kind = light_named(light_key.name)
+            mine = [light for light in self._lights if type(light) is kind]
+            packed = kind.pack_uniforms(mine, light_key.defines) if mine else {}
+            for p in kind.active_uniforms(light_key.defines):
+                name = kind.uniform_name(p.name)
+                padded = np.zeros((UBER_MAX_LIGHTS,) + ((3,) if p.glsl_type == "vec3" else ()), np.float32)
+                padded[:len(mine)] = packed.get(name, padded[:0])
                 values[name] = padded
-            values[f"u_{kind}_count"] = np.float32(counts[kind])
+            values[f"u_{light_key.name}_count"] = np.float32(len(mine))
         active = {t.name: t for t in spec.terms}
         flags = {"u_use_ka": spec.has_ka, "u_two_sided": spec.two_sided}
         for term in key.terms:

@@ -11,6 +11,7 @@ import re
 from dataclasses import dataclass
 
 from glphong.core.glsl_files import GLSL_VERSION, chunk_source
+from glphong.lights.model import light_for_key, light_source
 from glphong.materials.registry import model_for_key, model_source
 
 __all__ = ["Chunk", "resolve_chunk", "assemble", "effective_source", "name_chunks", "LINE_BLOCK", "PRELUDE_LINE"]
@@ -28,8 +29,8 @@ class Chunk:
     Attributes
     ----------
     label : str
-        As the key names it: a library chunk (``'shade'``), a model (``'model:<name>@<source hash>'``)
-        or a generated chunk (``'generated:material'``).
+        As the key names it: a library chunk (``'shade'``), a model (``'model:<name>@<source hash>'``), a
+        light kind (``'light:<name>@<source hash>'``) or a generated chunk (``'generated:material'``).
     prelude : str
         Generated declarations placed before it (a model's uniforms), outside its line numbering.
     text : str
@@ -63,6 +64,11 @@ def resolve_chunk(label, generated=None):
         model = model_for_key(*label[len("model:"):].split("@"))
         text, origin, first, _ = model_source(model)
         prelude = f"// uniforms of the model {model.name!r}, declared from its params\n" + model.uniform_declarations()
+        return Chunk(label, prelude, text, origin, first)
+    if label.startswith("light:"):
+        kind = light_for_key(*label[len("light:"):].split("@"))
+        text, origin, first, _ = light_source(kind)
+        prelude = f"// uniform arrays of the light kind {kind.name!r}, declared from its uniforms\n" + kind.uniform_declarations()
         return Chunk(label, prelude, text, origin, first)
     return Chunk(label, "", chunk_source(label), f"{label}.glsl")
 

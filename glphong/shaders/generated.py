@@ -1,18 +1,20 @@
 """The GLSL chunks generated from a program key: the material chunk that sums a material's terms
-(`material_chunk`, label ``generated:material``) and a textured G-buffer program's levels of detail
-(`lod_chunk`, label ``generated:levels_of_detail``).  Generated text, never text substitution: the
-rest of a program is the shipped chunk files.
+(`material_chunk`, label ``generated:material``), the loops over the program's light kinds (`lights_chunk`,
+label ``generated:lights``) and a textured G-buffer program's levels of detail (`lod_chunk`, label
+``generated:levels_of_detail``).  Generated text, never text substitution: the rest of a program is the
+shipped chunk files.
 """
 import numpy as np
 
 from glphong.materials.registry import model_named, model_source
 
-__all__ = ["MATERIAL_CHUNK", "LOD_CHUNK", "LIGHT_KINDS", "material_chunk", "lod_chunk", "model_chunk_label"]
+__all__ = ["MATERIAL_CHUNK", "LIGHTS_CHUNK", "LOD_CHUNK", "material_chunk", "lights_chunk", "lod_chunk",
+           "model_chunk_label"]
 
-#: the light kinds, in the order of the shader's loops
-LIGHT_KINDS = ("point", "unattenuated", "directional")
 #: the label of the generated material chunk
 MATERIAL_CHUNK = "generated:material"
+#: the label of the generated chunk of light loops
+LIGHTS_CHUNK = "generated:lights"
 #: the label of the generated levels-of-detail chunk of a textured G-buffer program
 LOD_CHUNK = "generated:levels_of_detail"
 
@@ -46,7 +48,7 @@ def material_chunk(key):
     if key.uber:
         lines += ["uniform float u_use_ka;"] + [f"uniform float u_use_{t.name};" for t in key.lit_terms]
         lines += [f"uniform float u_use_{t.name}_ambient;" for t in key.terms if t.ambient]
-        lines += [f"uniform float u_{kind}_count;" for kind in LIGHT_KINDS]
+        lines += [f"uniform float u_{light.name}_count;" for light in key.lights]
     if key.has_ka:
         lines.append("uniform vec3 u_ka;                 // k_a [W/(m^2 sr)]")
     if key.has_ambient:
@@ -78,6 +80,30 @@ def material_chunk(key):
             factors += ["color"] if "vertex" in mode else []
             lines.append(f"    u_{term}_{param} = {' * '.join(factors)};")
         lines.append("}")
+    return "\n".join(lines) + "\n"
+
+
+def lights_chunk(key):
+    """The generated GLSL of the key's light loops (label ``generated:lights``), one loop per kind present, in
+    `ProgramKey.lights` order (docs/design.md section 12):
+
+    ``add_lights(radiance, x, f, wo, lit)``: for each light j of kind k,
+    ``valid = k_incident(x, j, wi, E)``;  ``radiance += (lit && valid && n.wi > 0) ? light_term(material_response(f,
+    wi, wo, n.wi), E) : 0``.  Every light's term is computed and the gate selects it, without a branch (shade.glsl
+    says why); the loop bound is the compile-time ``<KIND>_LIGHT_COUNT`` (a uniform in the uber-shader).
+    """
+    lines = ["// light loops (generated from the program key): for each light j of each kind k present",
+             "//   valid = k_incident(x, j, wi, E);  L += (lit && valid && n.wi > 0) ? material_response(f, wi, wo, n.wi) E : 0",
+             "", "void add_lights(inout vec3 radiance, vec3 position, ShadingFrame f, vec3 wo, bool lit)", "{",
+             "    vec3 wi;", "    vec3 irradiance;", "    float n_dot_l;", "    bool valid;"]
+    for light in key.lights:
+        lines += [f"    for (int j = 0; j < {light.name.upper()}_LIGHT_COUNT; ++j) {{",
+                  f"        valid = {light.name}_incident(position, j, wi, irradiance);",
+                  "        n_dot_l = dot(f.n, wi);",
+                  "        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), irradiance);",
+                  "        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);",
+                  "    }"]
+    lines += ["}"]
     return "\n".join(lines) + "\n"
 
 

@@ -12,11 +12,12 @@ from dataclasses import dataclass, fields
 
 from glphong.materials.model import registered_models, surface_define
 from glphong.materials.params import LIBRARY_CHUNKS
-from glphong.shaders.generated import (LIGHT_KINDS, LOD_CHUNK, MATERIAL_CHUNK, lod_chunk, material_chunk,  # noqa: F401
+from glphong.lights.model import registered_lights
+from glphong.shaders.generated import (LIGHTS_CHUNK, LOD_CHUNK, MATERIAL_CHUNK, lights_chunk, lod_chunk, material_chunk,
                                        model_chunk_label)
 
-__all__ = ["ProgramKey", "TermKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "response_key", "UBER_MAX_LIGHTS",
-           "material_chunk", "LIGHT_KINDS"]
+__all__ = ["ProgramKey", "TermKey", "LightKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "response_key",
+           "light_keys", "UBER_MAX_LIGHTS", "material_chunk"]
 
 #: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
 UBER_MAX_LIGHTS = 8
@@ -84,6 +85,61 @@ class TermKey:
 
 
 @dataclass(frozen=True)
+class LightKey:
+    """The lights of one kind in a program.
+
+    Attributes
+    ----------
+    name : str
+        The kind's name (its GLSL prefix, `glphong.lights.LightModel.name`).
+    source_hash : str
+        Hash of the kind's GLSL and declarations: an edited definition is a different program.
+    count : int
+        How many lights of the kind the program loops over (the size of its uniform arrays).
+    defines : tuple of (str, str)
+        The kind's structural defines for the scene's lights of it (``RANGE`` where one has a range).
+    uses : tuple of str
+        Library chunks its GLSL calls.
+    """
+
+    name: str
+    source_hash: str
+    count: int
+    defines: tuple = ()
+    uses: tuple = ()
+
+    @property
+    def chunk(self):
+        """Chunk label of the kind's GLSL, ``light:<name>@<source hash>``."""
+        return f"light:{self.name}@{self.source_hash}"
+
+    def describe(self):
+        return f"{self.name}*{self.count}" + "".join(f"[{name.lower()}]" for name, _ in self.defines)
+
+
+def light_keys(lights):
+    """The `LightKey` of each kind present in ``lights`` (a scene's light instances), in the registry's loop order."""
+    out = []
+    for kind in registered_lights():
+        mine = [light for light in lights if type(light) is kind]
+        if mine:
+            out.append(LightKey(kind.name, kind.source_hash(), len(mine), tuple(kind.structural_defines(mine)),
+                                tuple(kind.uses)))
+    return tuple(out)
+
+
+def _as_light_keys(lights):
+    """`light_keys` of light instances, or of a ``{kind name: count}`` dict (no structural defines), or the keys."""
+    if isinstance(lights, dict):
+        return tuple(LightKey(kind.name, kind.source_hash(), lights[kind.name], (), tuple(kind.uses))
+                     for kind in registered_lights() if lights.get(kind.name, 0))
+    lights = tuple(lights)
+    if all(isinstance(light, LightKey) for light in lights):
+        return lights
+    return light_keys(lights)
+
+
+@dataclass(frozen=True)
 class ProgramKey:
     """What one program contains.
 
@@ -98,8 +154,8 @@ class ProgramKey:
         The material's terms that the program evaluates (lit, or answering ``L_a``), in order.
     has_ka : bool
         The constant term ``k_a``.
-    num_point_lights, num_unattenuated_lights, num_directional_lights : int
-        Compile-time light counts per kind.
+    lights : tuple of LightKey
+        The light kinds the program loops over, with their compile-time counts, in loop order.
     has_normal : bool
         Whether the program reads the normal attribute (not needed without lights).
     has_tangent, has_uv : bool
@@ -135,9 +191,7 @@ class ProgramKey:
     output: str = "radiance"
     terms: tuple = ()
     has_ka: bool = False
-    num_point_lights: int = 0
-    num_unattenuated_lights: int = 0
-    num_directional_lights: int = 0
+    lights: tuple = ()
     has_normal: bool = True
     has_tangent: bool = False
     has_uv: bool = False
@@ -152,7 +206,7 @@ class ProgramKey:
 
     def __post_init__(self):
         if self.output not in OUTPUTS or self.formulation not in FORMULATIONS or \
-                not all(isinstance(t, TermKey) for t in self.terms):
+                not all(isinstance(t, TermKey) for t in self.terms) or not all(isinstance(k, LightKey) for k in self.lights):
             raise ValueError(f"invalid ProgramKey {self}")
 
     @property
@@ -185,7 +239,11 @@ class ProgramKey:
     @property
     def num_lights(self):
         """Total number of lights the program loops over."""
-        return self.num_point_lights + self.num_unattenuated_lights + self.num_directional_lights
+        return sum(k.count for k in self.lights)
+
+    def light_count(self, kind):
+        """How many lights of ``kind`` (a name) the program loops over."""
+        return sum(k.count for k in self.lights if k.name == kind)
 
     def attributes(self):
         """Vertex attributes the program reads, in binding order."""
@@ -230,28 +288,29 @@ class ProgramKey:
             out += [(f"GBUFFER_{name.upper()}_LOCATION", str(2 + i)) for i, name in enumerate(self.gbuffer_planes())]
         if self.output != "gbuffer":
             out.append(("NEEDS_VIEW", b(self.needs_view)))
-            for kind in LIGHT_KINDS:
-                size = getattr(self, f"num_{kind}_lights")
-                out.append((f"NUM_{kind.upper()}_LIGHTS", str(size)))
-                out.append((f"{kind.upper()}_LIGHT_COUNT", f"int(u_{kind}_count)" if self.uber else str(size)))
+            out.append(("NUM_LIGHTS", str(self.num_lights)))
+            for light in self.lights:  # array sizes, loop bounds and each kind's structural defines, prefixed
+                upper = light.name.upper()
+                out.append((f"NUM_{upper}_LIGHTS", str(light.count)))
+                out.append((f"{upper}_LIGHT_COUNT", f"int(u_{light.name}_count)" if self.uber else str(light.count)))
+                out += [(f"{upper}_{name}", value) for name, value in light.defines]
             for term in self.terms:  # a model's structural defines, prefixed with its name
                 out += [(f"{term.name.upper()}_{name}", value) for name, value in term.defines]
                 out += [(surface_define(term.name, param), str(INPUT_MODES.index(mode) + 1)) for param, mode in term.inputs]
         return out
 
     def library_chunks(self):
-        """Library chunks the terms use, in first-use order."""
-        return tuple(dict.fromkeys(c for t in self.terms for c in t.uses))
+        """Library chunks the light kinds and the terms use, in first-use order."""
+        return tuple(dict.fromkeys([c for k in self.lights for c in k.uses] + [c for t in self.terms for c in t.uses]))
 
     def shading_chunks(self):
         """Chunks that define ``shade_point()`` and what it calls: only those the key needs."""
         chunks = ["common"]
-        if self.num_point_lights:
-            chunks.append("lights")
         chunks += self.library_chunks()
         chunks += ["surface"] if self.textured_inputs else []
         chunks += [t.chunk for t in self.terms]
-        chunks += [MATERIAL_CHUNK, "shade"]
+        chunks += [MATERIAL_CHUNK] + [k.chunk for k in self.lights] + ["shade"]
+        chunks += [LIGHTS_CHUNK] if self.lights else []
         return tuple(chunks)
 
     def vertex_chunks(self):
@@ -281,7 +340,10 @@ class ProgramKey:
         """Text of the chunks generated from the key (label -> GLSL)."""
         if self.output == "gbuffer":
             return {LOD_CHUNK: lod_chunk(self)} if self.lod_textures else {}
-        return {MATERIAL_CHUNK: material_chunk(self)}
+        out = {MATERIAL_CHUNK: material_chunk(self)}
+        if self.lights and self.output != "response":
+            out[LIGHTS_CHUNK] = lights_chunk(self)
+        return out
 
     def varyings(self):
         """Transform-feedback outputs of a 'points' or 'response' program."""
@@ -307,19 +369,24 @@ class ProgramKey:
             out.append(f"term {model.name}: {model_chunk_label(model.name)}{', ' + params if params else ''} ({reason})")
         used = set(self.library_chunks())
 
-        for chunk in LIBRARY_CHUNKS:
+        for chunk in ("lights",) + LIBRARY_CHUNKS:
             if chunk not in used:
-                out.append(f"library chunk {chunk}.glsl (no term of this program calls it)")
+                out.append(f"library chunk {chunk}.glsl (no term or light kind of this program calls it)")
         if not self.needs_view:
             out.append("view vector v = normalize(eye - x) and u_eye (no lit term reads it)")
         if not self.has_ka:
             out.append("constant term k_a (ka = 0)")
         if not self.has_ambient:
             out.append("ambient light L_a and u_ambient (no AmbientLight, or no term answers it)")
-        for kind in LIGHT_KINDS:
-            if not getattr(self, f"num_{kind}_lights"):
-                extra = " and lights.glsl" if kind == "point" else ""
-                out.append(f"{kind}-light loop, its uniform arrays{extra} (no {kind} light reaches this material)")
+        present = {k.name: k for k in self.lights}
+        for kind in registered_lights():
+            if kind.name not in present:
+                out.append(f"{kind.name}-light loop, its chunk {kind.source_label()} and uniform arrays "
+                           f"(no {kind.name} light reaches this material)")
+            else:
+                given = {name for name, _ in present[kind.name].defines}
+                out += [f"{kind.name} lights' {what} (no {kind.name} light of the scene needs it)"
+                        for name, what in kind.optional_code if name not in given]
         if not self.has_normal:
             out.append("normal attribute, its upload and the normal matrix (nothing reads a normal)")
         if not self.two_sided:
@@ -336,17 +403,17 @@ class ProgramKey:
         return out
 
     def describe(self):
-        """One line naming every field that is set, e.g. ``radiance terms=lambert[lit]+phong_lobe[lit] num_point_lights=2``."""
+        """One line naming every field that is set, e.g. ``radiance terms=lambert[lit]+phong_lobe[lit] lights=point*2``."""
         if self.uber:
             return (f"{self.output} uber (terms {'+'.join(t.name for t in self.terms) or 'none'}, "
-                    f"{UBER_MAX_LIGHTS} lights per kind, switched by uniforms)"
+                    f"{UBER_MAX_LIGHTS} lights of each of {'+'.join(k.name for k in self.lights)}, switched by uniforms)"
                     f"{'' if self.formulation == 'stable' else ' formulation=' + self.formulation}")
         parts = [self.output]
         for f in fields(self):
             v = getattr(self, f.name)
-            if f.name == "terms":
+            if f.name in ("terms", "lights"):
                 if v:
-                    parts.append("terms=" + "+".join(t.describe() for t in v))
+                    parts.append(f"{f.name}=" + "+".join(t.describe() for t in v))
             elif f.name != "output" and v not in (False, 0, None, "stable"):
                 parts.append(f.name if v is True else f"{f.name}={v}")
         return " ".join(parts)
@@ -388,14 +455,15 @@ def response_key(material):
                       has_uv="uv" in needs, two_sided=False)
 
 
-def program_key(material, light_counts, ambient_radiance, output="radiance", gbuffer_needs=None):
+def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_needs=None):
     """The program key of one material in a scene.
 
     Parameters
     ----------
     material : glphong.materials.Material
-    light_counts : dict of str to int
-        Number of lights per kind ('point', 'unattenuated', 'directional').
+    lights : sequence of LightModel, or tuple of LightKey, or dict of str to int
+        The scene's lights (`light_keys` of them), their keys, or a number of lights per kind name
+        (``{'point': 1}``: no structural defines).
     ambient_radiance : tuple of 3 float or None
         The scene's ``L_a``.
     output : {'radiance', 'gbuffer', 'points', 'display'}
@@ -407,26 +475,24 @@ def program_key(material, light_counts, ambient_radiance, output="radiance", gbu
     ProgramKey
     """
     if output == "gbuffer":
-        textured = program_key(material, light_counts, ambient_radiance).textured_inputs
+        textured = program_key(material, lights, ambient_radiance).textured_inputs
         if len(textured) > MAX_TEXTURED_INPUTS:
             raise ValueError(f"a material may texture at most {MAX_TEXTURED_INPUTS} parameters (the G-buffer holds one "
                              f"level of detail per texture); {type(material).__name__} textures {len(textured)}")
         return gbuffer_key(material, gbuffer_needs or (), len(textured))
     # lights matter only to a material with a term that reflects them
-    lit = sum(light_counts.values()) > 0 and any(not t.vanishes() for t in material.components)
+    lights = _as_light_keys(lights)
+    lit = bool(lights) and any(not t.vanishes() for t in material.components)
     terms = term_keys(material, lit, _ambient_present(ambient_radiance))
     needs = {n for t in terms if t.lit for n in t.needs}
     modes = [mode for t in terms for _, mode in t.inputs]
     if output == "points":
         _refuse_surface_inputs(terms, "shading at given points has no texture coordinates or vertex colours")
-    count = lambda kind: light_counts.get(kind, 0) if lit else 0  # noqa: E731
     return ProgramKey(
         output=output,
         terms=terms,
         has_ka=any(c > 0.0 for c in material.ka),
-        num_point_lights=count("point"),
-        num_unattenuated_lights=count("unattenuated"),
-        num_directional_lights=count("directional"),
+        lights=lights if lit else (),
         has_normal=lit,
         has_tangent="tangent" in needs,
         has_uv="uv" in needs or any("texture" in m for m in modes),
@@ -461,14 +527,17 @@ def _uber_builtins():
     return cached
 
 
-def uber_key(materials, output="radiance", formulation="stable", shade_per_vertex=False):
+def uber_key(materials, output="radiance", formulation="stable", shade_per_vertex=False, lights=()):
     """The uber-shader's key: every built-in model that needs no more than the view vector, every
-    term of ``materials``, and `UBER_MAX_LIGHTS` lights of each kind, switched at run time by uniforms.
+    term of ``materials``, and `UBER_MAX_LIGHTS` lights of each built-in kind (``in_uber``) and of each kind of
+    ``lights``, with every optional part of their code, switched at run time by uniforms.
 
     Parameters
     ----------
     materials : sequence of glphong.materials.Material
         The materials drawn with it (a scene's); their terms are all compiled in.
+    lights : sequence of LightModel
+        The scene's lights: their kinds join the built-in ones.
     """
     terms = {}
     drawn = [term for material in materials for term in material.components]
@@ -487,9 +556,11 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
                              f"{term.name!r} (defines {known.defines} and {key.defines}, or two definitions): "
                              "render it with specialise=True")
     needs = {n for t in terms.values() for n in t.needs}
+    kinds = {type(light).name for light in lights}
+    uber_lights = tuple(LightKey(k.name, k.source_hash(), UBER_MAX_LIGHTS, tuple((name, "1") for name, _ in k.optional_code),
+                                 tuple(k.uses)) for k in registered_lights() if k.in_uber or k.name in kinds)
     return ProgramKey(output=output, terms=tuple(terms[name] for name in sorted(terms)), has_ka=True,
-                      num_point_lights=UBER_MAX_LIGHTS, num_unattenuated_lights=UBER_MAX_LIGHTS,
-                      num_directional_lights=UBER_MAX_LIGHTS, has_normal=True, has_tangent="tangent" in needs,
+                      lights=uber_lights, has_normal=True, has_tangent="tangent" in needs,
                       has_uv="uv" in needs, two_sided=True, formulation=formulation, uber=True,
                       shade_per_vertex=shade_per_vertex)
 

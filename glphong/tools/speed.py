@@ -34,7 +34,7 @@ import numpy as np
 
 from glphong.scene import primitives
 from glphong.scene.camera import PerspectiveCamera
-from glphong.scene.lights import AmbientLight, PointLight
+from glphong.lights import AmbientLight, PointLight
 from glphong.materials.blinn import BlinnPhong
 from glphong.materials.lambert import Lambert
 from glphong.materials.phong import Phong

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = [
-    "ShadingFrame", "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "log_one_minus",
+    "ShadingFrame", "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "log_one_minus",
     "lobe_from_delta", "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
     "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "light_term", "FLT_MAX", "FRAME_PARALLEL_LIMIT",
 ]
@@ -157,6 +157,28 @@ def point_irradiance(intensity, d):
     d = np.asarray(d)[..., None]
     with np.errstate(over="ignore", under="ignore"):
         return np.minimum((intensity / d) / d, FLT_MAX)
+
+
+def range_window(d, range_):
+    """KHR_lights_punctual's range window ``clamp(1 - (d/range)^4, 0, 1)`` in lights.glsl's factored form
+    ``clamp(((range - d)/range) (1 + t) (1 + t^2), 0, 1)``, ``t = d/range``.
+
+    Parameters
+    ----------
+    d : (...) ndarray
+        Distance [m].
+    range_ : () or (...) ndarray
+        The light's range [m], > 0.
+
+    Returns
+    -------
+    (...) ndarray
+        The window, in [0, 1].
+    """
+    d = np.asarray(d)
+    with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
+        t = d / range_
+        return np.clip(((range_ - d) / range_) * (1 + t) * (1 + t * t), 0, 1)
 
 
 # --------------------------------------------------------------------------- lobe.glsl

@@ -1,0 +1,13 @@
+// lights/unattenuated.glsl -- the lecture's assignment light: a position and a value L_i used as E at every
+// distance (docs/design.md E2, section 12; glphong/lights/unattenuated.py).
+//
+// unattenuated_incident(x, j, out wi, out E) -> valid
+//   wi = (p_j - x) / |p_j - x|  by safe_normalize;  E = L_i,j [W/m^2], no falloff.
+
+bool unattenuated_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)
+{
+    float d;
+    bool valid = safe_normalize(u_unattenuated_position[j] - x, wi, d);
+    irradiance = u_unattenuated_radiance[j];
+    return valid;
+}
