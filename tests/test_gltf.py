@@ -8,7 +8,7 @@ their nodes to the JSON (nothing is downloaded).
   a camera is found by name, an unknown name is refused naming the cameras.
 - Point light of 683 cd, colour (1, 0.5, 0.25): ``Phi = 4 pi colour`` photometric, ``4 pi 683 colour``
   radiometric; a directional light of 683 lux travels along its node's -Z with ``E = colour`` (photometric).
-- Lights without ``light_units`` and spot lights are refused with what to do.
+- Lights without ``light_units`` are refused with what to do; spot lights load as `glphong.SpotLight`.
 - ``baseColorFactor`` 0.123457 (not an 8-bit colour) reaches the material exactly; the scene passes verify;
   a ``.glb``'s JSON chunk is read; ``glphong render FILE.gltf --light-units --camera`` renders it.
 """
@@ -42,7 +42,8 @@ def _document(tmp_path, spot=False):
     lights = [{"type": "point", "color": [1.0, 0.5, 0.25], "intensity": 683.0, "name": "bulb"},
               {"type": "directional", "color": [0.5, 0.5, 0.5], "intensity": 683.0, "name": "sun"}]
     if spot:
-        lights.append({"type": "spot", "name": "torch", "spot": {}})
+        lights.append({"type": "spot", "name": "torch", "color": [1.0, 1.0, 0.5], "intensity": 1366.0, "range": 7.5,
+                       "spot": {"innerConeAngle": 0.25, "outerConeAngle": 0.5}})
     document["extensions"] = {"KHR_lights_punctual": {"lights": lights}}
     document["extensionsUsed"] = ["KHR_lights_punctual"]
     half = math.sqrt(0.5)
@@ -50,7 +51,8 @@ def _document(tmp_path, spot=False):
                  {"name": "bulb", "translation": [2.0, 3.0, 4.0], "extensions": {"KHR_lights_punctual": {"light": 0}}},
                  {"name": "sun", "rotation": [-half, 0.0, 0.0, half], "extensions": {"KHR_lights_punctual": {"light": 1}}}]
     if spot:
-        new_nodes.append({"name": "torch", "extensions": {"KHR_lights_punctual": {"light": 2}}})
+        new_nodes.append({"name": "torch", "translation": [0.0, 1.0, 2.0], "rotation": [-half, 0.0, 0.0, half],
+                          "extensions": {"KHR_lights_punctual": {"light": 2}}})
     first = len(document["nodes"])
     document["nodes"] += new_nodes
     document["scenes"][document.get("scene", 0)]["nodes"] += list(range(first, first + len(new_nodes)))
@@ -93,13 +95,23 @@ def test_glb_and_named_camera(tmp_path):
 def test_refusals(tmp_path):
     with pytest.raises(ValueError, match="light_units='photometric'"):
         glphong.load_scene(_document(tmp_path))
-    spot = tmp_path / "spot"
-    spot.mkdir()
-    with pytest.raises(ValueError, match="'torch' is a spot light"):
-        glphong.load_scene(_document(spot, spot=True), light_units="photometric")
     (tmp_path / "bad.glb").write_bytes(b"glTF\x02\x00\x00\x00")
     with pytest.raises(ValueError, match="truncated glTF binary"):
         glphong.load_scene(tmp_path / "bad.glb")
+
+
+def test_spot_light_loads_in_both_unit_modes(tmp_path, glphong_backend, glphong_make_renderer):
+    """A KHR_lights_punctual spot light: position and -Z of its node, cone angles and range as written, intensity in
+    candela / 683 (photometric) or as W/sr (radiometric)."""
+    path = _document(tmp_path, spot=True)
+    for units, scale in (("photometric", 1.0 / 683.0), ("radiometric", 1.0)):
+        scene = glphong.load_scene(path, light_units=units)
+        (spot,) = [light for light in scene.lights if isinstance(light, glphong.SpotLight)]
+        np.testing.assert_allclose(spot.position, [0.0, 1.0, 2.0], atol=1e-12)
+        np.testing.assert_allclose(spot.direction, [0.0, -1.0, 0.0], atol=1e-12)
+        np.testing.assert_allclose(spot.intensity, 1366.0 * scale * np.array([1.0, 1.0, 0.5]), rtol=1e-15)
+        assert (spot.inner_cone_angle, spot.outer_cone_angle, spot.range) == (0.25, 0.5, 7.5)
+    assert glphong.verify(scene, glphong_make_renderer(48, 32, glphong_backend)).passed
 
 
 def test_cli_render_gltf(tmp_path, capsys):

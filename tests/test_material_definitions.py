@@ -121,7 +121,7 @@ def test_a_bad_definition_fails_when_the_class_is_defined(attrs, message):
 
 @pytest.mark.parametrize("kwargs, message", [
     ({"name": "k", "kind": "rgb"}, r"Param 'k' has no range: give low= and/or high="),
-    ({"name": "k", "kind": "vec3", "low": 0.0}, r"kind must be one of 'scalar', 'rgb'"),
+    ({"name": "k", "kind": "vec4", "low": 0.0}, r"kind must be one of 'scalar', 'rgb', 'vec3', 'direction'"),
     ({"name": "Ks", "kind": "rgb", "low": 0.0}, r"lowercase identifier"),
     ({"name": "ka", "kind": "rgb", "low": 0.0}, r"keyword every material takes"),
     ({"name": "m", "kind": "scalar", "low": 2.0, "high": 1.0}, r"low must be below high"),

@@ -64,8 +64,18 @@ def test_light_units(measured):
     np.testing.assert_allclose(m["ambient"], 0.03, rtol=1e-7)
 
 
+def test_spot_light_maps(measured):
+    """pyrender's SpotLight: cd taken as W/sr along the node's -Z axis, its cone angles as given."""
+    _, m = measured
+    spot = m["spot"]
+    assert spot["kind"] == "SpotLight"
+    np.testing.assert_allclose(spot["position"], [1.0, 2.0, 3.0])
+    np.testing.assert_allclose(spot["direction"], [0.0, 0.0, -1.0], atol=1e-12)
+    np.testing.assert_allclose(spot["intensity"], 2.0 * np.array([1.0, 0.5, 0.25]), rtol=1e-7)
+    np.testing.assert_allclose(spot["cones"], [0.2, 0.7], rtol=1e-7)
+
+
 def test_refusals_name_the_problem(measured):
     _, m = measured
-    assert "SpotLight" in m["spot"] and "point and directional" in m["spot"]
     assert "cannot be instanced" in m["instanced"]
     assert "not enabled on" in m["not_enabled"] and "enable(renderer)" in m["not_enabled"]

@@ -149,4 +149,4 @@ def test_cli_describe_default_scene():
     assert "terms=lambert[lit,ambient]+phong_lobe[lit]" in out.stdout, out.stdout
     assert "terms=lambert[lit,ambient]+blinn_lobe[lit]" in out.stdout and "gbuffer" in out.stdout
     assert re.search(r"fragment chunks: common lights lobe model:lambert@\w{12} model:phong_lobe@\w{12} "
-                     r"generated:material shade", out.stdout), out.stdout
+                     r"generated:material light:point@\w{12} shade generated:lights", out.stdout), out.stdout

@@ -26,6 +26,20 @@ def test_suite_covers_what_the_issue_lists():
         assert needle in names, needle
 
 
+def _light_input_sensitivity(key, u64, frame, n_valid, material, twin):
+    """The largest relative change of the twin when one light uniform moves by one float32 rounding (2^-24)."""
+    worst = 0.0
+    names = [name for light in key.lights for name in u64 if name.startswith(f"u_{light.name}_")]
+    for name in names:
+        for sign in (1.0, -1.0):
+            moved = dict(u64, **{name: u64[name] * (1.0 + sign * 2.0 ** -24)})
+            value = ref.shade_point(np.zeros((1, 3)), frame, n_valid, moved.get("u_eye"), key, moved, material)[0]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                change = np.nan_to_num(np.abs(value - twin) / np.abs(twin), nan=0.0, posinf=0.0)
+            worst = max(worst, float(np.max(change)))
+    return worst
+
+
 def test_float64_twin_agrees_with_the_mpmath_oracle():
     """On every case inside the valid range the twin, shading the uniforms, agrees with the oracle, which
     reads the constructors: to one float32 rounding of the inputs."""
@@ -40,9 +54,12 @@ def test_float64_twin_agrees_with_the_mpmath_oracle():
         expected = oracle(case_scene(case), case.normal, tangent=case.tangent, uv=case.uv)
         if case.in_range:
             # the oracle rounds the constructors' values to float32; the uniforms are derived in float64
-            # first (I = Phi / (4 pi), a unit direction) and then rounded: one float32 rounding apart,
-            # measured at most 4.8e-8 relative (power 3e38 W)
-            np.testing.assert_allclose(twin, expected, rtol=1e-7, atol=0, err_msg=case.name)
+            # first (I = Phi / (4 pi), a unit direction, a spot light's 1 - cos(outer)) and then rounded: one
+            # float32 rounding apart, measured at most 4.8e-8 relative (power 3e38 W) where the value is not
+            # more sensitive to its light's inputs than to a product's; near a spot light's cone edge or its range
+            # it is (the falloff's slope), and the tolerance grows by the twin's own change under that rounding
+            sensitivity = _light_input_sensitivity(key, u64, frame, n_valid, case.material, twin)
+            np.testing.assert_allclose(twin, expected, rtol=1e-7 + 2 * sensitivity, atol=0, err_msg=case.name)
             checked += 1
     assert checked > 80
 

@@ -311,7 +311,7 @@ def test_directional_light_valid_values_are_normalised():
     assert glphong.DirectionalLight((0.0, 0.0, -5e-324), 1.0).direction == (0.0, 0.0, -1.0)
     d = glphong.DirectionalLight((FLT_MAX, FLT_MAX, 0.0), 1.0).direction
     np.testing.assert_allclose(d, (math.sqrt(0.5), math.sqrt(0.5), 0.0), rtol=1e-15)
-    assert light.uniform_row()[0] == (0.0, 0.0, 1.0)
+    assert light.uniform_value("towards") == (0.0, 0.0, 1.0)
 
 
 @pytest.mark.parametrize("radiance, error, text", [
@@ -460,14 +460,15 @@ def test_scene_ambient_wrong_type(camera, bad):
 @pytest.mark.parametrize("bad", [glphong.AmbientLight(1.0), "light", None, (0.0, 0.0, 1.0), glphong.PointLight])
 def test_scene_bad_light_in_list(camera, bad):
     good = glphong.PointLight((0.0, 0.0, 1.0), 1.0)
-    with pytest.raises(TypeError, match=m("lights[1] must be a PointLight, UnattenuatedPointLight or DirectionalLight",
+    with pytest.raises(TypeError, match=m("lights[1] must be one of the glphong lights (PointLight, SpotLight, DirectionalLight, "
+                                          "UnattenuatedPointLight or a LightModel of yours)",
                                           f"got {type(bad).__name__}")):
         glphong.Scene(camera, lights=[good, bad])
 
 
 @pytest.mark.parametrize("bad", [glphong.PointLight((0, 0, 0), 1.0), None, 5, "lights"])
 def test_scene_lights_not_a_sequence(camera, bad):
-    with pytest.raises(TypeError, match=m("lights must be a sequence of PointLight, UnattenuatedPointLight or "
+    with pytest.raises(TypeError, match=m("lights must be a sequence of glphong lights (PointLight, SpotLight, "
                                           "DirectionalLight", f"got {type(bad).__name__}")):
         glphong.Scene(camera, lights=bad)
 
@@ -480,10 +481,10 @@ class _DuckLight:
 @pytest.mark.parametrize("bad", [glphong.AmbientLight(1.0), None, _DuckLight(), "point"])
 def test_scene_add_light_wrong_type(camera, bad):
     scene = glphong.Scene(camera, lights=[glphong.DirectionalLight((0, 0, -1), 1.0)])
-    with pytest.raises(TypeError, match=m("light must be a PointLight, UnattenuatedPointLight or DirectionalLight",
+    with pytest.raises(TypeError, match=m("light must be one of the glphong lights (PointLight, SpotLight, DirectionalLight",
                                           f"got {type(bad).__name__}")):
         scene.add_light(bad)
-    assert len(scene.lights) == 1 and scene.light_counts() == {"point": 0, "unattenuated": 0, "directional": 1}
+    assert len(scene.lights) == 1 and scene.light_counts() == {"point": 0, "unattenuated": 0, "directional": 1, "spot": 0}
 
 
 def test_scene_valid_lights(camera):

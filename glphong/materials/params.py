@@ -154,8 +154,10 @@ class Param:
             return _validate.vec3(self.name, value)
         if self.kind == "direction":
             return _validate.unit_vec3(self.name, value)
-        low = max(self.low, -_validate.FLT_MAX)
-        high = min(self.high, _validate.FLT_MAX)
+        # an infinite end means "as far as float32 goes"; a finite one beyond FLT_MAX (a light's power, 4 pi
+        # FLT_MAX, of which the GPU receives the intensity) is kept
+        low = self.low if np.isfinite(self.low) else -_validate.FLT_MAX
+        high = self.high if np.isfinite(self.high) else _validate.FLT_MAX
         low_inclusive = self.low_inclusive or self.low < -_validate.FLT_MAX
         high_inclusive = self.high_inclusive or self.high > _validate.FLT_MAX
         if self.kind == "rgb":

@@ -300,13 +300,17 @@ class ProgramKey:
         return out
 
     def library_chunks(self):
-        """Library chunks the light kinds and the terms use, in first-use order."""
-        return tuple(dict.fromkeys([c for k in self.lights for c in k.uses] + [c for t in self.terms for c in t.uses]))
+        """Library chunks the terms use, in first-use order."""
+        return tuple(dict.fromkeys(c for t in self.terms for c in t.uses))
+
+    def light_library_chunks(self):
+        """Library chunks the light kinds use and the terms do not, in first-use order."""
+        return tuple(c for c in dict.fromkeys(c for k in self.lights for c in k.uses) if c not in self.library_chunks())
 
     def shading_chunks(self):
         """Chunks that define ``shade_point()`` and what it calls: only those the key needs."""
         chunks = ["common"]
-        chunks += self.library_chunks()
+        chunks += self.light_library_chunks() + self.library_chunks()
         chunks += ["surface"] if self.textured_inputs else []
         chunks += [t.chunk for t in self.terms]
         chunks += [MATERIAL_CHUNK] + [k.chunk for k in self.lights] + ["shade"]
@@ -367,7 +371,7 @@ class ProgramKey:
         for model, reason in absent_terms:
             params = ", ".join(model.uniform_name(p.name) for p in model.params + model.tables)
             out.append(f"term {model.name}: {model_chunk_label(model.name)}{', ' + params if params else ''} ({reason})")
-        used = set(self.library_chunks())
+        used = set(self.library_chunks() + self.light_library_chunks())
 
         for chunk in ("lights",) + LIBRARY_CHUNKS:
             if chunk not in used:
