@@ -4,6 +4,8 @@
   scene (a vertex program captured by transform feedback), or its numpy twin on the same inputs;
 - `assert_twin_matches`: seeded random and edge direction sets, GPU against the twin under the
   tolerance band, with a failure message ready to paste into a regression test;
+- `assert_light_matches`: a light kind's GLSL against its twin at seeded points (`light_points`), through the
+  real shader, under the tolerance band;
 - `assert_render_matches`: the image-level cross-check (`glphong.verify`) as an assertion;
 - a pytest plugin: ``pytest_plugins = ["glphong.testing"]`` in a ``conftest.py`` gives the fixtures
   `glphong_backend` (each backend; a missing one skips with its reason unless
@@ -25,13 +27,20 @@ import numpy as np
 
 from glphong.checks.evaluate import (_gpu, _inputs, _twin, cosine_power_interval, direction,  # noqa: F401
                                      direction_sets, evaluate, float32_units, frame_around, rotate_toward)
-from glphong.checks.tolerances import BAND, EPS, response_band
+from glphong.checks import reference as ref
+from glphong.checks.probe import shade_points
+from glphong.checks.stability import case_inputs
+from glphong.checks.tolerances import BAND, EPS, point_band, response_band
 from glphong.checks.verify import verify
 from glphong.gpu.contexts import BACKENDS, BackendUnavailableError, create_context
+from glphong.gpu.programs import ProgramCache
 from glphong.gpu.renderer import Renderer
+from glphong.materials.cases import Case
+from glphong.materials.lambert import Lambert
 from glphong.shaders.key import response_key
 
-__all__ = ["evaluate", "direction_sets", "assert_twin_matches", "assert_render_matches", "TwinMismatch",
+__all__ = ["evaluate", "direction_sets", "assert_twin_matches", "assert_render_matches", "assert_light_matches",
+           "light_points", "TwinMismatch",
            "frame_around", "direction", "rotate_toward", "float32_units", "cosine_power_interval",
            "require_backend", "renderer_factory"]
 
@@ -149,6 +158,94 @@ def assert_render_matches(scene, renderer, band=BAND, worst=5):
             lines.append(f"  pixel (row {j}, col {i}): gpu {_literal(report.gpu[j, i])}, twin {_literal(report.reference[j, i])}, "
                          f"band ({_literal(report.low[j, i])}, {_literal(report.high[j, i])})")
     raise AssertionError("\n".join(lines))
+
+
+def light_points(light, n=2000, seed=0):
+    """Seeded test points for a light (N, 3) float32: for a kind with a ``position``, directions uniform on the
+    sphere about it at distances ``10^U(-3, 3)`` m (its whole cone included, whatever its axis); otherwise
+    uniform in ``[-10, 10]^3`` m."""
+    rng = np.random.default_rng(seed)
+    if hasattr(light, "position") and light.position is not None:
+        directions = rng.normal(size=(n, 3))
+        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+        distances = 10.0 ** rng.uniform(-3.0, 3.0, n)
+        return (np.asarray(light.position) + directions * distances[:, None]).astype(np.float32)
+    return rng.uniform(-10.0, 10.0, (n, 3)).astype(np.float32)
+
+
+def assert_light_matches(light, points=None, n=2000, seed=0, backend="auto", band=BAND, context=None, worst=5):
+    """Assert that a light's GLSL ``<kind>_incident`` agrees with its twin's ``incident`` at given points.
+
+    The light shines on a point of the lecture's Lambert term with ``k_d = 1`` whose normal is the twin's ``wi``,
+    so the GPU's ``shade_point`` returns ``E (n.wi)``, about ``E``: through the real shader (a 'points' program,
+    `glphong.checks.probe.shade_points`), judged in the tolerance band (the kind's ``band``).  Points the twin
+    says the light does not reach must give 0 (or a value in the band where the gate is uncertain).
+
+    Parameters
+    ----------
+    light : glphong.lights.LightModel
+        Any light, built-in or user-defined.
+    points : (N, 3) array_like, optional
+        World-space points [m] (default `light_points`).
+    n, seed : int
+        For the default points.
+    backend, band, context, worst
+        As in `assert_twin_matches`.
+
+    Returns
+    -------
+    dict
+        ``points``, ``lit`` (points with a non-zero twin), ``max_relative_error`` and ``max_band_width`` over the
+        lit points whose band is clear of 0.
+
+    Raises
+    ------
+    TwinMismatch
+        Listing the worst points with both values and the band, paste-ready.
+    """
+    points = light_points(light, n, seed) if points is None else np.ascontiguousarray(points, dtype=np.float32)
+    material = Lambert(1.0, two_sided=False)
+    key, uniforms = case_inputs(Case("light", "light", material, lights=(light,)))
+    kind = type(light)
+    p = kind.values_from_uniforms(uniforms, 0, np.float64, key.lights[0].defines)
+    valid, wi, _ = kind.twin().incident(points.astype(np.float64), p)
+    normals = np.where(np.asarray(valid)[:, None], np.nan_to_num(wi), (0.0, 0.0, 1.0)).astype(np.float32)
+    gl = context or create_context(backend)
+    programs = ProgramCache(gl.mgl)
+    try:
+        gpu = shade_points(gl, programs, key, uniforms, points, normals).astype(np.float64)
+    finally:
+        with gl:
+            programs.release()
+        if context is None:
+            gl.release()
+    u64 = {k: np.asarray(v, dtype=np.float64) for k, v in uniforms.items()}
+    n_valid, n64, _ = ref.safe_normalize(normals.astype(np.float64))
+    position = points.astype(np.float64)
+    twin = ref.shade_point(position, n64, n_valid, u64.get("u_eye"), key, u64, material)
+    low, high = point_band(key, u64, position, n64, n_valid, material, band)
+    ok = (gpu >= low) & (gpu <= high) & ~np.isnan(gpu)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        rel = np.where(twin != 0, np.abs(gpu - twin) / np.abs(twin), np.where(gpu == twin, 0.0, np.inf))
+        width = np.where(twin != 0, (high - low) / np.abs(twin), 0.0)
+    decided = (low > 0) & np.isfinite(rel) & np.isfinite(width)
+    figures = {"points": len(points), "lit": int(np.any(twin != 0, axis=1).sum()),
+               "max_relative_error": float(np.max(rel[decided], initial=0.0)),
+               "max_band_width": float(np.max(width[decided], initial=0.0))}
+    bad = ~np.all(ok, axis=1)
+    if not bad.any():
+        return figures
+    span = np.maximum(high - low, np.abs(twin) * EPS + np.finfo(np.float64).tiny)
+    distance = np.where(ok, 0.0, np.nan_to_num(np.maximum(low - gpu, gpu - high) / span, nan=np.inf))
+    order = np.argsort(-np.max(distance, axis=1))[:min(worst, int(bad.sum()))]
+    lines = [f"{type(light).__name__}: the GPU's irradiance left the tolerance band at {int(bad.sum())} of {len(points)} "
+             "points (Lambert k_d = 1, normal toward the light); worst first, paste-ready:"]
+    for i in order:
+        lines.append(f"  x = {_literal(points[i])}; gpu = {_literal(gpu[i])}; twin = {_literal(twin[i])}")
+        lines.append(f"  band = ({_literal(low[i])}, {_literal(high[i])})")
+    lines.append(f"  light = {light!r}")
+    lines.append("  # reproduce: glphong.testing.assert_light_matches(light, points=[x])")
+    raise TwinMismatch("\n".join(lines))
 
 
 # --------------------------------------------------------------------------- pytest plugin

@@ -13,7 +13,7 @@ from glphong.analysis.figures import LIGHT_ANGLES, Q_VALUES, phong_examples, pho
 from glphong.analysis.gallery import render_gallery
 from glphong.analysis.questions import format_properties, properties
 from glphong.batch import BatchError, orbit_scene, render_many
-from glphong.checks.stability import CASES, cases_for, run_stability
+from glphong.checks.stability import CASES, run_stability
 from glphong.checks.verify import verify
 from glphong.core.imaging import save_npy
 from glphong.core.version import __version__
@@ -21,6 +21,7 @@ from glphong.formats.load import load_scene
 from glphong.gpu.contexts import BackendUnavailableError
 from glphong.gpu.describe import describe, format_descriptions
 from glphong.gpu.renderer import Renderer
+from glphong.lights import registered_lights
 from glphong.materials import registered_models
 from glphong.materials.blinn import BlinnPhong
 from glphong.materials.phong import Phong
@@ -150,12 +151,13 @@ def _gallery(args):
 
 
 def _import_models(names):
-    """Import modules (dotted names or .py paths) that define material models; returns the new models."""
+    """Import modules (dotted names or .py paths) that define material models or light kinds; returns the new
+    models and light kinds."""
     import importlib
     import importlib.util
     import os
 
-    before = set(registered_models())
+    before = set(registered_models()) | set(registered_lights())
     for name in names:
         if name.endswith(".py") or os.sep in name:
             spec = importlib.util.spec_from_file_location(os.path.splitext(os.path.basename(name))[0], name)
@@ -166,13 +168,13 @@ def _import_models(names):
             spec.loader.exec_module(module)
         else:
             importlib.import_module(name)
-    return [m for m in registered_models() if m not in before]
+    return [m for m in registered_models() + registered_lights() if m not in before]
 
 
 def _stability(args):
     cases = list(CASES)
-    for model in _import_models(args.imports):
-        cases += cases_for(model)
+    for definition in _import_models(args.imports):
+        cases += list(definition.stability_cases())
     reports = [run_stability(args.backend, "stable", cases=cases)]
     if args.naive:
         reports.append(run_stability(args.backend, "naive", cases=cases))
@@ -396,7 +398,7 @@ def build_parser():
     stability.add_argument("--json", default=None, type=lambda t: t if t == "-" else _writable(t),
                            help="write the table(s) as JSON to this path ('-': stdout only)")
     stability.add_argument("--import", dest="imports", action="append", default=[], metavar="MODULE",
-                           help="import a module (dotted name or .py path) defining material models and add "
+                           help="import a module (dotted name or .py path) defining material models or light kinds and add "
                                 "their stability cases (repeatable)")
     stability.set_defaults(func=_stability)
     gallery = sub.add_parser("gallery", help="render one sphere per reflectance model under the same lights")
