@@ -23,6 +23,7 @@ _ARGUMENTS = {
     "fresnel_grazing": lambda out: [str(out / "fresnel_grazing.png")],
     "textured_scene": lambda out: [str(out)],
     "custom_material": lambda out: [str(out / "custom_material.png")],
+    "custom_light": lambda out: [str(out / "custom_light.png")],
     "model_scene": lambda out: [str(EXAMPLES / "data" / "torus.obj"), str(out / "model_scene.png")],
     "pyrender_scene": lambda out: ["egl", str(out / "pyrender_scene.png")],
     "batch_turntable": lambda out: ["8", str(out)],

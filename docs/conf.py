@@ -87,7 +87,7 @@ myst_enable_extensions = ["colon_fence"]
 sphinx_gallery_conf = {
     "examples_dirs": [str(HERE.parent / "examples")],
     "gallery_dirs": ["auto_examples"],
-    "filename_pattern": r"[\\/](tutorial|phong_examples|textured_scene|fresnel_grazing)\.py$",
+    "filename_pattern": r"[\\/](tutorial|phong_examples|textured_scene|fresnel_grazing|custom_light)\.py$",
     "ignore_pattern": r"__init__\.py",
     "within_subsection_order": "_gallery.order",
     "image_scrapers": ("matplotlib", "_gallery.png_scraper"),

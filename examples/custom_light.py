@@ -121,7 +121,7 @@ def main(out_path=None, size=(320, 240)):
         worst = float(np.max(np.abs(got[bright] - expected[bright]) / expected[bright]))
         print(f"floor against E = I0 cos(theta)^n / d^2: {int(bright.sum())} values, largest relative error {worst:.2g}")
         if out_path:
-            renderer.render(lit).save_png(out_path, exposure=2.0)
+            renderer.render(lit).save_png(out_path, exposure=1.0)
             print("wrote", out_path)
     return report, worst
 

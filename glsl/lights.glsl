@@ -1,5 +1,5 @@
 // lights.glsl -- library of the light kinds: irradiance of a point source and the glTF range window
-// (docs/design.md E1, section 12).
+// (docs/design.md E1, section 11).
 //
 // point_irradiance(intensity, d) -> E           E1:  E = Phi / (4 pi d^2)
 //   evaluated as min((I / d) / d, FLT_MAX) with I = Phi / (4 pi) [W/sr] computed on the host in

@@ -13,7 +13,7 @@
 //   times an irradiance of 0 would be NaN): a select, no branch.
 // The loops over the lights are generated from the key (generated:lights, glphong/shaders/generated.py):
 // one loop of compile-time length per light kind present, calling the kind's <kind>_incident(x, j, wi, E)
-// (glsl/lights/<kind>.glsl, docs/design.md section 12); a kind the scene lacks has no loop and no chunk.
+// (glsl/lights/<kind>.glsl, docs/design.md section 11); a kind the scene lacks has no loop and no chunk.
 // Light j contributes nothing unless n.l_j > 0 (and its direction normalises): every light's term is
 // computed and the gate selects it, without a branch.  llvmpipe (and a GPU's SIMD group) runs both sides
 // of a branch under a mask, so an `if`/`continue` saves nothing and costs control flow; written as

@@ -77,7 +77,7 @@ def test_lambert_point_band_closed_form(n_dot_l):
     (the last factor: one term in the sum)."""
     kd, e = 0.25, 3.0
     s = math.sqrt(1.0 - n_dot_l * n_dot_l)
-    u = {"u_lambert_kd": np.full(3, kd), "u_directional_direction": np.array([[s, 0.0, n_dot_l]]),
+    u = {"u_lambert_kd": np.full(3, kd), "u_directional_towards": np.array([[s, 0.0, n_dot_l]]),
          "u_directional_irradiance": np.full((1, 3), e)}
     low, high = tolerances.point_band(lambert_key(), u, np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]),
                                       np.array([True]), LAMBERT)
@@ -106,14 +106,14 @@ def test_gate_accepts_either_side_only_within_d_eps():
     kd, e = 0.25, 1.0
     for n_dot_l, low_is_zero in ((0.5 * D * EPS, True), (-0.5 * D * EPS, True), (4 * D * EPS, False)):
         s = math.sqrt(1.0 - n_dot_l * n_dot_l)
-        u = {"u_lambert_kd": np.full(3, kd), "u_directional_direction": np.array([[s, 0.0, n_dot_l]]),
+        u = {"u_lambert_kd": np.full(3, kd), "u_directional_towards": np.array([[s, 0.0, n_dot_l]]),
              "u_directional_irradiance": np.full((1, 3), e)}
         low, high = tolerances.point_band(lambert_key(), u, np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]),
                                           np.array([True]), LAMBERT)
         assert (low[0] == 0).all() == low_is_zero, n_dot_l
         np.testing.assert_allclose(high[0], kd * (n_dot_l + D * EPS) * e * (1 + A * EPS) * (1 + EPS), rtol=1e-12)
     # a light clearly behind the surface: nothing is accepted
-    u = {"u_lambert_kd": np.full(3, kd), "u_directional_direction": np.array([[0.6, 0.0, -0.8]]),
+    u = {"u_lambert_kd": np.full(3, kd), "u_directional_towards": np.array([[0.6, 0.0, -0.8]]),
          "u_directional_irradiance": np.full((1, 3), e)}
     low, high = tolerances.point_band(lambert_key(), u, np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([True]),
                                       LAMBERT)

@@ -1,4 +1,4 @@
-"""Lights as open definitions (docs/design.md section 12): `LightModel` and the built-in kinds, defined with it.
+"""Lights as open definitions (docs/design.md section 11): `LightModel` and the built-in kinds, defined with it.
 
 A kind is one module and one GLSL chunk (``glsl/lights/<name>.glsl``); the program key counts the lights of
 each kind generically, and the shader's loop over each present kind is generated (`glphong.shaders.generated`).

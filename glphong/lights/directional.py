@@ -1,4 +1,4 @@
-"""The kind 'directional': a light at infinity, constant direction and irradiance (docs/design.md section 12;
+"""The kind 'directional': a light at infinity, constant direction and irradiance (docs/design.md section 11;
 GLSL: ``glsl/lights/directional.glsl``).  glTF's and pyrender's directional lights."""
 import mpmath
 import numpy as np

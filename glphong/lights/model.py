@@ -1,4 +1,4 @@
-"""The light mechanism: a kind of light as an open definition (docs/design.md section 12).
+"""The light mechanism: a kind of light as an open definition (docs/design.md section 11).
 
 One light kind is one `LightModel` subclass, the way one reflectance model is one
 `glphong.materials.MaterialModel`: its parameters (`Param`, with units and ranges), its GLSL

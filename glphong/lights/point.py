@@ -1,4 +1,4 @@
-"""The kind 'point': an isotropic point source given by its power (docs/design.md E1, section 12; GLSL:
+"""The kind 'point': an isotropic point source given by its power (docs/design.md E1, section 11; GLSL:
 ``glsl/lights/point.glsl``).
 
 ``E = Phi / (4 pi d^2)`` at distance ``d``, times KHR_lights_punctual's window

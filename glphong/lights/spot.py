@@ -1,4 +1,4 @@
-"""The kind 'spot': KHR_lights_punctual's spot light (docs/design.md section 12; GLSL: ``glsl/lights/spot.glsl``).
+"""The kind 'spot': KHR_lights_punctual's spot light (docs/design.md section 11; GLSL: ``glsl/lights/spot.glsl``).
 
 A point source of intensity ``I`` [W/sr] along its axis, with the specification's angular falloff
 ``f = clamp(cos(theta) s + o, 0, 1)^2``, ``s = 1 / max(0.001, cos(inner) - cos(outer))``,

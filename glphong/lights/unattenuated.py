@@ -1,5 +1,5 @@
 """The kind 'unattenuated': the lecture's assignment light, a position and a value ``L_i`` used as the
-irradiance at every distance (docs/design.md E2, section 12; GLSL: ``glsl/lights/unattenuated.glsl``).
+irradiance at every distance (docs/design.md E2, section 11; GLSL: ``glsl/lights/unattenuated.glsl``).
 No glTF or pyrender light has it (both always fall off as ``1/d^2``)."""
 import numpy as np
 

@@ -12,7 +12,7 @@ from glphong.scene.camera import Camera
 from glphong.scene.geometry import MeshData
 from glphong.scene.from_trimesh import build_from_trimesh
 from glphong.shaders.key import GBUFFER_PLANES, light_keys, program_key
-from glphong.lights import AmbientLight, LightModel, light_named, registered_lights
+from glphong.lights import AmbientLight, LightModel, light_named
 from glphong.materials import Material
 from glphong.materials.surface import TextureImage
 from glphong.materials.table import TableData
@@ -151,10 +151,8 @@ class Scene:
         return build_from_trimesh(cls, trimesh_scene, camera, lights, ambient, materials, vertex_colors)
 
     def light_counts(self):
-        """Number of lights of every defined kind (0 for a kind the scene lacks), dict of kind name to int, in the
-        shader's loop order."""
-        present = {k.name: k.count for k in self.light_keys()}
-        return {kind.name: present.get(kind.name, 0) for kind in registered_lights()}
+        """Number of lights of each kind the scene has, dict of kind name to int, in the shader's loop order."""
+        return {k.name: k.count for k in self.light_keys()}
 
     def light_keys(self):
         """The `glphong.shaders.key.LightKey` of each kind present (computed once per state of the lights)."""

@@ -85,7 +85,7 @@ def material_chunk(key):
 
 def lights_chunk(key):
     """The generated GLSL of the key's light loops (label ``generated:lights``), one loop per kind present, in
-    `ProgramKey.lights` order (docs/design.md section 12):
+    `ProgramKey.lights` order (docs/design.md section 11):
 
     ``add_lights(radiance, x, f, wo, lit)``: for each light j of kind k,
     ``valid = k_incident(x, j, wi, E)``;  ``radiance += (lit && valid && n.wi > 0) ? light_term(material_response(f,

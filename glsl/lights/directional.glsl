@@ -1,4 +1,4 @@
-// lights/directional.glsl -- a light at infinity (docs/design.md section 12; glphong/lights/directional.py).
+// lights/directional.glsl -- a light at infinity (docs/design.md section 11; glphong/lights/directional.py).
 //
 // directional_incident(x, j, out wi, out E) -> true
 //   wi = the unit vector toward the light (the host negates the direction of travel);  E [W/m^2] constant.

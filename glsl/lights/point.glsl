@@ -1,4 +1,4 @@
-// lights/point.glsl -- the point light (docs/design.md E1, section 12; glphong/lights/point.py).
+// lights/point.glsl -- the point light (docs/design.md E1, section 11; glphong/lights/point.py).
 //
 // point_incident(x, j, out wi, out E) -> valid
 //   wi = (p_j - x) / |p_j - x|  by safe_normalize (valid: the difference is finite and non-zero)

@@ -1,4 +1,4 @@
-// lights/spot.glsl -- the spot light of KHR_lights_punctual (docs/design.md section 12; glphong/lights/spot.py).
+// lights/spot.glsl -- the spot light of KHR_lights_punctual (docs/design.md section 11; glphong/lights/spot.py).
 //
 // spot_incident(x, j, out wi, out E) -> valid
 //   wi = (p_j - x) / d,  d = |p_j - x|                      by safe_normalize

@@ -1,5 +1,5 @@
 // lights/unattenuated.glsl -- the lecture's assignment light: a position and a value L_i used as E at every
-// distance (docs/design.md E2, section 12; glphong/lights/unattenuated.py).
+// distance (docs/design.md E2, section 11; glphong/lights/unattenuated.py).
 //
 // unattenuated_incident(x, j, out wi, out E) -> valid
 //   wi = (p_j - x) / |p_j - x|  by safe_normalize;  E = L_i,j [W/m^2], no falloff.
