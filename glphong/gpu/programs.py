@@ -11,6 +11,7 @@ import moderngl
 import numpy as np
 
 from glphong.shaders.assembly import assemble, name_chunks
+from glphong.gpu.shadows import ShadowMap
 from glphong.gpu.textures import TextureStore
 from glphong.materials.registry import model_for_key
 from glphong.materials.surface import TextureImage
@@ -114,7 +115,7 @@ class Program:
             uniform = self.active.get(name)
             if uniform is None:
                 continue
-            if isinstance(value, (TableData, TextureImage)):
+            if isinstance(value, (TableData, TextureImage, ShadowMap)):
                 if name not in self.samplers or self.textures is None:
                     raise UniformError(f"uniform {name} of program {self.key.describe()!r} is not a sampler of a "
                                        "program with a texture store: it cannot take a table")
@@ -145,9 +146,12 @@ class Program:
         programs use the units too)."""
         last = self._written
         for name, uniform, data in pack:
-            if not isinstance(data, bytes):  # a table
+            if not isinstance(data, bytes):  # a table, or a texture drawn this frame (a shadow map)
                 unit = self.samplers.index(name)
-                self.textures.bind(data, unit)
+                if isinstance(data, ShadowMap):
+                    data.use(unit)
+                else:
+                    self.textures.bind(data, unit)
                 data = np.int32(unit).tobytes()
             if last.get(name) != data:
                 uniform.write(data)

@@ -20,6 +20,7 @@ from glphong.gpu.resources import ORPHANS, ORPHANS_LOCK, MeshBuffers, release_or
 from glphong.gpu.contexts import check_not_forked, create_context
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.key import FORMULATIONS, GBUFFER_PLANES, EncodeKey, uber_key
+from glphong.gpu.shadows import ShadowMaps
 from glphong.gpu.programs import ProgramCache
 from glphong.scene.scene import Scene
 
@@ -103,6 +104,12 @@ class Renderer:
         The EGL device (GPU) to render on, an index of ``eglQueryDevicesEXT``'s list (default 0; EGL
         only; `glphong.gpu.contexts.egl_device_count` says how many there are).  A batch passes it through
         (``render_many(..., device=1)``).
+    shadow_map_size : int
+        Texels along a side of each shadow map (a cube map's face), 16 to 8192 (default 1024); only lights with
+        ``shadows=True`` have maps (docs/design.md section 12).
+    shadow_filter_radius : int
+        Percentage-closer filtering over the (2 r + 1)^2 texels around the nearest, 0 to 8 (default 0: the
+        nearest texel alone, hard shadows).
     specialise : bool
         True (default): one program per distinct `ProgramKey`, containing only what the
         object needs.  False: every object drawn with the uber-shader (every built-in term,
@@ -116,7 +123,10 @@ class Renderer:
     """
 
     def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
-                 formulation="stable", specialise=True, culling="auto", device=None):
+                 formulation="stable", specialise=True, culling="auto", device=None, shadow_map_size=1024,
+                 shadow_filter_radius=0):
+        self.shadow_map_size = _validate.positive_int("shadow_map_size", shadow_map_size, 16, 8192)
+        self.shadow_filter_radius = _validate.positive_int("shadow_filter_radius", shadow_filter_radius, 0, 8)
         self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
         self.samples = _validate.choice("samples", _validate.positive_int("samples", samples, 1, 8), (1, 2, 4, 8))
         self.supersample = _validate.positive_int("supersample", supersample, 1, 8)
@@ -150,6 +160,7 @@ class Renderer:
         self.programs = ProgramCache(self._mgl)
         self._meshes = {}
         self._targets = {}
+        self._shadow_maps = ShadowMaps(self._mgl, self._targets)
         self._entries = weakref.WeakKeyDictionary()  # SceneObject -> {output: _ObjectEntry}
 
     def render_target_bytes(self, size=None):
@@ -342,8 +353,16 @@ class Renderer:
         """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading)."""
         per_vertex = output == "radiance" and self.shading == "vertex"
         if output == "radiance" and not self.specialise:
+            if any(k.shadowed for k in scene.light_keys()):
+                raise ValueError("the uber-shader holds no shadow maps, and the scene has lights with shadows=True: "
+                                 "render it with specialise=True")
             return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex, scene.lights)
         key = scene.program_key(obj, output)
+        if key.shadow_slots:
+            if per_vertex:
+                raise ValueError("shadows are looked up per pixel: a scene with lights with shadows=True needs "
+                                 "Renderer(shading='pixel')")
+            key = replace(key, shadow_size=self.shadow_map_size, shadow_filter=self.shadow_filter_radius)
         if per_vertex and key.textured_inputs:
             raise ValueError(f"object {obj.name!r}: {', '.join(f'{t}.{p}' for t, p in key.textured_inputs)} "
                              "are textured, which needs per-pixel shading (a vertex has no texture footprint): "
@@ -368,9 +387,28 @@ class Renderer:
         self._mgl.copy_framebuffer(resolved, target)
         return resolved
 
+    @property
+    def shadow_settings(self):
+        """``(shadow_map_size, shadow_filter_radius)``: what the twin needs to mirror this renderer's shadows."""
+        return self.shadow_map_size, self.shadow_filter_radius
+
+    def _shadow_values(self, scene, output):
+        """Draw the shadow maps the frame's programs read; their samplers' values (dict, empty without shadows)."""
+        if output not in ("radiance", "display") or not any(k.shadowed for k in scene.light_keys()):
+            return {}
+        keys = [self.program_key(scene, obj, output) for obj in scene.objects]
+        key = next((k for k in keys if k.shadow_slots), None)
+        if key is None:
+            return {}
+        casters = [obj for obj in scene.objects if obj.casts_shadow]
+        maps = self._shadow_maps.draw(scene.shadow_setups(key), casters, self.programs,
+                                      lambda mesh, program: self._mesh_buffers(mesh).vertex_array(self._mgl, program))
+        return maps
+
     def _draw(self, scene, output, fbo, frame_values=None):
         aspect = self.width / self.height
         self._purge_dead_meshes()
+        shadow_values = self._shadow_values(scene, output)
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self._mgl.enable(moderngl.DEPTH_TEST)
@@ -380,7 +418,7 @@ class Renderer:
         forward = tuple(-camera.pose[:3, 2])
         near, far = camera.znear, camera.zfar
         mirrored = culled = False
-        for program, frame_pack, entry in self._draw_list(scene, output, aspect, frame_values):
+        for program, frame_pack, entry in self._draw_list(scene, output, aspect, frame_values, shadow_values):
             program.write(frame_pack)
             program.write(entry.pack)
             if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
@@ -394,7 +432,7 @@ class Renderer:
         self._mgl.front_face = "ccw"
         self._mgl.disable(moderngl.CULL_FACE)
 
-    def _draw_list(self, scene, output, aspect, frame_values=None):
+    def _draw_list(self, scene, output, aspect, frame_values=None, shadow_values=None):
         """``(program, frame pack, object entry)`` per object, in order.
 
         Per frame, the uniforms every object shares (camera, lights) are packed once per program key;
@@ -402,7 +440,8 @@ class Renderer:
         are made once and kept (`_ObjectEntry`) while the scene's lights, ambient light and the object's
         index are what they were: objects, materials and poses are immutable.  The uber-shader's key is
         the scene's, the same for every object (made once per frame).  ``frame_values`` are uniforms the
-        call adds to every program's frame pack (the display programs' ``u_exposure``)."""
+        call adds to every program's frame pack (the display programs' ``u_exposure``), ``shadow_values`` the
+        shadow maps, added to the programs that read them."""
         drop = self.formulation == "naive"
         state = (output, scene.light_keys(), scene.ambient_radiance, self.formulation,
                  self.shading, self.specialise, self.culling)
@@ -428,7 +467,8 @@ class Renderer:
             frame = frame_packs.get(entry.program)
             if frame is None:
                 values = {} if shared is not None else scene.frame_uniform_values(entry.key, aspect)
-                pack = entry.program.pack(values | (frame_values or {}), drop)
+                shadows = (shadow_values or {}) if entry.key.shadow_slots else {}
+                pack = entry.program.pack(values | (frame_values or {}) | shadows, drop)
                 frame = frame_packs[entry.program] = (pack, tuple(name for name, _, _ in pack))
             if entry.checked != frame[1]:  # strict: every active uniform set, checked once per entry
                 entry.program.check_complete(frame[0], entry.pack)

@@ -21,12 +21,15 @@ class DirectionalLight(LightModel):
         normalised.
     irradiance : float or (3,) array_like
         Irradiance ``E`` [W/m^2] on a surface facing the light, >= 0.
+    shadows : bool
+        Cast shadows (an orthographic shadow map over the scene; default False).
     """
 
     name = "directional"
     params = (_DIRECTION, _IRRADIANCE)
     uniforms = (Param("towards", "direction", low=-1.0, high=1.0, doc="unit vector toward the light"), _IRRADIANCE)
     glsl = GlslFile("lights/directional.glsl")
+    shadow_map = "ortho"
     in_uber = True
     gltf_type = "directional"
     pyrender_type = "DirectionalLight"

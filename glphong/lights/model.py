@@ -124,6 +124,10 @@ class LightModel:
         The ``KHR_lights_punctual`` type it reads and writes (`from_gltf`, `to_gltf`).
     pyrender_type : str or None
         The pyrender light class it maps (`from_pyrender`, `to_pyrender`).
+    shadow_map : {'cube', 'ortho'} or None
+        How the kind's shadows are mapped (docs/design.md section 12): 'cube' for a light at a point (its
+        ``position``: six faces around it), 'ortho' for a light at infinity (its ``direction``: one orthographic
+        map); None: the kind casts no shadows.  Where set, the constructor takes ``shadows=False``.
 
     Methods a definition provides
     -----------------------------
@@ -152,6 +156,7 @@ class LightModel:
     in_uber = False
     gltf_type = None
     pyrender_type = None
+    shadow_map = None
     definition_error = LightDefinitionError
     definition_kind = "light"
     keywords = ()
@@ -180,11 +185,16 @@ class LightModel:
         _check_definition(cls)
         _REGISTRY[cls.name] = cls  # a re-run of the same definition (a notebook cell) replaces it
 
-    def __init__(self, *args, **kwargs):
+    def __init__(self, *args, shadows=False, **kwargs):
         if type(self).name is None:
             raise TypeError(f"{type(self).__name__} is not a light kind (it has no name)")
         for name, value in bind_arguments(type(self), type(self).params, args, kwargs).items():
             object.__setattr__(self, name, value)
+        if not isinstance(shadows, (bool, np.bool_)):
+            raise TypeError(f"shadows must be a bool, True or False (got {shadows!r})")
+        if shadows and self.shadow_map is None:
+            raise ValueError(f"{type(self).__name__} casts no shadows (its kind declares no shadow_map)")
+        object.__setattr__(self, "shadows", bool(shadows))
         self.check()
 
     def check(self):
@@ -197,8 +207,8 @@ class LightModel:
         return type(self).name
 
     def parameter_values(self):
-        """Every parameter's validated value by name (dict)."""
-        return {p.name: getattr(self, p.name) for p in self.params}
+        """Every parameter's validated value by name (dict), and ``shadows``."""
+        return {p.name: getattr(self, p.name) for p in self.params} | {"shadows": self.shadows}
 
     def __setattr__(self, name, value):
         raise AttributeError(f"{type(self).__name__} is immutable: make a new light instead of setting {name!r}")
@@ -210,8 +220,9 @@ class LightModel:
         return hash((type(self), tuple(self.parameter_values().items())))
 
     def __repr__(self):
+        optional = {p.name for p in self.params if p.optional}
         shown = [f"{k}={v!r}" for k, v in self.parameter_values().items()
-                 if not (v is None and next(p for p in self.params if p.name == k).optional)]
+                 if not (v is None and k in optional) and not (k == "shadows" and not v)]
         return f"{type(self).__name__}({', '.join(shown)})"
 
     # ---- what the program key and the uniforms are made of
@@ -415,6 +426,12 @@ def _check_definition(cls):
                                                             for k in c.__dict__}:
         raise err(f"{cls.__qualname__} declares uniforms different from its params, so it must define "
                   "uniform_value(self, name) giving each uniform's value")
+    if cls.shadow_map not in (None, "cube", "ortho"):
+        raise err(f"{cls.__qualname__}.shadow_map must be None, 'cube' (a light at its `position`) or 'ortho' (a light "
+                  f"at infinity along its `direction`) (got {cls.shadow_map!r})")
+    needed = {"cube": "position", "ortho": "direction"}.get(cls.shadow_map)
+    if needed and needed not in {p.name for p in cls.params}:
+        raise err(f"{cls.__qualname__}.shadow_map = {cls.shadow_map!r} needs a parameter named {needed!r}")
     if cls.glsl is None:
         raise err(f"{cls.__qualname__} has no glsl: set glsl to the GLSL source of "
                   f"`bool {name}_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)` or to a .glsl path")

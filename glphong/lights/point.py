@@ -48,12 +48,15 @@ class PointLight(LightModel):
     range : float or None
         KHR_lights_punctual's range [m] (> 0): ``E`` is multiplied by ``clamp(1 - (d/range)^4, 0, 1)``;
         None (default): no window.
+    shadows : bool
+        Cast shadows (a cube shadow map around the light; default False).
     """
 
     name = "point"
     params = (POSITION, Param("power", "rgb", low=0.0, high=_MAX_POWER, unit="W", doc="radiant flux Phi"), RANGE)
     uniforms = (POSITION, Param("intensity", "rgb", low=0.0, unit="W/sr", doc="Phi / (4 pi)"), RANGE)
     glsl = GlslFile("lights/point.glsl")
+    shadow_map = "cube"
     uses = ("lights",)
     in_uber = True
     gltf_type = "point"

@@ -50,6 +50,8 @@ class SpotLight(LightModel):
         which the specification excludes but files carry, is its hard edge smoothed over a cosine of 0.001).
     range : float or None
         KHR_lights_punctual's range [m] (> 0): ``E`` times ``clamp(1 - (d/range)^4, 0, 1)``; None: no window.
+    shadows : bool
+        Cast shadows (a cube shadow map around the light; default False).
     """
 
     name = "spot"
@@ -59,6 +61,7 @@ class SpotLight(LightModel):
                 Param("scale", "scalar", low=1.0, high=1000.0, doc="s = 1 / max(0.001, cos(inner) - cos(outer))"),
                 RANGE)
     glsl = GlslFile("lights/spot.glsl")
+    shadow_map = "cube"
     uses = ("lights",)
     gltf_type = "spot"
     pyrender_type = "SpotLight"

@@ -11,6 +11,7 @@ from glphong.core import validate as _validate
 from glphong.scene.camera import Camera
 from glphong.scene.geometry import MeshData
 from glphong.scene.from_trimesh import build_from_trimesh
+from glphong.scene.shadows import shadow_setups
 from glphong.shaders.key import GBUFFER_PLANES, light_keys, program_key
 from glphong.lights import AmbientLight, LightModel, light_named
 from glphong.materials import Material
@@ -36,12 +37,15 @@ class SceneObject:
         Object-to-world affine transform, float64, read-only (a renderer caches what it derives from it:
         move an object by adding it again with another pose).
     name : str
+    casts_shadow : bool
+        Drawn into the shadow maps of the scene's shadowing lights (default True).
     """
 
     mesh: MeshData
     material: Material
     pose: np.ndarray
     name: str
+    casts_shadow: bool = True
 
     @property
     def mirrored(self):
@@ -108,7 +112,7 @@ class Scene:
         self._lights.append(light)
         return light
 
-    def add(self, mesh, material, pose=None, smooth=True, name=None):
+    def add(self, mesh, material, pose=None, smooth=True, name=None, casts_shadow=True):
         """Add a mesh drawn with a material.
 
         Parameters
@@ -121,6 +125,9 @@ class Scene:
         smooth : bool
             Interpolated vertex normals (default) or flat face normals; ignored for MeshData.
         name : str, optional
+        casts_shadow : bool
+            Whether the object is drawn into the shadow maps of lights with ``shadows=True`` (default True); every
+            object receives shadows.
 
         Returns
         -------
@@ -132,6 +139,8 @@ class Scene:
             raise TypeError(f"smooth must be a bool, True or False (got {smooth!r})")
         if name is not None and not isinstance(name, str):
             raise TypeError(f"name must be a str or None (got {type(name).__name__})")
+        if not isinstance(casts_shadow, (bool, np.bool_)):
+            raise TypeError(f"casts_shadow must be a bool, True or False (got {casts_shadow!r})")
         if not isinstance(mesh, MeshData):
             import trimesh
 
@@ -141,7 +150,7 @@ class Scene:
         pose.setflags(write=False)
         data = mesh if isinstance(mesh, MeshData) else MeshData.from_trimesh(mesh, smooth=bool(smooth))
         _check_mesh_serves(data, material, name or f"object{len(self._objects)}")
-        obj = SceneObject(data, material, pose, name or f"object{len(self._objects)}")
+        obj = SceneObject(data, material, pose, name or f"object{len(self._objects)}", bool(casts_shadow))
         self._objects.append(obj)
         return obj
 
@@ -155,11 +164,18 @@ class Scene:
         return {k.name: k.count for k in self.light_keys()}
 
     def light_keys(self):
-        """The `glphong.shaders.key.LightKey` of each kind present (computed once per state of the lights)."""
+        """The `glphong.shaders.key.LightKey` of each kind present (computed once per state of the lights and of
+        whether any object casts shadows)."""
+        casters = any(obj.casts_shadow for obj in self._objects)
+        state = (len(self._lights), casters)
         cached = getattr(self, "_light_keys", None)
-        if cached is None or cached[0] != len(self._lights):
-            cached = self._light_keys = (len(self._lights), light_keys(self._lights))
+        if cached is None or cached[0] != state:
+            cached = self._light_keys = (state, light_keys(self._lights, casters))
         return cached[1]
+
+    def shadow_setups(self, key):
+        """The `glphong.scene.shadows.ShadowSetup` of each shadow map program ``key`` reads (its ``shadow_size``)."""
+        return shadow_setups(self, key.lights, key.shadow_size) if key.shadow_slots else []
 
     @property
     def ambient_radiance(self):
@@ -235,10 +251,12 @@ class Scene:
         """The uniforms of program ``key`` that every object of a frame shares: the camera's view-projection
         and eye, the lights and the ambient light (float32, dict of str to ndarray)."""
         values = {"u_view_projection": self.camera.projection_matrix(aspect) @ self.camera.view_matrix()}
-        if key.output != "gbuffer":
+        if key.output not in ("gbuffer", "shadow"):
             if key.needs_view:
                 values["u_eye"] = self.camera.eye
             values.update(self.light_uniform_values(key))
+            for setup in self.shadow_setups(key):
+                values.update(setup.uniform_values())
         return {name: _validate.float32_uniform(v) for name, v in values.items()}
 
     def object_uniform_values(self, index, key):

@@ -94,15 +94,35 @@ def lights_chunk(key):
     """
     lines = ["// light loops (generated from the program key): for each light j of each kind k present",
              "//   valid = k_incident(x, j, wi, E);  L += (lit && valid && n.wi > 0) ? material_response(f, wi, wo, n.wi) E : 0",
-             "", "void add_lights(inout vec3 radiance, vec3 position, ShadingFrame f, vec3 wo, bool lit)", "{",
-             "    vec3 wi;", "    vec3 irradiance;", "    float n_dot_l;", "    bool valid;"]
+             "// a shadowed light's E is multiplied by its map's visibility V (glsl/shadows.glsl), its kind unrolled"]
+    slots = {}
+    for slot, (light, j) in enumerate(key.shadow_slots):
+        slots[(light.name, j)] = slot
+        lines.append(f"uniform sampler2D u_shadow_map{slot};   // {light.name} light {j}: {light.shadow_map} map")
+        lines.append(f"uniform vec3 u_shadow_origin{slot};")
+        lines.append(f"uniform float u_shadow_texel{slot};")
+        if light.shadow_map == "ortho":
+            lines += [f"uniform vec3 u_shadow_axis{slot};", f"uniform vec3 u_shadow_e1{slot};", f"uniform vec3 u_shadow_e2{slot};"]
+    lines += ["", "void add_lights(inout vec3 radiance, vec3 position, ShadingFrame f, vec3 wo, bool lit)", "{",
+              "    vec3 wi;", "    vec3 irradiance;", "    float n_dot_l;", "    bool valid;"]
+    term = ["        n_dot_l = dot(f.n, wi);",
+            "        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), irradiance);",
+            "        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);"]
     for light in key.lights:
-        lines += [f"    for (int j = 0; j < {light.name.upper()}_LIGHT_COUNT; ++j) {{",
-                  f"        valid = {light.name}_incident(position, j, wi, irradiance);",
-                  "        n_dot_l = dot(f.n, wi);",
-                  "        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), irradiance);",
-                  "        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);",
-                  "    }"]
+        if not light.shadowed:
+            lines += [f"    for (int j = 0; j < {light.name.upper()}_LIGHT_COUNT; ++j) {{",
+                      f"        valid = {light.name}_incident(position, j, wi, irradiance);", *term, "    }"]
+            continue
+        for j in range(light.count):
+            lines += ["    {", f"        valid = {light.name}_incident(position, {j}, wi, irradiance);"]
+            slot = slots.get((light.name, j))
+            if slot is not None and light.shadow_map == "cube":
+                lines.append(f"        irradiance *= shadow_cube(u_shadow_map{slot}, u_shadow_origin{slot}, "
+                             f"u_shadow_texel{slot}, position, f.n);")
+            elif slot is not None:
+                lines.append(f"        irradiance *= shadow_ortho(u_shadow_map{slot}, u_shadow_origin{slot}, u_shadow_axis{slot}, "
+                             f"u_shadow_e1{slot}, u_shadow_e2{slot}, u_shadow_texel{slot}, position, f.n);")
+            lines += [*term, "    }"]
     lines += ["}"]
     return "\n".join(lines) + "\n"
 

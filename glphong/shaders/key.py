@@ -17,12 +17,13 @@ from glphong.shaders.generated import (LIGHTS_CHUNK, LOD_CHUNK, MATERIAL_CHUNK, 
                                        model_chunk_label)
 
 __all__ = ["ProgramKey", "TermKey", "LightKey", "EncodeKey", "program_key", "gbuffer_key", "uber_key", "response_key",
-           "light_keys", "UBER_MAX_LIGHTS", "material_chunk"]
+           "light_keys", "shadow_key", "UBER_MAX_LIGHTS", "material_chunk"]
 
 #: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
 UBER_MAX_LIGHTS = 8
 
-OUTPUTS = ("radiance", "gbuffer", "points", "display", "response")
+OUTPUTS = ("radiance", "gbuffer", "points", "display", "response", "shadow")
+SHADOW_PASSES = (None, "cube", "ortho")
 FORMULATIONS = ("stable", "naive")
 #: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed)
 GBUFFER_PLANES = ("tangent", "uv", "color", "lod")
@@ -100,6 +101,11 @@ class LightKey:
         The kind's structural defines for the scene's lights of it (``RANGE`` where one has a range).
     uses : tuple of str
         Library chunks its GLSL calls.
+    shadowed : tuple of int
+        The lights of the kind (their numbers j) that cast shadows: their terms are multiplied by their shadow
+        map's visibility (docs/design.md section 12).
+    shadow_map : {'cube', 'ortho'} or None
+        The kind's `glphong.lights.LightModel.shadow_map`.
     """
 
     name: str
@@ -107,6 +113,8 @@ class LightKey:
     count: int
     defines: tuple = ()
     uses: tuple = ()
+    shadowed: tuple = ()
+    shadow_map: str = None
 
     @property
     def chunk(self):
@@ -114,17 +122,20 @@ class LightKey:
         return f"light:{self.name}@{self.source_hash}"
 
     def describe(self):
-        return f"{self.name}*{self.count}" + "".join(f"[{name.lower()}]" for name, _ in self.defines)
+        shadowed = f"[shadows {','.join(map(str, self.shadowed))}]" if self.shadowed else ""
+        return f"{self.name}*{self.count}" + "".join(f"[{name.lower()}]" for name, _ in self.defines) + shadowed
 
 
-def light_keys(lights):
-    """The `LightKey` of each kind present in ``lights`` (a scene's light instances), in the registry's loop order."""
+def light_keys(lights, casters=True):
+    """The `LightKey` of each kind present in ``lights`` (a scene's light instances), in the registry's loop order;
+    ``casters``: whether any object casts shadows (without, no light is shadowed)."""
     out = []
     for kind in registered_lights():
         mine = [light for light in lights if type(light) is kind]
         if mine:
+            shadowed = tuple(j for j, light in enumerate(mine) if light.shadows) if casters else ()
             out.append(LightKey(kind.name, kind.source_hash(), len(mine), tuple(kind.structural_defines(mine)),
-                                tuple(kind.uses)))
+                                tuple(kind.uses), shadowed, kind.shadow_map))
     return tuple(out)
 
 
@@ -182,6 +193,12 @@ class ProgramKey:
     lod_textures : int
         G-buffer programs only: how many textures' levels of detail it writes there (``textureQueryLOD``,
         one per textured surface input of the object's material, at most 4; the rest are 0).
+    shadow_size : int
+        Texels along a side of each shadow map (the renderer's ``shadow_map_size``; 0 without shadowed lights).
+    shadow_filter : int
+        Radius of the percentage-closer filter in texels (0: the nearest texel alone).
+    shadow_pass : {'cube', 'ortho'} or None
+        For output 'shadow': the kind of map the pass draws.
     attribute_locations : tuple of (str, int)
         Where the tangent, uv and colour attributes are bound, where not at glphong's own locations
         (tangent 2, uv 3, colour 5): pyrender packs a primitive's attributes in order, so its uv is at 2
@@ -202,11 +219,15 @@ class ProgramKey:
     has_color: bool = False
     has_lod: bool = False
     lod_textures: int = 0
+    shadow_size: int = 0
+    shadow_filter: int = 0
+    shadow_pass: str = None
     attribute_locations: tuple = ()
 
     def __post_init__(self):
         if self.output not in OUTPUTS or self.formulation not in FORMULATIONS or \
-                not all(isinstance(t, TermKey) for t in self.terms) or not all(isinstance(k, LightKey) for k in self.lights):
+                not all(isinstance(t, TermKey) for t in self.terms) or not all(isinstance(k, LightKey) for k in self.lights) \
+                or self.shadow_pass not in SHADOW_PASSES:
             raise ValueError(f"invalid ProgramKey {self}")
 
     @property
@@ -240,6 +261,11 @@ class ProgramKey:
     def num_lights(self):
         """Total number of lights the program loops over."""
         return sum(k.count for k in self.lights)
+
+    @property
+    def shadow_slots(self):
+        """``(light key, j)`` of each shadowed light, in slot order (tuple)."""
+        return tuple((k, j) for k in self.lights for j in k.shadowed)
 
     def light_count(self, kind):
         """How many lights of ``kind`` (a name) the program loops over."""
@@ -284,10 +310,14 @@ class ProgramKey:
             # SWITCH(u_flag): a float uniform flag in the uber-shader, the constant true otherwise
             ("SWITCH(flag)", "((flag) > 0.5)" if self.uber else "true"),
         ]
+        if self.output == "shadow":
+            out.append(("SHADOW_ORTHO", b(self.shadow_pass == "ortho")))
         if self.output == "gbuffer":  # extra planes follow position and normal, packed in this order
             out += [(f"GBUFFER_{name.upper()}_LOCATION", str(2 + i)) for i, name in enumerate(self.gbuffer_planes())]
-        if self.output != "gbuffer":
+        if self.output not in ("gbuffer", "shadow"):
             out.append(("NEEDS_VIEW", b(self.needs_view)))
+            if self.shadow_slots:
+                out += [("SHADOW_MAP_SIZE", str(self.shadow_size)), ("SHADOW_FILTER_RADIUS", str(self.shadow_filter))]
             out.append(("NUM_LIGHTS", str(self.num_lights)))
             for light in self.lights:  # array sizes, loop bounds and each kind's structural defines, prefixed
                 upper = light.name.upper()
@@ -313,12 +343,15 @@ class ProgramKey:
         chunks += self.light_library_chunks() + self.library_chunks()
         chunks += ["surface"] if self.textured_inputs else []
         chunks += [t.chunk for t in self.terms]
+        chunks += ["shadows"] if self.shadow_slots else []
         chunks += [MATERIAL_CHUNK] + [k.chunk for k in self.lights] + ["shade"]
         chunks += [LIGHTS_CHUNK] if self.lights else []
         return tuple(chunks)
 
     def vertex_chunks(self):
         """Chunks of the vertex stage, in order."""
+        if self.output == "shadow":
+            return ("mesh_vertex",)
         if self.output == "response":
             return ("common",) + self.library_chunks() + tuple(t.chunk for t in self.terms) + \
                 (MATERIAL_CHUNK, "response_points")
@@ -332,6 +365,8 @@ class ProgramKey:
         """Chunks of the fragment stage, in order (none for 'points' and 'response')."""
         if self.output in ("points", "response"):
             return ()
+        if self.output == "shadow":
+            return ("common", "shadow_fragment")
         if self.output == "gbuffer":
             return ("common", "surface", LOD_CHUNK, "mesh_fragment") if self.lod_textures else ("common", "mesh_fragment")
         if self.shade_per_vertex:
@@ -344,6 +379,8 @@ class ProgramKey:
         """Text of the chunks generated from the key (label -> GLSL)."""
         if self.output == "gbuffer":
             return {LOD_CHUNK: lod_chunk(self)} if self.lod_textures else {}
+        if self.output == "shadow":
+            return {}
         out = {MATERIAL_CHUNK: material_chunk(self)}
         if self.lights and self.output != "response":
             out[LIGHTS_CHUNK] = lights_chunk(self)
@@ -365,6 +402,8 @@ class ProgramKey:
             return ["all shading code and lights (the G-buffer program writes the shading inputs only)",
                     "radiance output"] + [f"{name} output (no drawn term needs it)" for name in GBUFFER_PLANES
                                           if name not in self.gbuffer_planes()]
+        if self.output == "shadow":
+            return ["all shading code (the shadow pass writes each caster's distance from the light)"]
         if self.uber:
             return ["nothing: the uber-shader compiles every built-in term and the scene's own and switches at run time"]
         out = []
@@ -391,6 +430,8 @@ class ProgramKey:
                 given = {name for name, _ in present[kind.name].defines}
                 out += [f"{kind.name} lights' {what} (no {kind.name} light of the scene needs it)"
                         for name, what in kind.optional_code if name not in given]
+        if not self.shadow_slots:
+            out.append("shadow maps, their samplers and shadows.glsl (no light has shadows=True, or nothing casts)")
         if not self.has_normal:
             out.append("normal attribute, its upload and the normal matrix (nothing reads a normal)")
         if not self.two_sided:
@@ -600,6 +641,11 @@ class EncodeKey:
 
     def extensions(self):
         return ()
+
+
+def shadow_key(shadow_pass):
+    """The key of a shadow pass (a caster's distance from the light, glsl/shadow_fragment.glsl): 'cube' or 'ortho'."""
+    return ProgramKey(output="shadow", has_normal=False, two_sided=False, shadow_pass=shadow_pass)
 
 
 def gbuffer_key(material, needs=(), lod_textures=0):
