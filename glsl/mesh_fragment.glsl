@@ -59,6 +59,9 @@ layout(location = GBUFFER_COLOR_LOCATION) out vec4 out_color;
 #if HAS_LOD
 layout(location = GBUFFER_LOD_LOCATION) out vec4 out_lod;
 #endif
+#if HAS_FACE
+layout(location = GBUFFER_FACE_LOCATION) out vec4 out_face;
+#endif
 #else
 #if NEEDS_VIEW
 uniform vec4 u_eye;  // homogeneous eye (e, w): the view vector at x is normalize(e - w x)
@@ -95,6 +98,15 @@ void main()
 #if HAS_COLOR
     color = v_color;
 #endif
+#if HAS_FACE
+    // the triangle's own normal, from the derivatives of the interpolated position (the plane the shadow map
+    // samples; either orientation): the slope of the shadow bias (glsl/shadows.glsl)
+    vec3 face;
+    float face_len;
+    if (!safe_normalize(cross(dFdx(v_position), dFdy(v_position)), face, face_len)) {
+        face = n;
+    }
+#endif
 #if OUTPUT_GBUFFER
     out_position = vec4(v_position, u_object_id + 1.0);
     out_normal = vec4(n, 1.0);
@@ -112,9 +124,15 @@ void main()
 #elif HAS_LOD
     out_lod = vec4(0.0);                     // another object of the scene has textures, this one none
 #endif
+#if HAS_FACE
+    out_face = vec4(face, 1.0);
+#endif
 #else
 #if HAS_INPUTS
     material_inputs(uv, color);
+#endif
+#if HAS_FACE
+    shadow_face_normal = face;
 #endif
 #if OUTPUT_DISPLAY
     out_radiance = vec4(srgb_encode(u_exposure * shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye)), 1.0);

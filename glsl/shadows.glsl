@@ -6,15 +6,18 @@
 // (v_c / |v_a| + 1) / 2) SHADOW_MAP_SIZE with (b, c) the other two axes in order) for a light at a point, or an
 // orthographic map (texel coordinates e1 . (x - o), e2 . (x - o); depth a . (x - o)) for a light at infinity.
 //
-// shadow_bias(d, c, offset) -> b: the largest amount by which the stored distance of the receiver's own
-//   plane can fall short of the receiver's distance d, for a lookup ray up to `offset` away from the ray to x
-//   (offset an angle [rad] for a cube map: b = d (cos(t) / cos(t + offset) - 1), t the angle between the
-//   receiver's normal and the ray, c = |cos(t)|; offset a length [m] for an orthographic map: b = offset tan(t)),
-//   + SHADOW_QUANTUM: 16 eps of the largest coordinate involved (the stored distance's float32 arithmetic).
-//   A receiver seen edge-on (t + offset >= pi/2) gets b = FLT_MAX: it cannot shadow itself, and is lit.
+// shadow_bias_angle(d, c, offset, scale) / shadow_bias_length(c, offset, scale) -> B = 2 p + q:
+//   p, the largest amount by which the receiver's own plane, along a lookup ray up to `offset` away from the ray
+//   to x, can come nearer the light than x (offset an angle [rad] for a cube map: p = d (cos(t) / cos(t + offset)
+//   - 1), t the angle between the triangle's normal and the ray, c = |cos(t)|; a length [m] for an orthographic
+//   map: p = offset tan(t)), once for the receiver's own triangle and once more for a neighbouring triangle that
+//   bends toward the light (a curved or creased receiver), and q = SHADOW_QUANTUM scale, 16 eps of the largest
+//   coordinate involved (the stored distance's float32 arithmetic).  A receiver seen edge-on (t + offset >= pi/2)
+//   gets B = FLT_MAX: it cannot shadow itself, and is lit.
 //   offset = (SHADOW_FILTER_RADIUS + 1/2) sqrt(2) texels: the nearest texel's centre is within half a texel
 //   diagonal of x's own ray, and a filter of radius r reaches r texels further along each axis.
 // shadow_cube(map, o, texel_angle, x, n) / shadow_ortho(map, o, a, e1, e2, texel_size, x, n) -> V in [0, 1]
+//   (n: the triangle's own normal, shadow_face_normal)
 //   the fraction of the (2 r + 1)^2 texels around x's own (r = SHADOW_FILTER_RADIUS; 0: the nearest texel alone)
 //   whose stored distance is >= d - b (percentage-closer filtering); at a cube face's edge the filter stays on
 //   the face (clamped).  texel_angle = 2 / SHADOW_MAP_SIZE is the largest angle a cube texel subtends.
@@ -22,20 +25,23 @@
 // Key defines read here: SHADOW_MAP_SIZE, SHADOW_FILTER_RADIUS.
 
 const float SHADOW_QUANTUM = 9.5367431640625e-07;  // 16 eps: the stored distance's float32 error, relative
+// the triangle's own normal at the fragment (mesh_fragment.glsl sets it from the position's derivatives): the slope
+// of the plane the map samples, which a smooth shading normal does not give
+vec3 shadow_face_normal = vec3(0.0, 0.0, 1.0);
 
 float shadow_bias_angle(float d, float c, float offset, float scale)
 {
     float s = sqrt(max(1.0 - c * c, 0.0));
     float c_far = c * cos(offset) - s * sin(offset);  // cos(t + offset)
     float plane = c_far > 0.0 ? d * (c / c_far - 1.0) : FLT_MAX;
-    return min(plane + SHADOW_QUANTUM * scale, FLT_MAX);
+    return min(2.0 * plane + SHADOW_QUANTUM * scale, FLT_MAX);
 }
 
 float shadow_bias_length(float c, float offset, float scale)
 {
     float s = sqrt(max(1.0 - c * c, 0.0));
     float plane = c > 0.0 ? offset * (s / c) : FLT_MAX;
-    return min(plane + SHADOW_QUANTUM * scale, FLT_MAX);
+    return min(2.0 * plane + SHADOW_QUANTUM * scale, FLT_MAX);
 }
 
 float max_abs(vec3 v)

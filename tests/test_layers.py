@@ -137,7 +137,7 @@ def test_optional_dependencies_are_imported_only_where_used():
     code = ("import sys\n"
             "class Block:\n"
             "    def find_spec(self, name, path=None, target=None):\n"
-            "        if name.split('.')[0] in ('pyrender', 'matplotlib', 'tqdm', 'distributed', 'dask', 'DracoPy',\n"
+            "        if name.split('.')[0] in ('pyrender', 'matplotlib', 'tqdm', 'distributed', 'dask', 'DracoPy', 'embreex',\n"
             "                                  'importlinter', 'pytest', 'hypothesis', 'sphinx'):\n"
             "            raise ImportError('blocked ' + name)\n"
             "sys.meta_path.insert(0, Block())\n"

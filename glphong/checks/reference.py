@@ -16,6 +16,7 @@ Conventions of the mirror:
 `shade` is the image-level entry: it shades a G-buffer, fragment for fragment.
 """
 import sys
+from dataclasses import replace
 
 import numpy as np
 
@@ -27,6 +28,7 @@ from glphong.twin.functions import (BLINN_HALF_FLOOR, FLT_MAX, FRAME_PARALLEL_LI
                                     fresnel_schlick, half_cosine, light_term, lobe_from_delta, log_one_minus,
                                     phong_delta, phong_lobe, point_irradiance, range_window, safe_normalize,
                                     shading_frame)
+from glphong.checks.shadows import shadow_visibility
 from glphong.lights import light_for_key
 from glphong.materials import registered_models
 
@@ -227,7 +229,9 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
     if key.num_lights == 0:
         return radiance
     wo, lit = view_direction(position, n_valid, eye, key)
-    for valid, wi, irradiance in incident_light(position, key, uniforms):
+    for i, (valid, wi, irradiance) in enumerate(incident_light(position, key, uniforms)):
+        if f.visibility is not None and f.visibility[i] is not None:  # the ray-cast shadow (checks.shadows)
+            irradiance = irradiance * f.visibility[i][0][:, None]
         n_dot_l = _dot(f.n, wi)
         gate = lit & valid & (n_dot_l > 0)
         term = np.zeros_like(radiance)
@@ -241,11 +245,13 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
 
 
 # --------------------------------------------------------------------------- mesh_fragment.glsl
-def shade_inputs(scene, gbuffer, dtype=np.float64, band=None):
+def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None):
     """Per object, the fragments it covers and the inputs its program shaded them with.
 
     ``band`` (`glphong.checks.tolerances.BandConstants`): also the intervals of the surface inputs
-    (``f.input_bounds``), for the tolerance band.
+    (``f.input_bounds``), for the tolerance band.  ``shadows``: the renderer's ``(shadow_map_size,
+    shadow_filter_radius)`` (`glphong.Renderer.shadow_settings`), needed where a light has ``shadows=True``: each
+    shadowing light's visibility is then ray-cast (``f.visibility``, `glphong.checks.shadows`).
 
     Yields
     ------
@@ -269,6 +275,11 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None):
         if not selection.any():
             continue
         key = scene.program_key(obj)
+        if key.shadow_slots:
+            if shadows is None:
+                raise ValueError("the scene has lights with shadows=True: the twin needs the renderer's shadow settings "
+                                 "(shadows=renderer.shadow_settings)")
+            key = replace(key, shadow_size=shadows[0], shadow_filter=shadows[1])
         uniforms = {k: uniform_as(v, dtype) for k, v in scene.uniform_values(index, key, width / height).items()}
         position = gbuffer.position[selection].astype(dtype)
         n_valid, n, _ = safe_normalize(gbuffer.normal[selection].astype(dtype))
@@ -285,10 +296,31 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None):
             else:  # the values and their intervals from one sampling of each texture
                 inputs, bounds = input_bounds(uv64, color, lod, key, uniforms, band)
             f = type(f)(f.n, f.t, f.b, f.uv, {k: v.astype(dtype) for k, v in inputs.items()}, bounds)
+        if key.shadow_slots:
+            face, _ = _unit(gbuffer.face[selection].astype(np.float64))  # the triangles' own normals (the map's planes)
+            f = replace(f, visibility=_visibility(scene, key, gbuffer.position[selection].astype(np.float64), face,
+                                                  shadows[1]))
         yield selection, obj, key, uniforms, position, f, n_valid
 
 
-def shade(scene, gbuffer, dtype=np.float64):
+def _unit(v):
+    valid, unit, _ = safe_normalize(v)
+    return unit, valid
+
+
+def _visibility(scene, key, position, normal, filter_radius):
+    """Per light of ``key`` in loop order: None, or its ray-cast visibility ``(exact, low, high)``."""
+    setups = {(s.kind, s.index): s for s in scene.shadow_setups(key)}
+    out = []
+    for light in key.lights:
+        for j in range(light.count):
+            setup = setups.get((light.name, j))
+            out.append(None if setup is None else
+                       shadow_visibility(scene, setup, position, np.asarray(normal, dtype=np.float64), filter_radius))
+    return tuple(out)
+
+
+def shade(scene, gbuffer, dtype=np.float64, shadows=None):
     """Shade a G-buffer with the twin, fragment for fragment.
 
     Parameters
@@ -298,6 +330,8 @@ def shade(scene, gbuffer, dtype=np.float64):
         From ``Renderer.gbuffer(scene)`` at the same image size.
     dtype : numpy dtype
         float64 (the reference) or float32 (the GPU's formulation on the CPU).
+    shadows : (int, int), optional
+        The renderer's shadow settings, where a light casts shadows (`shade_inputs`).
 
     Returns
     -------
@@ -305,6 +339,6 @@ def shade(scene, gbuffer, dtype=np.float64):
         Radiance [W/(m^2 sr)], 0 where not covered.
     """
     out = np.zeros(gbuffer.position.shape, dtype)
-    for selection, obj, key, uniforms, position, f, n_valid in shade_inputs(scene, gbuffer, dtype):
+    for selection, obj, key, uniforms, position, f, n_valid in shade_inputs(scene, gbuffer, dtype, shadows=shadows):
         out[selection] = shade_point(position, f, n_valid, uniforms.get("u_eye"), key, uniforms, obj.material)
     return out

@@ -72,8 +72,11 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
     if key.num_lights:
         wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
         tol = band.D * EPS
-        for valid, wi, irradiance, (e_low, e_high) in ref.incident_light(position, key, u, band=band):
+        for i, (valid, wi, irradiance, (e_low, e_high)) in enumerate(ref.incident_light(position, key, u, band=band)):
             terms += 1
+            if f.visibility is not None and f.visibility[i] is not None:  # the shadow map's interval
+                _, v_low, v_high = f.visibility[i]
+                e_low, e_high = e_low * v_low[:, None], e_high * v_high[:, None]
             n_dot_l = ref._dot(f.n, wi)
             certain = (lit & valid & (n_dot_l > tol))[..., None]
             possible = lit & valid & (n_dot_l > -tol)
@@ -135,7 +138,7 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
     return low * (1 - m * EPS), high * (1 + m * EPS)
 
 
-def radiance_band(scene, gbuffer, band=BAND):
+def radiance_band(scene, gbuffer, band=BAND, shadows=None):
     """Per-pixel interval the GPU's radiance must lie in (`point_band` on every covered pixel).
 
     Parameters
@@ -143,6 +146,8 @@ def radiance_band(scene, gbuffer, band=BAND):
     scene : glphong.Scene
     gbuffer : glphong.GBuffer
     band : BandConstants
+    shadows : (int, int), optional
+        The renderer's shadow settings, where a light casts shadows (`glphong.checks.reference.shade_inputs`).
 
     Returns
     -------
@@ -151,6 +156,6 @@ def radiance_band(scene, gbuffer, band=BAND):
     """
     low = np.zeros(gbuffer.position.shape)
     high = np.zeros(gbuffer.position.shape)
-    for selection, obj, key, u, position, f, n_valid in ref.shade_inputs(scene, gbuffer, band=band):
+    for selection, obj, key, u, position, f, n_valid in ref.shade_inputs(scene, gbuffer, band=band, shadows=shadows):
         low[selection], high[selection] = point_band(key, u, position, f, n_valid, obj.material, band)
     return low, high

@@ -4,7 +4,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from glphong.checks import reference
-from glphong.checks.tolerances import BAND, radiance_band
+from glphong.checks.tolerances import BAND, point_band, radiance_band  # noqa: F401 - radiance_band re-exported
 from glphong.gpu.renderer import Renderer
 
 __all__ = ["VerifyReport", "verify", "compare", "relative_error"]
@@ -31,6 +31,9 @@ class VerifyReport:
         Covered pixels.
     mask_mismatch : int
         Pixels covered in the radiance render but not in the G-buffer, or the reverse.
+    shadow_band : (H, W) bool ndarray or None
+        Pixels where a shadowing light's visibility is uncertain: a shadow boundary, seen from the light, within
+        the filter's reach plus one texel, or an occluder nearer than the derived bias (docs/design.md section 12).
     """
 
     gpu: np.ndarray
@@ -41,6 +44,7 @@ class VerifyReport:
     outside: np.ndarray
     mask: np.ndarray
     mask_mismatch: int
+    shadow_band: np.ndarray = None
 
     @property
     def covered_pixels(self):
@@ -76,9 +80,16 @@ class VerifyReport:
         """True when every covered pixel lies in the band and the coverage masks agree."""
         return self.outside_count == 0 and self.mask_mismatch == 0
 
+    @property
+    def shadow_band_count(self):
+        """Covered pixels where a shadow map may decide either way (a shadow boundary or a contact within the
+        band, docs/design.md section 12), reported apart: the band holds them between shadowed and lit."""
+        return 0 if self.shadow_band is None else int((self.shadow_band & self.mask).sum())
+
     def summary(self):
         """The summary figures as a dict."""
-        return {"covered_pixels": self.covered_pixels, "max_relative_error": self.max_relative_error,
+        return {"covered_pixels": self.covered_pixels, "shadow_band": self.shadow_band_count,
+                "max_relative_error": self.max_relative_error,
                 "rms_relative_error": self.rms_relative_error, "outside_band": self.outside_count,
                 "nonfinite": self.nonfinite_count, "mask_mismatch": self.mask_mismatch, "passed": self.passed}
 
@@ -157,9 +168,34 @@ def verify(scene, renderer, band=BAND):
     with renderer._lock:  # one call: no resize from another thread between the two passes
         frame = renderer.render(scene)
         gbuffer = renderer.gbuffer(scene)
-    ref = reference.shade(scene, gbuffer)
-    low, high = radiance_band(scene, gbuffer, band)
+    ref, low, high, shadow_band = twin_and_band(scene, gbuffer, band, renderer.shadow_settings)
     mask = frame.mask & gbuffer.mask
     rel, outside = compare(frame.radiance, ref, low, high, mask)
     return VerifyReport(gpu=frame.radiance, reference=ref, low=low, high=high, relative_error=rel,
-                        outside=outside, mask=mask, mask_mismatch=int((frame.mask != gbuffer.mask).sum()))
+                        outside=outside, mask=mask, mask_mismatch=int((frame.mask != gbuffer.mask).sum()),
+                        shadow_band=shadow_band)
+
+
+def twin_and_band(scene, gbuffer, band=BAND, shadows=None):
+    """The float64 twin of a G-buffer, its tolerance band and the shadow band, in one pass over the objects (the
+    shadowing lights' rays are cast once).
+
+    Returns
+    -------
+    reference : (H, W, 3) float64 ndarray
+        `glphong.checks.reference.shade`.
+    low, high : (H, W, 3) float64 ndarray
+        `glphong.checks.tolerances.radiance_band`.
+    shadow_band : (H, W) bool ndarray
+        Pixels where a shadowing light's visibility is uncertain (the band holds it between 0 and 1).
+    """
+    ref = np.zeros(gbuffer.position.shape)
+    low, high = np.zeros_like(ref), np.zeros_like(ref)
+    shadow_band = np.zeros(gbuffer.mask.shape, bool)
+    for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, band=band, shadows=shadows):
+        ref[selection] = reference.shade_point(position, f, n_valid, u.get("u_eye"), key, u, obj.material)
+        low[selection], high[selection] = point_band(key, u, position, f, n_valid, obj.material, band)
+        for v in f.visibility or ():
+            if v is not None:
+                shadow_band[selection] |= v[1] != v[2]
+    return ref, low, high, shadow_band

@@ -95,6 +95,9 @@ class GBuffer:
     lod : (H, W, 4) float32 ndarray or None
         Per pixel, the level of detail the GPU used for each texture of the object's material, in the
         order of `glphong.shaders.key.ProgramKey.textured_inputs` (0 beyond), where a parameter is textured.
+    face : (H, W, 3) float32 ndarray or None
+        The covered triangle's own unit normal (either orientation), where a light casts shadows (the shadow
+        bias's slope, docs/design.md section 12).
     """
 
     position: np.ndarray
@@ -105,3 +108,4 @@ class GBuffer:
     uv: np.ndarray = None
     color: np.ndarray = None
     lod: np.ndarray = None
+    face: np.ndarray = None

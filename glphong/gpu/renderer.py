@@ -347,7 +347,8 @@ class Renderer:
                        tangent=np.ascontiguousarray(extra["tangent"]) if "tangent" in extra else None,
                        uv=np.ascontiguousarray(extra["uv"][..., :2]) if "uv" in extra else None,
                        color=np.ascontiguousarray(extra["color"][..., :3]) if "color" in extra else None,
-                       lod=np.ascontiguousarray(extra["lod"]) if "lod" in extra else None)
+                       lod=np.ascontiguousarray(extra["lod"]) if "lod" in extra else None,
+                       face=np.ascontiguousarray(extra["face"][..., :3]) if "face" in extra else None)
 
     def program_key(self, scene, obj, output="radiance"):
         """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading)."""

@@ -118,10 +118,10 @@ def lights_chunk(key):
             slot = slots.get((light.name, j))
             if slot is not None and light.shadow_map == "cube":
                 lines.append(f"        irradiance *= shadow_cube(u_shadow_map{slot}, u_shadow_origin{slot}, "
-                             f"u_shadow_texel{slot}, position, f.n);")
+                             f"u_shadow_texel{slot}, position, shadow_face_normal);")
             elif slot is not None:
                 lines.append(f"        irradiance *= shadow_ortho(u_shadow_map{slot}, u_shadow_origin{slot}, u_shadow_axis{slot}, "
-                             f"u_shadow_e1{slot}, u_shadow_e2{slot}, u_shadow_texel{slot}, position, f.n);")
+                             f"u_shadow_e1{slot}, u_shadow_e2{slot}, u_shadow_texel{slot}, position, shadow_face_normal);")
             lines += [*term, "    }"]
     lines += ["}"]
     return "\n".join(lines) + "\n"

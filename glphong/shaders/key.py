@@ -26,7 +26,7 @@ OUTPUTS = ("radiance", "gbuffer", "points", "display", "response", "shadow")
 SHADOW_PASSES = (None, "cube", "ortho")
 FORMULATIONS = ("stable", "naive")
 #: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed)
-GBUFFER_PLANES = ("tangent", "uv", "color", "lod")
+GBUFFER_PLANES = ("tangent", "uv", "color", "lod", "face")
 #: how a surface input is made (``<MODEL>_<PARAM>_INPUT`` is the mode's index plus 1)
 INPUT_MODES = ("texture", "vertex", "texture*vertex")
 #: textured parameters per material (one G-buffer plane of levels of detail)
@@ -193,6 +193,9 @@ class ProgramKey:
     lod_textures : int
         G-buffer programs only: how many textures' levels of detail it writes there (``textureQueryLOD``,
         one per textured surface input of the object's material, at most 4; the rest are 0).
+    has_face : bool
+        Whether the fragment stage computes the triangle's own (geometric) normal from the derivatives of the
+        position (the shadow bias's slope; for a G-buffer program: whether it writes it, the 'face' plane).
     shadow_size : int
         Texels along a side of each shadow map (the renderer's ``shadow_map_size``; 0 without shadowed lights).
     shadow_filter : int
@@ -219,6 +222,7 @@ class ProgramKey:
     has_color: bool = False
     has_lod: bool = False
     lod_textures: int = 0
+    has_face: bool = False
     shadow_size: int = 0
     shadow_filter: int = 0
     shadow_pass: str = None
@@ -300,6 +304,7 @@ class ProgramKey:
             ("HAS_COLOR", b(self.has_color)),
             ("HAS_INPUTS", b(bool(self.inputs))),
             ("HAS_LOD", b(self.has_lod)),
+            ("HAS_FACE", b(self.has_face)),
             *((f"{name.upper()}_LOCATION", str(where)) for name, where in
               ({"tangent": 2, "uv": 3, "color": 5} | dict(self.attribute_locations)).items()),
             ("NUM_LOD_TEXTURES", str(self.lod_textures)),
@@ -538,6 +543,7 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
         terms=terms,
         has_ka=any(c > 0.0 for c in material.ka),
         lights=lights if lit else (),
+        has_face=lit and any(k.shadowed for k in lights),
         has_normal=lit,
         has_tangent="tangent" in needs,
         has_uv="uv" in needs or any("texture" in m for m in modes),
@@ -654,4 +660,4 @@ def gbuffer_key(material, needs=(), lod_textures=0):
     writes."""
     return ProgramKey(output="gbuffer", has_normal=True, two_sided=material.two_sided,
                       has_tangent="tangent" in needs, has_uv="uv" in needs, has_color="color" in needs,
-                      has_lod="lod" in needs, lod_textures=lod_textures)
+                      has_lod="lod" in needs, lod_textures=lod_textures, has_face="face" in needs)

@@ -39,6 +39,9 @@ class ShadingFrame:
         the globals `material_inputs` sets); None where no parameter varies.
     input_bounds : dict of str to ((N, 3), (N, 3)) or None
         Their intervals for the tolerance band (`glphong.checks.tolerances.input_bounds`).
+    visibility : tuple or None
+        Per light of the program, in loop order: None (the light casts no shadows) or ``(exact, low, high)``,
+        each (N,), its ray-cast visibility and the interval a shadow map may give (`glphong.checks.shadows`).
     """
 
     n: np.ndarray
@@ -47,6 +50,7 @@ class ShadingFrame:
     uv: np.ndarray = None
     inputs: dict = None
     input_bounds: dict = None
+    visibility: tuple = None
 
     def select(self, mask):
         """The frame at the points where ``mask`` is true."""
@@ -54,7 +58,9 @@ class ShadingFrame:
         inputs = None if self.inputs is None else {k: v[mask] for k, v in self.inputs.items()}
         bounds = None if self.input_bounds is None else \
             {k: (lo[mask], hi[mask]) for k, (lo, hi) in self.input_bounds.items()}
-        return ShadingFrame(self.n[mask], pick(self.t), pick(self.b), pick(self.uv), inputs, bounds)
+        visibility = None if self.visibility is None else \
+            tuple(None if v is None else tuple(a[mask] for a in v) for v in self.visibility)
+        return ShadingFrame(self.n[mask], pick(self.t), pick(self.b), pick(self.uv), inputs, bounds, visibility)
 
 
 #: common.glsl FLT_MAX: vectors with a larger (or NaN) component do not normalise

@@ -1,0 +1,194 @@
+"""The twin of shadows: visibility by a float64 ray cast, and where a shadow map may disagree with it
+(docs/design.md section 12).
+
+For each pixel (a G-buffer position ``x`` with normal ``n``) and shadowing light, rays are cast against the
+triangles of every object that casts shadows, through trimesh's ray module: with Embree (``embreex``, the
+``[shadows]`` extra; single precision inside Embree, about 100 times faster) where it is installed, else trimesh's
+own float64 intersector (which needs ``rtree``).  The rays are the ray from the light to ``x`` (from the map's near plane, along the light's
+direction, for a light at infinity), and eight rays around it, a band radius ``rho`` away: the filter's radius
+``r sqrt(2)`` texels (the corner of its square) plus one texel (an angle for a cube map, a length for an
+orthographic one), which holds the nearest texel's centre (half a texel diagonal away) too.
+
+- The exact visibility is 1 where the ray reaches ``x`` (its first hit no nearer than ``d - q``, ``q`` the depth
+  quantum of glsl/shadows.glsl), else 0.
+- It is certain where every one of the nine rays agrees, against the derived bias ``B = 2 p + q`` of
+  glsl/shadows.glsl (``p`` the most the receiver's own plane comes nearer the light within the filter's reach): all
+  reach the receiver (the centre ray no hit nearer than ``d - q``, each other one none nearer than its own distance
+  to the receiver's tangent plane at ``x`` less ``p + q``), or all are blocked (the centre ray by something nearer
+  than ``d - B``, the others by more than ``B + p``).  Elsewhere a shadow boundary, seen from
+  the light, lies within ``rho`` of ``x``'s ray, or the occluder is nearer the receiver than ``b`` (contact, and a
+  receiver seen edge-on, whose bias is unbounded): the shadow map may decide either way, and the band holds the
+  term between visibility 0 and 1 there.
+
+The ring is a sampling of the disc of radius ``rho``: a shadow boundary that enters the disc and leaves it between
+two neighbouring ring rays without crossing the centre ray (a caster thinner than ``rho`` at that distance) is not
+seen.  The test scenes have none.
+"""
+import numpy as np
+import trimesh
+
+from glphong.core.validate import FLT_MAX
+
+__all__ = ["shadow_visibility", "shadow_plane_angle", "shadow_plane_length", "shadow_bias", "SHADOW_QUANTUM", "RING"]
+
+#: glsl/shadows.glsl SHADOW_QUANTUM: 16 eps, the stored distance's float32 error relative to its scale
+SHADOW_QUANTUM = 16 * 2.0 ** -24
+#: rays around the centre one
+RING = 8
+
+
+def shadow_plane_angle(d, c, offset):
+    """The plane term ``p = d (cos(t) / cos(t + offset) - 1)`` of glsl/shadows.glsl ``shadow_bias_angle`` (FLT_MAX
+    edge-on), float64."""
+    s = np.sqrt(np.maximum(1.0 - c * c, 0.0))
+    c_far = c * np.cos(offset) - s * np.sin(offset)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(c_far > 0.0, d * (c / c_far - 1.0), FLT_MAX)
+
+
+def shadow_plane_length(c, offset):
+    """The plane term ``p = offset tan(t)`` of glsl/shadows.glsl ``shadow_bias_length`` (FLT_MAX edge-on), float64."""
+    s = np.sqrt(np.maximum(1.0 - c * c, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(c > 0.0, offset * (s / c), FLT_MAX)
+
+
+def shadow_bias(plane, q):
+    """glsl/shadows.glsl's bias ``B = 2 p + q`` from its plane term (at most FLT_MAX)."""
+    return np.minimum(2.0 * plane + q, FLT_MAX)
+
+
+def _caster_mesh(scene):
+    """One trimesh of every caster's triangles in world space (cached on the scene per set of objects)."""
+    casters = tuple(obj for obj in scene.objects if obj.casts_shadow)
+    cached = getattr(scene, "_shadow_casters", None)
+    if cached is not None and cached[0] == tuple(id(o) for o in casters):
+        return cached[1]
+    vertices, faces, offset = [], [], 0
+    for obj in casters:
+        vertices.append(obj.mesh.positions @ obj.pose[:3, :3].T + obj.pose[:3, 3])
+        faces.append(obj.mesh.indices.reshape(-1, 3) + offset)
+        offset += len(obj.mesh.positions)
+    mesh = trimesh.Trimesh(np.concatenate(vertices), np.concatenate(faces), process=False) if casters else None
+    intersector = None if mesh is None else _intersector(mesh)
+    scene._shadow_casters = (tuple(id(o) for o in casters), intersector)
+    return intersector
+
+
+def _intersector(mesh):
+    """Embree's intersector where ``embreex`` is installed, else trimesh's float64 one (which needs ``rtree``)."""
+    try:
+        from trimesh.ray import ray_pyembree  # noqa: PLC0415 - optional: embreex
+
+        return ray_pyembree.RayMeshIntersector(mesh)
+    except ImportError:
+        pass
+    try:
+        intersector = trimesh.ray.ray_triangle.RayMeshIntersector(mesh)
+        intersector.intersects_id(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]))  # builds its tree: rtree
+        return intersector
+    except ImportError as exc:
+        raise ImportError(f"verifying shadows casts rays with trimesh, which needs embreex or {exc.name or 'rtree'}: "
+                          "pip install 'glphong[shadows]'") from None
+
+
+def _first_hits(intersector, origins, directions):
+    """Distance along each ray to its first hit (inf where none), float64 (N,)."""
+    out = np.full(len(origins), np.inf)
+    if intersector is None or not len(origins):
+        return out
+    _, ray, location = intersector.intersects_id(origins, directions, multiple_hits=False, return_locations=True)
+    if len(ray):
+        t = np.einsum("ij,ij->i", location - origins[ray], directions[ray])
+        keep = t > 0.0
+        np.minimum.at(out, ray[keep], t[keep])
+    return out
+
+
+def _ring(u, radius):
+    """``RING`` unit vectors at angle ``radius`` (N,) around each unit ``u`` (N, 3): (RING, N, 3)."""
+    helper = np.where(np.abs(u[:, :1]) < 0.9, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+    a = np.cross(u, helper)
+    a /= np.linalg.norm(a, axis=1, keepdims=True)
+    b = np.cross(u, a)
+    phi = 2.0 * np.pi * np.arange(RING) / RING
+    across = np.cos(phi)[:, None, None] * a + np.sin(phi)[:, None, None] * b
+    return np.cos(radius)[None, :, None] * u + np.sin(radius)[None, :, None] * across, across
+
+
+def _plane_distance(n, point, origins, directions):
+    """Distance along each ray to the plane through ``point`` with normal ``n`` (inf where it is not ahead)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.sum(n * (point - origins), axis=-1) / np.sum(n * directions, axis=-1)
+    return np.where(np.isfinite(t) & (t > 0.0), t, np.inf)
+
+
+def shadow_visibility(scene, setup, position, normal, filter_radius):
+    """A shadowing light's visibility at given points: the exact value and its interval.
+
+    Parameters
+    ----------
+    scene : glphong.Scene
+    setup : glphong.scene.shadows.ShadowSetup
+    position : (N, 3) float64 ndarray
+        Receiver points [m] (the G-buffer's).
+    normal : (N, 3) float64 ndarray
+        Their unit normals (either orientation).
+    filter_radius : int
+        The renderer's ``shadow_filter_radius``.
+
+    Returns
+    -------
+    exact, low, high : (N,) float64 ndarray
+        The ray-cast visibility (0 or 1) and the interval the shadow map's may lie in (the exact value where
+        certain, [0, 1] in the band).
+    """
+    intersector = _caster_mesh(scene)
+    n_points = len(position)
+    if not n_points:
+        empty = np.zeros(0)
+        return empty, empty, empty
+    reach = (filter_radius + 0.5) * np.sqrt(2.0) * setup.texel  # the farthest texel centre the lookup reads
+    band = (filter_radius * np.sqrt(2.0) + 1.0) * setup.texel  # the filter's radius plus one texel
+    radius = np.full(n_points, band)
+    scale_x = np.max(np.abs(position), axis=1) + np.max(np.abs(setup.origin))
+    if setup.map == "cube":
+        light = setup.origin
+        v = position - light
+        d = np.linalg.norm(v, axis=1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            u = v / d[:, None]
+        c = np.abs(np.sum(normal * u, axis=1))
+        plane = shadow_plane_angle(d, c, reach)
+        ring, _ = _ring(u, radius)
+        origins = np.broadcast_to(light, (RING + 1, n_points, 3))
+        directions = np.concatenate([u[None], ring])
+    else:
+        axis = setup.axis
+        d = (position - setup.origin) @ axis
+        c = np.abs(normal @ axis)
+        plane = shadow_plane_length(c, reach)
+        start = position - d[:, None] * axis
+        _, across = _ring(np.broadcast_to(axis, (n_points, 3)), radius)
+        origins = np.concatenate([start[None], start[None] + band * across])
+        directions = np.broadcast_to(axis, (RING + 1, n_points, 3))
+    q = SHADOW_QUANTUM * (np.abs(d) + scale_x)
+    bias = shadow_bias(plane, q)
+    hits = _first_hits(intersector, origins.reshape(-1, 3), np.ascontiguousarray(directions).reshape(-1, 3))
+    hits = hits.reshape(RING + 1, n_points)
+    planes = _plane_distance(normal[None], position[None], origins, directions)
+    planes[0] = d
+    # the centre ray reaches x unless something is nearer than d - q, and is blocked for the map by what is nearer
+    # than d - B; a ring ray reaches the receiver where nothing comes nearer than its distance to x's tangent plane
+    # less p + q (the neighbouring triangles' share of B: with x's own plane's p, the map cannot fall short of
+    # d - B), and is blocked where something does by more than B + p (so the map's texels within the filter's reach,
+    # whose own plane is at most p nearer than d, hold something nearer than d - B)
+    with np.errstate(invalid="ignore"):  # inf - inf where a ring ray meets neither the receiver's plane nor a caster
+        deficit = np.nan_to_num(planes - hits, nan=-np.inf)
+    clear = deficit <= plane + q
+    blocked = deficit > bias + plane
+    clear[0] = hits[0] >= d - q
+    blocked[0] = hits[0] < d - bias
+    exact = clear[0].astype(np.float64)
+    certain = np.all(clear, axis=0) | np.all(blocked, axis=0)
+    return exact, np.where(certain, exact, 0.0), np.where(certain, exact, 1.0)
