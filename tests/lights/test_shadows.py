@@ -207,3 +207,48 @@ def test_refusals(glphong_make_renderer):
     with pytest.raises(ValueError, match="shadow settings"):
         renderer = glphong_make_renderer(32, 32, "egl")
         glphong.reference.shade(scene, renderer.gbuffer(scene))
+
+
+def _blocked_run(blocked, body):
+    """Run ``body`` in a fresh interpreter where the top-level packages ``blocked`` cannot be imported."""
+    import subprocess
+    import sys
+    import textwrap
+
+    code = ("import sys\n"
+            "class Block:\n"
+            "    def find_spec(self, name, path=None, target=None):\n"
+            f"        if name.split('.')[0] in {tuple(blocked)!r}:\n"
+            "            raise ImportError('blocked ' + name, name=name)\n"
+            "sys.meta_path.insert(0, Block())\n" + textwrap.dedent(body))
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300)
+
+
+TWIN_RUN = """
+import numpy as np, glphong
+from glphong import primitives
+scene = glphong.Scene(glphong.PerspectiveCamera.look_at((0.0, -3.0, 3.0), (0.0, 0.0, 0.0)),
+                      [glphong.PointLight((0.3, 0.2, 2.0), 60.0, shadows=True)])
+pose = np.eye(4); pose[2, 3] = 0.7
+scene.add(primitives.sphere(3, radius=0.5), glphong.Lambert(0.3), pose=pose)
+scene.add(primitives.plane(4.0), glphong.Lambert(0.6))
+with glphong.Renderer(64, 48, backend="egl", shadow_map_size=256) as renderer:
+    report = glphong.verify(scene, renderer)
+print(report.passed, report.shadow_band_count, int(report.reference.sum() * 1e6))
+"""
+
+
+def test_without_embree_the_float64_intersector_gives_the_same_answer():
+    import importlib.util
+
+    if importlib.util.find_spec("rtree") is None:
+        pytest.skip("rtree is not installed: trimesh's float64 intersector needs it (pip install rtree)")
+    with_embree = _blocked_run((), TWIN_RUN)
+    float64 = _blocked_run(("embreex",), TWIN_RUN)
+    assert with_embree.returncode == 0 and float64.returncode == 0, with_embree.stderr[-1500:] + float64.stderr[-1500:]
+    assert with_embree.stdout.split()[0] == "True" and with_embree.stdout == float64.stdout
+
+
+def test_without_an_intersector_the_error_names_the_extra():
+    out = _blocked_run(("embreex", "rtree"), TWIN_RUN)
+    assert out.returncode != 0 and "pip install 'glphong[shadows]'" in out.stderr, out.stderr[-1500:]
