@@ -14,7 +14,7 @@ copy) with ``PYTHONPATH=<copy>`` prepended, ``GLPHONG_GLSL_DIR=<copy>/glsl`` (gl
 GLSL chunks from there), ``GLPHONG_REQUIRE_BACKENDS=egl,osmesa`` and
 ``PYTHONDONTWRITEBYTECODE=1``.  glphong is usually installed in editable mode pointing at the
 main checkout, so before any run the script checks, in the copy with that environment, that
-both ``glphong.__file__`` and ``glphong.gpu.programs.glsl_root()`` lie inside the copy, and stops
+both ``glphong.__file__`` and ``glphong.core.glsl_files.glsl_root()`` lie inside the copy, and stops
 if not.  The temporary copies are removed at the end.
 
 Examples
@@ -65,14 +65,16 @@ the code it mutated is gone).
 
 **Adding mutations.**  New models add their mutations: when a model, a light kind, a uniform
 or a GLSL chunk lands, append `Mutation` entries to its area of `MUTATIONS` (or open a new
-area) -- at least one for the GLSL, one for its numpy twin in ``glphong/reference.py`` and one
-for each new uniform's wiring on the host.  A mutation is
+area) -- at least one for the GLSL, one for its numpy twin (the library functions' in
+``glphong/twin/functions.py``, a model's ``response`` or a light kind's ``incident`` in its module) and
+one for each new uniform's wiring on the host (a light kind's ``uniform_value``, and its ``from_gltf`` /
+``from_pyrender`` where it has them).  A mutation is
 ``Mutation(name, path, old, new, what)``: ``name`` ``"<file>:<short-slug>"`` and unique;
 ``path`` relative to the repository root; ``old`` an exact snippet (whitespace included; add
 surrounding lines to make it unique); ``new`` its mutated text; ``what`` one line saying what
 the bug is.  Run ``--list`` to validate, then ``--only <name>`` to see it caught.  Mutate only
-code the tests can run: the ``naive`` formulation (naive.glsl) is compared only with itself
-and glphong/stability.py is a test tool, so neither is mutated here.
+code the tests can run: the ``NAIVE`` variants of the chunks are compared only with themselves
+and glphong/checks/stability.py is a test tool, so neither is mutated here.
 """
 import argparse
 import os
@@ -153,32 +155,51 @@ MUTATIONS = [
     M("lobe.glsl:blinn-floor-x10", "glsl/lobe.glsl",
       "const float BLINN_HALF_FLOOR = 9.5367431640625e-07;", "const float BLINN_HALF_FLOOR = 9.5367431640625e-06;",
       "BLINN_HALF_FLOOR 2^-20 -> 10 x 2^-20"),
-    M("shade.glsl:point-gate", "glsl/shade.glsl",
-      "point_irradiance(u_point_intensity[j], d));\n        radiance += (lit && valid && n_dot_l > 0.0)",
-      "point_irradiance(u_point_intensity[j], d));\n        radiance += (lit && valid && n_dot_l > 0.01)",
-      "point-light loop: gate n.l > 0.01 instead of n.l > 0"),
-    M("key.py:ka-1.01", "glphong/key.py",
+    # the light loops are generated (glphong/shaders/generated.py, lights_chunk): the gate is a Python string there
+    M("generated.py:light-gate-0.01", "glphong/shaders/generated.py",
+      '"        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);",',
+      '"        radiance += (lit && valid && n_dot_l > 0.01) ? term : vec3(0.0);",',
+      "generated light loops: gate n.l > 0.01 instead of n.l > 0 (every kind)"),
+    # the material chunk is generated too (glphong/shaders/generated.py, material_chunk)
+    M("generated.py:ka-1.01", "glphong/shaders/generated.py",
       '_switch(key, "u_use_ka", "radiance += u_ka;")', '_switch(key, "u_use_ka", "radiance += 1.01 * u_ka;")',
       "generated material_emission: 1.01 k_a"),
-    M("key.py:ambient-1.01", "glphong/key.py",
+    M("generated.py:ambient-1.01", "glphong/shaders/generated.py",
       'f"radiance += u_{t.name}_{t.ambient_param} * {scaled};"',
       'f"radiance += 1.01 * u_{t.name}_{t.ambient_param} * {scaled};"',
       "generated material_emission: every term's answer to L_a 1.01 k L_a (k_d L_a for Lambert)"),
-    M("key.py:response-1.01", "glphong/key.py",
+    M("generated.py:response-1.01", "glphong/shaders/generated.py",
       'f"response += {t.name}_response(f, wi, {view}, n_dot_l);"',
       'f"response += 1.01 * {t.name}_response(f, wi, {view}, n_dot_l);"',
       "generated material_response: every term 1% high (GPU only)"),
-    M("shade.glsl:point-E-1.01", "glsl/shade.glsl",
-      "point_irradiance(u_point_intensity[j], d));", "point_irradiance(1.01 * u_point_intensity[j], d));",
-      "point-light loop: irradiance of 1.01 I"),
-    M("shade.glsl:unattenuated-E-1.01", "glsl/shade.glsl",
-      "u_unattenuated_radiance[j]);", "1.01 * u_unattenuated_radiance[j]);",
-      "unattenuated-light loop: 1.01 L_i"),
-    M("shade.glsl:directional-E-1.01", "glsl/shade.glsl",
-      "u_directional_irradiance[j]);", "1.01 * u_directional_irradiance[j]);",
-      "directional-light loop: 1.01 E"),
+    # each light kind's <kind>_incident (glsl/lights/<kind>.glsl)
+    M("point.glsl:E-1.01", "glsl/lights/point.glsl",
+      "irradiance = point_irradiance(u_point_intensity[j], d);",
+      "irradiance = point_irradiance(1.01 * u_point_intensity[j], d);",
+      "point_incident: irradiance of 1.01 I"),
+    M("unattenuated.glsl:E-1.01", "glsl/lights/unattenuated.glsl",
+      "irradiance = u_unattenuated_radiance[j];", "irradiance = 1.01 * u_unattenuated_radiance[j];",
+      "unattenuated_incident: 1.01 L_i"),
+    M("directional.glsl:E-1.01", "glsl/lights/directional.glsl",
+      "irradiance = u_directional_irradiance[j];", "irradiance = 1.01 * u_directional_irradiance[j];",
+      "directional_incident: 1.01 E"),
+    M("spot.glsl:falloff-unsquared", "glsl/lights/spot.glsl",
+      "float g_d = g / d;", "float g_d = sqrt(g) / d;",
+      "spot_incident: the angular falloff g not squared (E = g I / d^2)"),
+    M("spot.glsl:chord-sign", "glsl/lights/spot.glsl",
+      "vec3 chord = -wi - u_spot_axis[j];", "vec3 chord = wi - u_spot_axis[j];",
+      "spot_incident: theta measured from wi, not -wi (the cone points back at the light)"),
+    M("point.glsl:range-ignored", "glsl/lights/point.glsl",
+      "irradiance = u_point_range[j] > 0.0 ? irradiance * range_window(d, u_point_range[j]) : irradiance;",
+      "irradiance = u_point_range[j] > 0.0 ? irradiance : irradiance;",
+      "point_incident: a point light's range window never applied"),
+    M("lights.glsl:range-window-squared", "glsl/lights.glsl",
+      "return clamp(((range - d) / range) * (1.0 + t) * (1.0 + t * t), 0.0, 1.0);",
+      "float w = clamp(((range - d) / range) * (1.0 + t) * (1.0 + t * t), 0.0, 1.0);\n    return w * w;",
+      "range_window: the window squared (three.js's and Filament's), GPU only"),
     M("shade.glsl:view-sign", "glsl/shade.glsl",
-      "safe_normalize(eye - position, wo, view_distance)", "safe_normalize(position - eye, wo, view_distance)",
+      "safe_normalize(eye.xyz - position * eye.w, wo, view_distance)",
+      "safe_normalize(position * eye.w - eye.xyz, wo, view_distance)",
       "view vector v points away from the eye"),
     M("srgb.glsl:gamma-2.42", "glsl/srgb.glsl",
       "pow(x, vec3(1.0 / 2.4))", "pow(x, vec3(1.0 / 2.42))",
@@ -192,39 +213,47 @@ MUTATIONS = [
     M("mesh_fragment.glsl:two-sided-flip", "glsl/mesh_fragment.glsl",
       "(SWITCH(u_two_sided) && !gl_FrontFacing) ? -n_raw", "(SWITCH(u_two_sided) && gl_FrontFacing) ? -n_raw",
       "two-sided: normal flipped on front faces instead of back faces"),
-    M("scene.py:uber-light-count", "glphong/scene.py",
-      'values[f"u_{kind}_count"] = np.float32(counts[kind])',
-      'values[f"u_{kind}_count"] = np.float32(max(counts[kind] - 1, 0))',
+    M("scene.py:uber-light-count", "glphong/scene/scene.py",
+      'values[f"u_{light_key.name}_count"] = np.float32(len(mine))',
+      'values[f"u_{light_key.name}_count"] = np.float32(max(len(mine) - 1, 0))',
       "uber-shader: the last light of each kind dropped"),
     M("common.glsl:frame-fallback", "glsl/common.glsl",
       "t = projected ? t : fallback;", "t = fallback;",
       "frame_from_tangent: the mesh's tangent ignored (always the basis around n)"),
-    # ------------------------------------------------------------------ the numpy twin (glphong/reference.py)
-    M("reference.py:point-irradiance-1.01", "glphong/reference.py",
+    # ------------------------------------------------------------------ the numpy twin (glphong/twin/functions.py,
+    # glphong/checks/reference.py, each kind's ``incident``)
+    M("functions.py:point-irradiance-1.01", "glphong/twin/functions.py",
       "return np.minimum((intensity / d) / d, FLT_MAX)", "return np.minimum((intensity / d) / (1.01 * d), FLT_MAX)",
       "twin point_irradiance: I / (1.01 d^2)"),
     M("lambert.py:twin-1.01", "glphong/materials/lambert.py",
       "return kd * np.asarray(n_dot_l)[..., None]", "return 1.01 * kd * np.asarray(n_dot_l)[..., None]",
       "twin lambert: 1.01 kd (n.l)"),
-    M("reference.py:lobe-clamp", "glphong/reference.py",
+    M("functions.py:lobe-clamp", "glphong/twin/functions.py",
       "dtype.type(-104)", "dtype.type(-80)",
       "twin lobe_from_delta: exponent clamp -104 -> -80"),
-    M("reference.py:series-1/3", "glphong/reference.py",
+    M("functions.py:series-1/3", "glphong/twin/functions.py",
       "dtype.type(1.0) / dtype.type(2 * k + 1)", "dtype.type(1.0) / dtype.type(2 * k + 1.01)",
       "twin log_one_minus: artanh series coefficients 1/(2k + 1.01)"),
-    M("reference.py:twin-phong-reflect-1.9", "glphong/reference.py",
+    M("functions.py:twin-phong-reflect-1.9", "glphong/twin/functions.py",
       "r = 2 * _dot(n, wi)[..., None] * n - wi", "r = 1.9 * _dot(n, wi)[..., None] * n - wi",
       "twin phong_delta: r = 1.9 (n.l) n - l"),
-    M("reference.py:twin-blinn-half-vector", "glphong/reference.py",
+    M("functions.py:twin-blinn-half-vector", "glphong/twin/functions.py",
       "ok_h, h, h_len = safe_normalize(wi + wo)\n    valid", "ok_h, h, h_len = safe_normalize(wi + 1.01 * wo)\n    valid",
       "twin blinn_delta: h from l + 1.01 v"),
-    M("reference.py:gate-0.01", "glphong/reference.py",
+    M("reference.py:gate-0.01", "glphong/checks/reference.py",
       "gate = lit & valid & (n_dot_l > 0)", "gate = lit & valid & (n_dot_l > 0.01)",
       "twin shade_point: gate n.l > 0.01"),
-    M("reference.py:frame-handedness", "glphong/reference.py",
+    M("functions.py:frame-handedness", "glphong/twin/functions.py",
       "b = (np.where(tangent[..., 3] < 0, -1.0, 1.0)[..., None] * np.cross(n, t)).astype(n.dtype)",
       "b = np.cross(n, t).astype(n.dtype)",
       "twin frame_from_tangent: the handedness w ignored"),
+    M("functions.py:range-window-squared", "glphong/twin/functions.py",
+      "return np.clip(((range_ - d) / range_) * (1 + t) * (1 + t * t), 0, 1)",
+      "return np.clip(((range_ - d) / range_) * (1 + t) * (1 + t * t), 0, 1) ** 2",
+      "twin range_window: the window squared"),
+    M("spot.py:twin-falloff-unsquared", "glphong/lights/spot.py",
+      "g_d = (g / d)[..., None]", "g_d = (np.sqrt(g) / d)[..., None]",
+      "twin SpotLight.incident: the angular falloff g not squared"),
     # ------------------------------------------------------------------ material uniforms (glphong/materials/model.py)
     # every parameter is uploaded by one generic line: a bug in one parameter's wiring is planted there,
     # conditioned on the parameter's name
@@ -237,97 +266,147 @@ MUTATIONS = [
         f"_validate.float32_uniform(term.uniform_value(p.name)) * np.float32(1.01 if p.name == {param!r} else 1.0)\n",
         f"u_<model>_{param} uploaded 1% high") for param in ("kd", "ks", "q")],
     M("testing.py:band-1.01", "glphong/testing.py",
-      "ok = (gpu >= low) & (gpu <= high) & ~np.isnan(gpu)",
-      "ok = (gpu >= low) & (gpu <= 1.01 * high) & ~np.isnan(gpu)",
+      "high = np.where(np.isnan(high) & ~certain, np.inf, high)\n    ok = (gpu >= low) & (gpu <= high) & ~np.isnan(gpu)",
+      "high = np.where(np.isnan(high) & ~certain, np.inf, high)\n    ok = (gpu >= low) & (gpu <= 1.01 * high) & ~np.isnan(gpu)",
       "assert_twin_matches accepts values 1% above the band"),
-    M("geometry.py:tangent-handedness", "glphong/geometry.py",
+    M("testing.py:light-band-1.01", "glphong/testing.py",
+      "low, high = point_band(key, u64, position, n64, n_valid, material, band)\n    ok = (gpu >= low) & (gpu <= high)",
+      "low, high = point_band(key, u64, position, n64, n_valid, material, band)\n    ok = (gpu >= low) & (gpu <= 1.01 * high)",
+      "assert_light_matches accepts values 1% above the band"),
+    M("geometry.py:tangent-handedness", "glphong/scene/geometry.py",
       "w = np.where(np.sum(np.cross(n_hat, t) * b_sum, axis=1) < 0.0, -1.0, 1.0)",
       "w = np.where(np.sum(np.cross(n_hat, t) * b_sum, axis=1) < 0.0, 1.0, -1.0)",
       "tangents from UVs: handedness w flipped"),
     M("model.py:generic-band-x100", "glphong/materials/model.py",
       "angle = constants.D * EPS", "angle = 100 * constants.D * EPS",
       "the generic band of user models 100 times too wide in the directions"),
-    # ------------------------------------------------------------------ light uniforms (glphong/lights.py)
-    M("lights.py:point-intensity-1.01", "glphong/lights.py",
+    # ------------------------------------------------------------------ light uniforms (glphong/lights/<kind>.py)
+    # each kind's uniforms come from its `uniform_value(name)` (default: the parameter of that name); a bug there
+    # reaches the GPU and the twin alike (the twin reads the uniforms), so only closed forms catch it
+    M("point.py:intensity-1.01", "glphong/lights/point.py",
       "return point_intensity(np.asarray(self.power))", "return point_intensity(np.asarray(self.power)) * 1.01",
       "PointLight.intensity 1% high (Phi / (4 pi) * 1.01)"),
-    M("lights.py:unattenuated-1.01", "glphong/lights.py",
-      "return self.position, self.radiance", "return self.position, tuple(1.01 * c for c in self.radiance)",
+    M("point.py:range-uniform-1.01", "glphong/lights/point.py",
+      'if name == "range":\n            return 0.0 if self.range is None else self.range\n        return getattr(self, name)\n\n'
+      '    optional_code',
+      'if name == "range":\n            return 0.0 if self.range is None else 1.01 * self.range\n        return getattr(self, name)\n\n'
+      '    optional_code',
+      "PointLight uploads its range 1% long"),
+    M("unattenuated.py:radiance-1.01", "glphong/lights/unattenuated.py",
+      "    in_uber = True\n\n    def incident(self, x, p):",
+      "    in_uber = True\n\n    def uniform_value(self, name):\n"
+      "        value = getattr(self, name)\n"
+      "        return tuple(1.01 * c for c in value) if name == \"radiance\" else value\n\n"
+      "    def incident(self, x, p):",
       "UnattenuatedPointLight uploads 1.01 L_i"),
-    M("lights.py:directional-sign", "glphong/lights.py",
-      "return tuple(-c for c in self.direction), self.irradiance",
-      "return tuple(c for c in self.direction), self.irradiance",
+    M("directional.py:towards-sign", "glphong/lights/directional.py",
+      'return tuple(-c for c in self.direction) if name == "towards" else getattr(self, name)',
+      'return tuple(c for c in self.direction) if name == "towards" else getattr(self, name)',
       "DirectionalLight uploads its travel direction, not the direction toward the light"),
-    M("lights.py:directional-E-1.01", "glphong/lights.py",
-      "return tuple(-c for c in self.direction), self.irradiance",
-      "return tuple(-c for c in self.direction), tuple(1.01 * c for c in self.irradiance)",
+    M("directional.py:E-1.01", "glphong/lights/directional.py",
+      'return tuple(-c for c in self.direction) if name == "towards" else getattr(self, name)',
+      'return tuple(-c for c in self.direction) if name == "towards" else tuple(1.01 * c for c in getattr(self, name))',
       "DirectionalLight uploads 1.01 E"),
-    M("lights.py:ambient-1.01", "glphong/lights.py",
+    M("spot.py:versin-outer-1.01", "glphong/lights/spot.py",
+      "return 2.0 * np.sin(0.5 * self.outer_cone_angle) ** 2",
+      "return 2.02 * np.sin(0.5 * self.outer_cone_angle) ** 2",
+      "SpotLight uploads 1 - cos(outer) 1% high (the cone's edge moves out)"),
+    M("spot.py:scale-floor-0.01", "glphong/lights/spot.py",
+      "return 1.0 / max(0.001, gap)", "return 1.0 / max(0.01, gap)",
+      "SpotLight: s = 1 / max(0.01, cos(inner) - cos(outer)) instead of the specification's 0.001"),
+    M("spot.py:axis-sign", "glphong/lights/spot.py",
+      'if name == "axis":\n            return self.direction',
+      'if name == "axis":\n            return tuple(-c for c in self.direction)',
+      "SpotLight uploads its axis reversed (the cone points away from where it should)"),
+    M("ambient.py:ambient-1.01", "glphong/lights/ambient.py",
       '    radiance: tuple\n\n    def __post_init__(self):\n'
       '        object.__setattr__(self, "radiance", _validate.rgb("radiance", self.radiance))',
       '    radiance: tuple\n\n    def __post_init__(self):\n'
       '        object.__setattr__(self, "radiance", tuple(1.01 * c for c in _validate.rgb("radiance", self.radiance)))',
       "AmbientLight stores 1.01 L_a"),
-    # ------------------------------------------------------------------ scene uniforms (glphong/scene.py)
-    M("scene.py:u_ambient-1.01", "glphong/scene.py",
+    # ------------------------------------------------------------------ scene uniforms (glphong/scene/scene.py)
+    M("scene.py:u_ambient-1.01", "glphong/scene/scene.py",
       'values["u_ambient"] = np.asarray(self.ambient_radiance, dtype=np.float32)',
       'values["u_ambient"] = np.asarray(self.ambient_radiance, dtype=np.float32) * np.float32(1.01)',
       "u_ambient uploaded 1% high"),
-    M("scene.py:u_eye-1.01", "glphong/scene.py",
-      'values["u_eye"] = self.camera.position', 'values["u_eye"] = self.camera.position * 1.01',
+    M("scene.py:u_eye-1.01", "glphong/scene/scene.py",  # u_eye is the homogeneous eye (e, w): scale e only
+      'values["u_eye"] = self.camera.eye', 'values["u_eye"] = self.camera.eye * np.array([1.01, 1.01, 1.01, 1.0])',
       "u_eye 1% off the camera centre"),
-    M("scene.py:u_model-x-1.01", "glphong/scene.py",
+    M("scene.py:u_model-x-1.01", "glphong/scene/scene.py",
       'values = {"u_model": obj.pose}',
       'values = {"u_model": obj.pose @ np.diag([1.01, 1.0, 1.0, 1.0])}',
       "u_model stretches objects 1% along their x"),
-    M("scene.py:normal-matrix-transpose", "glphong/scene.py",
+    M("scene.py:normal-matrix-transpose", "glphong/scene/scene.py",
       "return np.linalg.inv(self.pose[:3, :3]).T", "return np.linalg.inv(self.pose[:3, :3])",
       "normal matrix: inverse without the transpose"),
-    # ------------------------------------------------------------------ camera (glphong/camera.py)
-    M("camera.py:projection-x-1.01", "glphong/camera.py",
-      "[f / aspect, 0.0, 0.0, 0.0],", "[1.01 * f / aspect, 0.0, 0.0, 0.0],",
+    # ------------------------------------------------------------------ camera (glphong/scene/camera.py)
+    M("camera.py:projection-x-1.01", "glphong/scene/camera.py",
+      "return self._frustum(f / aspect, f, 0.0, 0.0)", "return self._frustum(1.01 * f / aspect, f, 0.0, 0.0)",
       "projection: x scale 1% high"),
-    M("camera.py:yfov-half", "glphong/camera.py",
+    M("camera.py:yfov-half", "glphong/scene/camera.py",
       "f = 1.0 / np.tan(self.yfov / 2.0)", "f = 1.0 / np.tan(self.yfov / 2.02)",
       "projection: tan(yfov / 2.02)"),
-    M("camera.py:view-translation", "glphong/camera.py",
+    M("camera.py:view-translation", "glphong/scene/camera.py",
       "view[:3, 3] = -r.T @ t", "view[:3, 3] = -r @ t",
       "view matrix: translation -R t instead of -R^T t"),
-    M("camera.py:znear-1.01", "glphong/camera.py",
+    M("camera.py:znear-1.01", "glphong/scene/camera.py",
       "2.0 * far * n / (n - far)]", "2.0 * far * (1.01 * n) / (n - far)]",
       "projection: the near plane 1% off znear"),
     # ------------------------------------------------------------------ one bug written in two places
-    M("lobe.glsl+reference.py:phong-reflect-1.9", "glsl/lobe.glsl",
+    M("lobe.glsl+functions.py:phong-reflect-1.9", "glsl/lobe.glsl",
       "vec3 r = 2.0 * dot(n, wi) * n - wi;", "vec3 r = 1.9 * dot(n, wi) * n - wi;",
       "Phong's 2 (n.l) -> 1.9 (n.l) in the GLSL and the twin alike",
-      also=(("glphong/reference.py", "r = 2 * _dot(n, wi)[..., None] * n - wi",
+      also=(("glphong/twin/functions.py", "r = 2 * _dot(n, wi)[..., None] * n - wi",
              "r = 1.9 * _dot(n, wi)[..., None] * n - wi"),)),
     M("lambert.glsl+lambert.py:kd-1.01", "glsl/materials/lambert.glsl",
       "return kd * n_dot_l;", "return 1.01 * kd * n_dot_l;",
       "Lambert 1.01 kd (n.l) in the GLSL and the twin alike",
       also=(("glphong/materials/lambert.py", "return kd * np.asarray(n_dot_l)[..., None]",
              "return 1.01 * kd * np.asarray(n_dot_l)[..., None]"),)),
-    # ------------------------------------------------------------------ tolerance band (glphong/tolerances.py)
-    M("tolerances.py:A-x100", "glphong/tolerances.py",
+    M("spot.glsl+spot.py:falloff-unsquared", "glsl/lights/spot.glsl",
+      "float g_d = g / d;", "float g_d = sqrt(g) / d;",
+      "spot light's falloff g not squared in the GLSL and the twin alike (only the closed form can tell)",
+      also=(("glphong/lights/spot.py", "g_d = (g / d)[..., None]", "g_d = (np.sqrt(g) / d)[..., None]"),)),
+    M("lights.glsl+functions.py:range-window-squared", "glsl/lights.glsl",
+      "return clamp(((range - d) / range) * (1.0 + t) * (1.0 + t * t), 0.0, 1.0);",
+      "float w = clamp(((range - d) / range) * (1.0 + t) * (1.0 + t * t), 0.0, 1.0);\n    return w * w;",
+      "the range window squared (three.js's and Filament's) in the GLSL and the twin alike",
+      also=(("glphong/twin/functions.py", "return np.clip(((range_ - d) / range_) * (1 + t) * (1 + t * t), 0, 1)",
+             "return np.clip(((range_ - d) / range_) * (1 + t) * (1 + t * t), 0, 1) ** 2"),)),
+    # ------------------------------------------------------------------ tolerance band (glphong/twin/band.py)
+    M("band.py:A-x100", "glphong/twin/band.py",
       "    A: float = 16.0", "    A: float = 1600.0", "band constant A x 100"),
-    M("tolerances.py:B-x100", "glphong/tolerances.py",
+    M("band.py:B-x100", "glphong/twin/band.py",
       "    B: float = 4.0", "    B: float = 400.0", "band constant B x 100"),
-    M("tolerances.py:C-x100", "glphong/tolerances.py",
+    M("band.py:C-x100", "glphong/twin/band.py",
       "    C: float = 6.0", "    C: float = 600.0", "band constant C x 100"),
-    M("tolerances.py:D-x100", "glphong/tolerances.py",
+    M("band.py:D-x100", "glphong/twin/band.py",
       "    D: float = 8.0", "    D: float = 800.0", "band constant D x 100"),
-    # ------------------------------------------------------------------ sRGB on the CPU (glphong/imaging.py)
-    M("imaging.py:gamma-2.42", "glphong/imaging.py",
+    # ------------------------------------------------------------------ sRGB on the CPU (glphong/core/imaging.py)
+    M("imaging.py:gamma-2.42", "glphong/core/imaging.py",
       "1.055 * np.power(x, 1.0 / 2.4) - 0.055", "1.055 * np.power(x, 1.0 / 2.42) - 0.055",
       "srgb_encode (numpy): exponent 1/2.42"),
-    # ------------------------------------------------------------------ pyrender lights (glphong/integrations/pyrender.py)
-    M("pyrender.py:point-4pi-1.01", "glphong/integrations/pyrender.py",
-      "glphong_lights.PointLight(pose[:3, 3], 4.0 * np.pi * value)",
-      "glphong_lights.PointLight(pose[:3, 3], 4.04 * np.pi * value)",
+    # ------------------------------------------------------------------ pyrender and glTF lights: each kind's
+    # from_pyrender / from_gltf (glphong/lights/<kind>.py); the ambient light in glphong/integrations/pyrender.py
+    M("point.py:pyrender-4pi-1.01", "glphong/lights/point.py",
+      "return cls(pose[:3, 3], power_from_intensity(value))",
+      "return cls(pose[:3, 3], 1.01 * power_from_intensity(value))",
       "pyrender PointLight: Phi = 4.04 pi I"),
-    M("pyrender.py:directional-sign", "glphong/integrations/pyrender.py",
-      "glphong_lights.DirectionalLight(-pose[:3, 2], value)", "glphong_lights.DirectionalLight(pose[:3, 2], value)",
+    M("directional.py:pyrender-sign", "glphong/lights/directional.py",
+      "return cls(-pose[:3, 2], value)", "return cls(pose[:3, 2], value)",
       "pyrender DirectionalLight: travels along +Z of its node"),
+    M("spot.py:pyrender-axis-sign", "glphong/lights/spot.py",
+      "cls(pose[:3, 3], -pose[:3, 2], value, light.innerConeAngle, light.outerConeAngle)",
+      "cls(pose[:3, 3], pose[:3, 2], value, light.innerConeAngle, light.outerConeAngle)",
+      "pyrender SpotLight: points along +Z of its node"),
+    M("spot.py:pyrender-cones-swapped", "glphong/lights/spot.py",
+      "cls(pose[:3, 3], -pose[:3, 2], value, light.innerConeAngle, light.outerConeAngle)",
+      "cls(pose[:3, 3], -pose[:3, 2], value, light.innerConeAngle, light.innerConeAngle)",
+      "pyrender SpotLight: the outer cone angle read as the inner one"),
+    M("spot.py:gltf-axis-sign", "glphong/lights/spot.py",
+      "return cls(tuple(pose[:3, 3]), tuple(-pose[:3, 2]), tuple(value),",
+      "return cls(tuple(pose[:3, 3]), tuple(pose[:3, 2]), tuple(value),",
+      "glTF spot light: points along +Z of its node"),
     M("pyrender.py:ambient-1.01", "glphong/integrations/pyrender.py",
       "ambient = np.asarray(scene.ambient_light, dtype=np.float64)",
       "ambient = 1.01 * np.asarray(scene.ambient_light, dtype=np.float64)",
@@ -339,7 +418,7 @@ MUTATIONS = [
     M("fresnel.glsl:dielectric-0.51", "glsl/fresnel.glsl",
       "float f = 0.5 * (ratio * ratio) * (1.0 + q * q);", "float f = 0.51 * (ratio * ratio) * (1.0 + q * q);",
       "dielectric Fresnel 2% high on the GPU"),
-    M("reference.py:schlick-power-4", "glphong/reference.py",
+    M("functions.py:schlick-power-4", "glphong/twin/functions.py",
       "return f0 + (1 - f0) * (m2 * m2 * m)[..., None]", "return f0 + (1 - f0) * (m2 * m2)[..., None]",
       "twin Schlick (1 - c)^4"),
     M("model.py:fresnel-forms-swapped", "glphong/materials/model.py",
@@ -349,7 +428,7 @@ MUTATIONS = [
     M("diffuse.glsl:inv-pi", "glsl/materials/diffuse.glsl",
       "const float DIFFUSE_INV_PI = 0.3183098861837907;", "const float DIFFUSE_INV_PI = 0.3215;",
       "Diffuse's 1/pi 1% high"),
-    M("key.py:ambient-scale-dropped", "glphong/key.py",
+    M("generated.py:ambient-scale-dropped", "glphong/shaders/generated.py",
       'scaled = "u_ambient" if t.ambient_scale == 1.0 else', 'scaled = "u_ambient" if True else',
       "the albedo models answer L_a with rho L_a instead of rho/pi L_a"),
 ]
@@ -446,7 +525,7 @@ def environment(copy):
 
 def check_import_paths(copy):
     """Stop unless glphong's Python files and GLSL chunks both come from the copy at ``copy``."""
-    code = "import glphong, glphong.gpu.programs as p; print(glphong.__file__); print(p.glsl_root())"
+    code = "import glphong, glphong.core.glsl_files as p; print(glphong.__file__); print(p.glsl_root())"
     out = subprocess.run([sys.executable, "-c", code], cwd=copy, env=environment(copy), capture_output=True,
                          text=True, timeout=300)
     if out.returncode != 0:

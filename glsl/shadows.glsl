@@ -1,8 +1,8 @@
 // shadows.glsl -- shadow-map visibility with a bias derived from the geometry (docs/design.md section 12).
 //
 // A shadowing light's map holds, per texel, the distance from the light of the nearest caster along the
-// texel centre's ray: a cube map (6 faces of SHADOW_MAP_SIZE^2 texels side by side in one float texture,
-// face f = 2 a + (s < 0) for the major axis a and its sign s, texel coordinates ((v_b / |v_a| + 1) / 2,
+// texel centre's ray: a cube map (6 faces of SHADOW_MAP_SIZE^2 texels in one float texture, 3 across and 2 up,
+// face f at ((f mod 3) N, (f / 3) N), f = 2 a + (s < 0) for the major axis a and its sign s, texel coordinates ((v_b / |v_a| + 1) / 2,
 // (v_c / |v_a| + 1) / 2) SHADOW_MAP_SIZE with (b, c) the other two axes in order) for a light at a point, or an
 // orthographic map (texel coordinates e1 . (x - o), e2 . (x - o); depth a . (x - o)) for a light at infinity.
 //
@@ -76,7 +76,7 @@ float shadow_cube(sampler2D map, vec3 origin, float texel_angle, vec3 x, vec3 n)
     for (int i = -SHADOW_FILTER_RADIUS; i <= SHADOW_FILTER_RADIUS; ++i) {
         for (int k = -SHADOW_FILTER_RADIUS; k <= SHADOW_FILTER_RADIUS; ++k) {
             ivec2 t = clamp(texel + ivec2(i, k), ivec2(0), ivec2(SHADOW_MAP_SIZE - 1));
-            float stored = texelFetch(map, ivec2(face * SHADOW_MAP_SIZE + t.x, t.y), 0).r;
+            float stored = texelFetch(map, ivec2((face % 3) * SHADOW_MAP_SIZE + t.x, (face / 3) * SHADOW_MAP_SIZE + t.y), 0).r;
             lit += stored >= d - bias ? 1.0 : 0.0;
         }
     }

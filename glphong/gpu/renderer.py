@@ -105,7 +105,8 @@ class Renderer:
         only; `glphong.gpu.contexts.egl_device_count` says how many there are).  A batch passes it through
         (``render_many(..., device=1)``).
     shadow_map_size : int
-        Texels along a side of each shadow map (a cube map's face), 16 to 8192 (default 1024); only lights with
+        Texels along a side of each shadow map (a cube map's face), 16 to 8192 and at most a third of the context's
+        largest texture (a cube map's faces lie three across: 5461 on llvmpipe) (default 1024); only lights with
         ``shadows=True`` have maps (docs/design.md section 12).
     shadow_filter_radius : int
         Percentage-closer filtering over the (2 r + 1)^2 texels around the nearest, 0 to 8 (default 0: the
@@ -151,6 +152,10 @@ class Renderer:
                 raise ValueError(f"samples must be at most this context's GL_MAX_SAMPLES = {max_samples} "
                                  f"({context.renderer_name}) (got {self.samples})")
             self._check_limits(self._size, context.renderer_name)
+            if 3 * self.shadow_map_size > self._max_size:
+                raise ValueError(f"shadow_map_size must be at most {self._max_size // 3} on this context ({context.renderer_name}): "
+                                 f"a cube map's six faces lie three across in one texture of at most {self._max_size} "
+                                 f"texels (got {self.shadow_map_size})")
         except BaseException:
             context.release()
             raise

@@ -1,7 +1,7 @@
 """Drawing the shadow maps of a frame (docs/design.md section 12).
 
-Each shadowing light's map (`glphong.scene.shadows.ShadowSetup`) is a float32 texture: six faces side by side for
-a light at a point, one square for a light at infinity.  The pass (`glphong.shaders.key.shadow_key`,
+Each shadowing light's map (`glphong.scene.shadows.ShadowSetup`) is a float32 texture: six faces (three across,
+two up) for a light at a point, one square for a light at infinity.  The pass (`glphong.shaders.key.shadow_key`,
 glsl/shadow_fragment.glsl) draws every object that casts shadows into it, writing its distance from the light, and
 blends with MIN into a target cleared to FLT_MAX, so each texel keeps the nearest caster's distance exactly as
 float32 computes it (no depth buffer and no depth precision in the way).  Textures are kept per size and reused
@@ -74,7 +74,7 @@ class ShadowMaps:
                 if setup.map == "ortho":
                     base["u_shadow_axis"] = setup.axis
                 for face, matrix in enumerate(setup.face_matrices()):
-                    fbo.viewport = (face * setup.size, 0, setup.size, setup.size)
+                    fbo.viewport = (*setup.face_origin(face), setup.size, setup.size)
                     for obj in casters:
                         program.bind({**base, "u_model": obj.pose, "u_view_projection": matrix})
                         vertex_array(obj.mesh, program).render(moderngl.TRIANGLES)

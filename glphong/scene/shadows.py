@@ -56,8 +56,12 @@ class ShadowSetup:
 
     @property
     def texture_size(self):
-        """``(width, height)`` of the map's texture: six faces side by side for a cube."""
-        return (6 * self.size, self.size) if self.map == "cube" else (self.size, self.size)
+        """``(width, height)`` of the map's texture: six faces, three across and two up, for a cube."""
+        return (3 * self.size, 2 * self.size) if self.map == "cube" else (self.size, self.size)
+
+    def face_origin(self, face):
+        """The texel where face ``face`` starts in the texture, ``(x, y)``."""
+        return (face % 3) * self.size, (face // 3) * self.size
 
     def face_matrices(self):
         """The clip matrices of the pass, (4, 4) float64 each: six for a cube (in `CUBE_FACES` order), one for an
