@@ -52,6 +52,25 @@ def _literal(a):
     return "[" + ", ".join(repr(float(x)) for x in np.asarray(a, dtype=np.float64).ravel()) + "]"
 
 
+def _judge(gpu, twin, low, high, certain, worst):
+    """``(figures, bad, order)`` of GPU values against the twin and its band, each (N, 3): the largest relative
+    error and band width where the value is decided (``certain`` and the band clear of 0), which rows leave the
+    band (NaN never passes), and the ``worst`` of them, farthest outside first."""
+    ok = (gpu >= low) & (gpu <= high) & ~np.isnan(gpu)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        rel = np.where(twin != 0, np.abs(gpu - twin) / np.abs(twin), np.where(gpu == twin, 0.0, np.inf))
+        width = np.where(twin != 0, (high - low) / np.abs(twin), 0.0)
+    decided = certain & (low > 0) & np.isfinite(rel) & np.isfinite(width)
+    figures = {"max_relative_error": float(np.max(rel[decided], initial=0.0)),
+               "max_band_width": float(np.max(width[decided], initial=0.0))}
+    bad = ~np.all(ok, axis=1)
+    span = np.maximum(high - low, np.abs(twin) * EPS + np.finfo(np.float64).tiny)
+    with np.errstate(invalid="ignore"):
+        distance = np.where(ok, 0.0, np.nan_to_num(np.maximum(low - gpu, gpu - high) / span, nan=np.inf))
+    order = np.argsort(-np.max(distance, axis=1))[:min(worst, int(bad.sum()))]
+    return figures, bad, order
+
+
 def assert_twin_matches(material, n=2000, seed=0, backend="auto", band=BAND, normal=(0.0, 0.0, 1.0),
                         tangent=(1.0, 0.0, 0.0), uv=None, context=None, worst=5):
     """Assert that a material's GLSL response lies in the tolerance band around its twin.
@@ -102,22 +121,12 @@ def assert_twin_matches(material, n=2000, seed=0, backend="auto", band=BAND, nor
                                                       n_dot_l[possible], material, band)
     low = np.where(certain, low, np.fmin(low, 0.0))
     high = np.where(np.isnan(high) & ~certain, np.inf, high)
-    ok = (gpu >= low) & (gpu <= high) & ~np.isnan(gpu)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        rel = np.where(twin != 0, np.abs(gpu - twin) / np.abs(twin), np.where(gpu == twin, 0.0, np.inf))
-        width = np.where(twin != 0, (high - low) / np.abs(twin), 0.0)
     # figures where the value is decided: the light gate certain and the band clear of 0 (a gate of
     # the model itself, such as Blinn's n.v > 0, uncertain there)
-    decided = certain & (low > 0) & np.isfinite(rel) & np.isfinite(width)
-    figures = {"pairs": len(wi), "nonzero": int(np.any(twin != 0, axis=1).sum()),
-               "max_relative_error": float(np.max(rel[decided], initial=0.0)),
-               "max_band_width": float(np.max(width[decided], initial=0.0))}
-    bad = ~np.all(ok, axis=1)
+    figures, bad, order = _judge(gpu, twin, low, high, certain, worst)
+    figures = {"pairs": len(wi), "nonzero": int(np.any(twin != 0, axis=1).sum())} | figures
     if not bad.any():
         return figures
-    span = np.maximum(high - low, np.abs(twin) * EPS + np.finfo(np.float64).tiny)
-    distance = np.where(ok, 0.0, np.nan_to_num(np.maximum(low - gpu, gpu - high) / span, nan=np.inf))
-    order = np.argsort(-np.max(distance, axis=1))[:min(worst, int(bad.sum()))]
     lines = [f"{type(material).__name__}: the GPU response left the tolerance band at {int(bad.sum())} of "
              f"{len(wi)} direction pairs (normal {_literal(normal[0])}); worst first, paste-ready:"]
     for i in order:
@@ -224,20 +233,10 @@ def assert_light_matches(light, points=None, n=2000, seed=0, backend="auto", ban
     position = points.astype(np.float64)
     twin = ref.shade_point(position, n64, n_valid, u64.get("u_eye"), key, u64, material)
     low, high = point_band(key, u64, position, n64, n_valid, material, band)
-    ok = (gpu >= low) & (gpu <= high) & ~np.isnan(gpu)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        rel = np.where(twin != 0, np.abs(gpu - twin) / np.abs(twin), np.where(gpu == twin, 0.0, np.inf))
-        width = np.where(twin != 0, (high - low) / np.abs(twin), 0.0)
-    decided = (low > 0) & np.isfinite(rel) & np.isfinite(width)
-    figures = {"points": len(points), "lit": int(np.any(twin != 0, axis=1).sum()),
-               "max_relative_error": float(np.max(rel[decided], initial=0.0)),
-               "max_band_width": float(np.max(width[decided], initial=0.0))}
-    bad = ~np.all(ok, axis=1)
+    figures, bad, order = _judge(gpu, twin, low, high, True, worst)
+    figures = {"points": len(points), "lit": int(np.any(twin != 0, axis=1).sum())} | figures
     if not bad.any():
         return figures
-    span = np.maximum(high - low, np.abs(twin) * EPS + np.finfo(np.float64).tiny)
-    distance = np.where(ok, 0.0, np.nan_to_num(np.maximum(low - gpu, gpu - high) / span, nan=np.inf))
-    order = np.argsort(-np.max(distance, axis=1))[:min(worst, int(bad.sum()))]
     lines = [f"{type(light).__name__}: the GPU's irradiance left the tolerance band at {int(bad.sum())} of {len(points)} "
              "points (Lambert k_d = 1, normal toward the light); worst first, paste-ready:"]
     for i in order:

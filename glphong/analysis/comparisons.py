@@ -325,6 +325,9 @@ def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=Non
                              "(pyrender point lights always fall off as 1/d^2)")
         if getattr(light, "range", None) is not None:
             raise ValueError(f"{light!r} has a range, which pyrender ignores: the images would differ")
+        if light.shadows:
+            raise ValueError(f"{light!r} casts shadows, which this comparison does not ask pyrender for: the images "
+                             "would differ (compare the scene with shadows=False)")
     pyrender = import_pyrender(platform) if platform is not None else importlib.import_module("pyrender")
     ambient = np.zeros(3) if scene.ambient is None else np.asarray(scene.ambient.radiance) / np.pi
     out = pyrender.Scene(bg_color=np.zeros(4), ambient_light=ambient)

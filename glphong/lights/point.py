@@ -12,7 +12,7 @@ from glphong.core.radiometry import point_intensity, power_from_intensity
 from glphong.lights.model import GlslFile, LightModel, Param, gltf_entry, mp32, mp_range_window, mp_toward
 from glphong.twin.functions import point_irradiance, range_window, safe_normalize
 
-__all__ = ["PointLight", "POSITION", "RANGE"]
+__all__ = ["PointLight", "POSITION", "RANGE", "WithRange"]
 
 _MAX_POWER = 4.0 * np.pi * _validate.FLT_MAX
 #: a light's position, shared by the positional kinds
@@ -35,7 +35,24 @@ def range_defines(lights):
     return (("RANGE", "1"),) if any(light.range is not None for light in lights) else ()
 
 
-class PointLight(LightModel):
+class WithRange:
+    """What a light kind with KHR_lights_punctual's ``range`` (the `RANGE` param) shares: the window's structural
+    define (``<KIND>_RANGE`` where one of the scene's lights of the kind has a range) and its uniform, 0 for none."""
+
+    optional_code = (("RANGE", "range window clamp(1 - (d/range)^4, 0, 1) and its uniform"),)
+    conditional_uniforms = {"range": "RANGE"}
+
+    @classmethod
+    def structural_defines(cls, lights):
+        return range_defines(lights)
+
+    def uniform_value(self, name):
+        if name == "range":
+            return 0.0 if self.range is None else self.range
+        return getattr(self, name)
+
+
+class PointLight(WithRange, LightModel):
     """Isotropic point source given by its power (docs/design.md E1).
 
     Parameters
@@ -68,18 +85,7 @@ class PointLight(LightModel):
         return point_intensity(np.asarray(self.power))
 
     def uniform_value(self, name):
-        if name == "intensity":
-            return self.intensity
-        if name == "range":
-            return 0.0 if self.range is None else self.range
-        return getattr(self, name)
-
-    optional_code = (("RANGE", "range window clamp(1 - (d/range)^4, 0, 1) and its uniform"),)
-    conditional_uniforms = {"range": "RANGE"}
-
-    @classmethod
-    def structural_defines(cls, lights):
-        return range_defines(lights)
+        return self.intensity if name == "intensity" else super().uniform_value(name)
 
     def incident(self, x, p):
         valid, wi, d = safe_normalize(p.position - x)

@@ -10,7 +10,7 @@ import numpy as np
 
 from glphong.core.radiometry import point_intensity
 from glphong.lights.model import GlslFile, LightModel, Param, gltf_entry, mp32, mp_dot, mp_range_window, mp_toward, pose_pointing
-from glphong.lights.point import POSITION, RANGE, range_defines, with_range
+from glphong.lights.point import POSITION, RANGE, WithRange, with_range
 from glphong.materials.cases import Case
 from glphong.materials.phong import Phong
 from glphong.twin.band import EPS
@@ -33,7 +33,7 @@ def spot_falloff(cos_theta, inner_cone_angle, outer_cone_angle):
     return np.clip(np.asarray(cos_theta) * s - np.cos(outer_cone_angle) * s, 0.0, 1.0) ** 2
 
 
-class SpotLight(LightModel):
+class SpotLight(WithRange, LightModel):
     """A spot light: a point source whose light is confined to a cone (KHR_lights_punctual).
 
     Parameters
@@ -80,16 +80,7 @@ class SpotLight(LightModel):
             half = 0.5 * np.array([self.outer_cone_angle, self.inner_cone_angle])
             gap = 2.0 * (np.sin(half[0]) - np.sin(half[1])) * (np.sin(half[0]) + np.sin(half[1]))
             return 1.0 / max(0.001, gap)
-        if name == "range":
-            return 0.0 if self.range is None else self.range
-        return getattr(self, name)
-
-    optional_code = (("RANGE", "range window clamp(1 - (d/range)^4, 0, 1) and its uniform"),)
-    conditional_uniforms = {"range": "RANGE"}
-
-    @classmethod
-    def structural_defines(cls, lights):
-        return range_defines(lights)
+        return super().uniform_value(name)
 
     def incident(self, x, p):
         valid, wi, d = safe_normalize(p.position - x)
