@@ -20,7 +20,9 @@
 //   (n: the triangle's own normal, shadow_face_normal)
 //   the fraction of the (2 r + 1)^2 texels around x's own (r = SHADOW_FILTER_RADIUS; 0: the nearest texel alone)
 //   whose stored distance is >= d - b (percentage-closer filtering); at a cube face's edge the filter stays on
-//   the face (clamped).  texel_angle = 2 / SHADOW_MAP_SIZE is the largest angle a cube texel subtends.
+//   the face (clamped).  texel_angle = 2 / SHADOW_MAP_SIZE, and a cube texel seen along the unit direction v
+//   subtends at most texel_angle m, m = max |v_i| (its face's axis component: 1 at a face's centre, 1/sqrt(3) at a
+//   corner), since a step ds of the face coordinate turns the ray by m^2 sqrt(1 + t^2) ds <= m ds.
 // Units: positions [m]; d, b [m]; texel_angle [rad]; texel_size [m].
 // Key defines read here: SHADOW_MAP_SIZE, SHADOW_FILTER_RADIUS.
 
@@ -67,7 +69,7 @@ float shadow_cube(sampler2D map, vec3 origin, float texel_angle, vec3 x, vec3 n)
     if (!safe_normalize(x - origin, v, d)) {
         return 1.0;
     }
-    float offset = (float(SHADOW_FILTER_RADIUS) + 0.5) * 1.4142135623730951 * texel_angle;
+    float offset = (float(SHADOW_FILTER_RADIUS) + 0.5) * 1.4142135623730951 * texel_angle * max_abs(v);
     float bias = shadow_bias_angle(d, abs(dot(n, v)), offset, d + max_abs(x) + max_abs(origin));
     vec2 st;
     int face = cube_face(v, st);

@@ -6,8 +6,9 @@ triangles of every object that casts shadows, through trimesh's ray module: with
 ``[shadows]`` extra; single precision inside Embree, about 100 times faster) where it is installed, else trimesh's
 own float64 intersector (which needs ``rtree``).  The rays are the ray from the light to ``x`` (from the map's near plane, along the light's
 direction, for a light at infinity), and eight rays around it, a band radius ``rho`` away: the filter's radius
-``r sqrt(2)`` texels (the corner of its square) plus one texel (an angle for a cube map, a length for an
-orthographic one), which holds the nearest texel's centre (half a texel diagonal away) too.
+``r sqrt(2)`` texels (the corner of its square) plus one texel (an angle for a cube map: a texel seen along the unit
+direction ``u`` subtends at most ``(2 / N) max |u_i|``; a length for an orthographic one), which holds the nearest
+texel's centre (half a texel diagonal away) too.
 
 - The exact visibility is 1 where the ray reaches ``x`` (its first hit no nearer than ``d - q``, ``q`` the depth
   quantum of glsl/shadows.glsl), else 0.
@@ -150,7 +151,6 @@ def shadow_visibility(scene, setup, position, normal, filter_radius):
         return empty, empty, empty
     reach = (filter_radius + 0.5) * np.sqrt(2.0) * setup.texel  # the farthest texel centre the lookup reads
     band = (filter_radius * np.sqrt(2.0) + 1.0) * setup.texel  # the filter's radius plus one texel
-    radius = np.full(n_points, band)
     scale_x = np.max(np.abs(position), axis=1) + np.max(np.abs(setup.origin))
     if setup.map == "cube":
         light = setup.origin
@@ -158,6 +158,8 @@ def shadow_visibility(scene, setup, position, normal, filter_radius):
         d = np.linalg.norm(v, axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
             u = v / d[:, None]
+        m = np.max(np.abs(u), axis=1)  # a cube texel along u subtends at most texel m (glsl/shadows.glsl)
+        reach, radius = reach * m, band * m
         c = np.abs(np.sum(normal * u, axis=1))
         plane = shadow_plane_angle(d, c, reach)
         ring, _ = _ring(u, radius)
@@ -169,7 +171,7 @@ def shadow_visibility(scene, setup, position, normal, filter_radius):
         c = np.abs(normal @ axis)
         plane = shadow_plane_length(c, reach)
         start = position - d[:, None] * axis
-        _, across = _ring(np.broadcast_to(axis, (n_points, 3)), radius)
+        _, across = _ring(np.broadcast_to(axis, (n_points, 3)), np.full(n_points, band))
         origins = np.concatenate([start[None], start[None] + band * across])
         directions = np.broadcast_to(axis, (RING + 1, n_points, 3))
     q = SHADOW_QUANTUM * (np.abs(d) + scale_x)
