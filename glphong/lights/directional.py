@@ -3,7 +3,7 @@ GLSL: ``glsl/lights/directional.glsl``).  glTF's and pyrender's directional ligh
 import mpmath
 import numpy as np
 
-from glphong.lights.model import GlslFile, LightModel, Param, gltf_entry, mp32, mp_dot, pose_pointing
+from glphong.lights.model import ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp32, mp_dot, pose_pointing
 
 __all__ = ["DirectionalLight"]
 
@@ -11,7 +11,7 @@ _DIRECTION = Param("direction", "direction", low=-1.0, high=1.0, doc="direction 
 _IRRADIANCE = Param("irradiance", "rgb", low=0.0, unit="W/m^2", doc="E on a surface facing the light")
 
 
-class DirectionalLight(LightModel):
+class DirectionalLight(ExactIrradiance, LightModel):
     """A light at infinity: constant direction and irradiance.
 
     Parameters
@@ -50,11 +50,6 @@ class DirectionalLight(LightModel):
     def stability_cases(cls):
         """None of its own: the suite's group 'dynamic range' has it."""
         return ()
-
-    def band(self, x, p, constants):
-        """Exact: ``E`` is the uniform itself."""
-        e = self.incident(x, p)[2]
-        return e, e
 
     @classmethod
     def from_gltf(cls, value, entry, pose):

@@ -38,7 +38,7 @@ from glphong.materials.registry import (_library_names, _strip_comments, _top_le
 from glphong.twin.band import EPS
 
 __all__ = ["LightModel", "LightDefinitionError", "registered_lights", "light_named", "light_for_key",
-           "light_cases", "light_source", "LIGHT_LIBRARY_CHUNKS", "Param", "GlslFile", "pose_pointing", "gltf_entry", "mp32", "mp_dot",
+           "light_cases", "light_source", "ExactIrradiance", "LIGHT_LIBRARY_CHUNKS", "Param", "GlslFile", "pose_pointing", "gltf_entry", "mp32", "mp_dot",
            "mp_toward", "mp_range_window"]
 
 #: library chunks a light kind may use: ``lights`` (``point_irradiance``, ``range_window``) and the materials' ones
@@ -482,6 +482,16 @@ def _check_glsl(cls, code):
     if unprefixed:
         raise err(f"{cls.__qualname__}.glsl defines {', '.join(unprefixed)} without the prefix {name}_ (lights and "
                   "materials share one program): prefix them")
+
+
+class ExactIrradiance:
+    """For a kind whose irradiance is a uniform itself, or one product or quotient of uniforms: its float32 error is
+    inside the ``(1 +- A eps)`` every light term gets, so its band is its twin's value (mix in before `LightModel`)."""
+
+    def band(self, x, p, constants):
+        """The twin's value: exact beyond the term's ``A eps``."""
+        e = self.incident(x, p)[2]
+        return e, e
 
 
 # --------------------------------------------------------------------------- shared by the kinds' oracles

@@ -9,7 +9,8 @@ import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.core.radiometry import point_intensity, power_from_intensity
-from glphong.lights.model import GlslFile, LightModel, Param, gltf_entry, mp32, mp_range_window, mp_toward
+from glphong.lights.model import (ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp32, mp_range_window,
+                                  mp_toward)
 from glphong.twin.functions import point_irradiance, range_window, safe_normalize
 
 __all__ = ["PointLight", "POSITION", "RANGE", "WithRange"]
@@ -107,9 +108,8 @@ class PointLight(WithRange, LightModel):
         """The twin's value: ``(I / d) / d`` is two quotients, inside the term's ``A eps``; the window (where
         present) is the generic band."""
         if p.defines.get("RANGE"):
-            return super().band(x, p, constants)
-        e = self.incident(x, p)[2]
-        return e, e
+            return LightModel.band(self, x, p, constants)
+        return ExactIrradiance.band(self, x, p, constants)
 
     @classmethod
     def from_gltf(cls, value, entry, pose):

@@ -3,14 +3,14 @@ irradiance at every distance (docs/design.md E2, section 11; GLSL: ``glsl/lights
 No glTF or pyrender light has it (both always fall off as ``1/d^2``)."""
 import numpy as np
 
-from glphong.lights.model import GlslFile, LightModel, Param, mp32, mp_toward
+from glphong.lights.model import ExactIrradiance, GlslFile, LightModel, Param, mp32, mp_toward
 from glphong.lights.point import POSITION
 from glphong.twin.functions import safe_normalize
 
 __all__ = ["UnattenuatedPointLight"]
 
 
-class UnattenuatedPointLight(LightModel):
+class UnattenuatedPointLight(ExactIrradiance, LightModel):
     """A positional light of value ``L_i`` with no distance falloff (docs/design.md E2).
 
     Parameters
@@ -38,8 +38,3 @@ class UnattenuatedPointLight(LightModel):
     def stability_cases(cls):
         """None of its own: the suite's group 'dynamic range' has it."""
         return ()
-
-    def band(self, x, p, constants):
-        """Exact: ``E`` is the uniform itself."""
-        e = self.incident(x, p)[2]
-        return e, e
