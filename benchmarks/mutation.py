@@ -39,11 +39,13 @@ Extra pytest arguments go to every run, the baseline included (e.g. a subset of 
 
 Notes
 -----
-**Time.**  The baseline costs one full suite run (about a minute on 2 cores with both backends: 53 s measured).
-A caught mutation stops at its first failing test (``-x``): from a few seconds to a minute or
-two, depending on how far down the suite the first catching test is.  A missed mutation costs a
-full suite run.  The whole list takes roughly 15 to 45 minutes; ``--timeout`` (default 900 s)
-bounds each run.
+**Time.**  The baseline costs one full suite run: 600 s measured on 2 cores with both backends
+(another test run sharing the machine).  A caught mutation stops at its first failing test
+(``-x``): 8 to 32 s where tests/lights or tests/materials catch it, 200 s at tests/test_conformance.py,
+364 to 455 s where the first catching test is as far down as tests/test_parameters_closed_form.py or
+tests/test_pyrender_integration.py.  A missed mutation costs a full suite run (497 s measured).
+The 33 light mutations took about 65 minutes in all; the whole list has not been timed since the
+suite grew, so select with ``--only``.  ``--timeout`` (default 900 s) bounds each run.
 
 **Verdicts.**  pytest's exit code decides:
 
@@ -157,8 +159,8 @@ MUTATIONS = [
       "BLINN_HALF_FLOOR 2^-20 -> 10 x 2^-20"),
     # the light loops are generated (glphong/shaders/generated.py, lights_chunk): the gate is a Python string there
     M("generated.py:light-gate-0.01", "glphong/shaders/generated.py",
-      '"        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);",',
-      '"        radiance += (lit && valid && n_dot_l > 0.01) ? term : vec3(0.0);",',
+      '"        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);"',
+      '"        radiance += (lit && valid && n_dot_l > 0.01) ? term : vec3(0.0);"',
       "generated light loops: gate n.l > 0.01 instead of n.l > 0 (every kind)"),
     # the material chunk is generated too (glphong/shaders/generated.py, material_chunk)
     M("generated.py:ka-1.01", "glphong/shaders/generated.py",
@@ -266,13 +268,12 @@ MUTATIONS = [
         f"_validate.float32_uniform(term.uniform_value(p.name)) * np.float32(1.01 if p.name == {param!r} else 1.0)\n",
         f"u_<model>_{param} uploaded 1% high") for param in ("kd", "ks", "q")],
     M("testing.py:band-1.01", "glphong/testing.py",
-      "high = np.where(np.isnan(high) & ~certain, np.inf, high)\n    ok = (gpu >= low) & (gpu <= high) & ~np.isnan(gpu)",
-      "high = np.where(np.isnan(high) & ~certain, np.inf, high)\n    ok = (gpu >= low) & (gpu <= 1.01 * high) & ~np.isnan(gpu)",
-      "assert_twin_matches accepts values 1% above the band"),
+      "ok = (gpu >= low) & (gpu <= high) & ~np.isnan(gpu)",
+      "ok = (gpu >= low) & (gpu <= 1.01 * high) & ~np.isnan(gpu)",
+      "_judge (assert_twin_matches and assert_light_matches) accepts values 1% above the band"),
     M("testing.py:light-band-1.01", "glphong/testing.py",
-      "low, high = point_band(key, u64, position, n64, n_valid, material, band)\n    ok = (gpu >= low) & (gpu <= high)",
-      "low, high = point_band(key, u64, position, n64, n_valid, material, band)\n    ok = (gpu >= low) & (gpu <= 1.01 * high)",
-      "assert_light_matches accepts values 1% above the band"),
+      "_judge(gpu, twin, low, high, True, worst)", "_judge(gpu, twin, low, 1.01 * high, True, worst)",
+      "assert_light_matches alone accepts values 1% above the band"),
     M("geometry.py:tangent-handedness", "glphong/scene/geometry.py",
       "w = np.where(np.sum(np.cross(n_hat, t) * b_sum, axis=1) < 0.0, -1.0, 1.0)",
       "w = np.where(np.sum(np.cross(n_hat, t) * b_sum, axis=1) < 0.0, 1.0, -1.0)",
@@ -287,11 +288,8 @@ MUTATIONS = [
       "return point_intensity(np.asarray(self.power))", "return point_intensity(np.asarray(self.power)) * 1.01",
       "PointLight.intensity 1% high (Phi / (4 pi) * 1.01)"),
     M("point.py:range-uniform-1.01", "glphong/lights/point.py",
-      'if name == "range":\n            return 0.0 if self.range is None else self.range\n        return getattr(self, name)\n\n'
-      '    optional_code',
-      'if name == "range":\n            return 0.0 if self.range is None else 1.01 * self.range\n        return getattr(self, name)\n\n'
-      '    optional_code',
-      "PointLight uploads its range 1% long"),
+      "return 0.0 if self.range is None else self.range", "return 0.0 if self.range is None else 1.01 * self.range",
+      "WithRange.uniform_value: point and spot lights upload their range 1% long"),
     M("unattenuated.py:radiance-1.01", "glphong/lights/unattenuated.py",
       "    in_uber = True\n\n    def incident(self, x, p):",
       "    in_uber = True\n\n    def uniform_value(self, name):\n"

@@ -100,7 +100,15 @@ class WrongGlsl(PhongLuminaire):
     glsl = PhongLuminaire.glsl.replace("u_luminaire_n[j]", "0.5 * u_luminaire_n[j]").replace("luminaire", "luminaire_wrong_glsl")
 
 
-@pytest.mark.parametrize("kind", [WrongTwin, WrongGlsl])
+class BrightGlsl(PhongLuminaire):
+    """The right twin, a GLSL 1% too bright: the GPU lands above the band (WrongTwin puts it below)."""
+
+    name = "luminaire_bright_glsl"
+    glsl = PhongLuminaire.glsl.replace("irradiance = min((u_luminaire_peak[j]", "irradiance = min((1.01 * u_luminaire_peak[j]") \
+        .replace("luminaire", "luminaire_bright_glsl")
+
+
+@pytest.mark.parametrize("kind", [WrongTwin, WrongGlsl, BrightGlsl])
 def test_planted_errors_fail(kind, glphong_backend, glphong_make_renderer):
     light = kind((0.0, 0.0, 1.0), (0.0, 0.3, -1.0), 4.0, n=5.0)
     with pytest.raises(TwinMismatch, match="left the tolerance band"):
