@@ -61,7 +61,7 @@ def main():
                                                        "with": lambda: renderer.render(shadowed)},
                                                       repeats=args.repeats, warmup=1)
                         key = renderer.program_key(shadowed, shadowed.objects[1])
-                        memory = shadow_map_bytes(shadowed.shadow_setups(key)) / 2 ** 20
+                        memory = shadow_map_bytes(shadowed.shadow_setups(key.lights, key.shadow_size)) / 2 ** 20
                         extra = (medians["with"] - medians["without"]) / count
                         print(f"| {size} | {kind} | {count} | {map_size} | {1000 * medians['without']:.1f} | "
                               f"{1000 * medians['with']:.1f} | {1000 * extra:.1f} | {memory:.0f} |", flush=True)

@@ -6,7 +6,7 @@
 // (v_c / |v_a| + 1) / 2) SHADOW_MAP_SIZE with (b, c) the other two axes in order) for a light at a point, or an
 // orthographic map (texel coordinates e1 . (x - o), e2 . (x - o); depth a . (x - o)) for a light at infinity.
 //
-// shadow_bias_angle(d, c, offset, scale) / shadow_bias_length(c, offset, scale) -> B = 2 p + q:
+// shadow_plane_angle(d, c, offset) / shadow_plane_length(c, offset) -> p;  shadow_bias(p, scale) -> B = 2 p + q:
 //   p, the largest amount by which the receiver's own plane, along a lookup ray up to `offset` away from the ray
 //   to x, can come nearer the light than x (offset an angle [rad] for a cube map: p = d (cos(t) / cos(t + offset)
 //   - 1), t the angle between the triangle's normal and the ray, c = |cos(t)|; a length [m] for an orthographic
@@ -31,18 +31,21 @@ const float SHADOW_QUANTUM = 9.5367431640625e-07;  // 16 eps: the stored distanc
 // of the plane the map samples, which a smooth shading normal does not give
 vec3 shadow_face_normal = vec3(0.0, 0.0, 1.0);
 
-float shadow_bias_angle(float d, float c, float offset, float scale)
+float shadow_plane_angle(float d, float c, float offset)
 {
     float s = sqrt(max(1.0 - c * c, 0.0));
     float c_far = c * cos(offset) - s * sin(offset);  // cos(t + offset)
-    float plane = c_far > 0.0 ? d * (c / c_far - 1.0) : FLT_MAX;
-    return min(2.0 * plane + SHADOW_QUANTUM * scale, FLT_MAX);
+    return c_far > 0.0 ? d * (c / c_far - 1.0) : FLT_MAX;
 }
 
-float shadow_bias_length(float c, float offset, float scale)
+float shadow_plane_length(float c, float offset)
 {
     float s = sqrt(max(1.0 - c * c, 0.0));
-    float plane = c > 0.0 ? offset * (s / c) : FLT_MAX;
+    return c > 0.0 ? offset * (s / c) : FLT_MAX;
+}
+
+float shadow_bias(float plane, float scale)
+{
     return min(2.0 * plane + SHADOW_QUANTUM * scale, FLT_MAX);
 }
 
@@ -70,7 +73,7 @@ float shadow_cube(sampler2D map, vec3 origin, float texel_angle, vec3 x, vec3 n)
         return 1.0;
     }
     float offset = (float(SHADOW_FILTER_RADIUS) + 0.5) * 1.4142135623730951 * texel_angle * max_abs(v);
-    float bias = shadow_bias_angle(d, abs(dot(n, v)), offset, d + max_abs(x) + max_abs(origin));
+    float bias = shadow_bias(shadow_plane_angle(d, abs(dot(n, v)), offset), d + max_abs(x) + max_abs(origin));
     vec2 st;
     int face = cube_face(v, st);
     ivec2 texel = clamp(ivec2(floor(st)), ivec2(0), ivec2(SHADOW_MAP_SIZE - 1));
@@ -90,7 +93,7 @@ float shadow_ortho(sampler2D map, vec3 origin, vec3 axis, vec3 e1, vec3 e2, floa
     vec3 r = x - origin;
     float d = dot(r, axis);
     float offset = (float(SHADOW_FILTER_RADIUS) + 0.5) * 1.4142135623730951 * texel_size;
-    float bias = shadow_bias_length(abs(dot(n, axis)), offset, abs(d) + max_abs(x) + max_abs(origin));
+    float bias = shadow_bias(shadow_plane_length(abs(dot(n, axis)), offset), abs(d) + max_abs(x) + max_abs(origin));
     vec2 st = vec2(dot(e1, r), dot(e2, r));
     if (any(lessThan(st, vec2(0.0))) || any(greaterThanEqual(st, vec2(float(SHADOW_MAP_SIZE))))) {
         return 1.0;  // outside the map: no caster there

@@ -50,7 +50,6 @@ import moderngl
 import numpy as np
 
 from glphong.gpu.contexts import create_context
-from glphong.lights import UnattenuatedPointLight
 from glphong.shaders.assembly import assemble
 from glphong.scene.camera import IntrinsicsCamera, OrthographicCamera
 from glphong.scene.scene import Scene
@@ -311,7 +310,8 @@ def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=Non
     Raises
     ------
     ValueError
-        The scene has an `UnattenuatedPointLight`, or ``samples`` is not 4.
+        The scene has a light whose kind has no pyrender counterpart (`UnattenuatedPointLight`), a range or
+        shadows, or ``samples`` is not 4.
     """
 
     if not isinstance(scene, Scene):
@@ -320,9 +320,9 @@ def to_pyrender(scene, samples=PYRENDER_SAMPLES, aspect_ratio=None, platform=Non
         raise ValueError(f"pyrender 0.1.45 always renders with {PYRENDER_SAMPLES}x MSAA (EGL) "
                          f"or none (OSMesa); samples={samples!r} cannot be honoured")
     for light in scene.lights:
-        if isinstance(light, UnattenuatedPointLight):
-            raise ValueError(f"UnattenuatedPointLight at {light.position} has no pyrender equivalent "
-                             "(pyrender point lights always fall off as 1/d^2)")
+        if type(light).pyrender_type is None:  # the kind's own definition says (UnattenuatedPointLight: none)
+            raise ValueError(f"{light!r} has no pyrender equivalent (its kind names no pyrender light; pyrender's "
+                             "point lights always fall off as 1/d^2)")
         if getattr(light, "range", None) is not None:
             raise ValueError(f"{light!r} has a range, which pyrender ignores: the images would differ")
         if light.shadows:

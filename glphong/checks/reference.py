@@ -297,20 +297,15 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None):
                 inputs, bounds = input_bounds(uv64, color, lod, key, uniforms, band)
             f = type(f)(f.n, f.t, f.b, f.uv, {k: v.astype(dtype) for k, v in inputs.items()}, bounds)
         if key.shadow_slots:
-            face, _ = _unit(gbuffer.face[selection].astype(np.float64))  # the triangles' own normals (the map's planes)
+            _, face, _ = safe_normalize(gbuffer.face[selection].astype(np.float64))  # the triangles' own normals
             f = replace(f, visibility=_visibility(scene, key, gbuffer.position[selection].astype(np.float64), face,
                                                   shadows[1]))
         yield selection, obj, key, uniforms, position, f, n_valid
 
 
-def _unit(v):
-    valid, unit, _ = safe_normalize(v)
-    return unit, valid
-
-
 def _visibility(scene, key, position, normal, filter_radius):
     """Per light of ``key`` in loop order: None, or its ray-cast visibility ``(exact, low, high)``."""
-    setups = {(s.kind, s.index): s for s in scene.shadow_setups(key)}
+    setups = {(s.kind, s.index): s for s in scene.shadow_setups(key.lights, key.shadow_size)}
     out = []
     for light in key.lights:
         for j in range(light.count):

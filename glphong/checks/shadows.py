@@ -29,6 +29,7 @@ import numpy as np
 import trimesh
 
 from glphong.core.validate import FLT_MAX
+from glphong.twin.functions import perpendiculars
 
 __all__ = ["shadow_visibility", "shadow_plane_angle", "shadow_plane_length", "shadow_bias", "SHADOW_QUANTUM", "RING"]
 
@@ -39,8 +40,7 @@ RING = 8
 
 
 def shadow_plane_angle(d, c, offset):
-    """The plane term ``p = d (cos(t) / cos(t + offset) - 1)`` of glsl/shadows.glsl ``shadow_bias_angle`` (FLT_MAX
-    edge-on), float64."""
+    """glsl/shadows.glsl ``shadow_plane_angle`` in float64: ``p = d (cos(t) / cos(t + offset) - 1)`` (FLT_MAX edge-on)."""
     s = np.sqrt(np.maximum(1.0 - c * c, 0.0))
     c_far = c * np.cos(offset) - s * np.sin(offset)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -48,15 +48,15 @@ def shadow_plane_angle(d, c, offset):
 
 
 def shadow_plane_length(c, offset):
-    """The plane term ``p = offset tan(t)`` of glsl/shadows.glsl ``shadow_bias_length`` (FLT_MAX edge-on), float64."""
+    """glsl/shadows.glsl ``shadow_plane_length`` in float64: ``p = offset tan(t)`` (FLT_MAX edge-on)."""
     s = np.sqrt(np.maximum(1.0 - c * c, 0.0))
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(c > 0.0, offset * (s / c), FLT_MAX)
 
 
-def shadow_bias(plane, q):
-    """glsl/shadows.glsl's bias ``B = 2 p + q`` from its plane term (at most FLT_MAX)."""
-    return np.minimum(2.0 * plane + q, FLT_MAX)
+def shadow_bias(plane, scale):
+    """glsl/shadows.glsl ``shadow_bias`` in float64: ``B = 2 p + q``, ``q = SHADOW_QUANTUM scale`` (at most FLT_MAX)."""
+    return np.minimum(2.0 * plane + SHADOW_QUANTUM * scale, FLT_MAX)
 
 
 def _caster_mesh(scene):
@@ -108,10 +108,7 @@ def _first_hits(intersector, origins, directions):
 
 def _ring(u, radius):
     """``RING`` unit vectors at angle ``radius`` (N,) around each unit ``u`` (N, 3): (RING, N, 3)."""
-    helper = np.where(np.abs(u[:, :1]) < 0.9, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
-    a = np.cross(u, helper)
-    a /= np.linalg.norm(a, axis=1, keepdims=True)
-    b = np.cross(u, a)
+    a, b = perpendiculars(u)
     phi = 2.0 * np.pi * np.arange(RING) / RING
     across = np.cos(phi)[:, None, None] * a + np.sin(phi)[:, None, None] * b
     return np.cos(radius)[None, :, None] * u + np.sin(radius)[None, :, None] * across, across
@@ -175,7 +172,7 @@ def shadow_visibility(scene, setup, position, normal, filter_radius):
         origins = np.concatenate([start[None], start[None] + band * across])
         directions = np.broadcast_to(axis, (RING + 1, n_points, 3))
     q = SHADOW_QUANTUM * (np.abs(d) + scale_x)
-    bias = shadow_bias(plane, q)
+    bias = shadow_bias(plane, np.abs(d) + scale_x)
     hits = _first_hits(intersector, origins.reshape(-1, 3), np.ascontiguousarray(directions).reshape(-1, 3))
     hits = hits.reshape(RING + 1, n_points)
     planes = _plane_distance(normal[None], position[None], origins, directions)

@@ -18,7 +18,6 @@ to 0, irradiance beyond FLT_MAX saturates at FLT_MAX, and sums beyond FLT_MAX be
 import json
 from dataclasses import asdict, dataclass, field, replace
 
-import mpmath
 import numpy as np
 
 from glphong.checks.tolerances import FLT_MAX, FLT_MIN, point_band
@@ -166,6 +165,8 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
     (3,) float64 ndarray
         Radiance [W/(m^2 sr)].
     """
+    import mpmath  # noqa: PLC0415 - the oracle's, kept out of import time
+
     mp = mpmath.mp
     mp.dps = digits
     f = lambda x: mpmath.mpf(float(np.float32(x)))  # noqa: E731
@@ -231,6 +232,8 @@ def _oracle_frame(n, tangent, handedness, uv, unit, dot):
 
 def _light_twin_at(light, x):
     """A light kind's twin at one mpmath point, in float64 (for kinds without an oracle): ``(wi, E)`` or None."""
+    import mpmath  # noqa: PLC0415 - the oracle's, kept out of import time
+
     valid, wi, e = light.incident(np.array([[float(c) for c in x]]), light.values())
     if not valid[0]:
         return None
@@ -239,6 +242,8 @@ def _light_twin_at(light, x):
 
 def _twin_at(term, n, l, v, ndl, tangent, uv):
     """A term's twin response at one mpmath geometry, in float64 (for models without an oracle)."""
+    import mpmath  # noqa: PLC0415 - the oracle's, kept out of import time
+
     as64 = lambda a: np.array([[float(c) for c in a]])  # noqa: E731
     key = ProgramKey(terms=(TermKey(term.name, "", tuple(term.needs)),), has_tangent="tangent" in term.needs,
                      has_uv="uv" in term.needs)

@@ -4,7 +4,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from glphong.checks import reference
-from glphong.checks.tolerances import BAND, point_band, radiance_band  # noqa: F401 - radiance_band re-exported
+from glphong.checks.tolerances import BAND, point_band
 from glphong.gpu.renderer import Renderer
 
 __all__ = ["VerifyReport", "verify", "compare", "relative_error"]

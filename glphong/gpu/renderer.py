@@ -399,17 +399,14 @@ class Renderer:
         return self.shadow_map_size, self.shadow_filter_radius
 
     def _shadow_values(self, scene, output):
-        """Draw the shadow maps the frame's programs read; their samplers' values (dict, empty without shadows)."""
-        if output not in ("radiance", "display") or not any(k.shadowed for k in scene.light_keys()):
-            return {}
-        keys = [self.program_key(scene, obj, output) for obj in scene.objects]
-        key = next((k for k in keys if k.shadow_slots), None)
-        if key is None:
+        """Draw the shadow maps the frame's programs read; their samplers' values (dict, empty without shadows).
+        Every lit program shares the scene's light keys, so the maps are the scene's (`Scene.shadow_setups`)."""
+        lights = scene.light_keys()
+        if output not in ("radiance", "display") or not any(k.shadowed for k in lights):
             return {}
         casters = [obj for obj in scene.objects if obj.casts_shadow]
-        maps = self._shadow_maps.draw(scene.shadow_setups(key), casters, self.programs,
+        return self._shadow_maps.draw(scene.shadow_setups(lights, self.shadow_map_size), casters, self.programs,
                                       lambda mesh, program: self._mesh_buffers(mesh).vertex_array(self._mgl, program))
-        return maps
 
     def _draw(self, scene, output, fbo, frame_values=None):
         aspect = self.width / self.height

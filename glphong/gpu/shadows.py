@@ -8,7 +8,6 @@ float32 computes it (no depth buffer and no depth precision in the way).  Textur
 from frame to frame; the maps are redrawn every frame.
 """
 import moderngl
-import numpy as np
 
 from glphong.core.validate import FLT_MAX
 from glphong.shaders.key import shadow_key
@@ -94,8 +93,3 @@ class ShadowMaps:
             texture.repeat_x = texture.repeat_y = False
             fbo = self._targets[key] = self._mgl.framebuffer(color_attachments=[texture])
         return fbo.color_attachments[0], fbo
-
-    def read(self, shadow_map):
-        """The map's texels as a (height, width) float32 array, row 0 at the bottom (GL's order: texelFetch's)."""
-        data = np.frombuffer(shadow_map.texture.read(), dtype=np.float32)
-        return data.reshape(shadow_map.texture.size[1], shadow_map.texture.size[0]).copy()

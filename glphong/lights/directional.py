@@ -1,9 +1,8 @@
 """The kind 'directional': a light at infinity, constant direction and irradiance (docs/design.md section 11;
 GLSL: ``glsl/lights/directional.glsl``).  glTF's and pyrender's directional lights."""
-import mpmath
 import numpy as np
 
-from glphong.lights.model import ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp32, mp_dot, pose_pointing
+from glphong.lights.model import ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp, mp32, mp_dot, pose_pointing
 
 __all__ = ["DirectionalLight"]
 
@@ -42,8 +41,8 @@ class DirectionalLight(ExactIrradiance, LightModel):
         return np.ones(shape[:-1], bool), np.broadcast_to(p.towards, shape), np.broadcast_to(p.irradiance, shape)
 
     def oracle(self, x):
-        towards = [-mpmath.mpf(c) for c in self.direction]
-        length = mpmath.sqrt(mp_dot(towards, towards))
+        towards = [-mp().mpf(c) for c in self.direction]
+        length = mp().sqrt(mp_dot(towards, towards))
         return [c / length for c in towards], mp32(self.irradiance)
 
     @classmethod

@@ -24,7 +24,6 @@ The built-in kinds (`glphong.lights.PointLight`, `UnattenuatedPointLight`, `Dire
 import inspect
 import re
 
-import mpmath
 import numpy as np
 
 from glphong.core import validate as _validate
@@ -36,9 +35,10 @@ from glphong.materials.params import (_GLSL_KEYWORDS, _IDENT, LIBRARY_CHUNKS, RE
 from glphong.materials.registry import (_library_names, _strip_comments, _top_level_names, hashed_source,
                                         registered_models)
 from glphong.twin.band import EPS
+from glphong.twin.functions import perpendiculars
 
 __all__ = ["LightModel", "LightDefinitionError", "registered_lights", "light_named", "light_for_key",
-           "light_cases", "light_source", "ExactIrradiance", "LIGHT_LIBRARY_CHUNKS", "Param", "GlslFile", "pose_pointing", "gltf_entry", "mp32", "mp_dot",
+           "light_cases", "light_source", "ExactIrradiance", "LIGHT_LIBRARY_CHUNKS", "Param", "GlslFile", "pose_pointing", "gltf_entry", "mp", "mp32", "mp_dot",
            "mp_toward", "mp_range_window"]
 
 #: library chunks a light kind may use: ``lights`` (``point_irradiance``, ``range_window``) and the materials' ones
@@ -85,10 +85,10 @@ def light_source(cls):
     return hashed_source(cls, _SOURCES, _BY_HASH)
 
 
-def light_cases(light, name=None):
+def light_cases(light):
     """Generic stability geometry for one light (a `glphong.materials.cases.Case` each): the light over a
     Lambert+Phong point at normal, oblique and grazing incidence of the point's normal."""
-    name = name or type(light).name
+    name = type(light).name
     material = Phong(0.3, 0.4, 20.0)
     out = []
     for label, normal in (("normal", (0.0, 0.0, 1.0)), ("oblique 60 deg", (0.0, np.sin(np.pi / 3), np.cos(np.pi / 3))),
@@ -343,11 +343,8 @@ class LightModel:
             if param.kind == "vec3":
                 variants = [value * np.where(np.arange(3) == axis, 1.0 + s * d, 1.0) for axis in range(3) for s in (1, -1)]
             elif param.kind == "direction":
-                helper = np.array([1.0, 0.0, 0.0]) if abs(value[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-                a = np.cross(value, helper)
-                a /= np.linalg.norm(a)
                 variants = [(value + s * d * axis) / np.linalg.norm(value + s * d * axis)
-                            for axis in (a, np.cross(value, a)) for s in (1, -1)]
+                            for axis in perpendiculars(value) for s in (1, -1)]
             else:
                 variants = [value * (1.0 + s * constants.A * EPS) for s in (1, -1)]
             for v in variants:
@@ -495,9 +492,17 @@ class ExactIrradiance:
 
 
 # --------------------------------------------------------------------------- shared by the kinds' oracles
+def mp():
+    """The ``mpmath`` module, imported when an oracle first runs: only the stability suite evaluates oracles, and
+    ``import glphong`` does not pay for mpmath (the materials' oracles import it the same way)."""
+    import mpmath  # noqa: PLC0415 - the stability suite's, kept out of import time
+
+    return mpmath
+
+
 def mp32(values):
     """``values`` (a number or a sequence) rounded to float32, as a list of mpmath numbers (one number: a list of 1)."""
-    return [mpmath.mpf(float(np.float32(v))) for v in np.ravel(np.asarray(values, dtype=np.float64))]
+    return [mp().mpf(float(np.float32(v))) for v in np.ravel(np.asarray(values, dtype=np.float64))]
 
 
 def mp_dot(a, b):
@@ -508,13 +513,13 @@ def mp_dot(a, b):
 def mp_toward(position, x):
     """``(unit vector from x toward position, distance)`` in mpmath, or ``(None, 0)`` where they coincide."""
     to = [a - b for a, b in zip(position, x)]
-    d = mpmath.sqrt(mp_dot(to, to))
+    d = mp().sqrt(mp_dot(to, to))
     return (None, d) if d == 0 else ([c / d for c in to], d)
 
 
 def mp_range_window(d, range_):
     """``clamp(1 - (d/range)^4, 0, 1)`` in mpmath (1 for no range)."""
-    return mpmath.mpf(1) if range_ is None else min(max(1 - (d / mpmath.mpf(range_)) ** 4, 0), 1)
+    return mp().mpf(1) if range_ is None else min(max(1 - (d / mp().mpf(range_)) ** 4, 0), 1)
 
 
 # --------------------------------------------------------------------------- shared by the kinds' counterparts

@@ -4,12 +4,11 @@
 ``E = Phi / (4 pi d^2)`` at distance ``d``, times KHR_lights_punctual's window
 ``clamp(1 - (d/range)^4, 0, 1)`` where a ``range`` is given (pyrender ignores range).
 """
-import mpmath
 import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.core.radiometry import point_intensity, power_from_intensity
-from glphong.lights.model import (ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp32, mp_range_window,
+from glphong.lights.model import (ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp, mp32, mp_range_window,
                                   mp_toward)
 from glphong.twin.functions import point_irradiance, range_window, safe_normalize
 
@@ -102,7 +101,7 @@ class PointLight(WithRange, LightModel):
         wi, d = mp_toward(mp32(self.position), x)
         if wi is None:
             return None
-        return wi, [phi / (4 * mpmath.pi * d * d) * mp_range_window(d, self.range) for phi in mp32(self.power)]
+        return wi, [phi / (4 * mp().pi * d * d) * mp_range_window(d, self.range) for phi in mp32(self.power)]
 
     def band(self, x, p, constants):
         """The twin's value: ``(I / d) / d`` is two quotients, inside the term's ``A eps``; the window (where

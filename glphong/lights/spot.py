@@ -5,11 +5,10 @@ A point source of intensity ``I`` [W/sr] along its axis, with the specification'
 ``o = -cos(outer) s``, so ``E = f I / d^2`` at distance ``d`` (times the range window, where given).
 pyrender's ``SpotLight`` has the same falloff and ignores range.
 """
-import mpmath
 import numpy as np
 
 from glphong.core.radiometry import point_intensity
-from glphong.lights.model import GlslFile, LightModel, Param, gltf_entry, mp32, mp_dot, mp_range_window, mp_toward, pose_pointing
+from glphong.lights.model import GlslFile, LightModel, Param, gltf_entry, mp, mp32, mp_dot, mp_range_window, mp_toward, pose_pointing
 from glphong.lights.point import POSITION, RANGE, WithRange, with_range
 from glphong.materials.cases import Case
 from glphong.materials.phong import Phong
@@ -118,6 +117,7 @@ class SpotLight(WithRange, LightModel):
         if wi is None:
             return None
         axis = mp32(self.direction)
+        mpmath = mp()
         axis = [c / mpmath.sqrt(mp_dot(axis, axis)) for c in axis]
         cos_theta = -mp_dot(wi, axis)
         cos_outer = mpmath.cos(mpmath.mpf(self.outer_cone_angle))

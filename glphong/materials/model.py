@@ -31,6 +31,7 @@ from glphong.materials.cases import generic_cases
 from glphong.materials.fresnel import FRESNEL_PARAMS, fresnel_uniform_values
 from glphong.materials.surface import SurfaceInput
 from glphong.twin.band import EPS
+from glphong.twin.functions import perpendiculars
 
 __all__ = ["Param", "Choice", "Table", "TableData", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
            "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
@@ -476,7 +477,7 @@ class MaterialModel(Material):
         angle = constants.D * EPS
         for which in ("wi", "wo"):
             vector = wi if which == "wi" else wo
-            for axis in _perpendiculars(vector):
+            for axis in perpendiculars(vector):
                 for sign in (1.0, -1.0):
                     turned = vector + sign * angle * axis
                     turned = turned / np.linalg.norm(turned, axis=-1, keepdims=True)
@@ -528,14 +529,6 @@ class MaterialModel(Material):
         """The model's extreme cases for `glphong.checks.stability` (default: generic geometry, see there)."""
 
         return generic_cases(cls.name, cls.example())
-
-
-def _perpendiculars(v):
-    """Two unit vectors perpendicular to each row of ``v`` (N, 3)."""
-    helper = np.where(np.abs(v[..., :1]) < 0.9, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
-    a = np.cross(v, helper)
-    a = a / np.linalg.norm(a, axis=-1, keepdims=True)
-    return a, np.cross(v, a)
 
 
 class MaterialSum(Material):

@@ -173,9 +173,15 @@ class Scene:
             cached = self._light_keys = (state, light_keys(self._lights, casters))
         return cached[1]
 
-    def shadow_setups(self, key):
-        """The `glphong.scene.shadows.ShadowSetup` of each shadow map program ``key`` reads (its ``shadow_size``)."""
-        return shadow_setups(self, key.lights, key.shadow_size) if key.shadow_slots else []
+    def shadow_setups(self, lights, size):
+        """The `glphong.scene.shadows.ShadowSetup` of each shadowing light of ``lights`` (a program key's `LightKey`
+        tuple) with maps of ``size`` texels, in slot order; made once per state of the scene (objects and lights are
+        only ever added), not once per frame or object: the bounds walk every vertex."""
+        state = (len(self._objects), len(self._lights), lights, size)
+        cached = getattr(self, "_shadow_setups", None)
+        if cached is None or cached[0] != state:
+            cached = self._shadow_setups = (state, shadow_setups(self, lights, size))
+        return cached[1]
 
     @property
     def ambient_radiance(self):
@@ -255,8 +261,9 @@ class Scene:
             if key.needs_view:
                 values["u_eye"] = self.camera.eye
             values.update(self.light_uniform_values(key))
-            for setup in self.shadow_setups(key):
-                values.update(setup.uniform_values())
+            if key.shadow_slots:
+                for setup in self.shadow_setups(key.lights, key.shadow_size):
+                    values.update(setup.uniform_values())
         return {name: _validate.float32_uniform(v) for name, v in values.items()}
 
     def object_uniform_values(self, index, key):

@@ -9,6 +9,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from glphong.twin.functions import perpendiculars
+
 __all__ = ["ShadowSetup", "shadow_setups", "scene_bounds", "CUBE_FACES"]
 
 #: the cube's faces in map order: (major axis, sign, the two other axes)
@@ -136,10 +138,7 @@ def shadow_setups(scene, key_lights, size):
                                        2.0 / size, far * 1e-7, far))
                 continue
             axis = np.asarray(light.direction, dtype=np.float64)
-            helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-            u1 = np.cross(axis, helper)
-            u1 /= np.linalg.norm(u1)
-            u2 = np.cross(axis, u1)
+            u1, u2 = perpendiculars(axis)
             centre = 0.5 * (low + high)
             offsets = corners - centre
             half = max(float(np.max(np.abs(offsets @ u1))), float(np.max(np.abs(offsets @ u2))), 1e-30) * (1.0 + 2.0 / size)

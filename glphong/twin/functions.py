@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = [
-    "ShadingFrame", "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "log_one_minus",
+    "ShadingFrame", "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "perpendiculars", "log_one_minus",
     "lobe_from_delta", "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
     "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "light_term", "FLT_MAX", "FRAME_PARALLEL_LIMIT",
 ]
@@ -329,3 +329,12 @@ def light_term(response, irradiance):
     """``response * E``, exactly 0 where ``E = 0`` (shade.glsl): an overflowed response never makes NaN."""
     with np.errstate(invalid="ignore", over="ignore"):
         return np.where(irradiance == 0, 0.0, response * irradiance).astype(np.result_type(response, irradiance))
+
+
+def perpendiculars(v):
+    """Two unit vectors perpendicular to each row of ``v`` (..., 3) and to each other: ``a = normalize(v x h)`` with
+    ``h`` the x axis (the y axis where ``|v_x| >= 0.9``), and ``b = v x a`` (unit where ``v`` is)."""
+    helper = np.where(np.abs(v[..., :1]) < 0.9, np.array([1.0, 0.0, 0.0]), np.array([0.0, 1.0, 0.0]))
+    a = np.cross(v, helper)
+    a = a / np.linalg.norm(a, axis=-1, keepdims=True)
+    return a, np.cross(v, a)

@@ -8,12 +8,18 @@
 - The band is not vacuous: a shadow map looked up one texel off, or a bias ten times too small (acne), fails.
 - What a scene does not need is left out: no shadowing light (or nothing that casts), no shadow code.
 """
+import importlib.util
+import subprocess
+import sys
+import textwrap
+
 import numpy as np
 import pytest
 import trimesh
 
 import glphong
 from glphong import primitives
+from glphong.checks.shadows import shadow_visibility
 from glphong.shaders import assembly
 
 SPHERE_CENTRE, SPHERE_RADIUS = np.array([0.0, 0.0, 0.7]), 0.5
@@ -118,9 +124,8 @@ def test_sphere_shadow_is_the_closed_form_cone(glphong_make_renderer):
     edges = mesh.positions[mesh.indices.reshape(-1, 3)]
     half_angle = np.max(np.arcsin(np.linalg.norm(edges[:, 0] - edges[:, 1], axis=1) / (2 * SPHERE_RADIUS)))
     inner = SPHERE_RADIUS * np.cos(half_angle) ** 2  # the polyhedron contains the sphere through its faces' centres
-    from glphong.checks.shadows import shadow_visibility
     key = renderer.program_key(scene, scene.objects[1])
-    (setup,) = scene.shadow_setups(key)
+    (setup,) = scene.shadow_setups(key.lights, key.shadow_size)
     exact, low, high = shadow_visibility(scene, setup, x, np.tile([0.0, 0.0, 1.0], (len(x), 1)), 0)
     assert np.all(exact[distance > SPHERE_RADIUS * (1 + 1e-9)] == 1.0)
     assert np.all(exact[distance < inner * (1 - 1e-9)] == 0.0)
@@ -135,7 +140,7 @@ def test_sphere_shadow_is_the_closed_form_cone(glphong_make_renderer):
 PLANTED = {
     "the map looked up one texel off": ("ivec2 texel = clamp(ivec2(floor(st)),",
                                         "ivec2 texel = clamp(ivec2(floor(st)) + ivec2(1, 0),"),
-    "a bias ten times too small": ("    float bias = shadow_bias_", "    float bias = 0.1 * shadow_bias_"),
+    "a bias ten times too small": ("    float bias = shadow_bias(", "    float bias = 0.1 * shadow_bias("),
 }
 
 
@@ -211,10 +216,6 @@ def test_refusals(glphong_make_renderer):
 
 def _blocked_run(blocked, body):
     """Run ``body`` in a fresh interpreter where the top-level packages ``blocked`` cannot be imported."""
-    import subprocess
-    import sys
-    import textwrap
-
     code = ("import sys\n"
             "class Block:\n"
             "    def find_spec(self, name, path=None, target=None):\n"
@@ -239,8 +240,6 @@ print(report.passed, report.shadow_band_count, int(report.reference.sum() * 1e6)
 
 
 def test_without_embree_the_float64_intersector_gives_the_same_answer():
-    import importlib.util
-
     if importlib.util.find_spec("rtree") is None:
         pytest.skip("rtree is not installed: trimesh's float64 intersector needs it (pip install rtree)")
     with_embree = _blocked_run((), TWIN_RUN)
