@@ -29,6 +29,9 @@ from glphong.twin.functions import (BLINN_HALF_FLOOR, FLT_MAX, FRAME_PARALLEL_LI
                                     phong_delta, phong_lobe, point_irradiance, range_window, safe_normalize,
                                     shading_frame)
 from glphong.checks.shadows import shadow_visibility
+from glphong.twin.area import (area_angle, area_clip, area_edge_powers, area_polygon_cosine,  # noqa: F401
+                               area_polygon_lobe, area_solid_angle, area_triangle_sample)
+from glphong.shaders.generated import closed_form
 from glphong.lights import light_for_key
 from glphong.materials import registered_models
 
@@ -36,7 +39,8 @@ __all__ = [
     "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "log_one_minus", "lobe_from_delta",
     "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
     "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
-    "shade_inputs", "shade", "input_bounds",
+    "shade_inputs", "shade", "input_bounds", "area_angle", "area_clip", "area_polygon_cosine", "area_solid_angle",
+    "area_edge_powers", "area_polygon_lobe", "area_triangle_sample", "extended_reflection", "exact_reflection",
 ]
 
 def __getattr__(name):
@@ -71,6 +75,8 @@ def incident_light(position, key, uniforms, band=None):
     """
     out = []
     for light_key in key.lights:
+        if light_key.extended:  # integrated over their solid angle: extended_reflection
+            continue
         kind = light_for_key(light_key.name, light_key.source_hash)
         twin = kind.twin()
         for j in range(light_key.count):
@@ -169,14 +175,7 @@ def input_bounds(uv, color, lod, key, u, band=BAND):
 
 def material_response(f, wi, wo, n_dot_l, key, uniforms, material):
     """Sum of the lit terms' twins (the generated material chunk's ``material_response``); (N, 3)."""
-    terms = _terms(material)
-    out = np.zeros(np.shape(wi), np.result_type(f.n, wi))
-    for term_key in key.lit_terms:  # a term that does not need the view gets v = 0, as in the GLSL
-        term = terms[term_key.name]
-        p = term.values_from_uniforms(uniforms, dtype=out.dtype, inputs=f.inputs)
-        view = wo if "view" in term.needs else np.zeros_like(wi)
-        out = out + term.response(f, wi, view, n_dot_l, p)
-    return out
+    return terms_response(f, wi, wo, n_dot_l, key.lit_terms, uniforms, _terms(material))
 
 
 def view_direction(position, n_valid, eye, key):
@@ -241,7 +240,100 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
                 term[gate] = light_term(material_response(g, wi[gate], wo[gate], n_dot_l[gate], key, uniforms, material),
                                         irradiance[gate])
         radiance = radiance + term
+    if any(k.extended for k in key.lights):
+        radiance = radiance + extended_reflection(position, f, wo, lit, key, uniforms, material)
     return radiance
+
+
+def extended_lights(key, uniforms, dtype):
+    """Each extended light of the key, in loop order: ``(light_key, twin, p, closed, sampled)`` with ``p`` its
+    `ParamValues` and ``closed``/``sampled`` the lit terms (`TermKey`) it reflects in closed form and by samples."""
+    for light_key in key.lights:
+        if not light_key.extended:
+            continue
+        kind = light_for_key(light_key.name, light_key.source_hash)
+        closed = [t for t in key.lit_terms if closed_form(t, light_key)]
+        sampled = [t for t in key.lit_terms if not closed_form(t, light_key)]
+        for j in range(light_key.count):
+            yield light_key, kind.twin(), kind.values_from_uniforms(uniforms, j, dtype=dtype, defines=light_key.defines), \
+                closed, sampled
+
+
+def view_reflected(n, wo):
+    """``reflect(-wo, n) = 2 (n.wo) n - wo``: the axis of the lecture's Phong lobe under an extended light."""
+    return -wo - 2.0 * _dot(n, -wo)[..., None] * n
+
+
+def extended_reflection(position, f, wo, lit, key, uniforms, material):
+    """The generated loops over the extended lights (docs/design.md section 13), (N, 3): per light, each closed-form
+    term's ``k E(n)`` or ``k_s`` times the lobe integral about ``r_v``, plus the other terms summed over the light's
+    weighted directions, gated by ``lit``."""
+    terms = _terms(material)
+    out = np.zeros_like(position)
+    for light_key, twin, p, closed, sampled in extended_lights(key, uniforms, position.dtype):
+        reflected = np.zeros_like(position)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+            if any(t.integral.form == "irradiance" for t in closed):
+                e = twin.irradiance(position, f.n, p)
+            for t in closed:
+                values = terms[t.name].values_from_uniforms(uniforms, dtype=position.dtype, inputs=f.inputs)
+                k = getattr(values, t.integral.scale)
+                if t.integral.form == "irradiance":
+                    reflected = reflected + k * (np.float32(t.integral.factor).astype(position.dtype) * e)
+                else:
+                    q = float(getattr(values, t.integral.exponent))
+                    reflected = reflected + k * twin.lobe(position, f.n, view_reflected(f.n, wo), q, p)
+            for k in range(int(p.defines["MAX_SAMPLES"]) if sampled else 0):
+                valid, wi, irradiance = twin.sample(position, f.n, k, p)
+                n_dot_l = _dot(f.n, wi)
+                gate = valid & (n_dot_l > 0)
+                if gate.any():
+                    g = f.select(gate)
+                    term = np.zeros_like(position)
+                    term[gate] = light_term(terms_response(g, wi[gate], wo[gate], n_dot_l[gate], sampled, uniforms,
+                                                           terms), irradiance[gate])
+                    reflected = reflected + term
+        out = out + np.where(lit[:, None], reflected, 0.0)
+    return out
+
+
+def exact_reflection(position, f, wo, lit, key, uniforms, material):
+    """The exact integral of every lit term's response over each extended light, ``integral f_r L (n.w)^+ dw``
+    [W/(m^2 sr)], by the kind's float64 quadrature (``exact``; docs/design.md section 13), gated by ``lit``.
+
+    Returns
+    -------
+    value : (N, 3) float64 ndarray
+    error : (N,) float64 ndarray
+        The quadrature's absolute error estimate, summed over the lights.
+    converged : (N,) bool ndarray
+    """
+    terms = _terms(material)
+    out = np.zeros(position.shape)
+    error = np.zeros(len(position))
+    converged = np.ones(len(position), bool)
+    for light_key, twin, p, _, _ in extended_lights(key, uniforms, np.float64):
+        def integrand(index, w):
+            g = f.select(index)
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                return terms_response(g, w, wo[index], _dot(g.n, w), key.lit_terms, uniforms, terms)
+
+        value, err, ok = twin.exact(position, f.n, p, integrand)
+        out = out + np.where(lit[:, None], value, 0.0)
+        error = error + np.where(lit, err, 0.0)
+        converged &= ok | ~lit
+    return out, error, converged
+
+
+def terms_response(f, wi, wo, n_dot_l, term_keys, uniforms, terms):
+    """The sum of ``term_keys``' twins (`material_response`; ``material_response_<kind>`` where they are the terms an
+    extended kind samples), (N, 3); a term that does not need the view gets v = 0, as in the GLSL."""
+    out = np.zeros(np.shape(wi), np.result_type(f.n, wi))
+    for term_key in term_keys:
+        term = terms[term_key.name]
+        p = term.values_from_uniforms(uniforms, dtype=out.dtype, inputs=f.inputs)
+        out = out + term.response(f, wi, wo if "view" in term.needs else np.zeros_like(wi), n_dot_l, p)
+    return out
 
 
 # --------------------------------------------------------------------------- mesh_fragment.glsl
@@ -308,6 +400,8 @@ def _visibility(scene, key, position, normal, filter_radius):
     setups = {(s.kind, s.index): s for s in scene.shadow_setups(key.lights, key.shadow_size)}
     out = []
     for light in key.lights:
+        if light.extended:  # no shadows; not in incident_light's list
+            continue
         for j in range(light.count):
             setup = setups.get((light.name, j))
             out.append(None if setup is None else

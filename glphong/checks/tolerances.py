@@ -92,12 +92,59 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
                 t_hi = np.nan_to_num(ref.light_term(f_hi, e_high) * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
             lo = lo + np.where(certain, t_lo, 0.0)
             hi = hi + np.where(possible[..., None], t_hi, 0.0)
+        for e_lo, e_hi in extended_band(key, u, position, f, wo, lit, material, band):
+            terms += 1
+            lo, hi = lo + e_lo, hi + e_hi
     low = lo * (1 - terms * EPS)
     high = hi * (1 + terms * EPS)
     return np.where(low < FLT_MIN, 0.0, low), np.where(high > FLT_MAX, np.inf, high)
 
 
-def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
+def extended_band(key, u, position, f, wo, lit, material, band=BAND):
+    """Per extended light of the key, the interval ``(low, high)`` (each (N, 3)) of its generated loop's ``reflected``
+    (docs/design.md section 13): each closed-form term ``k`` times the kind's ``irradiance_band`` or ``lobe_band``
+    (``k`` at both ends of its surface input's interval) widened by ``(1 +- A eps)``; each weighted direction as a
+    punctual light (the kind's ``sample_band``, the sampled terms' `response_band`, the uncertain gate); the sum of
+    ``m`` contributions widened by ``(1 +- m eps)``; 0 where not ``lit``."""
+    terms = {t.name: t for t in material.components}
+    ends = _input_ends(f)
+    tol = band.D * EPS
+    for light_key, twin, p, closed, sampled in ref.extended_lights(key, u, np.float64):
+        lo, hi = np.zeros_like(position), np.zeros_like(position)
+        count = 0
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            if any(t.integral.form == "irradiance" for t in closed):
+                e_lo, e_hi = twin.irradiance_band(position, f.n, p, band)
+            for t in closed:
+                k_lo, k_hi = (getattr(terms[t.name].values_from_uniforms(u, inputs=i), t.integral.scale) for i in ends)
+                factor = float(np.float32(t.integral.factor))
+                if t.integral.form == "irradiance":
+                    c_lo, c_hi = e_lo, e_hi
+                else:
+                    q = float(getattr(terms[t.name].values_from_uniforms(u), t.integral.exponent))
+                    c_lo, c_hi = twin.lobe_band(position, f.n, ref.view_reflected(f.n, wo), q, p, band)
+                lo = lo + np.minimum(k_lo, k_hi) * factor * c_lo * (1 - 2 * band.A * EPS)
+                hi = hi + np.maximum(k_lo, k_hi) * factor * c_hi * (1 + 2 * band.A * EPS)
+                count += 1
+            for k in range(int(p.defines["MAX_SAMPLES"]) if sampled else 0):
+                valid, wi, _ = twin.sample(position, f.n, k, p)
+                s_lo, s_hi = twin.sample_band(position, f.n, k, p, band)
+                n_dot_l = ref._dot(f.n, wi)
+                certain = (valid & (n_dot_l > tol))[..., None]
+                possible = valid & (n_dot_l > -tol)
+                r_lo, r_hi = np.zeros_like(position), np.zeros_like(position)
+                if possible.any():
+                    r_lo[possible], r_hi[possible] = response_band(key, u, f.select(possible), wi[possible], wo[possible],
+                                                                   n_dot_l[possible], material, band, sampled)
+                t_lo = np.nan_to_num(ref.light_term(r_lo, np.where(s_lo < FLT_MIN, 0.0, s_lo)) * (1 - band.A * EPS), nan=0.0)
+                t_hi = np.nan_to_num(ref.light_term(r_hi, s_hi) * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
+                lo = lo + np.where(certain, t_lo, 0.0)
+                hi = hi + np.where(possible[..., None], t_hi, 0.0)
+                count += 1
+        yield (np.where(lit[:, None], lo * (1 - count * EPS), 0.0), np.where(lit[:, None], hi * (1 + count * EPS), 0.0))
+
+
+def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND, term_keys=None):
     """Interval of the GLSL ``material_response()``: the sum of the lit terms' bands.
 
     Parameters
@@ -111,6 +158,8 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
         May be down to ``-D eps`` where the light gate is uncertain.
     material : glphong.materials.Material
     band : BandConstants
+    term_keys : sequence of TermKey, optional
+        The terms summed (default the key's lit terms; an extended kind's sampled ones).
 
     Returns
     -------
@@ -118,9 +167,10 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
         Widened by ``(1 -+ m eps)`` for the sum of m terms.
     """
     models = {term.name: term for term in material.components}
+    term_keys = key.lit_terms if term_keys is None else term_keys
     low = np.zeros(np.shape(wi))
     high = np.zeros(np.shape(wi))
-    for term_key in key.lit_terms:
+    for term_key in term_keys:
         term = models[term_key.name]
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
             if term.surface_inputs():  # the band at both ends of the inputs' intervals (first order inside)
@@ -134,7 +184,7 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND):
         t_lo = np.where((t_lo > 0) & (t_lo < FLT_MIN), 0.0, t_lo)
         t_hi = np.where((t_hi < 0) & (t_hi > -FLT_MIN), 0.0, t_hi)
         low, high = low + t_lo, high + t_hi
-    m = max(len(key.lit_terms) - 1, 0)
+    m = max(len(term_keys) - 1, 0)
     return low * (1 - m * EPS), high * (1 + m * EPS)
 
 

@@ -34,6 +34,13 @@ class VerifyReport:
     shadow_band : (H, W) bool ndarray or None
         Pixels where a shadowing light's visibility is uncertain: a shadow boundary, seen from the light, within
         the filter's reach plus one texel, or an occluder nearer than the derived bias (docs/design.md section 12).
+    exact : (H, W, 3) float64 ndarray or None
+        Where the scene has extended lights (docs/design.md section 13): the radiance with each extended light's
+        exact integral (float64 quadrature) in place of the shader's method, which the twin reproduces.  The
+        method's own error is `method_error` (the twin against this), apart from the GPU's float32 error (the
+        twin against the GPU, under the band).
+    exact_error : (H, W) float64 ndarray or None
+        The quadrature's absolute error estimate per pixel.
     """
 
     gpu: np.ndarray
@@ -45,6 +52,24 @@ class VerifyReport:
     mask: np.ndarray
     mask_mismatch: int
     shadow_band: np.ndarray = None
+    exact: np.ndarray = None
+    exact_error: np.ndarray = None
+
+    @property
+    def method_error(self):
+        """``|twin - exact| / |exact|`` (H, W, 3): the extended lights' methods against their exact integrals (NaN
+        outside the mask; None without extended lights)."""
+        if self.exact is None:
+            return None
+        return np.where(self.mask[..., None], relative_error(self.reference, self.exact), np.nan)
+
+    def method_error_figures(self):
+        """``(mean, max)`` of the finite `method_error` over covered channels with a non-zero exact value, or None."""
+        if self.exact is None:
+            return None
+        e = self.method_error[self.mask]
+        e = e[np.isfinite(e)]
+        return (float(e.mean()), float(e.max())) if e.size else (0.0, 0.0)
 
     @property
     def covered_pixels(self):
@@ -87,17 +112,24 @@ class VerifyReport:
         return 0 if self.shadow_band is None else int((self.shadow_band & self.mask).sum())
 
     def summary(self):
-        """The summary figures as a dict."""
-        return {"covered_pixels": self.covered_pixels, "shadow_band": self.shadow_band_count,
-                "max_relative_error": self.max_relative_error,
-                "rms_relative_error": self.rms_relative_error, "outside_band": self.outside_count,
-                "nonfinite": self.nonfinite_count, "mask_mismatch": self.mask_mismatch, "passed": self.passed}
+        """The summary figures as a dict (with ``method_mean_error`` and ``method_max_error`` where the scene has
+        extended lights)."""
+        out = {"covered_pixels": self.covered_pixels, "shadow_band": self.shadow_band_count,
+               "max_relative_error": self.max_relative_error,
+               "rms_relative_error": self.rms_relative_error, "outside_band": self.outside_count,
+               "nonfinite": self.nonfinite_count, "mask_mismatch": self.mask_mismatch, "passed": self.passed}
+        figures = self.method_error_figures()
+        if figures is not None:
+            out["method_mean_error"], out["method_max_error"] = figures
+        return out
 
     def __str__(self):
         s = self.summary()
+        method = (f"; method against exact: mean rel err {s['method_mean_error']:.3g}, max {s['method_max_error']:.3g}"
+                  if "method_max_error" in s else "")
         return (f"{'PASS' if s['passed'] else 'FAIL'}: {s['covered_pixels']} px, max rel err {s['max_relative_error']:.3g}, "
                 f"rms rel err {s['rms_relative_error']:.3g}, outside band {s['outside_band']}, "
-                f"non-finite {s['nonfinite']}, mask mismatch {s['mask_mismatch']}")
+                f"non-finite {s['nonfinite']}, mask mismatch {s['mask_mismatch']}{method}")
 
 
 def relative_error(value, reference):
@@ -139,14 +171,17 @@ def compare(gpu, reference_radiance, low, high, mask):
     return rel, outside
 
 
-def verify(scene, renderer, band=BAND):
-    """Render ``scene``, shade its G-buffer with the float64 twin, compare under the band.
+def verify(scene, renderer, band=BAND, exact=None):
+    """Render ``scene``, shade its G-buffer with the float64 twin, compare under the band; where the scene has
+    extended lights, also the twin against their exact integrals (the method error map).
 
     Parameters
     ----------
     scene : glphong.Scene
     renderer : glphong.Renderer
     band : glphong.checks.tolerances.BandConstants
+    exact : bool, optional
+        Compute the exact integrals (`VerifyReport.exact`); default: where the scene has extended lights.
 
     Returns
     -------
@@ -171,9 +206,27 @@ def verify(scene, renderer, band=BAND):
     ref, low, high, shadow_band = twin_and_band(scene, gbuffer, band, renderer.shadow_settings)
     mask = frame.mask & gbuffer.mask
     rel, outside = compare(frame.radiance, ref, low, high, mask)
+    if exact is None:
+        exact = any(light.extent == "extended" for light in scene.lights)
+    exact_radiance, exact_error = exact_image(scene, gbuffer, renderer.shadow_settings) if exact else (None, None)
     return VerifyReport(gpu=frame.radiance, reference=ref, low=low, high=high, relative_error=rel,
                         outside=outside, mask=mask, mask_mismatch=int((frame.mask != gbuffer.mask).sum()),
-                        shadow_band=shadow_band)
+                        shadow_band=shadow_band, exact=exact_radiance, exact_error=exact_error)
+
+
+def exact_image(scene, gbuffer, shadows=None):
+    """The radiance of a G-buffer with every extended light's exact integral (float64 quadrature) in place of the
+    shader's method (docs/design.md section 13): ``(radiance (H, W, 3), error estimate (H, W))``."""
+    out = np.zeros(gbuffer.position.shape)
+    error = np.zeros(gbuffer.mask.shape)
+    for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, shadows=shadows):
+        radiance = reference.shade_point(position, f, n_valid, u.get("u_eye"), key, u, obj.material)
+        if any(k.extended for k in key.lights):  # the shader's method out, the exact integral in
+            wo, lit = reference.view_direction(position, n_valid, u.get("u_eye"), key)
+            value, error[selection], _ = reference.exact_reflection(position, f, wo, lit, key, u, obj.material)
+            radiance = radiance - reference.extended_reflection(position, f, wo, lit, key, u, obj.material) + value
+        out[selection] = radiance
+    return out, error
 
 
 def twin_and_band(scene, gbuffer, band=BAND, shadows=None):

@@ -13,6 +13,7 @@ import numpy as np
 from glphong.shaders.assembly import assemble, name_chunks
 from glphong.gpu.shadows import ShadowMap
 from glphong.gpu.textures import TextureStore
+from glphong.lights import light_for_key
 from glphong.materials.registry import model_for_key
 from glphong.materials.surface import TextureImage
 from glphong.materials.table import TableData
@@ -59,6 +60,10 @@ class Program:
 
         self.optional = {model_for_key(t.name, t.source_hash).uniform_name(p.name)
                          for t in getattr(key, "terms", ()) for p in model_for_key(t.name, t.source_hash).uniform_params()}
+        # an extended light's uniforms that only its sampled method reads are not active where every term has a
+        # closed form (docs/design.md section 13)
+        self.optional |= {light_for_key(k.name, k.source_hash).uniform_name(p.name) for k in getattr(key, "lights", ())
+                          if k.extended for p in light_for_key(k.name, k.source_hash).uniform_params()}
         #: the bytes last written to each uniform (`write` skips unchanged ones)
         self._written = {}
         #: sampler uniforms in texture-unit order

@@ -10,6 +10,10 @@ from glphong.lights.unattenuated import UnattenuatedPointLight
 from glphong.lights.directional import DirectionalLight
 from glphong.lights.spot import SpotLight
 from glphong.lights.ambient import AmbientLight
+from glphong.lights.extended import ExtendedLight
+from glphong.lights.area import PolygonLight, RectLight
+from glphong.lights.sphere import SphereLight
 
 __all__ = ["LightModel", "LightDefinitionError", "registered_lights", "light_named", "light_for_key", "light_cases",
-           "pose_pointing", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "SpotLight", "AmbientLight"]
+           "pose_pointing", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "SpotLight", "AmbientLight",
+           "ExtendedLight", "RectLight", "PolygonLight", "SphereLight"]

@@ -23,6 +23,7 @@ The built-in kinds (`glphong.lights.PointLight`, `UnattenuatedPointLight`, `Dire
 """
 import inspect
 import re
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -41,10 +42,45 @@ __all__ = ["LightModel", "LightDefinitionError", "registered_lights", "light_nam
            "light_cases", "light_source", "ExactIrradiance", "LIGHT_LIBRARY_CHUNKS", "Param", "GlslFile", "pose_pointing", "gltf_entry", "mp", "mp32", "mp_dot",
            "mp_toward", "mp_range_window"]
 
-#: library chunks a light kind may use: ``lights`` (``point_irradiance``, ``range_window``) and the materials' ones
-LIGHT_LIBRARY_CHUNKS = ("lights",) + LIBRARY_CHUNKS
-#: what the twin may be asked at most per light, beyond its uniforms: the structural defines
-_TWIN_ARGS = ("x", "p")
+#: library chunks a light kind may use: ``lights`` (``point_irradiance``, ``range_window``), ``area`` (a polygon seen
+#: from a point, after ``angle``) and the materials' ones
+LIGHT_LIBRARY_CHUNKS = ("lights", "area") + LIBRARY_CHUNKS
+
+
+@dataclass(frozen=True)
+class ContractFunction:
+    """One function a light kind defines twice, in GLSL (``<kind>_<suffix>``) and as its numpy twin (method
+    ``suffix``): checked when the kind is defined.
+
+    Attributes
+    ----------
+    suffix : str
+    returns : str
+        The GLSL return type (the twin's return value in words, for messages).
+    arguments : tuple of str
+        The GLSL parameters, e.g. ``('vec3 x', 'int j', 'out vec3 wi')``.
+    twin : tuple of str
+        The twin's arguments after ``self``.
+    """
+
+    suffix: str
+    returns: str
+    arguments: tuple
+    twin: tuple
+
+    def glsl(self, name):
+        """The GLSL signature."""
+        return f"{self.returns.split()[0]} {name}_{self.suffix}({', '.join(self.arguments)})"
+
+    def pattern(self, name):
+        """A regular expression matching the GLSL signature with any parameter names."""
+        parts = [r"\s+".join(re.escape(w) for w in a.split()[:-1]) + r"\s+\w+" for a in self.arguments]
+        return (rf"\b{self.returns.split()[0]}\s+{name}_{self.suffix}\s*\(\s*" + r"\s*,\s*".join(parts) + r"\s*\)")
+
+
+#: a punctual kind's function: at a point, whether the light reaches it, its direction and the irradiance
+INCIDENT = ContractFunction("incident", "bool (valid (N,) bool, wi (N, 3) unit vectors toward the light, irradiance "
+                            "(N, 3) [W/m^2])", ("vec3 x", "int j", "out vec3 wi", "out vec3 irradiance"), ("x", "p"))
 
 
 class LightDefinitionError(DefinitionError):
@@ -157,6 +193,13 @@ class LightModel:
     gltf_type = None
     pyrender_type = None
     shadow_map = None
+    #: 'punctual' (one direction and irradiance per light and point) or 'extended' (`glphong.lights.ExtendedLight`)
+    extent = "punctual"
+    #: uniform name -> entries per light, for a uniform that holds several values per light (a polygon's vertices):
+    #: declared ``u_<name>_<uniform>[NUM_<NAME>_LIGHTS * n]``, light j's entries at ``j * n + i``
+    uniform_lengths = {}
+    #: scalar uniforms that hold exact small integers (a count, a sample knob): the generic band does not perturb them
+    exact_uniforms = ()
     definition_error = LightDefinitionError
     definition_kind = "light"
     keywords = ()
@@ -200,6 +243,12 @@ class LightModel:
     def check(self):
         """Checks across parameters (default none); raise ValueError naming them."""
 
+    @classmethod
+    def contract(cls):
+        """The functions the kind defines in GLSL and as its twin (tuple of `ContractFunction`): a punctual kind's
+        ``incident``."""
+        return (INCIDENT,)
+
     # ---- identity
     @property
     def kind(self):
@@ -222,7 +271,8 @@ class LightModel:
     def __repr__(self):
         optional = {p.name for p in self.params if p.optional}
         shown = [f"{k}={v!r}" for k, v in self.parameter_values().items()
-                 if not (v is None and k in optional) and not (k == "shadows" and not v)]
+                 if not (v is None and k in optional) and not (k == "shadows" and not v)
+                 and not (k == "method" and v == "auto")]
         return f"{type(self).__name__}({', '.join(shown)})"
 
     # ---- what the program key and the uniforms are made of
@@ -241,11 +291,18 @@ class LightModel:
         return getattr(self, name)
 
     @classmethod
+    def key_integrals(cls, lights=()):
+        """None for a punctual kind; an extended kind's closed forms for a scene's ``lights`` of it
+        (`glphong.shaders.key.LightKey.integrals`)."""
+        return None
+
+    @classmethod
     def uniform_declarations(cls):
         """The GLSL declarations of the kind's uniform arrays, generated from `uniform_params`."""
-        size = f"NUM_{cls.name.upper()}_LIGHTS"
         lines = []
         for p in cls.uniform_params():
+            length = cls.uniform_lengths.get(p.name)
+            size = f"NUM_{cls.name.upper()}_LIGHTS" + (f" * {length}" if length else "")
             line = (f"uniform {p.glsl_type} {cls.uniform_name(p.name)}[{size}];  // {p.kind}"
                     f"{' in ' + p.interval if p.kind in ('scalar', 'rgb') else ''}{' [' + p.unit + ']' if p.unit else ''}")
             define = cls.conditional_uniforms.get(p.name)
@@ -284,16 +341,23 @@ class LightModel:
         """The uniform arrays of ``lights`` (all of this kind), float32, by uniform name: (N, 3) or (N,); those a
         program with ``defines`` declares (default: the lights' own `structural_defines`)."""
         defines = cls.structural_defines(lights) if defines is None else defines
-        return {cls.uniform_name(p.name): np.array([_validate.float32_uniform(light.uniform_value(p.name))
-                                                    for light in lights], dtype=np.float32)
-                for p in cls.active_uniforms(defines)}
+        out = {}
+        for p in cls.active_uniforms(defines):
+            values = np.array([_validate.float32_uniform(light.uniform_value(p.name)) for light in lights], dtype=np.float32)
+            out[cls.uniform_name(p.name)] = values.reshape((-1,) + values.shape[2:]) if p.name in cls.uniform_lengths \
+                else values
+        return out
 
     @classmethod
     def values_from_uniforms(cls, uniforms, j, dtype=np.float64, defines=()):
         """`ParamValues` of light ``j`` from a program's uniforms, in ``dtype``, with ``defines`` (pairs) as the dict
         ``p.defines``."""
-        values = {p.name: np.asarray(uniforms[cls.uniform_name(p.name)][j], dtype=dtype)
-                  for p in cls.active_uniforms(defines)}
+        def entry(p):
+            array = uniforms[cls.uniform_name(p.name)]
+            n = cls.uniform_lengths.get(p.name)
+            return array[j] if n is None else array[j * n:(j + 1) * n]
+
+        values = {p.name: np.asarray(entry(p), dtype=dtype) for p in cls.active_uniforms(defines)}
         return ParamValues(values | {"defines": dict(defines)})
 
     def values(self, dtype=np.float64):
@@ -322,34 +386,12 @@ class LightModel:
         add up worst-case.  The built-in kinds whose only error is that of a product or quotient return
         the twin's value (their error is inside the term's ``A eps``).
         """
-        base = np.asarray(self.incident(x, p)[2], dtype=np.float64)
-        up, down = np.zeros_like(base), np.zeros_like(base)
+        return sensitivity_band(lambda x_, p_: self.incident(x_, p_)[2], x, p, self.perturbed_uniforms(), constants)
 
-        def add(x_, p_):
-            with np.errstate(all="ignore"):
-                delta = np.nan_to_num(np.asarray(self.incident(x_, p_)[2], dtype=np.float64) - base, nan=0.0)
-            np.maximum(up, delta, out=up)
-            np.minimum(down, delta, out=down)
-
-        d = constants.D * EPS
-        for axis in range(3):
-            for sign in (1.0, -1.0):
-                moved = np.array(x, dtype=np.float64)
-                moved[:, axis] *= 1.0 + sign * d
-                add(moved, p)
-        for param in self.uniform_params():
-            value = np.asarray(getattr(p, param.name), dtype=np.float64)
-            variants = []
-            if param.kind == "vec3":
-                variants = [value * np.where(np.arange(3) == axis, 1.0 + s * d, 1.0) for axis in range(3) for s in (1, -1)]
-            elif param.kind == "direction":
-                variants = [(value + s * d * axis) / np.linalg.norm(value + s * d * axis)
-                            for axis in perpendiculars(value) for s in (1, -1)]
-            else:
-                variants = [value * (1.0 + s * constants.A * EPS) for s in (1, -1)]
-            for v in variants:
-                add(x, ParamValues({**p.__dict__, param.name: v}))
-        return base + down, base + up
+    @classmethod
+    def perturbed_uniforms(cls):
+        """The uniforms the generic band perturbs: all but `exact_uniforms` (tuple of Param)."""
+        return tuple(p for p in cls.uniform_params() if p.name not in cls.exact_uniforms)
 
     @classmethod
     def example(cls, **overrides):
@@ -385,6 +427,54 @@ class LightModel:
         """``(light, pose)``: the light of the ``pyrender`` module and its node pose (4, 4), or None where pyrender
         has no equivalent."""
         return None
+
+
+def sensitivity_band(evaluate, x, p, params, constants, directions=()):
+    """The generic band: ``evaluate(x, p, *directions)`` (N, 3) and its first-order sensitivity to its inputs, each
+    perturbed by a few ulps as float32 arithmetic perturbs them, added worst-case (`LightModel.band`).
+
+    ``x`` (N, 3) and every 'vec3' uniform of ``params`` are scaled componentwise by ``1 +- D eps`` (each entry of a
+    uniform with several per light), every 'direction' uniform and each of ``directions`` ((N, 3) unit vectors: a
+    normal, a reflected view) rotated by ``D eps`` about two axes, every scalar and rgb uniform scaled by
+    ``1 +- A eps``.  Returns ``(low, high)``, each (N, 3).
+    """
+    base = np.asarray(evaluate(x, p, *directions), dtype=np.float64)
+    up, down = np.zeros_like(base), np.zeros_like(base)
+
+    def add(x_, p_, dirs):
+        with np.errstate(all="ignore"):
+            delta = np.nan_to_num(np.asarray(evaluate(x_, p_, *dirs), dtype=np.float64) - base, nan=0.0)
+        np.maximum(up, delta, out=up)
+        np.minimum(down, delta, out=down)
+
+    d = constants.D * EPS
+    for axis in range(3):
+        for sign in (1.0, -1.0):
+            moved = np.array(x, dtype=np.float64)
+            moved[:, axis] *= 1.0 + sign * d
+            add(moved, p, directions)
+    for i, v in enumerate(directions):
+        for axis in perpendiculars(v):
+            for s in (1, -1):
+                turned = v + s * d * axis
+                add(x, p, directions[:i] + (turned / np.linalg.norm(turned, axis=-1, keepdims=True),) + directions[i + 1:])
+    for param in params:
+        value = np.asarray(getattr(p, param.name), dtype=np.float64)
+        variants = []
+        if param.kind == "vec3":
+            for index in np.ndindex(value.shape):
+                for s in (1, -1):
+                    moved = value.copy()
+                    moved[index] *= 1.0 + s * d
+                    variants.append(moved)
+        elif param.kind == "direction":
+            variants = [(value + s * d * axis) / np.linalg.norm(value + s * d * axis)
+                        for axis in perpendiculars(value) for s in (1, -1)]
+        else:
+            variants = [value * (1.0 + s * constants.A * EPS) for s in (1, -1)]
+        for v in variants:
+            add(x, ParamValues({**p.__dict__, param.name: v}), directions)
+    return base + down, base + up
 
 
 # --------------------------------------------------------------------------- definition-time checks
@@ -429,36 +519,37 @@ def _check_definition(cls):
     needed = {"cube": "position", "ortho": "direction"}.get(cls.shadow_map)
     if needed and needed not in {p.name for p in cls.params}:
         raise err(f"{cls.__qualname__}.shadow_map = {cls.shadow_map!r} needs a parameter named {needed!r}")
+    contract = cls.contract()
+    wanted = " and ".join(f"`{f.glsl(name)}`" for f in contract)
     if cls.glsl is None:
-        raise err(f"{cls.__qualname__} has no glsl: set glsl to the GLSL source of "
-                  f"`bool {name}_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)` or to a .glsl path")
-    incident = cls.__dict__.get("incident")
-    if incident is None and all(c.__dict__.get("incident") is None for c in cls.__mro__[1:-1] if c is not LightModel):
-        raise err(f"{cls.__qualname__} defines no numpy twin: add `def incident(self, x, p)` returning "
-                  "(valid (N,) bool, wi (N, 3) unit vectors toward the light, irradiance (N, 3) [W/m^2]), the same "
-                  "formulation as its GLSL")
-    if incident is not None:
-        try:
-            args = [a for a in list(inspect.signature(incident).parameters.values())[1:]
-                    if a.kind in (a.POSITIONAL_ONLY, a.POSITIONAL_OR_KEYWORD)]
-        except (TypeError, ValueError):
-            args = None
-        if args is not None and len(args) != len(_TWIN_ARGS):
-            raise err(f"{cls.__qualname__}.incident must take (self, {', '.join(_TWIN_ARGS)}) "
-                      f"(got ({', '.join(['self'] + [a.name for a in args])}))")
+        raise err(f"{cls.__qualname__} has no glsl: set glsl to the GLSL source of {wanted} or to a .glsl path")
+    for function in contract:
+        method = cls.__dict__.get(function.suffix)
+        inherited = [c.__dict__.get(function.suffix) for c in cls.__mro__[1:-1] if c.__module__ != __name__
+                     and not c.__dict__.get("abstract_contract", False)]
+        if method is None and all(m is None for m in inherited):
+            raise err(f"{cls.__qualname__} defines no numpy twin: add `def {function.suffix}(self, "
+                      f"{', '.join(function.twin)})` returning {function.returns}, the same formulation as its GLSL")
+        if method is not None:
+            try:
+                args = [a for a in list(inspect.signature(method).parameters.values())[1:]
+                        if a.kind in (a.POSITIONAL_ONLY, a.POSITIONAL_OR_KEYWORD)]
+            except (TypeError, ValueError):
+                args = None
+            if args is not None and len(args) != len(function.twin):
+                raise err(f"{cls.__qualname__}.{function.suffix} must take (self, {', '.join(function.twin)}) "
+                          f"(got ({', '.join(['self'] + [a.name for a in args])}))")
     _SOURCES.pop(cls, None)
     _check_glsl(cls, _strip_comments(light_source(cls)[0]))
 
 
 def _check_glsl(cls, code):
     err, name = LightDefinitionError, cls.name
-    wanted = f"bool {name}_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)"
-    pattern = (rf"\bbool\s+{name}_incident\s*\(\s*vec3\s+\w+\s*,\s*int\s+\w+\s*,\s*out\s+vec3\s+\w+\s*,"
-               rf"\s*out\s+vec3\s+\w+\s*\)")
-    if not re.search(pattern, code):
-        found = re.search(rf"\b\w+\s+{name}_incident\s*\([^)]*\)", code)
-        raise err(f"{cls.__qualname__}.glsl must define `{wanted}` (name = {name!r} gives the prefix); "
-                  + (f"found `{found.group(0)}`" if found else f"found no {name}_incident"))
+    for function in cls.contract():
+        if not re.search(function.pattern(name), code):
+            found = re.search(rf"\b\w+\s+{name}_{function.suffix}\s*\([^)]*\)", code)
+            raise err(f"{cls.__qualname__}.glsl must define `{function.glsl(name)}` (name = {name!r} gives the prefix); "
+                      + (f"found `{found.group(0)}`" if found else f"found no {name}_{function.suffix}"))
     read = set(re.findall(rf"\bu_{name}_([A-Za-z_]\w*)", code))
     declared = {p.name for p in cls.uniform_params()}
     if read - declared:

@@ -14,7 +14,7 @@ rho_d      rgb     [0, 1]      1       diffuse albedo (kd = rho_d / pi)
 """
 import numpy as np
 
-from glphong.materials.model import GlslFile, MaterialModel, Param, Properties
+from glphong.materials.model import GlslFile, Integral, MaterialModel, Param, Properties
 from glphong.materials.cases import generic_cases
 from glphong.twin.band import EPS
 
@@ -51,6 +51,10 @@ class Diffuse(MaterialModel):
 
     def response(self, f, wi, wo, n_dot_l, p):
         return diffuse(p.rho_d, n_dot_l)
+
+    def integral_form(self):
+        """``(rho_d / pi) E(n)`` under an extended light (docs/design.md section 13)."""
+        return Integral("irradiance", "rho_d", factor=1.0 / np.pi)
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
         """``rho_d / pi [max(n.l - D eps, 0), n.l + D eps]`` widened by 2 eps (the constant and the product)."""

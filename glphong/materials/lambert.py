@@ -12,7 +12,7 @@ kd         rgb     >= 0        1/sr    diffuse BRDF value k_d
 """
 import numpy as np
 
-from glphong.materials.model import GlslFile, MaterialModel, Param, Properties
+from glphong.materials.model import GlslFile, Integral, MaterialModel, Param, Properties
 from glphong.materials.cases import generic_cases
 from glphong.twin.band import EPS
 
@@ -47,6 +47,10 @@ class Lambert(MaterialModel):
 
     def response(self, f, wi, wo, n_dot_l, p):
         return lambert(p.kd, n_dot_l)
+
+    def integral_form(self):
+        """``k_d E(n)`` under an extended light (docs/design.md section 13)."""
+        return Integral("irradiance", "kd")
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
         """``k_d [max(n.l - D eps, 0), n.l + D eps]``: the dot product's absolute error (docs/design.md section 4)."""

@@ -19,6 +19,8 @@ models use exactly this mechanism; a definition is checked when its class is cre
 missing twin, a GLSL function of the wrong name or signature, a parameter without a range or a
 name that clashes fails there, with a message saying what is wrong.
 """
+from dataclasses import dataclass
+
 import numpy as np
 
 from glphong.core import validate as _validate
@@ -33,7 +35,7 @@ from glphong.materials.surface import SurfaceInput
 from glphong.twin.band import EPS
 from glphong.twin.functions import perpendiculars
 
-__all__ = ["Param", "Choice", "Table", "TableData", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
+__all__ = ["Integral", "Param", "Choice", "Table", "TableData", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
            "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
 
 
@@ -178,6 +180,30 @@ def bind_arguments(cls, params, args, kwargs):
     return out
 
 
+@dataclass(frozen=True)
+class Integral:
+    """How a term's response integrates in closed form against an extended light (docs/design.md section 13).
+
+    Attributes
+    ----------
+    form : {'irradiance', 'lobe'}
+        'irradiance': the response is ``factor k (n.l)`` and the term reflects ``factor k E(n)``, the light's
+        irradiance; 'lobe': the response is ``factor k max(r_v . l, 0)^q`` (``r_v`` the view reflected about
+        ``n``) and the term reflects ``factor k integral max(r_v . w, 0)^q L(w) [n.w > 0] dw``.
+    scale : str
+        The rgb parameter ``k`` (its uniform ``u_<model>_<scale>``, a surface input where textured).
+    factor : float
+        A constant factor (``1/pi`` for an albedo).
+    exponent : str or None
+        The scalar parameter ``q`` of a 'lobe' (an integer where the term offers this form).
+    """
+
+    form: str
+    scale: str
+    factor: float = 1.0
+    exponent: str = None
+
+
 class MaterialModel(Material):
     """One reflectance model (a term of a material), defined the way the built-ins are.
 
@@ -233,6 +259,9 @@ class MaterialModel(Material):
         constructor's values rounded to float32), returning a list of 3.
     stability_cases(cls)  (optional classmethod)
         The model's extreme cases (default: grazing, behind and opposite geometry at example values).
+    integral_form(self)  (optional)
+        How the term reflects an extended light in closed form (an `Integral`), or None (default): the light's
+        weighted directions are then summed with ``response`` (docs/design.md section 13).
     """
 
     params = ()
@@ -272,6 +301,10 @@ class MaterialModel(Material):
                     "choose another name")
         check_definition(cls, MaterialModel)
         register(cls)  # a re-run of the same definition (a notebook cell) replaces it
+
+    def integral_form(self):
+        """How this term reflects an extended light in closed form (`Integral`), or None: sampled (default)."""
+        return None
 
     def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
         if type(self).name is None:

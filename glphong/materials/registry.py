@@ -164,7 +164,7 @@ def _generated_names(cls):
 def _library_names():
     """What the library chunks define at file scope (read once: the shader folder is fixed at import)."""
     names = {"material_emission", "material_response", "shade_point"}
-    for chunk in ("common", "lights") + LIBRARY_CHUNKS + ("shade", "srgb"):
+    for chunk in ("common", "lights", "area") + LIBRARY_CHUNKS + ("shade", "srgb"):
         names |= _top_level_names(_strip_comments(chunk_source(chunk)))
     return frozenset(names)
 

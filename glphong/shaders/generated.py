@@ -94,7 +94,9 @@ def lights_chunk(key):
     """
     lines = ["// light loops (generated from the program key): for each light j of each kind k present",
              "//   valid = k_incident(x, j, wi, E);  L += (lit && valid && n.wi > 0) ? material_response(f, wi, wo, n.wi) E : 0",
-             "// a shadowed light's E is multiplied by its map's visibility V (glsl/shadows.glsl), its kind unrolled"]
+             "// a shadowed light's E is multiplied by its map's visibility V (glsl/shadows.glsl), its kind unrolled;",
+             "// an extended kind (docs/design.md section 13): each term's closed form (k E(n), k_s lobe about r_v) where",
+             "// the kind has it, the other terms over its weighted directions"]
     slots = {}
     for slot, (light, j) in enumerate(key.shadow_slots):
         slots[(light.name, j)] = slot
@@ -109,6 +111,9 @@ def lights_chunk(key):
             "        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), irradiance);",
             "        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);"]
     for light in key.lights:
+        if light.extended:
+            lines += _extended_loop(key, light)
+            continue
         if not light.shadowed:
             lines += [f"    for (int j = 0; j < {light.name.upper()}_LIGHT_COUNT; ++j) {{",
                       f"        valid = {light.name}_incident(position, j, wi, irradiance);", *term, "    }"]
@@ -124,7 +129,54 @@ def lights_chunk(key):
                              f"u_shadow_e1{slot}, u_shadow_e2{slot}, u_shadow_texel{slot}, position, shadow_face_normal);")
             lines += [*term, "    }"]
     lines += ["}"]
-    return "\n".join(lines) + "\n"
+    sampled = [_sampled_response(key, light) for light in key.lights if light.extended]
+    return "\n".join([line for chunk in sampled for line in chunk] + lines) + "\n"
+
+
+def closed_form(term, light):
+    """Whether ``term`` (a `TermKey`) reflects the extended ``light`` (a `LightKey`) in closed form (its integral's
+    form is one the kind's GLSL offers), else by the kind's weighted directions."""
+    return term.integral is not None and term.integral.form in light.integrals
+
+
+def _sampled_response(key, light):
+    """``material_response_<kind>``: the sum of the lit terms that the extended kind's samples carry."""
+    sampled = [t for t in key.lit_terms if not closed_form(t, light)]
+    if not sampled:
+        return []
+    lines = [f"// the terms without a closed form under {light.name} lights, summed over its weighted directions",
+             f"vec3 material_response_{light.name}(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)", "{",
+             "    vec3 response = vec3(0.0);"]
+    for t in sampled:
+        view = "wo" if "view" in t.needs else "vec3(0.0)"
+        lines.append(f"    response += {t.name}_response(f, wi, {view}, n_dot_l);")
+    return lines + ["    return response;", "}", ""]
+
+
+def _extended_loop(key, light):
+    """The loop over an extended kind's lights (docs/design.md section 13): each closed-form term reflects the
+    kind's integral (``k E(n)``, ``k_s`` times the lobe integral about ``r_v``), the others its weighted
+    directions; the sum is gated by ``lit`` once."""
+    upper = light.name.upper()
+    lines = [f"    for (int j = 0; j < {upper}_LIGHT_COUNT; ++j) {{", "        vec3 reflected = vec3(0.0);"]
+    closed = [t for t in key.lit_terms if closed_form(t, light)]
+    if any(t.integral.form == "irradiance" for t in closed):
+        lines.append(f"        vec3 e_extended = {light.name}_irradiance(position, f.n, j);")
+    for t in closed:
+        k = f"u_{t.name}_{t.integral.scale}"
+        k = k if t.integral.factor == 1.0 else f"({_glsl_float(t.integral.factor)} * {k})"
+        if t.integral.form == "irradiance":
+            lines.append(f"        reflected += {k} * e_extended;")
+        else:
+            lines.append(f"        reflected += {k} * {light.name}_lobe(position, f.n, reflect(-wo, f.n), "
+                         f"u_{t.name}_{t.integral.exponent}, j);")
+    if len(closed) < len(key.lit_terms):
+        lines += [f"        for (int k = 0; k < {upper}_MAX_SAMPLES; ++k) {{",
+                  f"            valid = {light.name}_sample(position, f.n, j, k, wi, irradiance);",
+                  "            n_dot_l = dot(f.n, wi);",
+                  f"            vec3 term = light_term(material_response_{light.name}(f, wi, wo, n_dot_l), irradiance);",
+                  "            reflected += (valid && n_dot_l > 0.0) ? term : vec3(0.0);", "        }"]
+    return lines + ["        radiance += lit ? reflected : vec3(0.0);", "    }"]
 
 
 def lod_chunk(key):

@@ -60,6 +60,8 @@ class TermKey:
     inputs : tuple of (str, str)
         The parameters the program sets per fragment (surface inputs, glsl/surface.glsl) and how:
         ``(param, mode)`` with mode ``'texture'``, ``'vertex'`` or ``'texture*vertex'``.
+    integral : glphong.materials.model.Integral or None
+        How the term reflects an extended light in closed form, where the program has one (else sampled).
     """
 
     name: str
@@ -72,6 +74,7 @@ class TermKey:
     ambient_param: str = None
     ambient_scale: float = 1.0
     inputs: tuple = ()
+    integral: object = None
 
     @property
     def chunk(self):
@@ -106,6 +109,9 @@ class LightKey:
         map's visibility (docs/design.md section 12).
     shadow_map : {'cube', 'ortho'} or None
         The kind's `glphong.lights.LightModel.shadow_map`.
+    integrals : tuple of str or None
+        None for a punctual kind; for an extended kind (docs/design.md section 13) the closed forms its GLSL
+        offers ('irradiance', 'lobe'); other terms are summed over its weighted directions.
     """
 
     name: str
@@ -115,6 +121,12 @@ class LightKey:
     uses: tuple = ()
     shadowed: tuple = ()
     shadow_map: str = None
+    integrals: tuple = None
+
+    @property
+    def extended(self):
+        """Whether the kind integrates over a solid angle (an area or environment light)."""
+        return self.integrals is not None
 
     @property
     def chunk(self):
@@ -135,14 +147,15 @@ def light_keys(lights, casters=True):
         if mine:
             shadowed = tuple(j for j, light in enumerate(mine) if light.shadows) if casters else ()
             out.append(LightKey(kind.name, kind.source_hash(), len(mine), tuple(kind.structural_defines(mine)),
-                                tuple(kind.uses), shadowed, kind.shadow_map))
+                                tuple(kind.uses), shadowed, kind.shadow_map, kind.key_integrals(mine)))
     return tuple(out)
 
 
 def _as_light_keys(lights):
     """`light_keys` of light instances, or of a ``{kind name: count}`` dict (no structural defines), or the keys."""
     if isinstance(lights, dict):
-        return tuple(LightKey(kind.name, kind.source_hash(), lights[kind.name], (), tuple(kind.uses))
+        return tuple(LightKey(kind.name, kind.source_hash(), lights[kind.name], (), tuple(kind.uses),
+                              integrals=kind.key_integrals())
                      for kind in registered_lights() if lights.get(kind.name, 0))
     lights = tuple(lights)
     if all(isinstance(light, LightKey) for light in lights):
@@ -473,24 +486,25 @@ def _ambient_present(ambient_radiance):
     return ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance)
 
 
-def _term_key(term, lit, ambient, uber=False):
+def _term_key(term, lit, ambient, uber=False, extended=False):
     surface = term.surface_inputs()
     inputs = tuple((p.name, surface[p.name].mode) for p in term.params
                    if p.name in surface and (lit or (ambient and p.name == term.ambient)))
     return TermKey(term.name, term.source_hash(), tuple(term.needs), lit=lit, ambient=ambient,
                    uses=term.library_uses(uber), defines=term.structural_defines(uber), ambient_param=term.ambient,
-                   ambient_scale=float(term.ambient_scale), inputs=inputs)
+                   ambient_scale=float(term.ambient_scale), inputs=inputs, integral=term.integral_form() if lit and extended else None)
 
 
-def term_keys(material, lit, ambient_present):
-    """The `TermKey` of each term of ``material`` that a program evaluates."""
+def term_keys(material, lit, ambient_present, extended=False):
+    """The `TermKey` of each term of ``material`` that a program evaluates; ``extended``: the program has an
+    extended light (each lit term's closed form, `TermKey.integral`, is part of the key)."""
     out = []
     for term in material.components:
         if term.vanishes():
             continue
         answers = ambient_present and term.answers_ambient()
         if lit or answers:
-            out.append(_term_key(term, lit=lit, ambient=answers))
+            out.append(_term_key(term, lit=lit, ambient=answers, extended=extended))
     return tuple(out)
 
 
@@ -533,7 +547,7 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
     # lights matter only to a material with a term that reflects them
     lights = _as_light_keys(lights)
     lit = bool(lights) and any(not t.vanishes() for t in material.components)
-    terms = term_keys(material, lit, _ambient_present(ambient_radiance))
+    terms = term_keys(material, lit, _ambient_present(ambient_radiance), extended=any(k.extended for k in lights))
     needs = {n for t in terms if t.lit for n in t.needs}
     modes = [mode for t in terms for _, mode in t.inputs]
     if output == "points":
@@ -590,6 +604,10 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
     lights : sequence of LightModel
         The scene's lights: their kinds join the built-in ones.
     """
+    extended = sorted({type(light).name for light in lights if type(light).extent == "extended"})
+    if extended:
+        raise ValueError(f"the uber-shader holds punctual lights only, but the scene has {', '.join(extended)} lights, "
+                         "which integrate over a solid angle (docs/design.md section 13): render it with specialise=True")
     terms = {}
     drawn = [term for material in materials for term in material.components]
     textured = [f"{t.name}.{name}" for t in drawn for name in t.surface_inputs()]

@@ -1,4 +1,4 @@
-"""The float64 integrals of an equirectangular radiance map (docs/design.md section 12): the twin's side of the
+"""The float64 integrals of an equirectangular radiance map (docs/design.md section 13): the twin's side of the
 lecture's continuous version for an environment light, exact per texel.
 
 Layout: a map of ``H x W`` texels, row ``i`` covering the polar angle ``theta`` in ``[pi i / H, pi (i + 1) / H]``
