@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from glphong.tools.bench import BenchCase, Method, methods, quick_cases, run_bench
+from glphong.tools.bench_continuous import continuous_methods
 
 
 @pytest.fixture(scope="module")
@@ -22,9 +23,18 @@ def tiny_report():
 def test_every_method_and_knob_produces_a_point(tiny_report):
     got = {(p["method"], p["knob_value"]) for p in tiny_report.points}
     want = {(m.name, v) for m in methods(quick=True) if m.kind != "pyrender" for v in m.values}
+    want |= {(name, v) for name, _, values, _, _ in continuous_methods(quick=True) for v in values}
     assert got == want
     for p in tiny_report.points:
         assert p["seconds"] > 0 and np.isfinite(p["relative_rms"]) and p["interior_pixels"] > 100
+
+
+def test_area_lights_against_their_exact_integrals(tiny_report):
+    err = {(p["method"], p["knob_value"], p["case"]): p["relative_rms"] for p in tiny_report.points}
+    closed = [e for (m, _, _), e in err.items() if m.startswith("area light, closed")]
+    sampled = {k: e for (m, k, _), e in err.items() if m.startswith("area light, sampled")}
+    assert closed and max(closed) < 1e-5  # Lambert's edge formula and Arvo's recurrence: float32 rounding only
+    assert sampled[2] < sampled[1] and sampled[1] > 1e-3  # the midpoint rule converges from a visible error
 
 
 def test_errors_behave_as_the_methods_promise(tiny_report):
@@ -62,7 +72,7 @@ def test_quick_cases_and_pyrender_reported_when_missing(monkeypatch):
     only_pyrender = [m for m in methods(quick=True) if m.kind == "pyrender"]
     monkeypatch.setitem(__import__("sys").modules, "pyrender", None)  # import pyrender -> ImportError
     report = run_bench(32, 24, cases=quick_cases()[:1], method_list=only_pyrender, repeats=1, reference_samples=1,
-                       scaling=False, targets=False, progress=False)
+                       scaling=False, targets=False, progress=False, continuous=False)
     assert report.points == [] and "pyrender is not installed" in report.skipped[0]
 
 

@@ -29,6 +29,7 @@ from glphong.checks.raycast import AnalyticObject, Plane, Sphere, compare_to_ref
 from glphong.core.timing import alternating_medians
 from glphong.gpu.contexts import available_backends
 from glphong.gpu.renderer import Renderer
+from glphong.tools.bench_continuous import continuous_points
 
 __all__ = ["BenchCase", "standard_cases", "quick_cases", "Method", "methods", "run_bench", "BenchReport"]
 
@@ -62,7 +63,7 @@ class BenchCase:
         return cls(kd=(0.18, 0.12, 0.08), ks=0.6, q=self.q, ka=0.003)
 
     def camera(self):
-        return PerspectiveCamera.look_at((0.0, 1.6, 4.2), (0.0, -0.2, 0.0), yfov=math.radians(40.0))
+        return family_camera()
 
     def light_list(self):
         out = []
@@ -74,17 +75,7 @@ class BenchCase:
     def scene(self, tessellation):
         """The scene with spheres tessellated at ``tessellation`` (icosphere level) and a plane
         of ``2^tessellation`` segments per side."""
-        scene = Scene(self.camera(), lights=self.light_list(), ambient=AmbientLight(0.02))
-        material = self.material()
-        for center, radius in SPHERES:
-            pose = np.eye(4)
-            pose[:3, 3] = center
-            scene.add(primitives.sphere(tessellation, radius), material, pose=pose)
-        pose = np.eye(4)
-        pose[:3, :3] = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]  # z-up plane -> y-up
-        pose[1, 3] = PLANE_Y
-        scene.add(primitives.plane(PLANE_SIZE, 2 ** min(tessellation, 7)), material, pose=pose)
-        return scene
+        return family_scene(self.material(), self.light_list(), tessellation, AmbientLight(0.02))
 
     def analytic_objects(self):
         """The exact geometry for `glphong.checks.raycast.render_reference`."""
@@ -93,6 +84,26 @@ class BenchCase:
         objects = [AnalyticObject(Sphere(center, radius), material) for center, radius in SPHERES]
         objects.append(AnalyticObject(Plane((0.0, PLANE_Y, 0.0), (0.0, 1.0, 0.0), PLANE_SIZE / 2), material))
         return objects
+
+
+def family_camera():
+    """The family's camera."""
+    return PerspectiveCamera.look_at((0.0, 1.6, 4.2), (0.0, -0.2, 0.0), yfov=math.radians(40.0))
+
+
+def family_scene(material, lights, tessellation=4, ambient=None):
+    """The family's geometry (two spheres on a plane, the bench's camera) drawn with ``material`` under ``lights``:
+    spheres tessellated at ``tessellation`` (icosphere level), a plane of ``2^tessellation`` segments per side."""
+    scene = Scene(family_camera(), lights=lights, ambient=ambient)
+    for center, radius in SPHERES:
+        pose = np.eye(4)
+        pose[:3, 3] = center
+        scene.add(primitives.sphere(tessellation, radius), material, pose=pose)
+    pose = np.eye(4)
+    pose[:3, :3] = [[1, 0, 0], [0, 0, 1], [0, -1, 0]]  # z-up plane -> y-up
+    pose[1, 3] = PLANE_Y
+    scene.add(primitives.plane(PLANE_SIZE, 2 ** min(tessellation, 7)), material, pose=pose)
+    return scene
 
 
 def standard_cases():
@@ -201,7 +212,7 @@ class BenchReport:
                 ax.annotate(f"{r['knob'][0]}{r['knob_value']}", (1000 * r["seconds"], r["relative_rms"]),
                             fontsize=6, xytext=(3, 3), textcoords="offset points")
         ax.set_xlabel(f"frame time [ms] ({self.width}x{self.height}, median after warm-up)")
-        ax.set_ylabel("relative RMS error vs converged ray cast (interior pixels)")
+        ax.set_ylabel("relative RMS error vs the exact reference (ray cast; area lights: exact integral)")
         ax.set_title("glphong work-precision (t = tessellation level, s = supersampling factor)")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
@@ -300,7 +311,7 @@ def _available(method):
 
 
 def run_bench(width=256, height=192, cases=None, method_list=None, repeats=5, reference_samples=6,
-              scaling=True, targets=True, progress=True):
+              scaling=True, targets=True, progress=True, continuous=True):
     """Run the work-precision report.
 
     Parameters
@@ -317,6 +328,8 @@ def run_bench(width=256, height=192, cases=None, method_list=None, repeats=5, re
         Ray-cast samples per pixel axis of the converged reference.
     scaling, targets : bool
         Also measure the scaling table and the speed ratios.
+    continuous : bool
+        Also the area lights' methods against their exact integrals (`glphong.tools.bench_continuous`).
     progress : bool
         Show a tqdm progress bar (when tqdm is installed).
 
@@ -346,6 +359,8 @@ def run_bench(width=256, height=192, cases=None, method_list=None, repeats=5, re
                     bar.update()
     if bar:
         bar.close()
+    if continuous:  # the lecture's continuous version: area lights against their exact integrals
+        report.points += continuous_points(family_scene, width, height, repeats, quick=len(cases) <= 2)
     if scaling:
         report.scaling = scaling_table(repeats=repeats, quick=len(cases) <= 2)
     if targets:
