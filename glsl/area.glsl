@@ -24,6 +24,8 @@
 // area_polygon_lobe(p, e, count, w, q) -> integral over the polygon of (w.u)^q du  [sr], integer q >= 0, the
 //   polygon clipped to w.u >= 0 (Arvo 1995, irradiance tensors):
 //   = ((q even) Omega - sum_i (w . m_i) S_i) / (q + 1).       q = 1 is Lambert's edge formula.
+// area_clipped_cosine(p, e, count, n) = area_polygon_cosine(clip(P, n), n)              E(n) / L, exact
+// area_clipped_lobe(p, e, count, n, r, q) = area_polygon_lobe(clip(clip(P, n), r), r, q)  the lobe / L, exact
 // area_triangle_sample(a, e1, e2, m, k, out point, out weight): cell k of the m^2 congruent sub-triangles of the
 //   triangle (a, a + e1, a + e2): its centroid and area [m^2] (the midpoint rule of the sampled method).
 // Key defines read here: none.
@@ -182,6 +184,19 @@ float area_polygon_lobe(vec3 p[AREA_MAX_VERTICES], vec3 e[AREA_MAX_VERTICES], in
     int qi = int(q);
     float omega = qi - 2 * (qi / 2) == 0 ? area_solid_angle(p, e, count) : 0.0;
     return max((omega - sum) / (q + 1.0), 0.0);
+}
+
+float area_clipped_cosine(vec3 p[AREA_MAX_VERTICES], vec3 e[AREA_MAX_VERTICES], int count, vec3 n)
+{
+    count = area_clip(p, e, count, n);
+    return area_polygon_cosine(p, e, count, n);
+}
+
+float area_clipped_lobe(vec3 p[AREA_MAX_VERTICES], vec3 e[AREA_MAX_VERTICES], int count, vec3 n, vec3 r, float q)
+{
+    count = area_clip(p, e, count, n);
+    count = area_clip(p, e, count, r);
+    return area_polygon_lobe(p, e, count, r, q);
 }
 
 void area_triangle_sample(vec3 a, vec3 e1, vec3 e2, int m, int k, out vec3 point, out float weight)

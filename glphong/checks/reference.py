@@ -29,8 +29,8 @@ from glphong.twin.functions import (BLINN_HALF_FLOOR, FLT_MAX, FRAME_PARALLEL_LI
                                     phong_delta, phong_lobe, point_irradiance, range_window, safe_normalize,
                                     shading_frame)
 from glphong.checks.shadows import shadow_visibility
-from glphong.twin.area import (area_angle, area_clip, area_edge_powers, area_polygon_cosine,  # noqa: F401
-                               area_polygon_lobe, area_solid_angle, area_triangle_sample)
+from glphong.twin.area import (area_angle, area_clip, area_clipped_cosine, area_clipped_lobe, area_edge_powers,  # noqa: F401
+                               area_polygon_cosine, area_polygon_lobe, area_solid_angle, area_triangle_sample)
 from glphong.shaders.generated import closed_form
 from glphong.lights import light_for_key
 from glphong.materials import registered_models
@@ -40,7 +40,7 @@ __all__ = [
     "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
     "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
     "shade_inputs", "shade", "input_bounds", "area_angle", "area_clip", "area_polygon_cosine", "area_solid_angle",
-    "area_edge_powers", "area_polygon_lobe", "area_triangle_sample", "extended_reflection", "exact_reflection",
+    "area_edge_powers", "area_polygon_lobe", "area_clipped_cosine", "area_clipped_lobe", "area_triangle_sample", "extended_reflection", "exact_reflection",
 ]
 
 def __getattr__(name):

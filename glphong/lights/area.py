@@ -21,8 +21,8 @@ from glphong.lights.extended import SAMPLES, ExtendedLight, extended_cases
 from glphong.lights.model import GlslFile, Param
 from glphong.materials.lambert import Lambert
 from glphong.materials.params import ParamValues
-from glphong.twin.area import (area_clip, area_clip_rounding, area_cosine_rounding, area_lobe_rounding, area_polygon_cosine,
-                               area_polygon_lobe, area_triangle_sample, polygon_arrays)
+from glphong.twin.area import (area_clip, area_clip_rounding, area_clipped_cosine, area_clipped_lobe,
+                               area_cosine_rounding, area_lobe_rounding, area_triangle_sample, polygon_arrays)
 from glphong.twin.functions import safe_normalize
 from glphong.twin.quadrature import polygon_integral
 
@@ -38,19 +38,17 @@ def _dot(a, b):
     return np.sum(a * b, axis=-1)
 
 
-def _reflect_area(p_e_count, n, r, q, radiance, form):
-    """The closed forms shared by the area kinds: clip to ``n`` (and ``r``), integrate (the tails of rect_irradiance,
-    rect_lobe and their polygon twins)."""
-    p, e, count = area_clip(*p_e_count, n)
-    if form == "irradiance":
-        return radiance * area_polygon_cosine(p, e, count, n)[:, None]
-    p, e, count = area_clip(p, e, count, r)
-    return radiance * area_polygon_lobe(p, e, count, r, q)[:, None]
+class _Polygonal:
+    """What the polygon kinds share, given ``polygon_of(x, p)`` (their GLSL's ``<kind>_polygon``): the closed forms'
+    twins (rect.glsl's and polygon.glsl's ``_irradiance`` and ``_lobe``) and their bands, the generic sensitivity band
+    (inputs moved by a few ulps) plus the float32 rounding of the edge formulas and the clips themselves
+    (`area_cosine_rounding`, `area_lobe_rounding`, `area_clip_rounding`), which no input perturbation shows."""
 
+    def irradiance(self, x, n, p):
+        return p.radiance * area_clipped_cosine(*self.polygon_of(x, p), n)[:, None]
 
-class _AreaBands:
-    """The area kinds' bands: the generic sensitivity band (inputs moved by a few ulps) plus the float32 rounding of
-    the edge formulas themselves (`area_cosine_rounding`, `area_lobe_rounding`), which no input perturbation shows."""
+    def lobe(self, x, n, r, q, p):
+        return p.radiance * area_clipped_lobe(*self.polygon_of(x, p), n, r, q)[:, None]
 
     def irradiance_band(self, x, n, p, constants):
         low, high = super().irradiance_band(x, n, p, constants)
@@ -76,7 +74,7 @@ def _exact_polygon(vertices, x, n, radiance, integrand, clip):
     return polygon_integral(x, n, vertices, radiance, integrand, clip=clip)
 
 
-class RectLight(_AreaBands, ExtendedLight):
+class RectLight(_Polygonal, ExtendedLight):
     """A one-sided uniform parallelogram light: corners ``center +- u/2 +- v/2``, emitting along ``u x v``.
 
     Parameters
@@ -134,12 +132,6 @@ class RectLight(_AreaBands, ExtendedLight):
 
     polygon_of = rect_polygon
 
-    def irradiance(self, x, n, p):
-        return _reflect_area(self.rect_polygon(x, p), n, None, None, p.radiance, "irradiance")
-
-    def lobe(self, x, n, r, q, p):
-        return _reflect_area(self.rect_polygon(x, p), n, r, q, p.radiance, "lobe")
-
     def sample(self, x, n, k, p):
         m = int(p.samples)
         a, b = k // m, k - (k // m) * m
@@ -173,7 +165,7 @@ class RectLight(_AreaBands, ExtendedLight):
         return _exact_polygon(corners, x, n, p.radiance, integrand, clip)
 
 
-class PolygonLight(_AreaBands, ExtendedLight):
+class PolygonLight(_Polygonal, ExtendedLight):
     """A one-sided uniform planar convex polygon light, emitting toward the side from which its vertices run
     counter-clockwise.
 
@@ -251,12 +243,6 @@ class PolygonLight(_AreaBands, ExtendedLight):
         return points, edges, np.where(front, count, 0)
 
     polygon_of = polygon_polygon
-
-    def irradiance(self, x, n, p):
-        return _reflect_area(self.polygon_polygon(x, p), n, None, None, p.radiance, "irradiance")
-
-    def lobe(self, x, n, r, q, p):
-        return _reflect_area(self.polygon_polygon(x, p), n, r, q, p.radiance, "lobe")
 
     def sample(self, x, n, k, p):
         m = int(p.samples)

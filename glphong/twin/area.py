@@ -17,7 +17,7 @@ from glphong.twin.band import EPS
 from glphong.twin.functions import atan2_first_quadrant
 
 __all__ = ["AREA_MAX_VERTICES", "area_angle", "area_clip", "area_polygon_cosine", "area_solid_angle",
-           "area_edge_powers", "area_polygon_lobe", "area_cosine_rounding", "area_lobe_rounding", "area_clip_rounding", "area_triangle_sample", "polygon_arrays"]
+           "area_edge_powers", "area_polygon_lobe", "area_clipped_cosine", "area_clipped_lobe", "area_cosine_rounding", "area_lobe_rounding", "area_clip_rounding", "area_triangle_sample", "polygon_arrays"]
 
 #: vertices a polygon may have after two clips (a light has at most 8)
 AREA_MAX_VERTICES = 10
@@ -258,6 +258,16 @@ def area_polygon_lobe(p, e, count, w, q):
     total = (weights * sums).sum(axis=1)
     omega = area_solid_angle(p, e, count) if int(q) % 2 == 0 else 0.0
     return np.where(count >= 3, np.maximum((omega - total) / (q + 1), 0.0), 0.0)
+
+
+def area_clipped_cosine(p, e, count, n):
+    """`area_polygon_cosine` of the polygon clipped by ``n`` (area.glsl), (N,)."""
+    return area_polygon_cosine(*area_clip(p, e, count, n), n)
+
+
+def area_clipped_lobe(p, e, count, n, r, q):
+    """`area_polygon_lobe` about ``r`` of the polygon clipped by ``n`` and by ``r`` (area.glsl), (N,)."""
+    return area_polygon_lobe(*area_clip(*area_clip(p, e, count, n), r), r, q)
 
 
 def area_triangle_sample(a, e1, e2, m, k):

@@ -3,8 +3,8 @@
 // Vertices v_i (i < count_j <= 8), counter-clockwise seen from the side the light emits to (its front normal
 // u_polygon_normal[j], made on the host), edges e_i = v_{i+1} - v_i (host, float64 rounded once), radiance L_j.
 // polygon_polygon(x, j, p, e) -> count: p_i = v_i - x and the edges; 0 where x is not in front, (x - v_0).N <= 0.
-// polygon_irradiance(x, n, j) = L_j area_polygon_cosine(clip(P, n))             E(n), exact
-// polygon_lobe(x, n, r, q, j) = L_j area_polygon_lobe(clip(clip(P, n), r))      Arvo, exact for integer q
+// polygon_irradiance(x, n, j) = L_j area_clipped_cosine(P, n)             E(n), exact
+// polygon_lobe(x, n, r, q, j) = L_j area_clipped_lobe(P, n, r, q)    Arvo, exact for integer q
 // polygon_sample(x, n, j, k, wi, E): the fan's triangle t = 1 + k / m^2 (v_0, v_t, v_{t+1}), its sub-triangle
 //   k mod m^2 of m^2 (area_triangle_sample), centroid y, area A_k:  E = L_j cos_l A_k / d^2, cos_l = -wi.N;
 //   valid where t + 1 < count_j, the direction normalises and cos_l > 0.
@@ -25,8 +25,7 @@ vec3 polygon_irradiance(vec3 x, vec3 n, int j)
     vec3 p[AREA_MAX_VERTICES];
     vec3 e[AREA_MAX_VERTICES];
     int count = polygon_polygon(x, j, p, e);
-    count = area_clip(p, e, count, n);
-    return u_polygon_radiance[j] * area_polygon_cosine(p, e, count, n);
+    return u_polygon_radiance[j] * area_clipped_cosine(p, e, count, n);
 }
 
 vec3 polygon_lobe(vec3 x, vec3 n, vec3 r, float q, int j)
@@ -34,9 +33,7 @@ vec3 polygon_lobe(vec3 x, vec3 n, vec3 r, float q, int j)
     vec3 p[AREA_MAX_VERTICES];
     vec3 e[AREA_MAX_VERTICES];
     int count = polygon_polygon(x, j, p, e);
-    count = area_clip(p, e, count, n);
-    count = area_clip(p, e, count, r);
-    return u_polygon_radiance[j] * area_polygon_lobe(p, e, count, r, q);
+    return u_polygon_radiance[j] * area_clipped_lobe(p, e, count, n, r, q);
 }
 
 bool polygon_sample(vec3 x, vec3 n, int j, int k, out vec3 wi, out vec3 irradiance)

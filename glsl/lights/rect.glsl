@@ -4,8 +4,8 @@
 // rect_polygon(x, j, p, e) -> count: the corners relative to x, counter-clockwise seen from the front
 //   (c - u/2 - v/2, then + u, + v, - u) with the edges u, v, -u, -v exactly; 0 where x is not in front,
 //   (x - c).(u x v) <= 0.
-// rect_irradiance(x, n, j) = L_j area_polygon_cosine(clip(P, n))          E(n), exact (Lambert's edge formula)
-// rect_lobe(x, n, r, q, j) = L_j area_polygon_lobe(clip(clip(P, n), r))   Arvo, exact for integer q
+// rect_irradiance(x, n, j) = L_j area_clipped_cosine(P, n)          E(n), exact (Lambert's edge formula)
+// rect_lobe(x, n, r, q, j) = L_j area_clipped_lobe(P, n, r, q) Arvo, exact for integer q
 // rect_sample(x, n, j, k, wi, E): cell k = (a, b) of m x m (m = u_rect_samples[j]), its centre y:
 //   wi = (y - x)/d,  E = L_j cos_l (A / m^2) / d^2,  cos_l = -wi.(u x v)/A,  A = |u x v|  (the midpoint rule);
 //   valid where k < m^2, the direction normalises and cos_l > 0.
@@ -32,8 +32,7 @@ vec3 rect_irradiance(vec3 x, vec3 n, int j)
     vec3 p[AREA_MAX_VERTICES];
     vec3 e[AREA_MAX_VERTICES];
     int count = rect_polygon(x, j, p, e);
-    count = area_clip(p, e, count, n);
-    return u_rect_radiance[j] * area_polygon_cosine(p, e, count, n);
+    return u_rect_radiance[j] * area_clipped_cosine(p, e, count, n);
 }
 
 vec3 rect_lobe(vec3 x, vec3 n, vec3 r, float q, int j)
@@ -41,9 +40,7 @@ vec3 rect_lobe(vec3 x, vec3 n, vec3 r, float q, int j)
     vec3 p[AREA_MAX_VERTICES];
     vec3 e[AREA_MAX_VERTICES];
     int count = rect_polygon(x, j, p, e);
-    count = area_clip(p, e, count, n);
-    count = area_clip(p, e, count, r);
-    return u_rect_radiance[j] * area_polygon_lobe(p, e, count, r, q);
+    return u_rect_radiance[j] * area_clipped_lobe(p, e, count, n, r, q);
 }
 
 bool rect_sample(vec3 x, vec3 n, int j, int k, out vec3 wi, out vec3 irradiance)
