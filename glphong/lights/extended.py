@@ -117,13 +117,13 @@ class ExtendedLight(LightModel):
 
     def lobe_band(self, x, n, r, q, p, constants):
         """Interval of the float32 ``<kind>_lobe``: ``(low, high)``, each (N, 3)."""
-        return sensitivity_band(lambda x_, p_, n_, r_: self.lobe(x_, n_, r_, q, p_), x, p, self.uniform_params(),
-                                constants, (n, r))
+        return sensitivity_band(lambda x_, p_, n_, r_: self.lobe(x_, n_, r_, q, p_), x, p,
+                                self.perturbed_uniforms(), constants, (n, r))
 
     def sample_band(self, x, n, k, p, constants):
         """Interval of the float32 irradiance of ``<kind>_sample`` ``k``: ``(low, high)``, each (N, 3)."""
-        return sensitivity_band(lambda x_, p_, n_: self.sample(x_, n_, k, p_)[2], x, p, self.uniform_params(),
-                                constants, (n,))
+        return sensitivity_band(lambda x_, p_, n_: self.sample(x_, n_, k, p_)[2], x, p,
+                                self.perturbed_uniforms(), constants, (n,))
 
     def exact(self, x, n, p, integrand, clip=()):
         """The float64 integral over the light (see the class docstring); a kind without one raises."""

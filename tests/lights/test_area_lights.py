@@ -28,6 +28,7 @@ from glphong.materials.cases import Case
 from glphong.materials.phong import PhongLobe
 from glphong.shaders.generated import lights_chunk
 from glphong.shaders import assembly
+from glphong.twin.quadrature import disk_integral
 from glphong.shaders.key import uber_key
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -75,6 +76,7 @@ LIGHTS = {
     "polygon": lambda: glphong.PolygonLight([(0.0, 0.5, 1.0), (0.5, 0.5, 1.0), (0.6, 0.5, 1.5), (0.2, 0.5, 1.8),
                                              (-0.3, 0.5, 1.4)], 5.0, samples=2),
     "sphere": lambda: glphong.SphereLight((0.3, 0.5, 0.5), 0.3, 5.0, samples=3),
+    "disk": lambda: glphong.DiskLight((0.2, 0.6, 0.9), (-0.1, -0.6, -0.5), 0.45, 5.0, samples=3),
 }
 
 
@@ -89,7 +91,7 @@ def test_verify_reports_both_error_maps(kind, glphong_backend, glphong_make_rend
     plane = (renderer.gbuffer(scene).object_index == 0)[..., None]
     closed = report.method_error[plane & lit]  # Phong with an integer q: every term in closed form
     sampled = report.method_error[~plane & lit]  # Blinn-Phong: the light's weighted directions
-    if kind != "sphere":  # (under a sphere the Phong lobe has no closed form: sampled there too)
+    if kind not in ("sphere", "disk"):  # (under a sphere or a disk the Phong lobe is sampled too)
         # exact up to the float32 uniforms: a polygon's edges, rounded apart from its vertices, close to ~1e-8 m
         assert closed.max() < 1e-5 and np.median(closed) < 1e-6, (closed.max(), np.median(closed))
     assert np.median(sampled) > 1e-6  # the sampled method's own error shows
@@ -132,6 +134,23 @@ def test_lambert_under_a_covering_rect_is_pi_l(glphong_backend):
     a = size / 2
     closed = 4 * radiance * a / np.hypot(a, 1.0) * np.arctan(a / np.hypot(a, 1.0))  # the form factor, 4 corners
     assert abs(gpu[0, 0] - closed) <= 3e-6 * closed and abs(closed - np.pi * radiance) < 1e-3
+
+
+def test_disk_on_its_axis_and_across_the_horizon(glphong_backend):
+    radius, d, radiance = 0.5, 1.5, 3.0
+    light = glphong.DiskLight((0.0, 0.0, d), (0.0, 0.0, -1.0), radius, radiance)
+    gpu = _points_gpu(glphong_backend, glphong.Lambert(1.0), light, np.zeros((1, 3)), [(0.0, 0.0, 1.0)])
+    closed = np.pi * radiance * radius ** 2 / (radius ** 2 + d ** 2)  # the textbook on-axis disk
+    assert abs(gpu[0, 0] - closed) <= 2e-6 * closed
+    # across the horizon: against the independent quadrature (glphong.twin.quadrature), tilting the normal to 90 deg
+    tilts = np.linspace(0.0, np.pi / 2, 12)
+    normals = np.stack([np.sin(tilts), np.zeros(12), np.cos(tilts)], axis=1)
+    gpu = _points_gpu(glphong_backend, glphong.Lambert(1.0), light, np.zeros((12, 3)), normals)[:, 0]
+    p = light.values()
+    exact = disk_integral(np.zeros((12, 3)), normals, p.center, p.normal, float(p.radius), p.radiance,
+                          lambda i, w: np.sum(normals[i] * w, axis=-1))[0][:, 0]
+    assert np.all(np.abs(gpu - exact) <= 3e-6 * exact.max()), np.abs(gpu - exact).max()
+    assert exact[-1] < 0.1 * exact[0]  # at 90 deg most of the disk's light is below the horizon
 
 
 def test_sphere_is_a_point_light_of_its_power(glphong_backend):
@@ -234,6 +253,9 @@ PLANTED = {  # (chunk, text, planted text, light)
     # moves one by 5.2e-5 against a half-width of 1.5e-6
     "a clip point 1 % off along its edge": ("area", "d[i] / (d[i] - d[next])", "1.01 * d[i] / (d[i] - d[next])",
                                             "rect+phong"),
+    # the first draft's bug, found by the quadrature: this term set to 0 on the disk's axis, where it is -w
+    "the disk's arc without its log term": ("light:disk", "float L = -w * disk_log1p_over(rho * w);",
+                                            "float L = 0.0 * w;", "disk"),
     "the sphere's horizon branch 1e-4 off": ("light:sphere", "+ atan2_first_quadrant(s, X)",
                                              "+ 1.0001 * atan2_first_quadrant(s, X)", "sphere"),
 }
