@@ -20,7 +20,6 @@ from glphong.core import validate as _validate
 from glphong.lights.extended import SAMPLES, ExtendedLight, extended_cases
 from glphong.lights.model import GlslFile, Param
 from glphong.materials.lambert import Lambert
-from glphong.materials.params import ParamValues
 from glphong.twin.area import (area_clip, area_clip_rounding, area_clipped_cosine, area_clipped_lobe,
                                area_cosine_rounding, area_lobe_rounding, area_triangle_sample, polygon_arrays)
 from glphong.twin.functions import safe_normalize
@@ -68,10 +67,6 @@ class _Polygonal:
             + area_clip_rounding(*by_n, r)
         slack = p.radiance * slack[:, None]
         return np.maximum(low - slack, 0.0), high + slack
-
-
-def _exact_polygon(vertices, x, n, radiance, integrand, clip):
-    return polygon_integral(x, n, vertices, radiance, integrand, clip=clip)
 
 
 class RectLight(_Polygonal, ExtendedLight):
@@ -161,8 +156,8 @@ class RectLight(_Polygonal, ExtendedLight):
             ("q = 1e4, the lobe on an edge", cls((0.5, 0.0, 1.0), (0.0, 1.0, 0.0), (1.0, 0.0, 0.0), 2.0), 10000)))
 
     def exact(self, x, n, p, integrand, clip=()):
-        corners = np.asarray(self.rect_polygon(np.zeros((1, 3)), ParamValues({**p.__dict__}))[0][0, :4], np.float64)
-        return _exact_polygon(corners, x, n, p.radiance, integrand, clip)
+        a = p.center - 0.5 * p.u - 0.5 * p.v  # the corners of the float32 uniforms, in float64
+        return polygon_integral(x, n, np.stack([a, a + p.u, a + p.u + p.v, a + p.v]), p.radiance, integrand, clip=clip)
 
 
 class PolygonLight(_Polygonal, ExtendedLight):
@@ -265,7 +260,7 @@ class PolygonLight(_Polygonal, ExtendedLight):
             ("q = 7", cls(pentagon, 2.0), 7)))
 
     def exact(self, x, n, p, integrand, clip=()):
-        return _exact_polygon(np.asarray(p.vertex[:int(p.count)], np.float64), x, n, p.radiance, integrand, clip)
+        return polygon_integral(x, n, np.asarray(p.vertex[:int(p.count)], np.float64), p.radiance, integrand, clip=clip)
 
 
 def _convex_polygon(vertices):
