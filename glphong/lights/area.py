@@ -17,7 +17,7 @@ Far away the light is a point of intensity ``L A cos(theta_l)`` [W/sr]: ``E -> L
 import numpy as np
 
 from glphong.core import validate as _validate
-from glphong.lights.extended import SAMPLES, ExtendedLight, extended_cases
+from glphong.lights.extended import CENTER, RADIANCE, SAMPLES, ExtendedLight, extended_cases
 from glphong.lights.model import GlslFile, Param
 from glphong.materials.lambert import Lambert
 from glphong.twin.area import (area_clip, area_clip_rounding, area_clipped_cosine, area_clipped_lobe,
@@ -30,7 +30,6 @@ __all__ = ["RectLight", "PolygonLight", "MAX_POLYGON_VERTICES"]
 #: vertices a PolygonLight may have
 MAX_POLYGON_VERTICES = 8
 
-_RADIANCE = Param("radiance", "rgb", low=0.0, unit="W/(m^2 sr)", doc="emitted radiance, uniform over the light")
 
 
 def _dot(a, b):
@@ -85,10 +84,10 @@ class RectLight(_Polygonal, ExtendedLight):
     """
 
     name = "rect"
-    params = (Param("center", "vec3", low=-np.inf, unit="m", doc="centre"),
+    params = (CENTER,
               Param("u", "vec3", low=-np.inf, unit="m", doc="first edge vector"),
               Param("v", "vec3", low=-np.inf, unit="m", doc="second edge vector; emits along u x v"),
-              _RADIANCE, SAMPLES)
+              RADIANCE, SAMPLES)
     glsl = GlslFile("lights/rect.glsl")
     uses = ("angle", "area")
     integrals = ("irradiance", "lobe")
@@ -175,12 +174,12 @@ class PolygonLight(_Polygonal, ExtendedLight):
     """
 
     name = "polygon"
-    params = (_RADIANCE, SAMPLES)
+    params = (RADIANCE, SAMPLES)
     uniforms = (Param("vertex", "vec3", low=-np.inf, unit="m", doc="the vertices, padded to 8"),
                 Param("edge", "vec3", low=-np.inf, unit="m", doc="v_{i+1} - v_i, in float64, padded to 8"),
                 Param("count", "scalar", low=3.0, high=8.0, doc="number of vertices"),
                 Param("normal", "direction", low=-np.inf, doc="front normal: the side it emits to"),
-                _RADIANCE, SAMPLES)
+                RADIANCE, SAMPLES)
     uniform_lengths = {"vertex": MAX_POLYGON_VERTICES, "edge": MAX_POLYGON_VERTICES}
     exact_uniforms = ("samples", "count")
     glsl = GlslFile("lights/polygon.glsl")

@@ -6,7 +6,7 @@ docstring of disk.glsl); every other term is summed over ``samples^2`` cells of 
 """
 import numpy as np
 
-from glphong.lights.extended import SAMPLES, ExtendedLight, extended_cases
+from glphong.lights.extended import CENTER, RADIANCE, RADIUS, SAMPLES, ExtendedLight, extended_cases
 from glphong.lights.model import GlslFile, Param
 from glphong.twin.area import area_angle
 from glphong.twin.band import EPS
@@ -55,11 +55,7 @@ class DiskLight(ExtendedLight):
     """
 
     name = "disk"
-    params = (Param("center", "vec3", low=-np.inf, unit="m", doc="centre"),
-              Param("normal", "direction", low=-np.inf, doc="the side it emits to"),
-              Param("radius", "scalar", low=0.0, low_inclusive=False, unit="m", doc="radius"),
-              Param("radiance", "rgb", low=0.0, unit="W/(m^2 sr)", doc="emitted radiance"),
-              SAMPLES)
+    params = (CENTER, Param("normal", "direction", low=-np.inf, doc="the side it emits to"), RADIUS, RADIANCE, SAMPLES)
     glsl = GlslFile("lights/disk.glsl")
     uses = ("angle", "area")
     integrals = ("irradiance",)

@@ -23,7 +23,7 @@ from glphong.materials.cases import Case
 from glphong.materials.lambert import Lambert
 from glphong.materials.phong import Phong, PhongLobe
 
-__all__ = ["ExtendedLight", "IRRADIANCE", "LOBE", "SAMPLE", "SAMPLES", "extended_cases"]
+__all__ = ["ExtendedLight", "IRRADIANCE", "LOBE", "SAMPLE", "SAMPLES", "CENTER", "RADIUS", "RADIANCE", "extended_cases"]
 
 #: E(n) at x: what a Lambert term reflects, times its k_d
 IRRADIANCE = ContractFunction("irradiance", "vec3 (irradiance (N, 3) [W/m^2])", ("vec3 x", "vec3 n", "int j"),
@@ -35,6 +35,10 @@ LOBE = ContractFunction("lobe", "vec3 (lobe integral (N, 3) [W/m^2])", ("vec3 x"
 SAMPLE = ContractFunction("sample", "bool (valid (N,) bool, wi (N, 3) unit vectors, irradiance (N, 3) [W/m^2])",
                           ("vec3 x", "vec3 n", "int j", "int k", "out vec3 wi", "out vec3 irradiance"),
                           ("x", "n", "k", "p"))
+#: the parameters the area kinds share
+CENTER = Param("center", "vec3", low=-float("inf"), unit="m", doc="centre")
+RADIUS = Param("radius", "scalar", low=0.0, low_inclusive=False, unit="m", doc="radius")
+RADIANCE = Param("radiance", "rgb", low=0.0, unit="W/(m^2 sr)", doc="emitted radiance, uniform over the light")
 #: the sampled method's knob, shared by the area kinds
 SAMPLES = Param("samples", "scalar", low=1.0, high=64.0, default=4.0,
                 doc="cells per side of the sampled method (an integer; the terms without a closed form)")

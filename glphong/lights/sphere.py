@@ -8,8 +8,8 @@ tends to a `PointLight` of that power as ``R -> 0`` (tested).
 """
 import numpy as np
 
-from glphong.lights.extended import SAMPLES, ExtendedLight, extended_cases
-from glphong.lights.model import GlslFile, Param
+from glphong.lights.extended import CENTER, RADIANCE, RADIUS, SAMPLES, ExtendedLight, extended_cases
+from glphong.lights.model import GlslFile
 from glphong.twin.area import area_angle
 from glphong.twin.band import EPS
 from glphong.twin.functions import atan2_first_quadrant, perpendiculars, safe_normalize
@@ -38,10 +38,7 @@ class SphereLight(ExtendedLight):
     """
 
     name = "sphere"
-    params = (Param("center", "vec3", low=-np.inf, unit="m", doc="centre"),
-              Param("radius", "scalar", low=0.0, low_inclusive=False, unit="m", doc="radius"),
-              Param("radiance", "rgb", low=0.0, unit="W/(m^2 sr)", doc="radiance leaving its surface"),
-              SAMPLES)
+    params = (CENTER, RADIUS, RADIANCE, SAMPLES)
     glsl = GlslFile("lights/sphere.glsl")
     uses = ("angle", "area")
     integrals = ("irradiance",)
