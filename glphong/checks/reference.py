@@ -199,7 +199,7 @@ def view_direction(position, n_valid, eye, key):
     return wo, n_valid & ok_v
 
 
-def shade_point(position, n, n_valid, eye, key, uniforms, material):
+def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=None):
     """E6 at each point (shade.glsl's ``shade_point``).
 
     Parameters
@@ -217,6 +217,10 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
         As in `incident_light`.
     material : glphong.materials.Material
         The material whose terms' twins are summed.
+    extended : callable, optional
+        What the extended lights reflect, ``extended(position, f, wo, lit, key, uniforms, material) -> (N, 3)``:
+        default `extended_reflection` (the shader's methods); `glphong.checks.verify.exact_image` passes the exact
+        integrals.
 
     Returns
     -------
@@ -241,7 +245,7 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material):
                                         irradiance[gate])
         radiance = radiance + term
     if any(k.extended for k in key.lights):
-        radiance = radiance + extended_reflection(position, f, wo, lit, key, uniforms, material)
+        radiance = radiance + (extended or extended_reflection)(position, f, wo, lit, key, uniforms, material)
     return radiance
 
 
@@ -305,24 +309,22 @@ def exact_reflection(position, f, wo, lit, key, uniforms, material):
     -------
     value : (N, 3) float64 ndarray
     error : (N,) float64 ndarray
-        The quadrature's absolute error estimate, summed over the lights.
-    converged : (N,) bool ndarray
+        The quadrature's absolute error estimate, summed over the lights (where it did not converge to its
+        tolerance, this says by how much).
     """
     terms = _terms(material)
     out = np.zeros(position.shape)
     error = np.zeros(len(position))
-    converged = np.ones(len(position), bool)
     for light_key, twin, p, _, _ in extended_lights(key, uniforms, np.float64):
         def integrand(index, w):
             g = f.select(index)
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
                 return terms_response(g, w, wo[index], _dot(g.n, w), key.lit_terms, uniforms, terms)
 
-        value, err, ok = twin.exact(position, f.n, p, integrand)
+        value, err, _ = twin.exact(position, f.n, p, integrand)
         out = out + np.where(lit[:, None], value, 0.0)
         error = error + np.where(lit, err, 0.0)
-        converged &= ok | ~lit
-    return out, error, converged
+    return out, error
 
 
 def terms_response(f, wi, wo, n_dot_l, term_keys, uniforms, terms):

@@ -261,7 +261,10 @@ def _extended_exact(light, terms, x, n, v, tangent, uv):
                                           np.sum(frame.n[index] * w, axis=-1), term.values())
         return out
 
-    value, _, converged = light.exact(np.array([x]), np.array([n]), light.values(), integrand)
+    value, error, converged = light.exact(np.array([x]), np.array([n]), light.values(), integrand)
+    if not converged[0]:
+        raise RuntimeError(f"{light!r}: its exact integral at {x} did not converge (error estimate {error[0]:.3g}); the "
+                           "case has no trustworthy expected value")
     return np.asarray(value, dtype=np.float64)[0]
 
 

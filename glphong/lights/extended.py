@@ -87,6 +87,10 @@ class ExtendedLight(LightModel):
     def parameter_values(self):
         return super().parameter_values() | {"method": self.method}
 
+    #: methods a definition must give besides its contract's twins (checked when the class is made): its exact
+    #: integral, which `glphong.verify` and the stability suite compare the methods with
+    required_methods = ("exact",)
+
     @classmethod
     def key_integrals(cls, lights=()):
         """The kind's closed forms, or none where one of the scene's lights of the kind asks ``method='sampled'`` (the
@@ -129,13 +133,6 @@ class ExtendedLight(LightModel):
         return sensitivity_band(lambda x_, p_, n_: self.sample(x_, n_, k, p_)[2], x, p,
                                 self.perturbed_uniforms(), constants, (n,))
 
-    def exact(self, x, n, p, integrand, clip=()):
-        """The float64 integral over the light (see the class docstring); a kind without one raises."""
-        raise NotImplementedError(f"{type(self).__name__} has no exact integral: define exact(self, x, n, p, integrand, clip)")
-
-    def power(self):
-        """The light's radiant power [W] per channel (3,), for comparisons with point lights."""
-        raise NotImplementedError
 
 
 def extended_cases(kind, cases):

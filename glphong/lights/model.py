@@ -541,6 +541,12 @@ def _check_definition(cls):
                           f"(got ({', '.join(['self'] + [a.name for a in args])}))")
     _SOURCES.pop(cls, None)
     _check_glsl(cls, _strip_comments(light_source(cls)[0]))
+    for method in getattr(cls, "required_methods", ()):
+        if all(c.__dict__.get(method) is None for c in cls.__mro__[:-1] if c.__module__ != __name__
+               and not c.__dict__.get("abstract_contract", False)):
+            raise err(f"{cls.__qualname__} defines no `{method}`: an extended kind gives its float64 exact integral, "
+                      f"`def exact(self, x, n, p, integrand, clip=())` (glphong.twin.quadrature has polygons, spheres "
+                      "and disks)")
 
 
 def _check_glsl(cls, code):

@@ -224,6 +224,22 @@ def test_the_uber_shader_refuses_extended_lights():
         uber_key([glphong.Lambert(0.5)], lights=[LIGHTS["rect"]()])
 
 
+def test_an_extended_kind_must_give_its_exact_integral():
+    with pytest.raises(LightDefinitionError, match=r"defines no `exact`"):
+        class Flat(glphong.ExtendedLight):  # noqa: F841 - defined to be refused
+            name = "glowpanel"
+            params = (glphong.Param("radiance", "rgb", low=0.0),)
+            glsl = ("vec3 glowpanel_irradiance(vec3 x, vec3 n, int j) { return u_glowpanel_radiance[j]; }\n"
+                    "bool glowpanel_sample(vec3 x, vec3 n, int j, int k, out vec3 wi, out vec3 irradiance)"
+                    " { wi = n; irradiance = vec3(0.0); return false; }")
+
+            def irradiance(self, x, n, p):
+                return np.broadcast_to(p.radiance, x.shape)
+
+            def sample(self, x, n, k, p):
+                return np.zeros(len(x), bool), n, np.zeros_like(x)
+
+
 def test_an_extended_kind_is_checked_like_any_light():
     with pytest.raises(LightDefinitionError, match=r"must define `bool glow_sample\(vec3 x, vec3 n, int j, int k"):
         class Glow(glphong.ExtendedLight):  # noqa: F841 - defined to be refused
