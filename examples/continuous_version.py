@@ -2,8 +2,10 @@
 
 The continuous version integrates over the incident light,
 ``L_r = integral f_r(w_i, w_r) L_i(w_i) cos(theta_i) dw_i``; the discrete version sums over point lights,
-``L_r = sum_j f_r(l_j, v) E_j cos(theta_j)``.  The same two spheres on a floor are lit three ways:
+``L_r = sum_j f_r(l_j, v) E_j cos(theta_j)``.  The same two spheres on a floor are lit four ways:
 
+0. a sky (``glphong.EnvironmentLight`` of the bench's sky map, a sun at 35 degrees): Lambert by the irradiance cube
+   map, the Phong lobe by spherical harmonics, each with its error against the exact integral measured;
 1. a rectangular panel of radiance ``L`` (``glphong.RectLight``): Lambert and the lecture's Phong lobe in closed
    form, exact;
 2. a spherical lamp (``glphong.SphereLight``) of the same power;
@@ -11,7 +13,8 @@ The continuous version integrates over the incident light,
    sends straight down (the panel's midpoint rule).
 
 Each render is checked by ``glphong.verify``, whose second error map compares the shader's method with the exact
-integral (a float64 quadrature over the light): the panel's is at the quadrature's tolerance.  The soft shadow-less
+integral (a float64 quadrature over the light): the panel's is at the quadrature's tolerance.  The sky's exact
+integral costs about 40 ms a pixel, so its render is verified at ``verify_size`` (20 x 15 by default).  The soft shadow-less
 highlight of the panel against the sixteen sharp highlights of the point lights is the difference the lecture
 draws between the two versions.
 
@@ -23,6 +26,8 @@ import numpy as np
 
 import glphong
 from glphong import primitives
+from glphong.lights.environment import Y_UP
+from glphong.tools.bench_continuous import sky_map
 
 L = 6.0  # the panel's radiance [W/(m^2 sr)]
 CENTER, U, V = np.array([0.0, 1.6, 0.6]), np.array([1.6, 0.0, 0.0]), np.array([0.0, -0.25, 0.9])  # emits along U x V: down
@@ -56,19 +61,20 @@ def point_lights(cells=4):
     return out
 
 
-def main(out=None, width=240, height=180):
+def main(out=None, width=240, height=180, verify_size=(20, 15)):
     panel = glphong.RectLight(CENTER, U, V, L)
     lamp = glphong.SphereLight.from_power(CENTER, 0.2, float(panel.power()[0]))
+    sky = glphong.EnvironmentLight(sky_map(), rotation=Y_UP, scale=0.05, order=16, resolution=17)
     images = []
-    with glphong.Renderer(width, height) as renderer:
-        for label, lights in (("panel (RectLight)", [panel]), ("lamp (SphereLight)", [lamp]),
-                              ("16 point lights", point_lights())):
+    with glphong.Renderer(width, height) as renderer, glphong.Renderer(*verify_size) as small:
+        for label, lights in (("sky (EnvironmentLight)", [sky]), ("panel (RectLight)", [panel]),
+                              ("lamp (SphereLight)", [lamp]), ("16 point lights", point_lights())):
             scene = scene_under(lights)
-            report = glphong.verify(scene, renderer)
-            print(f"{label:20s} {report}")
+            report = glphong.verify(scene, small if lights[0] is sky else renderer)
+            print(f"{label:22s} {report}")
             assert report.passed
             images.append(renderer.render(scene).radiance)
-    strip = np.concatenate(images, axis=1)  # radiance [W/(m^2 sr)], the three side by side
+    strip = np.concatenate(images, axis=1)  # radiance [W/(m^2 sr)], the four side by side
     if out:
         glphong.imaging.save_png(out, strip, exposure=1.5)
         print("wrote", out)

@@ -21,7 +21,7 @@ from glphong.scene.camera import Camera, IntrinsicsCamera, OrthographicCamera, P
 from glphong.gpu.contexts import BackendUnavailableError, available_backends, create_context
 from glphong.gpu.describe import describe, format_descriptions
 from glphong.lights import (AmbientLight, DirectionalLight, ExtendedLight, LightModel, PointLight, PolygonLight, RectLight,
-                            SphereLight, DiskLight,                             SpotLight, UnattenuatedPointLight)
+                            SphereLight, DiskLight, EnvironmentLight,                             SpotLight, UnattenuatedPointLight)
 from glphong.formats.gltf_export import save_gltf
 from glphong.formats.load import load_scene
 from glphong.materials import Material, MaterialModel, MaterialSum, Param, Texture, VertexColors
@@ -46,7 +46,7 @@ _moved.install()  # the module paths of 0.1.0 keep working (glphong._moved)
 
 __all__ = [
     "Camera", "PerspectiveCamera", "IntrinsicsCamera", "OrthographicCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "SpotLight", "AmbientLight", "LightModel",
-    "ExtendedLight", "RectLight", "PolygonLight", "SphereLight", "DiskLight",
+    "ExtendedLight", "RectLight", "PolygonLight", "SphereLight", "DiskLight", "EnvironmentLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
     "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
     "DielectricFresnel", "Texture", "VertexColors", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "Frame", "GBuffer",

@@ -249,18 +249,21 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=Non
     return radiance
 
 
-def extended_lights(key, uniforms, dtype):
+def extended_lights(key, uniforms, dtype, lights=None):
     """Each extended light of the key, in loop order: ``(light_key, twin, p, closed, sampled)`` with ``p`` its
-    `ParamValues` and ``closed``/``sampled`` the lit terms (`TermKey`) it reflects in closed form and by samples."""
+    `ParamValues` and ``closed``/``sampled`` the lit terms (`TermKey`) it reflects in closed form and by samples;
+    ``twin`` the scene's light itself where ``lights`` (the scene's lights) is given, else a bare instance of its kind
+    (the twin reads only its arguments)."""
     for light_key in key.lights:
         if not light_key.extended:
             continue
         kind = light_for_key(light_key.name, light_key.source_hash)
         closed = [t for t in key.lit_terms if closed_form(t, light_key)]
         sampled = [t for t in key.lit_terms if not closed_form(t, light_key)]
+        mine = [light for light in lights if type(light) is kind] if lights is not None else []
         for j in range(light_key.count):
-            yield light_key, kind.twin(), kind.values_from_uniforms(uniforms, j, dtype=dtype, defines=light_key.defines), \
-                closed, sampled
+            yield light_key, mine[j] if mine else kind.twin(), \
+                kind.values_from_uniforms(uniforms, j, dtype=dtype, defines=light_key.defines), closed, sampled
 
 
 def view_reflected(n, wo):
@@ -301,9 +304,11 @@ def extended_reflection(position, f, wo, lit, key, uniforms, material):
     return out
 
 
-def exact_reflection(position, f, wo, lit, key, uniforms, material):
+def exact_reflection(position, f, wo, lit, key, uniforms, material, lights=None):
     """The exact integral of every lit term's response over each extended light, ``integral f_r L (n.w)^+ dw``
-    [W/(m^2 sr)], by the kind's float64 quadrature (``exact``; docs/design.md section 13), gated by ``lit``.
+    [W/(m^2 sr)], by the kind's float64 quadrature (``exact``; docs/design.md section 13), gated by ``lit``;
+    ``lights``: the scene's lights (needed by a kind whose exact integral reads more than its uniforms: an
+    environment light's map).
 
     Returns
     -------
@@ -315,7 +320,7 @@ def exact_reflection(position, f, wo, lit, key, uniforms, material):
     terms = _terms(material)
     out = np.zeros(position.shape)
     error = np.zeros(len(position))
-    for light_key, twin, p, _, _ in extended_lights(key, uniforms, np.float64):
+    for light_key, twin, p, _, _ in extended_lights(key, uniforms, np.float64, lights):
         def integrand(index, w):
             g = f.select(index)
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):

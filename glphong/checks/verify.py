@@ -222,7 +222,7 @@ def exact_image(scene, gbuffer, shadows=None):
     error = np.zeros(gbuffer.mask.shape)
     for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, shadows=shadows):
         def exact(*arguments):  # the exact integrals in place of the shader's methods, keeping the error estimate
-            value, error[selection] = reference.exact_reflection(*arguments)
+            value, error[selection] = reference.exact_reflection(*arguments, lights=scene.lights)
             return value
 
         out[selection] = reference.shade_point(position, f, n_valid, u.get("u_eye"), key, u, obj.material, exact)

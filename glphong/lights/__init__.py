@@ -14,7 +14,9 @@ from glphong.lights.extended import ExtendedLight
 from glphong.lights.area import PolygonLight, RectLight
 from glphong.lights.sphere import SphereLight
 from glphong.lights.disk import DiskLight
+from glphong.lights.environment import EnvironmentLight
 
 __all__ = ["LightModel", "LightDefinitionError", "registered_lights", "light_named", "light_for_key", "light_cases",
            "pose_pointing", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "SpotLight", "AmbientLight",
-           "ExtendedLight", "RectLight", "PolygonLight", "SphereLight", "DiskLight"]
+           "ExtendedLight", "RectLight", "PolygonLight", "SphereLight", "DiskLight",
+           "EnvironmentLight"]

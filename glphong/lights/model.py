@@ -196,7 +196,9 @@ class LightModel:
     #: 'punctual' (one direction and irradiance per light and point) or 'extended' (`glphong.lights.ExtendedLight`)
     extent = "punctual"
     #: uniform name -> entries per light, for a uniform that holds several values per light (a polygon's vertices):
-    #: declared ``u_<name>_<uniform>[NUM_<NAME>_LIGHTS * n]``, light j's entries at ``j * n + i``
+    #: declared ``u_<name>_<uniform>[NUM_<NAME>_LIGHTS * n]``, light j's entries at ``j * n + i``; ``n`` an int, or
+    #: the name of one of the kind's structural defines whose value it is (an environment map's texels: each light's
+    #: entries padded with zeros to the scene's largest)
     uniform_lengths = {}
     #: scalar uniforms that hold exact small integers (a count, a sample knob): the generic band does not perturb them
     exact_uniforms = ()
@@ -302,6 +304,7 @@ class LightModel:
         lines = []
         for p in cls.uniform_params():
             length = cls.uniform_lengths.get(p.name)
+            length = f"{cls.name.upper()}_{length}" if isinstance(length, str) else length
             size = f"NUM_{cls.name.upper()}_LIGHTS" + (f" * {length}" if length else "")
             line = (f"uniform {p.glsl_type} {cls.uniform_name(p.name)}[{size}];  // {p.kind}"
                     f"{' in ' + p.interval if p.kind in ('scalar', 'rgb') else ''}{' [' + p.unit + ']' if p.unit else ''}")
@@ -343,10 +346,33 @@ class LightModel:
         defines = cls.structural_defines(lights) if defines is None else defines
         out = {}
         for p in cls.active_uniforms(defines):
-            values = np.array([_validate.float32_uniform(light.uniform_value(p.name)) for light in lights], dtype=np.float32)
-            out[cls.uniform_name(p.name)] = values.reshape((-1,) + values.shape[2:]) if p.name in cls.uniform_lengths \
-                else values
+            length = cls.uniform_length(p.name, defines)
+            values = [_validate.float32_uniform(light.uniform_value(p.name)) for light in lights]
+            if length is not None:  # each light's entries, padded with zeros to the declared length
+                values = [np.concatenate([v, np.zeros((length - len(v),) + v.shape[1:], np.float32)]) for v in values]
+            values = np.array(values, dtype=np.float32)
+            out[cls.uniform_name(p.name)] = values.reshape((-1,) + values.shape[2:]) if length is not None else values
         return out
+
+    @classmethod
+    def uniform_length(cls, name, defines=()):
+        """Entries per light of uniform ``name`` (`uniform_lengths`; a define's value where it names one), or None
+        for one entry."""
+        length = cls.uniform_lengths.get(name)
+        if isinstance(length, str):
+            given = dict(defines)
+            if length not in given:
+                raise KeyError(f"{cls.__qualname__}.uniform_lengths[{name!r}] names the structural define {length!r}, "
+                               "which structural_defines did not give")
+            return int(given[length])
+        return length
+
+    @classmethod
+    def usage_defines(cls, defines, uses):
+        """Defines a program adds to the kind's structural ``defines`` (pairs) from what its terms ``uses`` of an
+        extended kind ('irradiance', 'lobe', 'sample'): where they condition uniforms (`conditional_uniforms`), a
+        program declares and is given only what it reads (default none)."""
+        return ()
 
     @classmethod
     def values_from_uniforms(cls, uniforms, j, dtype=np.float64, defines=()):
@@ -354,7 +380,7 @@ class LightModel:
         ``p.defines``."""
         def entry(p):
             array = uniforms[cls.uniform_name(p.name)]
-            n = cls.uniform_lengths.get(p.name)
+            n = cls.uniform_length(p.name, defines)
             return array[j] if n is None else array[j * n:(j + 1) * n]
 
         values = {p.name: np.asarray(entry(p), dtype=dtype) for p in cls.active_uniforms(defines)}
@@ -363,6 +389,7 @@ class LightModel:
     def values(self, dtype=np.float64):
         """`ParamValues` of this light alone (its float32 uniforms in ``dtype``; defines as for itself)."""
         defines = self.structural_defines([self])
+        defines = tuple(defines) + tuple(self.usage_defines(defines, ("irradiance", "lobe", "sample")))
         return self.values_from_uniforms(self.pack_uniforms([self], defines), 0, dtype, defines)
 
     @classmethod

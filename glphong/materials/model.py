@@ -186,16 +186,17 @@ class Integral:
 
     Attributes
     ----------
-    form : {'irradiance', 'lobe'}
+    form : {'irradiance', 'lobe', 'lobe_real'}
         'irradiance': the response is ``factor k (n.l)`` and the term reflects ``factor k E(n)``, the light's
         irradiance; 'lobe': the response is ``factor k max(r_v . l, 0)^q`` (``r_v`` the view reflected about
-        ``n``) and the term reflects ``factor k integral max(r_v . w, 0)^q L(w) [n.w > 0] dw``.
+        ``n``) with an integer ``q`` and the term reflects ``factor k integral max(r_v . w, 0)^q L(w) [n.w > 0] dw``;
+        'lobe_real': the same for a ``q`` that is not (a kind lists the forms it integrates in its ``integrals``).
     scale : str
         The rgb parameter ``k`` (its uniform ``u_<model>_<scale>``, a surface input where textured).
     factor : float
         A constant factor (``1/pi`` for an albedo).
     exponent : str or None
-        The scalar parameter ``q`` of a 'lobe' (an integer where the term offers this form).
+        The scalar parameter ``q`` of a lobe.
     """
 
     form: str

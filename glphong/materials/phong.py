@@ -76,11 +76,13 @@ class PhongLobe(MaterialModel):
         return p.ks * fresnel_factor(p, n_dot_l) * phong_lobe(f.n, wi, wo, p.q)[..., None]
 
     def integral_form(self):
-        """``k_s integral max(r_v . w, 0)^q L(w) [n.w > 0] dw`` under an extended light, for an integer ``q`` up to
-        `LOBE_MAX_Q` and no Fresnel factor (the lobe is then zonal about ``r_v``; docs/design.md section 13);
-        otherwise None (sampled)."""
-        if self.fresnel is None and float(self.q).is_integer() and self.q <= LOBE_MAX_Q:
-            return Integral("lobe", "ks", exponent="q")
+        """``k_s integral max(r_v . w, 0)^q L(w) [n.w > 0] dw`` under an extended light where there is no Fresnel factor
+        (the lobe is then zonal about ``r_v``; docs/design.md section 13): form 'lobe' for an integer ``q`` up to
+        `LOBE_MAX_Q` (what Arvo's edge recurrences take), 'lobe_real' for any other ``q`` (what the environment
+        light's harmonics take); None with a Fresnel factor (sampled)."""
+        if self.fresnel is None:
+            integer = float(self.q).is_integer() and self.q <= LOBE_MAX_Q
+            return Integral("lobe" if integer else "lobe_real", "ks", exponent="q")
         return None
 
     def band(self, f, wi, wo, n_dot_l, p, constants):

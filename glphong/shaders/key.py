@@ -8,11 +8,11 @@ it is in the light loop and whether it answers ``L_a``): terms a material does n
 parameters make them vanish, light kinds a scene lacks and vertex attributes nobody reads are
 left out of the source.  Nothing here knows any model by name; the numpy twin reads the same key.
 """
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 from glphong.materials.model import registered_models, surface_define
 from glphong.materials.params import LIBRARY_CHUNKS
-from glphong.lights.model import registered_lights
+from glphong.lights.model import light_for_key, registered_lights
 from glphong.shaders.generated import (LIGHTS_CHUNK, LOD_CHUNK, MATERIAL_CHUNK, lights_chunk, lod_chunk, material_chunk,
                                        model_chunk_label)
 
@@ -548,6 +548,7 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
     lights = _as_light_keys(lights)
     lit = bool(lights) and any(not t.vanishes() for t in material.components)
     terms = term_keys(material, lit, _ambient_present(ambient_radiance), extended=any(k.extended for k in lights))
+    lights = tuple(_with_usage(k, terms) if k.extended else k for k in lights)
     needs = {n for t in terms if t.lit for n in t.needs}
     modes = [mode for t in terms for _, mode in t.inputs]
     if output == "points":
@@ -564,6 +565,17 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
         two_sided=material.two_sided and lit,
         has_color=any("vertex" in m for m in modes),
     )
+
+
+def _with_usage(light, terms):
+    """An extended kind's `LightKey` with the defines its kind adds for what the program's lit ``terms`` use of it
+    (`glphong.lights.LightModel.usage_defines`: its closed forms 'irradiance' and 'lobe', its samples 'sample')."""
+    lit = [t for t in terms if t.lit]
+    closed = {t.integral.form for t in lit if t.integral is not None and t.integral.form in light.integrals}
+    uses = tuple(sorted(closed)) + (("sample",) if any(t.integral is None or t.integral.form not in light.integrals
+                                                       for t in lit) else ())
+    extra = tuple(light_for_key(light.name, light.source_hash).usage_defines(light.defines, uses))
+    return replace(light, defines=light.defines + extra) if extra else light
 
 
 def _refuse_surface_inputs(terms, why):

@@ -11,9 +11,8 @@ from +z (row 0 at the zenith), column ``j`` the azimuth ``phi`` in ``[2 pi j / W
   ``T = [theta/2 - sin(2 theta)/4]`` and ``S = [sin^2(theta)/2]`` between ``theta0`` and ``theta1``.
 - `irradiance`: ``E(n) = sum_k L_k integral_texel (n.w)^+ dw``.  A texel wholly above the surface's horizon
   contributes ``L_k (n . M_k)`` exactly; one wholly below, 0.  A texel whose angular radius ``r`` (a bound on how far
-  its points are from its centre) does not decide it (``|n . w_centre| <= r``) is split into 2 x 2 sub-texels, to
-  ``depth`` levels; a sub-texel still undecided then contributes ``L_k max(n . M, 0)``, off by at most
-  ``2 L_k Omega r`` (``n . w`` lies within ``2r`` of 0 over it; returned summed as the error bound).
+  its points are from its centre) does not decide it (``|n . w_centre| <= r``) is integrated over its part above the
+  horizon: in closed form in ``theta``, by Gauss-Legendre in ``phi`` on the pieces over which that is smooth.
 """
 import numpy as np
 
@@ -65,8 +64,15 @@ def _radius(t0, t1, p0, p1):
     return 0.5 * (t1 - t0) + 0.5 * (p1 - p0) * largest_sine
 
 
-def irradiance(radiance, normals, depth=6):
+def irradiance(radiance, normals, nodes=12):
     """Irradiance ``E(n) = integral L(w) (n.w)^+ dw`` of an equirectangular map at unit normals, float64.
+
+    A texel wholly above the horizon contributes ``L_k (n . M_k)`` exactly, one wholly below nothing.  A texel the
+    horizon crosses is integrated in ``theta`` in closed form over the part above it, ``n_z [sin^2/2] + s(phi)
+    [theta/2 - sin(2 theta)/4]`` with ``s = n_x cos(phi) + n_y sin(phi)`` between the clipped ends, and in ``phi`` by
+    Gauss-Legendre on the pieces between the azimuths where the horizon crosses the texel's ``theta`` edges (``s(phi)
+    = -n_z cot(theta_edge)``), over which the integrand is smooth: ``nodes`` points, and ``nodes / 2`` for the error
+    estimate.
 
     Parameters
     ----------
@@ -74,15 +80,15 @@ def irradiance(radiance, normals, depth=6):
         Radiance per texel [W/(m^2 sr)] (module docstring for the layout).
     normals : (N, 3) array_like
         Unit normals.
-    depth : int
-        Levels of 2 x 2 splitting of the texels the horizon crosses.
+    nodes : int
+        Gauss-Legendre points per piece of a texel the horizon crosses.
 
     Returns
     -------
     E : (N,) or (N, 3) float64 ndarray
         [W/m^2].
     bound : (N,) or (N, 3) float64 ndarray
-        A bound on ``|E - exact|`` (texels still crossed by the horizon after ``depth`` splits).
+        The error estimate (the difference of the two rules, summed over the crossed texels, times their radiance).
     """
     radiance = np.asarray(radiance, dtype=np.float64)
     grey = radiance.ndim == 2
@@ -103,28 +109,207 @@ def irradiance(radiance, normals, depth=6):
         c = n @ centres.T
         out[a:a + 256] = np.where(c > radius, n @ moments.T, 0.0) @ flat
         rows, texels = np.nonzero(np.abs(c) <= radius)
-        e, b = _split(n[rows], t0[texels], t1[texels], p0[texels], p1[texels], depth)
+        e, b = _crossed(n[rows], t0[texels], t1[texels], p0[texels], p1[texels], nodes)
         np.add.at(out, a + rows, e[:, None] * flat[texels])
         np.add.at(bound, a + rows, b[:, None] * np.abs(flat[texels]))
     return (out[:, 0], bound[:, 0]) if grey else (out, bound)
 
 
-def _split(n, t0, t1, p0, p1, depth):
-    """``(integral (n.w)^+ dw, error bound)`` over lat-long rectangles (each with its own normal ``n``, (K, 3)),
-    splitting, level by level, the sub-rectangles the horizon still crosses."""
-    total, bound = np.zeros(len(n)), np.zeros(len(n))
-    owner = np.arange(len(n))
-    for _ in range(depth):
-        tm, pm = 0.5 * (t0 + t1), 0.5 * (p0 + p1)
-        t0, t1 = np.concatenate([t0, t0, tm, tm]), np.concatenate([tm, tm, t1, t1])
-        p0, p1 = np.concatenate([p0, pm, p0, pm]), np.concatenate([pm, p1, pm, p1])
-        owner, n = np.tile(owner, 4), np.tile(n, (4, 1))
-        centre = np.sum(n * _direction(0.5 * (t0 + t1), 0.5 * (p0 + p1)), axis=1)
-        r = _radius(t0, t1, p0, p1)
-        above = centre > r
-        np.add.at(total, owner[above], np.sum(n[above] * _moment(t0[above], t1[above], p0[above], p1[above]), axis=1))
-        keep = np.abs(centre) <= r
-        t0, t1, p0, p1, owner, n = t0[keep], t1[keep], p0[keep], p1[keep], owner[keep], n[keep]
-    np.add.at(total, owner, np.maximum(np.sum(n * _moment(t0, t1, p0, p1), axis=1), 0.0))
-    np.add.at(bound, owner, 2.0 * _solid_angle(t0, t1, p0, p1) * _radius(t0, t1, p0, p1))
-    return total, bound
+def _crossed(n, t0, t1, p0, p1, nodes):
+    """``(integral (n.w)^+ dw, error estimate)`` over lat-long rectangles the horizon crosses (each with its own
+    normal ``n``, (K, 3)): closed form in ``theta``, Gauss-Legendre in ``phi`` on smooth pieces."""
+    rho, beta = np.hypot(n[:, 0], n[:, 1]), np.arctan2(n[:, 1], n[:, 0])
+    cuts = []
+    for edge in (t0, t1):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratio = -n[:, 2] * np.cos(edge) / (np.sin(edge) * rho)
+        ok = (np.sin(edge) > 1e-12) & (rho > 0) & (np.abs(ratio) < 1)
+        delta = np.arccos(np.clip(np.nan_to_num(ratio), -1.0, 1.0))
+        cuts += [np.where(ok, np.mod(beta + sign * delta, 2 * np.pi), np.nan) for sign in (1.0, -1.0)]
+    cuts = np.stack(cuts, axis=1)
+    cuts = np.sort(np.where((cuts > p0[:, None]) & (cuts < p1[:, None]), cuts, p1[:, None]), axis=1)
+    edges = np.concatenate([p0[:, None], cuts, p1[:, None]], axis=1)
+
+    def rule(count):
+        x, w = np.polynomial.legendre.leggauss(count)
+        a, b = edges[:, :-1, None], edges[:, 1:, None]
+        f = a + (b - a) * 0.5 * (x + 1.0)                                  # (K, pieces, count)
+        s = n[:, 0, None, None] * np.cos(f) + n[:, 1, None, None] * np.sin(f)
+        alpha = np.arctan2(s, np.broadcast_to(n[:, 2, None, None], s.shape))
+        low, high = alpha - np.pi / 2, alpha + np.pi / 2
+        wrap = high < 0
+        low, high = np.where(wrap, low + 2 * np.pi, low), np.where(wrap, high + 2 * np.pi, high)
+        lo = np.maximum(t0[:, None, None], low)
+        hi = np.maximum(np.minimum(t1[:, None, None], high), lo)
+        inner = n[:, 2, None, None] * (np.sin(hi) ** 2 - np.sin(lo) ** 2) / 2 + s * (
+            (hi - lo) / 2 - (np.sin(2 * hi) - np.sin(2 * lo)) / 4)
+        return np.sum(inner * (b - a) * 0.5 * w, axis=(1, 2))
+
+    fine = rule(nodes)
+    return fine, np.abs(fine - rule(max(nodes // 2, 2)))
+
+
+# --------------------------------------------------------------------------- what EnvironmentLight's GLSL reads
+# (glsl/lights/environment.glsl mirrors these function by function; docs/design.md section 13)
+def cube_texel_directions(resolution):
+    """The unit directions of a cube map's texel centres, (6 R^2, 3) float64, in the order ``face * R^2 + t * R + s``:
+    face ``2 a + (major < 0)`` about axis ``a`` (x, y, z), ``s`` along axis ``(a + 1) % 3`` and ``t`` along
+    ``(a + 2) % 3``, texel centres at ``-1 + (2 i + 1)/R`` of the face's square ``[-1, 1]^2``."""
+    R = int(resolution)
+    centres = -1.0 + (2.0 * np.arange(R) + 1.0) / R
+    t, s = np.meshgrid(centres, centres, indexing="ij")
+    out = []
+    for face in range(6):
+        axis, sign = face // 2, -1.0 if face % 2 else 1.0
+        d = np.zeros((R, R, 3))
+        d[..., axis] = sign
+        d[..., (axis + 1) % 3] = s
+        d[..., (axis + 2) % 3] = t
+        out.append(d.reshape(-1, 3))
+    d = np.concatenate(out)
+    return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+
+def environment_cube(n, table, resolution):
+    """The cube map ``table`` (6 R^2, 3) at unit directions ``n`` (N, 3): the face of ``n``'s largest component
+    (ties to x, then y), its texel coordinates ``u = (s + 1) R/2 - 1/2`` clamped to the face's texel centres, and
+    the bilinear blend of the four texels about ``u``.  Returns ``(value (N, 3), spread (N,))``: spread is the
+    largest difference among the four texels (what a shift of ``u`` can change), for the band."""
+    R = int(resolution)
+    a = np.abs(n)
+    axis = np.where((a[:, 0] >= a[:, 1]) & (a[:, 0] >= a[:, 2]), 0, np.where(a[:, 1] >= a[:, 2], 1, 2))
+    rows = np.arange(len(n))
+    major = n[rows, axis]
+    s = n[rows, (axis + 1) % 3] / np.abs(major)
+    t = n[rows, (axis + 2) % 3] / np.abs(major)
+    face = 2 * axis + (major < 0.0)
+    u = np.clip((np.stack([s, t], axis=1) + 1.0) * (0.5 * R) - 0.5, 0.0, R - 1.0)
+    i0 = np.minimum(np.floor(u).astype(np.int64), R - 2)
+    fr = u - i0
+    base = face * R * R
+
+    def texel(ds, dt):
+        return table[base + (i0[:, 1] + dt) * R + i0[:, 0] + ds]
+
+    corners = [texel(0, 0), texel(1, 0), texel(0, 1), texel(1, 1)]
+    low = corners[0] + (corners[1] - corners[0]) * fr[:, :1]
+    high = corners[2] + (corners[3] - corners[2]) * fr[:, :1]
+    value = low + (high - low) * fr[:, 1:]
+    stack = np.stack(corners)
+    return value, np.max(np.max(stack, axis=0) - np.min(stack, axis=0), axis=1)
+
+
+def sh_count(order):
+    """``(L + 1)^2`` coefficients of the real spherical harmonics up to order ``L``."""
+    return (int(order) + 1) ** 2
+
+
+def sh_lobe_weights(q, order):
+    """``lambda_l(q) = 2 pi c_l(q)``, ``c_l(q) = integral_0^1 t^q P_l(t) dt`` (Funk-Hecke for ``max(t, 0)^q``), (L + 1,):
+    ``c_0 = 1/(q + 1)``, ``c_1 = 1/(q + 2)``, ``c_l = c_(l-2) (q - l + 2)/(q + l + 1)``.  ``q = 1`` gives Ramamoorthi and
+    Hanrahan's clamped-cosine weights ``pi, 2 pi/3, pi/4, 0, -pi/24, ...``."""
+    q = float(q)
+    c = np.zeros(int(order) + 1)
+    c[0] = 1.0 / (q + 1.0)
+    if order >= 1:
+        c[1] = 1.0 / (q + 2.0)
+    for l in range(2, int(order) + 1):
+        c[l] = c[l - 2] * (q - l + 2.0) / (q + l + 1.0)
+    return 2.0 * np.pi * c
+
+
+def sh_legendre(z, order):
+    """The normalised associated Legendre functions without their ``sin^m(theta)``, ``Pbar_l^m(z)`` for ``0 <= m <= l
+    <= L``, as a dict ``(l, m) -> (N,)``: ``Pbar_0^0 = 1/sqrt(4 pi)``, ``Pbar_m^m = Pbar_(m-1)^(m-1) sqrt((2m + 1)/(2m))``,
+    ``Pbar_l^m = a (z Pbar_(l-1)^m - b Pbar_(l-2)^m)`` with ``a = sqrt((4 l^2 - 1)/(l^2 - m^2))`` and ``b =
+    sqrt(((l - 1)^2 - m^2)/(4 (l - 1)^2 - 1))``, so that ``Y_l0 = Pbar_l^0(z)`` and ``Y_l,+-m = sqrt(2) Pbar_l^m(z)``
+    times the real and imaginary parts of ``(x + i y)^m`` are orthonormal over the sphere."""
+    z = np.asarray(z, dtype=np.float64)
+    out = {}
+    pmm = np.full(z.shape, 0.28209479177387814)
+    for m in range(int(order) + 1):
+        if m > 0:
+            pmm = pmm * np.sqrt((2.0 * m + 1.0) / (2.0 * m))
+        pa, pb = np.zeros(z.shape), pmm
+        out[(m, m)] = pmm
+        for l in range(m + 1, int(order) + 1):
+            a = np.sqrt((4.0 * l * l - 1.0) / (l * l - m * m))
+            b = np.sqrt(((l - 1.0) ** 2 - m * m) / (4.0 * (l - 1.0) ** 2 - 1.0))
+            p = a * (z * pb - b * pa)
+            pa, pb = pb, p
+            out[(l, m)] = p
+    return out
+
+
+def sh_project(radiance, order, nodes=24):
+    """The map's real spherical-harmonic coefficients ``L_lm = sum_k L_k integral_texel Y_lm dw``, ((L + 1)^2, 3)
+    float64, index ``l^2 + l + m``: the azimuthal integrals of ``cos(m phi)``, ``sin(m phi)`` exact, the polar ones by
+    ``nodes``-point Gauss-Legendre in ``theta`` per row (the integrand ``Pbar_l^m(cos) sin^(m+1)`` is smooth)."""
+    radiance = np.asarray(radiance, dtype=np.float64)
+    values = radiance[..., None] if radiance.ndim == 2 else radiance
+    H, W = values.shape[:2]
+    theta, phi = texel_edges(H, W)
+    x, w = np.polynomial.legendre.leggauss(nodes)
+    t = theta[:-1, None] + (theta[1:] - theta[:-1])[:, None] * 0.5 * (x[None, :] + 1.0)        # (H, G)
+    weight = (theta[1:] - theta[:-1])[:, None] * 0.5 * w[None, :] * np.sin(t)
+    legendre = sh_legendre(np.cos(t), order)
+    out = np.zeros((sh_count(order), values.shape[-1]))
+    for m in range(int(order) + 1):
+        if m == 0:
+            parts = ((0, phi[1:] - phi[:-1]),)
+        else:
+            parts = ((m, (np.sin(m * phi[1:]) - np.sin(m * phi[:-1])) / m * np.sqrt(2.0)),
+                     (-m, (np.cos(m * phi[:-1]) - np.cos(m * phi[1:])) / m * np.sqrt(2.0)))
+        for signed, azimuth in parts:
+            per_row = np.einsum("hwc,w->hc", values, azimuth)                                    # (H, C)
+            for l in range(m, int(order) + 1):
+                polar = np.sum(weight * legendre[(l, m)] * np.sin(t) ** m, axis=1)               # (H,)
+                out[l * l + l + signed] = polar @ per_row
+    return out if radiance.ndim == 3 else out[:, 0]
+
+
+def environment_sh(r, q, coefficients, frame, order):
+    """``sum_l lambda_l(q) sum_m L_lm Y_lm(d)`` at ``d = frame r`` (map coordinates), (N, 3): the spherical harmonics'
+    convolution with ``max(t, 0)^q`` (Funk-Hecke), evaluated as environment.glsl does (the Legendre recurrence of
+    `sh_legendre`, ``(x + i y)^m`` by complex multiplication).  Also returns ``sum |terms|`` (N,), for the band."""
+    d = np.asarray(r, dtype=np.float64) @ np.asarray(frame, dtype=np.float64).T
+    lam = sh_lobe_weights(q, order)
+    coefficients = np.asarray(coefficients, dtype=np.float64)
+    legendre = sh_legendre(d[:, 2], order)
+    out = np.zeros((len(d), coefficients.shape[-1]))
+    magnitude = np.zeros(len(d))
+    cm, sm = np.ones(len(d)), np.zeros(len(d))
+    for m in range(int(order) + 1):
+        if m > 0:
+            cm, sm = d[:, 0] * cm - d[:, 1] * sm, d[:, 0] * sm + d[:, 1] * cm
+        for l in range(m, int(order) + 1):
+            p = legendre[(l, m)]
+            if m == 0:
+                term = p[:, None] * coefficients[l * l + l]
+            else:
+                term = (np.sqrt(2.0) * p)[:, None] * (cm[:, None] * coefficients[l * l + l + m]
+                                                      + sm[:, None] * coefficients[l * l + l - m])
+            out = out + lam[l] * term
+            magnitude = magnitude + np.abs(lam[l]) * np.max(np.abs(term), axis=1)
+    return out, magnitude
+
+
+def downsample(radiance, rows):
+    """The map averaged onto ``rows x 2 rows`` lat-long texels, exactly (each new texel's radiance is the old
+    texels' radiance integrated over their overlap with it, in solid angle, over its own solid angle): (rows, 2 rows,
+    C) float64."""
+    radiance = np.asarray(radiance, dtype=np.float64)
+    values = radiance[..., None] if radiance.ndim == 2 else radiance
+    H, W = values.shape[:2]
+    z_old, z_new = np.cos(texel_edges(H, 1)[0]), np.cos(texel_edges(rows, 1)[0])
+    p_old, p_new = texel_edges(1, W)[1], texel_edges(1, 2 * rows)[1]
+
+    def overlap(a, b, decreasing=False):  # lengths of the overlaps of intervals [a_i, a_i+1] and [b_j, b_j+1]
+        if decreasing:
+            a, b = -a, -b
+        return np.maximum(np.minimum(a[1:, None], b[None, 1:]) - np.maximum(a[:-1, None], b[None, :-1]), 0.0)
+
+    Z = overlap(z_new, z_old, decreasing=True)          # (rows, H)
+    P = overlap(p_new, p_old)                           # (2 rows, W)
+    flux = np.einsum("ah,hwc,bw->abc", Z, values, P)
+    return flux / texel_solid_angles(rows, 2 * rows)[..., None]

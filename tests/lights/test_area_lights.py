@@ -257,7 +257,7 @@ def test_an_extended_kind_is_checked_like_any_light():
 def test_the_continuous_version_example_runs():
     example = runpy.run_path(str(ROOT / "examples" / "continuous_version.py"))
     strip = example["main"](width=48, height=36)  # asserts each render passes verify
-    assert strip.shape == (36, 144, 3) and strip.max() > 0
+    assert strip.shape == (36, 192, 3) and strip.max() > 0
 
 
 PLANTED = {  # (chunk, text, planted text, light)
