@@ -64,7 +64,7 @@ def point_lights(cells=4):
 def main(out=None, width=240, height=180, verify_size=(20, 15)):
     panel = glphong.RectLight(CENTER, U, V, L)
     lamp = glphong.SphereLight.from_power(CENTER, 0.2, float(panel.power()[0]))
-    sky = glphong.EnvironmentLight(sky_map(), rotation=Y_UP, scale=0.05, order=16, resolution=17)
+    sky = glphong.EnvironmentLight(sky_map(), rotation=Y_UP, scale=0.012, order=16, resolution=17)
     images = []
     with glphong.Renderer(width, height) as renderer, glphong.Renderer(*verify_size) as small:
         for label, lights in (("sky (EnvironmentLight)", [sky]), ("panel (RectLight)", [panel]),

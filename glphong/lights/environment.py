@@ -12,7 +12,8 @@ The lecture's continuous version for it, three ways:
   or, with ``irradiance='sh'``, the spherical harmonics up to ``order`` convolved with the clamped cosine (order 2:
   Ramamoorthi and Hanrahan).
 - The lecture's Phong lobe (``k_s max(r_v.w, 0)^q``): the spherical harmonics up to ``order`` convolved with the lobe
-  (Funk-Hecke, the zonal weights ``2 pi c_l(q)`` in closed form, any ``q``), not clipped at the surface's horizon.
+  (Funk-Hecke, the zonal weights ``2 pi c_l(q)`` in closed form, any ``q``), times the part of the lobe above the
+  surface's horizon under a uniform sky (exact where the radiance is uniform across the horizon).
 - Every other term: the map averaged onto ``samples x 2 samples`` texels, each a direction (its moment's) and an
   irradiance.
 
@@ -26,7 +27,7 @@ import numpy as np
 
 from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
 from glphong.core.rgbe import read_hdr
-from glphong.lights.extended import SAMPLES, ExtendedLight, extended_cases
+from glphong.lights.extended import ExtendedLight, extended_cases
 from glphong.lights.model import GlslFile, Param
 from glphong.materials.lambert import Lambert
 from glphong.twin import environment as env
@@ -141,7 +142,7 @@ class EnvironmentLight(ExtendedLight):
     params = (RESOLUTION, ORDER, ENV_SAMPLES)
     uniforms = _UNIFORMS
     glsl = GlslFile("lights/environment.glsl")
-    uses = ()
+    uses = ("angle",)
     integrals = ("irradiance", "lobe", "lobe_real")
     uniform_lengths = {"irradiance": "MAP_TEXELS", "sh": "SH_COEFFICIENTS", "frame": 3,
                        "sample_direction": "SAMPLE_TEXELS", "sample_irradiance": "SAMPLE_TEXELS"}
@@ -268,7 +269,8 @@ class EnvironmentLight(ExtendedLight):
         return env.environment_sh(n, 1.0, p.sh, p.frame, int(p.defines["SH_ORDER"]))[0]
 
     def lobe(self, x, n, r, q, p):
-        return env.environment_sh(r, q, p.sh, p.frame, int(p.defines["SH_ORDER"]))[0]
+        horizon = env.environment_horizon(q, np.clip(np.sum(n * r, axis=-1), 0.0, 1.0))
+        return env.environment_sh(r, q, p.sh, p.frame, int(p.defines["SH_ORDER"]))[0] * horizon[:, None]
 
     def sample(self, x, n, k, p):
         count = 2 * int(p.samples) ** 2
@@ -294,11 +296,18 @@ class EnvironmentLight(ExtendedLight):
         return low - slack[:, None], high + slack[:, None]
 
     def lobe_band(self, x, n, r, q, p, constants):
-        """The sensitivity to ``r``'s rounding plus ``(16 + 8 L) eps`` of the sum of ``|terms|`` (the recurrences'
-        rounding; the lobe weights' ``c_l(q)`` recurrence included)."""
+        """The sensitivity to the rounding of ``n`` and ``r``, plus ``(16 + 12 L) eps`` of the sum of the harmonics'
+        ``|terms|`` (the recurrences' rounding, the lobe weights' ``c_l(q)`` included) times the horizon factor
+        ``h``, plus the harmonics' value times ``h``'s own rounding, ``eps (64 + 2 (q + 1) |log s|) (1 - h)`` (the
+        exponent of its weights is off by that many ulps of its size)."""
         low, high = super().lobe_band(x, n, r, q, p, constants)
         order = int(p.defines["SH_ORDER"])
-        slack = (16 + 8 * order + 4 * order) * EPS * env.environment_sh(r, q, p.sh, p.frame, order)[1]
+        value, magnitude = env.environment_sh(r, q, p.sh, p.frame, order)
+        c = np.clip(np.sum(n * r, axis=-1), 0.0, 1.0)
+        h = env.environment_horizon(q, c)
+        s = np.maximum(np.sqrt(np.maximum(1.0 - c * c, 0.0)), 1e-30)
+        slack = (16 + 12 * order) * EPS * magnitude * np.abs(h) + np.max(np.abs(value), axis=1) * EPS * (
+            64 + 2 * (q + 1) * np.abs(np.log(s))) * np.abs(1.0 - h)
         return low - slack[:, None], high + slack[:, None]
 
     def sample_band(self, x, n, k, p, constants):

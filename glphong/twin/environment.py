@@ -16,6 +16,8 @@ from +z (row 0 at the zenith), column ``j`` the azimuth ``phi`` in ``[2 pi j / W
 """
 import numpy as np
 
+from glphong.twin.functions import atan2_first_quadrant
+
 __all__ = ["texel_edges", "texel_solid_angles", "texel_moments", "texel_directions", "irradiance"]
 
 
@@ -313,3 +315,29 @@ def downsample(radiance, rows):
     P = overlap(p_new, p_old)                           # (2 rows, W)
     flux = np.einsum("ah,hwc,bw->abc", Z, values, P)
     return flux / texel_solid_angles(rows, 2 * rows)[..., None]
+
+
+#: environment_horizon's 24-point Gauss-Legendre nodes and weights on [0, 1], rounded to float32 as the GLSL holds them
+HORIZON_NODES, HORIZON_WEIGHTS = (np.float32(0.5 * a).astype(np.float64) for a in
+                                  (np.polynomial.legendre.leggauss(24)[0] + 1.0, np.polynomial.legendre.leggauss(24)[1]))
+
+
+def environment_log1p(x):
+    """``log(1 + x)`` as environment.glsl computes it: ``log(u) x / (u - 1)``, ``u = 1 + x`` (``x`` where ``u == 1``)."""
+    u = 1.0 + x
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(u == 1.0, x, np.log(u) * x / (u - 1.0))
+
+
+def environment_horizon(q, c):
+    """The part of the lobe ``max(r.w, 0)^q`` above the horizon of ``n`` under a uniform sky, ``c = n.r`` in [0, 1],
+    (N,): ``1 - (q + 1) J / pi``, ``J = 2 s^(q+1) integral_0^1 atan2(v sqrt(2 - v^2), c (1 - v^2)) (1 - v^2)^q v dv``,
+    ``s = sqrt(1 - c^2)``, by 24-point Gauss-Legendre on ``[0, min(1, 5/sqrt(q + 1))]`` (environment.glsl)."""
+    c = np.asarray(c, dtype=np.float64)
+    s = np.maximum(np.sqrt(np.maximum(1.0 - c * c, 0.0)), 1e-30)
+    span = min(1.0, 5.0 / np.sqrt(q + 1.0))
+    v = span * HORIZON_NODES[None, :]
+    u = 1.0 - v * v
+    weight = np.exp((q + 1.0) * np.log(s)[:, None] + q * environment_log1p(-v * v))
+    angle = atan2_first_quadrant(v * np.sqrt(2.0 - v * v), c[:, None] * u)
+    return 1.0 - 2.0 * (q + 1.0) / np.pi * span * np.sum(HORIZON_WEIGHTS * angle * weight * v, axis=1)

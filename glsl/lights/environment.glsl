@@ -6,11 +6,11 @@
 //     (6 R^2 texels, R = u_environment_resolution[j]), each computed from the map's exact per-texel integrals;
 //   ENVIRONMENT_IRRADIANCE_SH: environment_sh(n, 1, j), the spherical harmonics up to ENVIRONMENT_SH_ORDER convolved
 //     with the clamped cosine (order 2: Ramamoorthi and Hanrahan 2001).
-// environment_lobe(x, n, r, q, j) = environment_sh(r, q, j) = sum_l lambda_l(q) sum_m L_lm Y_lm(F r), the lobe
-//   max(r.w, 0)^q convolved with the map (Funk-Hecke), lambda_l(q) = 2 pi c_l(q), c_l(q) = integral_0^1 t^q P_l(t) dt:
-//   c_0 = 1/(q+1), c_1 = 1/(q+2), c_l = c_(l-2) (q - l + 2)/(q + l + 1); F (u_environment_frame) turns world
-//   directions into the map's.  It is not clipped at the surface's horizon (the method error map shows where that
-//   matters); Y_lm by the normalised Legendre recurrence times Re/Im (x + i y)^m.
+// environment_lobe(x, n, r, q, j) = environment_sh(r, q, j) environment_horizon(q, n.r): the lobe max(r.w, 0)^q
+//   convolved with the map (Funk-Hecke), sum_l lambda_l(q) sum_m L_lm Y_lm(F r), lambda_l(q) = 2 pi c_l(q),
+//   c_l(q) = integral_0^1 t^q P_l(t) dt: c_0 = 1/(q+1), c_1 = 1/(q+2), c_l = c_(l-2) (q - l + 2)/(q + l + 1);
+//   F (u_environment_frame) turns world directions into the map's; Y_lm by the normalised Legendre recurrence times
+//   Re/Im (x + i y)^m; times the part of the lobe above the surface's horizon under a uniform sky.
 // environment_sample(x, n, j, k, wi, E): texel k of the map averaged onto s x 2s lat-long texels
 //   (s = u_environment_samples[j]): wi its moment's direction M_k/|M_k| (world), E = Lbar_k |M_k|, so that
 //   (n.wi) E = Lbar_k n.M_k, the texel's exact irradiance where it is wholly above the horizon.
@@ -85,6 +85,49 @@ vec3 environment_sh(vec3 r, float q, int j)
 }
 #endif
 
+#if defined(ENVIRONMENT_SH)
+// environment_horizon(q, c): the part of the lobe max(r.w, 0)^q above the horizon of n, c = n.r >= 0, for a uniform
+//   sky: 1 - (q + 1) J / pi, the part below being 2 J with (substituting t = s (1 - v^2) in its integral over t = w.r)
+//   J = 2 s^(q+1) integral_0^1 atan2(v sqrt(2 - v^2), c (1 - v^2)) (1 - v^2)^q v dv,  s = sqrt(1 - c^2);
+//   24-point Gauss-Legendre on [0, V], V = min(1, 5/sqrt(q + 1)) ((1 - v^2)^q < e^-25 beyond), the weight
+//   exp((q + 1) log(s) + q log1p(-v^2)).  Exact for a sky of uniform radiance across the horizon; the convolution
+//   times it is the harmonics' lobe clipped at the horizon (docs/design.md section 13 says when it is not exact).
+const float ENVIRONMENT_NODES[24] = float[24](
+    0.00240638991817832, 0.012635721825063229, 0.030862724408507347, 0.0567922368645668,
+    0.0899990051984787, 0.12993790209293365, 0.17595317959785461, 0.22728925943374634,
+    0.28310325741767883, 0.3424786627292633, 0.4044405519962311, 0.4679715633392334,
+    0.5320284366607666, 0.5955594182014465, 0.6575213670730591, 0.7168967723846436, 0.7727107405662537,
+    0.8240468502044678, 0.8700621128082275, 0.9100009799003601, 0.9432077407836914, 0.9691372513771057,
+    0.9873642921447754, 0.9975935816764832);
+const float ENVIRONMENT_WEIGHTS[24] = float[24](
+    0.006170615088194609, 0.014265694655478, 0.022138718515634537, 0.029649293050169945,
+    0.03667324036359787, 0.04309508204460144, 0.04880932718515396, 0.053722135722637177,
+    0.057752832770347595, 0.06083523482084274, 0.06291873008012772, 0.06396909803152084,
+    0.06396909803152084, 0.06291873008012772, 0.06083523482084274, 0.057752832770347595,
+    0.053722135722637177, 0.04880932718515396, 0.04309508204460144, 0.03667324036359787,
+    0.029649293050169945, 0.022138718515634537, 0.014265694655478, 0.006170615088194609);
+
+float environment_log1p(float x)
+{
+    float u = 1.0 + x;
+    return u == 1.0 ? x : log(u) * x / (u - 1.0);
+}
+
+float environment_horizon(float q, float c)
+{
+    float s = max(sqrt(max(1.0 - c * c, 0.0)), 1e-30);
+    float span = min(1.0, 5.0 / sqrt(q + 1.0));
+    float sum = 0.0;
+    for (int i = 0; i < 24; ++i) {
+        float v = span * ENVIRONMENT_NODES[i];
+        float u = 1.0 - v * v;
+        float weight = exp((q + 1.0) * log(s) + q * environment_log1p(-v * v));
+        sum += ENVIRONMENT_WEIGHTS[i] * atan2_first_quadrant(v * sqrt(2.0 - v * v), c * u) * weight * v;
+    }
+    return 1.0 - 2.0 * (q + 1.0) / 3.14159265358979 * span * sum;
+}
+#endif
+
 vec3 environment_irradiance(vec3 x, vec3 n, int j)
 {
 #if defined(ENVIRONMENT_IRRADIANCE_MAP)
@@ -99,7 +142,7 @@ vec3 environment_irradiance(vec3 x, vec3 n, int j)
 vec3 environment_lobe(vec3 x, vec3 n, vec3 r, float q, int j)
 {
 #if defined(ENVIRONMENT_SH)
-    return environment_sh(r, q, j);
+    return environment_sh(r, q, j) * environment_horizon(q, clamp(dot(n, r), 0.0, 1.0));
 #else
     return vec3(0.0);
 #endif

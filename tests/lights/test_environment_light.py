@@ -3,7 +3,8 @@ against closed forms that share nothing with glphong's GLSL or twin, on both bac
 
 - A constant map ``L``: ``E = pi L`` at every normal (a Lambert sphere shows ``k_d pi L`` everywhere), by the
   irradiance cube map and by the spherical harmonics; the Phong lobe seen along the normal is ``k_s 2 pi L/(q + 1)``
-  (the whole lobe above the horizon) for q from 1 to 1e5.
+  (the whole lobe above the horizon) for q from 1 to 1e5; seen at grazing angles, the lobe clipped at the horizon
+  (against the independent quadrature).
 - A map of one bright texel is a `DirectionalLight` of the texel's irradiance ``L Omega`` along its moment, within
   the method's measured error plus the texel's own extent.
 - `glphong.verify` passes and reports both error maps; the spherical harmonics of order 2 ring under a sun.
@@ -59,6 +60,8 @@ def test_constant_sky_gives_pi_l_on_a_lambert_sphere(irradiance, glphong_backend
     expected = kd * np.pi * np.asarray(radiance, np.float32)
     rel = np.abs(image[mask] - expected) / expected
     assert mask.sum() > 200 and rel.max() < 3e-6, rel.max()
+    if irradiance == "map":  # the cube map's texels: exact per-texel integrals, their estimate at rounding level
+        assert light.irradiance_map_bound() < 1e-9 * np.pi * max(radiance)
 
 
 @pytest.mark.parametrize("q", [1.0, 2.0, 20.0, 2.5, 1e3, 1e5])
@@ -68,6 +71,20 @@ def test_phong_lobe_along_the_normal_under_a_constant_sky(q, glphong_backend):
     gpu = _points_gpu(glphong_backend, PhongLobe(ks, q), light, [(0.0, 0.0, 1.0)], eye=(0.0, 0.0, 2.0))
     expected = ks * 2 * np.pi * radiance / (q + 1)
     assert abs(gpu[0, 0] - expected) <= 2e-6 * expected, (gpu[0, 0], expected)
+
+
+@pytest.mark.parametrize("q, elevation", [(20.0, 10.0), (20.0, 2.0), (100.0, 5.0), (1.0, 0.5)])
+def test_the_lobe_is_clipped_at_the_horizon_under_a_uniform_sky(q, elevation, glphong_backend):
+    radiance, ks = 2.0, 0.5
+    e = np.radians(elevation)
+    r = np.array([np.cos(e), 0.0, np.sin(e)])  # r_v, seen from v = (-cos e, 0, sin e)
+    light = glphong.EnvironmentLight(np.full((4, 8), radiance), order=2, samples=1)
+    gpu = _points_gpu(glphong_backend, PhongLobe(ks, q), light, [(0.0, 0.0, 1.0)], eye=(-2 * np.cos(e), 0.0, 2 * np.sin(e)))
+    clipped, error, converged = environment_integral(np.array([[0.0, 0.0, 1.0]]), np.full((8, 16), radiance),
+                                                     lambda i, w: np.maximum(w @ r, 0.0) ** q, clip=(r[None],))
+    expected = ks * clipped[0, 0]
+    assert converged[0] and expected < 0.9 * ks * 2 * np.pi * radiance / (q + 1)  # a visible part was below
+    assert abs(gpu[0, 0] - expected) <= 2e-4 * expected, (gpu[0, 0], expected)
 
 
 def test_one_bright_texel_is_a_directional_light(glphong_backend, glphong_make_renderer):
