@@ -269,7 +269,7 @@ class EnvironmentLight(ExtendedLight):
         return env.environment_sh(n, 1.0, p.sh, p.frame, int(p.defines["SH_ORDER"]))[0]
 
     def lobe(self, x, n, r, q, p):
-        horizon = env.environment_horizon(q, np.clip(np.sum(n * r, axis=-1), 0.0, 1.0))
+        horizon = env.environment_horizon(q, np.clip(np.sum(n * r, axis=-1), -1.0, 1.0))
         return env.environment_sh(r, q, p.sh, p.frame, int(p.defines["SH_ORDER"]))[0] * horizon[:, None]
 
     def sample(self, x, n, k, p):
@@ -303,11 +303,11 @@ class EnvironmentLight(ExtendedLight):
         low, high = super().lobe_band(x, n, r, q, p, constants)
         order = int(p.defines["SH_ORDER"])
         value, magnitude = env.environment_sh(r, q, p.sh, p.frame, order)
-        c = np.clip(np.sum(n * r, axis=-1), 0.0, 1.0)
+        c = np.clip(np.sum(n * r, axis=-1), -1.0, 1.0)
         h = env.environment_horizon(q, c)
         s = np.maximum(np.sqrt(np.maximum(1.0 - c * c, 0.0)), 1e-30)
         slack = (16 + 12 * order) * EPS * magnitude * np.abs(h) + np.max(np.abs(value), axis=1) * EPS * (
-            64 + 2 * (q + 1) * np.abs(np.log(s))) * np.abs(1.0 - h)
+            64 + 2 * (q + 1) * np.abs(np.log(s))) * np.where(c < 0.0, h, 1.0 - h)
         return low - slack[:, None], high + slack[:, None]
 
     def sample_band(self, x, n, k, p, constants):

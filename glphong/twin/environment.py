@@ -66,15 +66,16 @@ def _radius(t0, t1, p0, p1):
     return 0.5 * (t1 - t0) + 0.5 * (p1 - p0) * largest_sine
 
 
-def irradiance(radiance, normals, nodes=12):
+def irradiance(radiance, normals, nodes=12, rtol=1e-13):
     """Irradiance ``E(n) = integral L(w) (n.w)^+ dw`` of an equirectangular map at unit normals, float64.
 
     A texel wholly above the horizon contributes ``L_k (n . M_k)`` exactly, one wholly below nothing.  A texel the
     horizon crosses is integrated in ``theta`` in closed form over the part above it, ``n_z [sin^2/2] + s(phi)
     [theta/2 - sin(2 theta)/4]`` with ``s = n_x cos(phi) + n_y sin(phi)`` between the clipped ends, and in ``phi`` by
     Gauss-Legendre on the pieces between the azimuths where the horizon crosses the texel's ``theta`` edges (``s(phi)
-    = -n_z cot(theta_edge)``), over which the integrand is smooth: ``nodes`` points, and ``nodes / 2`` for the error
-    estimate.
+    = -n_z cot(theta_edge)``), over which the integrand is smooth: ``nodes`` points against ``nodes / 2``, doubled
+    where they differ by more than ``rtol`` of the texel's value (a horizon passing near a pole of a coarse map is
+    sharp in ``phi``), to 16 times ``nodes``.
 
     Parameters
     ----------
@@ -83,7 +84,9 @@ def irradiance(radiance, normals, nodes=12):
     normals : (N, 3) array_like
         Unit normals.
     nodes : int
-        Gauss-Legendre points per piece of a texel the horizon crosses.
+        Gauss-Legendre points per piece of a texel the horizon crosses, at first.
+    rtol : float
+        The difference between two rules, relative to a crossed texel's integral, at which the doubling stops.
 
     Returns
     -------
@@ -106,18 +109,19 @@ def irradiance(radiance, normals, nodes=12):
     radius = _radius(t0, t1, p0, p1)
     out = np.zeros((len(normals), flat.shape[1]))
     bound = np.zeros_like(out)
-    for a in range(0, len(normals), 256):  # chunks of normals x every texel
-        n = normals[a:a + 256]
+    step = max(1, min(256, 2_000_000 // len(flat)))  # chunks of normals x every texel, at most 2e6 pairs
+    for a in range(0, len(normals), step):
+        n = normals[a:a + step]
         c = n @ centres.T
-        out[a:a + 256] = np.where(c > radius, n @ moments.T, 0.0) @ flat
+        out[a:a + step] = np.where(c > radius, n @ moments.T, 0.0) @ flat
         rows, texels = np.nonzero(np.abs(c) <= radius)
-        e, b = _crossed(n[rows], t0[texels], t1[texels], p0[texels], p1[texels], nodes)
+        e, b = _crossed(n[rows], t0[texels], t1[texels], p0[texels], p1[texels], nodes, rtol)
         np.add.at(out, a + rows, e[:, None] * flat[texels])
         np.add.at(bound, a + rows, b[:, None] * np.abs(flat[texels]))
     return (out[:, 0], bound[:, 0]) if grey else (out, bound)
 
 
-def _crossed(n, t0, t1, p0, p1, nodes):
+def _crossed(n, t0, t1, p0, p1, nodes, rtol):
     """``(integral (n.w)^+ dw, error estimate)`` over lat-long rectangles the horizon crosses (each with its own
     normal ``n``, (K, 3)): closed form in ``theta``, Gauss-Legendre in ``phi`` on smooth pieces."""
     rho, beta = np.hypot(n[:, 0], n[:, 1]), np.arctan2(n[:, 1], n[:, 0])
@@ -132,23 +136,34 @@ def _crossed(n, t0, t1, p0, p1, nodes):
     cuts = np.sort(np.where((cuts > p0[:, None]) & (cuts < p1[:, None]), cuts, p1[:, None]), axis=1)
     edges = np.concatenate([p0[:, None], cuts, p1[:, None]], axis=1)
 
-    def rule(count):
+    def rule(count, k):
         x, w = np.polynomial.legendre.leggauss(count)
-        a, b = edges[:, :-1, None], edges[:, 1:, None]
+        a, b = edges[k, :-1, None], edges[k, 1:, None]
         f = a + (b - a) * 0.5 * (x + 1.0)                                  # (K, pieces, count)
-        s = n[:, 0, None, None] * np.cos(f) + n[:, 1, None, None] * np.sin(f)
-        alpha = np.arctan2(s, np.broadcast_to(n[:, 2, None, None], s.shape))
+        s = n[k, 0, None, None] * np.cos(f) + n[k, 1, None, None] * np.sin(f)
+        alpha = np.arctan2(s, np.broadcast_to(n[k, 2, None, None], s.shape))
         low, high = alpha - np.pi / 2, alpha + np.pi / 2
         wrap = high < 0
         low, high = np.where(wrap, low + 2 * np.pi, low), np.where(wrap, high + 2 * np.pi, high)
-        lo = np.maximum(t0[:, None, None], low)
-        hi = np.maximum(np.minimum(t1[:, None, None], high), lo)
-        inner = n[:, 2, None, None] * (np.sin(hi) ** 2 - np.sin(lo) ** 2) / 2 + s * (
+        lo = np.maximum(t0[k, None, None], low)
+        hi = np.maximum(np.minimum(t1[k, None, None], high), lo)
+        inner = n[k, 2, None, None] * (np.sin(hi) ** 2 - np.sin(lo) ** 2) / 2 + s * (
             (hi - lo) / 2 - (np.sin(2 * hi) - np.sin(2 * lo)) / 4)
         return np.sum(inner * (b - a) * 0.5 * w, axis=(1, 2))
 
-    fine = rule(nodes)
-    return fine, np.abs(fine - rule(max(nodes // 2, 2)))
+    everything = np.arange(len(n))
+    coarse = rule(max(nodes // 2, 2), everything)
+    value, bound = rule(nodes, everything), np.zeros(len(n))
+    bound = np.abs(value - coarse)
+    left = everything[bound > rtol * np.abs(value)]
+    count = nodes
+    while len(left) and count < 16 * nodes:  # double the rule where two disagree
+        count *= 2
+        finer = rule(count, left)
+        bound[left] = np.abs(finer - value[left])
+        value[left] = finer
+        left = left[bound[left] > rtol * np.abs(finer)]
+    return value, bound
 
 
 # --------------------------------------------------------------------------- what EnvironmentLight's GLSL reads
@@ -236,22 +251,23 @@ def sh_legendre(z, order):
         out[(m, m)] = pmm
         for l in range(m + 1, int(order) + 1):
             a = np.sqrt((4.0 * l * l - 1.0) / (l * l - m * m))
-            b = np.sqrt(((l - 1.0) ** 2 - m * m) / (4.0 * (l - 1.0) ** 2 - 1.0))
+            b = np.sqrt(((l - 1.0) ** 2 - m * m) / (4.0 * (l - 1.0) ** 2 - 1.0)) if l > m + 1 else 0.0
             p = a * (z * pb - b * pa)
             pa, pb = pb, p
             out[(l, m)] = p
     return out
 
 
-def sh_project(radiance, order, nodes=24):
+def sh_project(radiance, order, nodes=None):
     """The map's real spherical-harmonic coefficients ``L_lm = sum_k L_k integral_texel Y_lm dw``, ((L + 1)^2, 3)
     float64, index ``l^2 + l + m``: the azimuthal integrals of ``cos(m phi)``, ``sin(m phi)`` exact, the polar ones by
-    ``nodes``-point Gauss-Legendre in ``theta`` per row (the integrand ``Pbar_l^m(cos) sin^(m+1)`` is smooth)."""
+    ``nodes``-point Gauss-Legendre in ``theta`` per row (the integrand ``Pbar_l^m(cos) sin^(m+1)`` is smooth; default
+    ``max(24, order + 2)``, which integrates a row of any height)."""
     radiance = np.asarray(radiance, dtype=np.float64)
     values = radiance[..., None] if radiance.ndim == 2 else radiance
     H, W = values.shape[:2]
     theta, phi = texel_edges(H, W)
-    x, w = np.polynomial.legendre.leggauss(nodes)
+    x, w = np.polynomial.legendre.leggauss(max(24, int(order) + 2) if nodes is None else nodes)
     t = theta[:-1, None] + (theta[1:] - theta[:-1])[:, None] * 0.5 * (x[None, :] + 1.0)        # (H, G)
     weight = (theta[1:] - theta[:-1])[:, None] * 0.5 * w[None, :] * np.sin(t)
     legendre = sh_legendre(np.cos(t), order)
@@ -313,7 +329,7 @@ def downsample(radiance, rows):
 
     Z = overlap(z_new, z_old, decreasing=True)          # (rows, H)
     P = overlap(p_new, p_old)                           # (2 rows, W)
-    flux = np.einsum("ah,hwc,bw->abc", Z, values, P)
+    flux = np.einsum("ah,hwc,bw->abc", Z, values, P, optimize=True)
     return flux / texel_solid_angles(rows, 2 * rows)[..., None]
 
 
@@ -330,14 +346,18 @@ def environment_log1p(x):
 
 
 def environment_horizon(q, c):
-    """The part of the lobe ``max(r.w, 0)^q`` above the horizon of ``n`` under a uniform sky, ``c = n.r`` in [0, 1],
+    """The part of the lobe ``max(r.w, 0)^q`` above the horizon of ``n`` under a uniform sky, ``c = n.r`` in [-1, 1],
     (N,): ``1 - (q + 1) J / pi``, ``J = 2 s^(q+1) integral_0^1 atan2(v sqrt(2 - v^2), c (1 - v^2)) (1 - v^2)^q v dv``,
-    ``s = sqrt(1 - c^2)``, by 24-point Gauss-Legendre on ``[0, min(1, 5/sqrt(q + 1))]`` (environment.glsl)."""
+    ``s = sqrt(1 - c^2)`` (``log s = log1p(-c^2)/2``), by 24-point Gauss-Legendre on ``[0, min(1, 5/sqrt(q + 1))]``;
+    for ``c < 0`` the mirror image (environment.glsl).  The rule is exact to about 1e-9 for integer ``q``; for ``q <
+    1`` the weight ``(1 - v^2)^q`` is singular at ``v = 1`` and the rule is within 6e-5."""
     c = np.asarray(c, dtype=np.float64)
-    s = np.maximum(np.sqrt(np.maximum(1.0 - c * c, 0.0)), 1e-30)
+    a = np.abs(c)
+    log_s = np.where(a * a < 1.0, 0.5 * environment_log1p(-a * a), -100.0)
     span = min(1.0, 5.0 / np.sqrt(q + 1.0))
     v = span * HORIZON_NODES[None, :]
     u = 1.0 - v * v
-    weight = np.exp((q + 1.0) * np.log(s)[:, None] + q * environment_log1p(-v * v))
-    angle = atan2_first_quadrant(v * np.sqrt(2.0 - v * v), c[:, None] * u)
-    return 1.0 - 2.0 * (q + 1.0) / np.pi * span * np.sum(HORIZON_WEIGHTS * angle * weight * v, axis=1)
+    weight = np.exp((q + 1.0) * log_s[:, None] + q * environment_log1p(-v * v))
+    angle = atan2_first_quadrant(v * np.sqrt(2.0 - v * v), a[:, None] * u)
+    below = 2.0 * (q + 1.0) / np.pi * span * np.sum(HORIZON_WEIGHTS * angle * weight * v, axis=1)
+    return np.where(c < 0.0, below, 1.0 - below)

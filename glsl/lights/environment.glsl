@@ -70,7 +70,8 @@ vec3 environment_sh(vec3 r, float q, int j)
                 float fl = float(l);
                 float fm = float(m);
                 float a = sqrt((4.0 * fl * fl - 1.0) / (fl * fl - fm * fm));
-                float b = sqrt(((fl - 1.0) * (fl - 1.0) - fm * fm) / (4.0 * (fl - 1.0) * (fl - 1.0) - 1.0));
+                float b = l > m + 1 ? sqrt(((fl - 1.0) * (fl - 1.0) - fm * fm) / (4.0 * (fl - 1.0) * (fl - 1.0) - 1.0))
+                                    : 0.0;                  // (0 at l = m + 1, where the ratio is -0/1 or 0/-1)
                 p = a * (d.z * pb - b * pa);
                 pa = pb;
                 pb = p;
@@ -90,7 +91,8 @@ vec3 environment_sh(vec3 r, float q, int j)
 //   sky: 1 - (q + 1) J / pi, the part below being 2 J with (substituting t = s (1 - v^2) in its integral over t = w.r)
 //   J = 2 s^(q+1) integral_0^1 atan2(v sqrt(2 - v^2), c (1 - v^2)) (1 - v^2)^q v dv,  s = sqrt(1 - c^2);
 //   24-point Gauss-Legendre on [0, V], V = min(1, 5/sqrt(q + 1)) ((1 - v^2)^q < e^-25 beyond), the weight
-//   exp((q + 1) log(s) + q log1p(-v^2)).  Exact for a sky of uniform radiance across the horizon; the convolution
+//   exp((q + 1) log(s) + q log1p(-v^2)), log(s) = log1p(-c^2)/2; for c < 0 (r below the horizon) the mirror image,
+//   the part below of |c|.  Exact for a sky of uniform radiance across the horizon; the convolution
 //   times it is the harmonics' lobe clipped at the horizon (docs/design.md section 13 says when it is not exact).
 const float ENVIRONMENT_NODES[24] = float[24](
     0.00240638991817832, 0.012635721825063229, 0.030862724408507347, 0.0567922368645668,
@@ -115,16 +117,18 @@ float environment_log1p(float x)
 
 float environment_horizon(float q, float c)
 {
-    float s = max(sqrt(max(1.0 - c * c, 0.0)), 1e-30);
+    float a = abs(c);
+    float log_s = a * a < 1.0 ? 0.5 * environment_log1p(-a * a) : -100.0;   // log(sqrt(1 - c^2)), no cancellation
     float span = min(1.0, 5.0 / sqrt(q + 1.0));
     float sum = 0.0;
     for (int i = 0; i < 24; ++i) {
         float v = span * ENVIRONMENT_NODES[i];
         float u = 1.0 - v * v;
-        float weight = exp((q + 1.0) * log(s) + q * environment_log1p(-v * v));
-        sum += ENVIRONMENT_WEIGHTS[i] * atan2_first_quadrant(v * sqrt(2.0 - v * v), c * u) * weight * v;
+        float weight = exp((q + 1.0) * log_s + q * environment_log1p(-v * v));
+        sum += ENVIRONMENT_WEIGHTS[i] * atan2_first_quadrant(v * sqrt(2.0 - v * v), a * u) * weight * v;
     }
-    return 1.0 - 2.0 * (q + 1.0) / 3.14159265358979 * span * sum;
+    float below = 2.0 * (q + 1.0) / 3.14159265358979 * span * sum;
+    return c < 0.0 ? below : 1.0 - below;                   // r below the horizon: the mirror image
 }
 #endif
 
@@ -142,7 +146,7 @@ vec3 environment_irradiance(vec3 x, vec3 n, int j)
 vec3 environment_lobe(vec3 x, vec3 n, vec3 r, float q, int j)
 {
 #if defined(ENVIRONMENT_SH)
-    return environment_sh(r, q, j) * environment_horizon(q, clamp(dot(n, r), 0.0, 1.0));
+    return environment_sh(r, q, j) * environment_horizon(q, clamp(dot(n, r), -1.0, 1.0));
 #else
     return vec3(0.0);
 #endif

@@ -87,6 +87,27 @@ def test_the_lobe_is_clipped_at_the_horizon_under_a_uniform_sky(q, elevation, gl
     assert abs(gpu[0, 0] - expected) <= 2e-4 * expected, (gpu[0, 0], expected)
 
 
+@pytest.mark.parametrize("q", [1.0, 20.0, 1e3])
+def test_the_horizon_factor_against_the_quadrature(q):
+    """environment_horizon at elevations of r_v from -20 to 60 degrees (below the horizon: interpolated normals)."""
+    elevations = np.radians([-20.0, -3.0, 0.3, 3.0, 20.0, 60.0])
+    got = env.environment_horizon(q, np.sin(elevations))
+    for e, h in zip(elevations, got):
+        r = np.array([np.cos(e), 0.0, np.sin(e)])
+        value, _, converged = environment_integral(np.array([[0.0, 0.0, 1.0]]), np.ones((8, 16)),
+                                                   lambda i, w: np.maximum(w @ r, 0.0) ** q, clip=(r[None],),
+                                                   extent=np.pi / 64 if q > 100 else np.pi / 16)
+        expected = value[0, 0] * (q + 1) / (2 * np.pi)
+        assert converged[0] and abs(h - expected) < 1e-5, (q, np.degrees(e), h, expected)
+
+
+def test_the_horizon_factor_in_closed_form():
+    """r_v on the horizon: half the lobe is above it, for every q (the rule's q < 1 limit: 6e-5); along n: all."""
+    for q, tolerance in ((0.25, 6e-5), (0.5, 6e-5), (2.5, 1e-8), (1e5, 1e-8)):
+        assert abs(env.environment_horizon(q, np.array([0.0]))[0] - 0.5) < tolerance, q
+        assert np.allclose(env.environment_horizon(q, np.array([1.0, -1.0])), [1.0, 0.0], rtol=0, atol=1e-30)
+
+
 def test_one_bright_texel_is_a_directional_light(glphong_backend, glphong_make_renderer):
     H, W, row, col, L = 32, 64, 9, 13, 500.0
     single = np.zeros((H, W, 3))
