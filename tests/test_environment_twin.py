@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from glphong.twin.environment import irradiance, texel_directions, texel_moments, texel_solid_angles
+from glphong.twin.environment_quadrature import environment_integral
 
 
 def _quadrature(height, width, i, j, f, samples=400):
@@ -61,3 +62,18 @@ def test_against_quadrature_where_the_horizon_cuts_texels():
                     for i in range(6) for j in range(12))
     assert abs(e[0] - reference) <= bound[0] + 1e-5 * reference
     assert bound[0] < 1e-3 * reference
+
+
+@pytest.mark.parametrize("shape", [(2, 4), (7, 13), (16, 32)])
+def test_row_runs_and_crossed_texels_against_the_quadrature(shape):
+    """The lit runs summed from prefix sums and the crossed texels integrated apart give the independent quadrature's
+    irradiance, at random normals and at the poles and the equator (where a row's classification is undecided)."""
+    rng = np.random.default_rng(sum(shape))
+    normals = rng.normal(size=(24, 3))
+    normals = np.concatenate([normals / np.linalg.norm(normals, axis=1, keepdims=True),
+                              [[0, 0, 1.0], [0, 0, -1.0], [1.0, 0, 0], [0, -1.0, 0], [0.6, 0, 0.8]]])
+    radiance = rng.random(shape + (3,))
+    e, bound = irradiance(radiance, normals)
+    value, _, converged = environment_integral(normals, radiance, lambda i, w: np.sum(normals[i] * w, axis=1))
+    assert converged.all() and np.max(np.abs(e - value) / value) < 1e-12
+    assert np.all(bound < 1e-9 * value)

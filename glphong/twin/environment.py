@@ -66,7 +66,7 @@ def _radius(t0, t1, p0, p1):
     return 0.5 * (t1 - t0) + 0.5 * (p1 - p0) * largest_sine
 
 
-def irradiance(radiance, normals, nodes=12, rtol=1e-13):
+def irradiance(radiance, normals, nodes=12, rtol=1e-12):
     """Irradiance ``E(n) = integral L(w) (n.w)^+ dw`` of an equirectangular map at unit normals, float64.
 
     A texel wholly above the horizon contributes ``L_k (n . M_k)`` exactly, one wholly below nothing.  A texel the
@@ -74,8 +74,10 @@ def irradiance(radiance, normals, nodes=12, rtol=1e-13):
     [theta/2 - sin(2 theta)/4]`` with ``s = n_x cos(phi) + n_y sin(phi)`` between the clipped ends, and in ``phi`` by
     Gauss-Legendre on the pieces between the azimuths where the horizon crosses the texel's ``theta`` edges (``s(phi)
     = -n_z cot(theta_edge)``), over which the integrand is smooth: ``nodes`` points against ``nodes / 2``, doubled
-    where they differ by more than ``rtol`` of the texel's value (a horizon passing near a pole of a coarse map is
-    sharp in ``phi``), to 16 times ``nodes``.
+    where they differ by more than ``rtol`` times the texel's solid angle (a horizon passing near a pole of a coarse
+    map is sharp in ``phi``), to 16 times ``nodes``.  The texels wholly above the horizon are summed per row from
+    prefix sums of ``L_k M_k`` (they are a run of each row), so a normal costs the rows and the crossed texels, not
+    every texel.
 
     Parameters
     ----------
@@ -86,7 +88,8 @@ def irradiance(radiance, normals, nodes=12, rtol=1e-13):
     nodes : int
         Gauss-Legendre points per piece of a texel the horizon crosses, at first.
     rtol : float
-        The difference between two rules, relative to a crossed texel's integral, at which the doubling stops.
+        The difference between two rules, relative to a crossed texel's solid angle (the most its integral can be),
+        at which the doubling stops.
 
     Returns
     -------
@@ -98,27 +101,78 @@ def irradiance(radiance, normals, nodes=12, rtol=1e-13):
     radiance = np.asarray(radiance, dtype=np.float64)
     grey = radiance.ndim == 2
     values = radiance[..., None] if grey else radiance
-    height, width = values.shape[:2]
+    H, W = values.shape[:2]
+    channels = values.shape[-1]
     normals = np.asarray(normals, dtype=np.float64).reshape(-1, 3)
-    theta, phi = texel_edges(height, width)
-    t0, t1 = np.repeat(theta[:-1], width), np.repeat(theta[1:], width)
-    p0, p1 = np.tile(phi[:-1], height), np.tile(phi[1:], height)
-    flat = values.reshape(-1, values.shape[-1])
-    moments = _moment(t0, t1, p0, p1)
-    centres = _direction(0.5 * (t0 + t1), 0.5 * (p0 + p1))
-    radius = _radius(t0, t1, p0, p1)
-    out = np.zeros((len(normals), flat.shape[1]))
+    theta, phi = texel_edges(H, W)
+    # per row, the prefix sums of L_k M_k along phi (the rows' texels wholly above a horizon are a run of them)
+    weighted = (_moment(theta[:-1, None], theta[1:, None], phi[None, :-1], phi[None, 1:])[..., :, None]
+                * values[:, :, None, :]).reshape(H, W, 3 * channels)
+    prefix = np.concatenate([np.zeros((H, 1, 3 * channels)), np.cumsum(weighted, axis=1)], axis=1)
+    flat = values.reshape(-1, channels)
+    out = np.zeros((len(normals), channels))
     bound = np.zeros_like(out)
-    step = max(1, min(256, 2_000_000 // len(flat)))  # chunks of normals x every texel, at most 2e6 pairs
+    step = max(1, min(256, 4_000_000 // (H * W)))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cot = np.cos(theta) / np.sin(theta)
+    cot[0], cot[-1] = np.inf, -np.inf
     for a in range(0, len(normals), step):
         n = normals[a:a + step]
-        c = n @ centres.T
-        out[a:a + step] = np.where(c > radius, n @ moments.T, 0.0) @ flat
-        rows, texels = np.nonzero(np.abs(c) <= radius)
-        e, b = _crossed(n[rows], t0[texels], t1[texels], p0[texels], p1[texels], nodes, rtol)
-        np.add.at(out, a + rows, e[:, None] * flat[texels])
-        np.add.at(bound, a + rows, b[:, None] * np.abs(flat[texels]))
+        above, below = _row_runs(n, cot, W)
+        out[a:a + step] = _run_sums(n, prefix, above, W, channels)
+        k, row, col = _crossed_texels(above, below, W)
+        e, b = _crossed(n[k], theta[row], theta[row + 1], phi[col], phi[col + 1], nodes, rtol)
+        texel = row * W + col
+        np.add.at(out, a + k, e[:, None] * flat[texel])
+        np.add.at(bound, a + k, b[:, None] * np.abs(flat[texel]))
     return (out[:, 0], bound[:, 0]) if grey else (out, bound)
+
+
+def _row_runs(n, cot, W):
+    """For each normal (K, 3) and row, the run of texels wholly above the horizon and the run wholly below, each
+    ``(first, count)`` (K, H) int on the circle of ``W`` columns.  ``n.w = n_z cos(theta) + rho sin(theta) cos(phi -
+    beta)`` is positive over a row's texel iff it is at both of the row's edges (over less than pi in theta a
+    sinusoid positive at both ends is positive between), i.e. iff ``cos(phi - beta) > max_edges(-n_z cot(theta))/rho``
+    over the texel: an arc about ``beta``; below, likewise, an arc about ``beta + pi``.  Undecided comparisons (a
+    pole's 0 * inf) count as neither: such texels are integrated as crossed ones, which is exact for any texel."""
+    rho, beta, nz = np.hypot(n[:, 0], n[:, 1]), np.arctan2(n[:, 1], n[:, 0]), n[:, 2]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        edge = -nz[:, None, None] * np.stack([cot[:-1], cot[1:]], axis=-1)[None]          # (K, H, 2)
+        high = np.max(edge, axis=-1) / rho[:, None]
+        low = np.min(edge, axis=-1) / rho[:, None]
+    high = np.where(np.isnan(high), np.inf, high)
+    low = np.where(np.isnan(low), -np.inf, low)
+    step = 2 * np.pi / W
+    runs = []
+    for centre, half, full, none in ((beta[:, None], np.arccos(np.clip(high, -1.0, 1.0)), high < -1.0, high >= 1.0),
+                                     (beta[:, None] + np.pi, np.pi - np.arccos(np.clip(low, -1.0, 1.0)), low > 1.0,
+                                      low <= -1.0)):
+        first = np.floor((centre - half) / step).astype(np.int64) + 1
+        last = np.ceil((centre + half) / step).astype(np.int64) - 2
+        count = np.clip(last - first + 1, 0, W)
+        count = np.where(full, W, np.where(none, 0, count))
+        runs.append((np.mod(np.where(full, 0, first), W), count))
+    return runs
+
+
+def _run_sums(n, prefix, above, W, channels):
+    """``n . sum L_k M_k`` over each normal's runs of wholly lit texels, (K, C)."""
+    first, count = above
+    rows = np.arange(prefix.shape[0])[None, :]
+    end = first + count
+    inside = np.minimum(end, W)
+    total = prefix[rows, inside] - prefix[rows, first] + np.where((end > W)[..., None],
+                                                                  prefix[rows, np.maximum(end - W, 0)], 0.0)
+    total = total.sum(axis=1).reshape(len(n), 3, channels)                                   # (K, 3, C)
+    return np.einsum("kd,kdc->kc", n, total)
+
+
+def _crossed_texels(above, below, W):
+    """``(normal, row, column)`` of every texel in neither run."""
+    col = np.arange(W)[None, None, :]
+    lit = np.mod(col - above[0][..., None], W) < above[1][..., None]
+    dark = np.mod(col - below[0][..., None], W) < below[1][..., None]
+    return np.nonzero(~(lit | dark))
 
 
 def _crossed(n, t0, t1, p0, p1, nodes, rtol):
@@ -152,17 +206,18 @@ def _crossed(n, t0, t1, p0, p1, nodes, rtol):
         return np.sum(inner * (b - a) * 0.5 * w, axis=(1, 2))
 
     everything = np.arange(len(n))
+    tolerance = rtol * _solid_angle(t0, t1, p0, p1)   # of the largest the texel's integral can be
     coarse = rule(max(nodes // 2, 2), everything)
-    value, bound = rule(nodes, everything), np.zeros(len(n))
+    value = rule(nodes, everything)
     bound = np.abs(value - coarse)
-    left = everything[bound > rtol * np.abs(value)]
+    left = everything[bound > tolerance]
     count = nodes
     while len(left) and count < 16 * nodes:  # double the rule where two disagree
         count *= 2
         finer = rule(count, left)
         bound[left] = np.abs(finer - value[left])
         value[left] = finer
-        left = left[bound[left] > rtol * np.abs(finer)]
+        left = left[bound[left] > tolerance[left]]
     return value, bound
 
 
