@@ -187,6 +187,12 @@ class EnvironmentLight(ExtendedLight):
         object.__setattr__(self, "_cache", {})
         super().__init__(resolution, order, samples, method=method)
 
+    def __setstate__(self, state):
+        """Unpickled (a batch worker's copy): the map and the rotation read-only again, as constructed."""
+        self.__dict__.update(state)
+        for name in ("radiance", "rotation"):
+            state[name].setflags(write=False)
+
     def check(self):
         super().check()
         for name in ("resolution", "order"):

@@ -10,6 +10,8 @@ against closed forms that share nothing with glphong's GLSL or twin, on both bac
 - `glphong.verify` passes and reports both error maps; the spherical harmonics of order 2 ring under a sun.
 - Specialisation: a Lambert-only material declares and is given the irradiance map alone.
 """
+import pickle
+
 import numpy as np
 import pytest
 
@@ -232,5 +234,7 @@ def test_files_and_bad_input(tmp_path, monkeypatch):
     monkeypatch.setitem(__import__("sys").modules, "OpenEXR", None)
     with pytest.raises(ImportError, match=r"glphong\[exr\]"):
         glphong.EnvironmentLight(tmp_path / "sky.exr")
+    copy = pickle.loads(pickle.dumps(light))  # a batch worker's copy: equal, and as immutable
+    assert copy == light and not copy.radiance.flags.writeable
     assert glphong.EnvironmentLight(sky) == glphong.EnvironmentLight(sky.copy())
     assert glphong.EnvironmentLight(sky) != glphong.EnvironmentLight(sky * 2)
