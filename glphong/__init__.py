@@ -30,6 +30,7 @@ from glphong.materials.blinn import BlinnPhong
 from glphong.materials.cook_torrance import CookTorrance
 from glphong.materials.fresnel import DielectricFresnel, SchlickFresnel
 from glphong.materials.diffuse import Diffuse
+from glphong.materials.gltf_pbr import GltfPBR
 from glphong.materials.lafortune import Lafortune
 from glphong.materials.lambert import Lambert
 from glphong.materials.measured import MeasuredBRDF
@@ -48,7 +49,7 @@ __all__ = [
     "Camera", "PerspectiveCamera", "IntrinsicsCamera", "OrthographicCamera", "opencv_pose", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "SpotLight", "AmbientLight", "LightModel",
     "ExtendedLight", "RectLight", "PolygonLight", "SphereLight", "DiskLight", "EnvironmentLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
-    "NormalizedBlinnPhong", "CookTorrance", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
+    "NormalizedBlinnPhong", "CookTorrance", "GltfPBR", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
     "DielectricFresnel", "Texture", "VertexColors", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
     "imaging", "lights", "materials", "primitives", "radiometry", "reference", "filesafety", "__version__",

@@ -45,6 +45,8 @@ GALLERY = (
     ("Cook-Torrance m=0.25", lambda: _m("CookTorrance")(ALBEDO, 0.25)),
     ("Cook-Torrance 1982", lambda: _m("CookTorrance")(ALBEDO, 0.25, form="1982")),
     ("Cook-Torrance dielectric", lambda: _m("CookTorrance")(ALBEDO, 0.15, fresnel=_m("DielectricFresnel")(1.5))),
+    ("glTF dielectric roughness 0.4", lambda: _m("GltfPBR")(ALBEDO, 0.0, 0.4)),
+    ("glTF metal roughness 0.3", lambda: _m("GltfPBR")((0.95, 0.64, 0.54), 1.0, 0.3)),
     ("Lafortune off-specular", lambda: _m("Lafortune")(ALBEDO, [(2.5, -1.0, -1.0, 0.8, 30.0)])),
     ("Lafortune retro-reflective", lambda: _m("Lafortune")(ALBEDO, [(0.5, 1.0, 1.0, 1.0, 6.0)])),
     ("Oren-Nayar sigma=1", lambda: _m("OrenNayar")(ALBEDO, 1.0)),

@@ -92,10 +92,13 @@ from glphong.materials.fresnel import DielectricFresnel, FresnelSlot, SchlickFre
 from glphong.materials.model import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
 from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
 from glphong.materials.fresnel import fresnel_oracle
-from glphong.twin.functions import safe_normalize
+from glphong.twin.functions import microfacet_geometry
 
 __all__ = ["CookTorranceLobe", "CookTorrance", "cook_torrance_geometry", "cook_torrance_beckmann",
            "cook_torrance_masking", "COOK_TORRANCE_EXP_LIMIT", "COOK_TORRANCE_FORM_RATIO"]
+
+#: the half-vector geometry, now the library chunk microfacet.glsl shared with `GltfPBR` (this name is kept)
+cook_torrance_geometry = microfacet_geometry
 
 #: cook_torrance_lobe.glsl COOK_TORRANCE_EXP_LIMIT: tan^2(theta_h) / m^2 at which D is set to 0
 COOK_TORRANCE_EXP_LIMIT = 104.0
@@ -115,40 +118,6 @@ _FORM = Choice("form", ("microfacet", "1982"), default="microfacet",
 
 def _dot(a, b):
     return np.sum(a * b, axis=-1)
-
-
-def cook_torrance_geometry(n, wi, wo, n_dot_l):
-    """The cosines of the Cook-Torrance term (cook_torrance_lobe.glsl).
-
-    Parameters
-    ----------
-    n, wi, wo : (..., 3) ndarray
-        Unit normal, directions toward the light and the viewer.
-    n_dot_l : (...) ndarray
-
-    Returns
-    -------
-    valid : (...) bool ndarray
-        ``l + v`` normalises, ``n.v > 0`` and ``n.l > 0``.
-    n_dot_v, n_dot_h, h_dot_l, tan2 : (...) ndarray
-        ``n.v``; ``n.h = (n.l + n.v)/|l + v|``; ``h.l = |l + v|/2``; ``tan^2(theta_h) = delta (2 - delta)
-        / (n.h)^2`` with ``delta = |h - n|^2 / 2``.  1, 1, 1 and 0 where not valid.
-    """
-
-    ok, h, h_len = safe_normalize(wi + wo)
-    dtype = h.dtype
-    one = dtype.type(1)
-    nv = _dot(n, wo).astype(dtype)
-    n_dot_l = np.asarray(n_dot_l).astype(dtype)
-    valid = ok & (nv > 0) & (n_dot_l > 0)
-    length = np.where(valid, h_len, one).astype(dtype)
-    with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
-        nh = np.where(valid, (n_dot_l + nv) / length, one).astype(dtype)
-        e = h - n
-        delta = (dtype.type(0.5) * _dot(e, e)).astype(dtype)
-        sin2 = np.maximum(delta * (dtype.type(2) - delta), dtype.type(0)).astype(dtype)
-        tan2 = np.where(valid, sin2 / (nh * nh), dtype.type(0)).astype(dtype)
-    return valid, np.where(valid, nv, one).astype(dtype), nh, (dtype.type(0.5) * length).astype(dtype), tan2
 
 
 def cook_torrance_beckmann(tan2, m):
@@ -181,6 +150,20 @@ def cook_torrance_masking(n_dot_l, n_dot_v, n_dot_h, h_dot_l):
         return np.minimum(np.minimum(shadowing / n_dot_v, k), big).astype(dtype)
 
 
+def oracle_half_vector(f, wi, wo, n_dot_l):
+    """For the microfacet models' mpmath oracles: ``(dot, n.v, h)`` with ``h = (l + v)/|l + v|`` straight from the
+    textbook, ``h`` None where ``n.l <= 0``, ``n.v <= 0`` or ``l = -v`` (the response is 0 there)."""
+    import mpmath  # noqa: PLC0415 - the stability suite's, kept out of import time
+
+    dot = lambda a, b: sum(x * y for x, y in zip(a, b))  # noqa: E731
+    n_dot_v = dot(f.n, wo)
+    s = [a + b for a, b in zip(wi, wo)]
+    length = mpmath.sqrt(dot(s, s))
+    if not (n_dot_l > 0 and n_dot_v > 0 and length > 0):
+        return dot, n_dot_v, None
+    return dot, n_dot_v, [x / length for x in s]
+
+
 class CookTorranceLobe(MaterialModel):
     """The Cook-Torrance specular term alone: ``f_r = F(h.l) D G / (4 (n.l)(n.v))`` (form="microfacet")
     or the paper's ``F(h.l) D' G / (pi (n.l)(n.v))`` (form="1982", exactly 4 times as large).
@@ -198,6 +181,7 @@ class CookTorranceLobe(MaterialModel):
     params = (_M,)
     needs = ("view",)
     glsl = GlslFile("materials/cook_torrance_lobe.glsl")
+    uses = ("microfacet",)
     vanishes_with = ()
     choices = (_FORM,)
     fresnel_slot = FresnelSlot(cosine="h.l", default=SchlickFresnel(0.04))
@@ -231,13 +215,9 @@ class CookTorranceLobe(MaterialModel):
         cos^4 in the denominator, 1/((n.l)(n.v)) formed): 0 where n.v <= 0 or l = -v."""
         import mpmath
 
-        dot = lambda a, b: sum(x * y for x, y in zip(a, b))  # noqa: E731
-        n_dot_v = dot(f.n, wo)
-        s = [a + b for a, b in zip(wi, wo)]
-        length = mpmath.sqrt(dot(s, s))
-        if not (n_dot_l > 0 and n_dot_v > 0 and length > 0):
+        dot, n_dot_v, h = oracle_half_vector(f, wi, wo, n_dot_l)
+        if h is None:
             return [mpmath.mpf(0)] * 3
-        h = [x / length for x in s]
         n_dot_h = dot(f.n, h)
         v_dot_h = dot(wo, h)
         cos2 = n_dot_h * n_dot_h

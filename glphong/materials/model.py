@@ -228,7 +228,7 @@ class MaterialModel(Material):
     uses : tuple of str
         Library chunks the GLSL calls: ``'lobe'`` (``log_one_minus``, ``lobe_from_delta``, the Phong and
         Blinn lobes), ``'fresnel'`` (``fresnel_schlick``, ``fresnel_dielectric``), ``'angle'``
-        (``atan2_first_quadrant``).
+        (``atan2_first_quadrant``), ``'microfacet'`` (``microfacet_geometry``).
     ambient : str or None
         The rgb parameter ``k`` of the model's answer ``k L_a`` to the ambient light, or None.
     vanishes_with : tuple of str

@@ -23,12 +23,12 @@ KINDS = {"scalar": "float", "rgb": "vec3", "vec3": "vec3", "direction": "vec3"}
 #: what a model may ask for beyond the normal and the light direction
 NEEDS = ("view", "tangent", "uv")
 #: library chunks (glsl/<name>.glsl) a model may use besides common.glsl, which is always there
-LIBRARY_CHUNKS = ("lobe", "fresnel", "angle")
+LIBRARY_CHUNKS = ("lobe", "fresnel", "angle", "microfacet")
 #: names a model may not take: GLSL prefixes and uniforms of the shading loop and the library
 RESERVED_NAMES = frozenset({
     "material", "shade", "common", "lights", "light", "point", "unattenuated", "directional", "ambient",
     "eye", "model", "normal", "view", "use", "ka", "safe", "lobe", "srgb", "encode", "mesh", "uber", "naive",
-    "frame", "gl", "object", "exposure", "radiance", "fullscreen", "fresnel"})
+    "frame", "gl", "object", "exposure", "radiance", "fullscreen", "fresnel", "microfacet"})
 #: material-level keywords every material takes
 MATERIAL_KEYWORDS = ("ka", "two_sided")
 _GLSL_KEYWORDS = frozenset("""attribute const uniform varying layout centroid flat smooth noperspective break continue

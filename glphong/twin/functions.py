@@ -17,7 +17,8 @@ import numpy as np
 __all__ = [
     "ShadingFrame", "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "perpendiculars", "log_one_minus",
     "lobe_from_delta", "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
-    "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "light_term", "FLT_MAX", "FRAME_PARALLEL_LIMIT",
+    "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "microfacet_geometry", "light_term", "FLT_MAX",
+    "FRAME_PARALLEL_LIMIT",
 ]
 
 
@@ -338,3 +339,37 @@ def perpendiculars(v):
     a = np.cross(v, helper)
     a = a / np.linalg.norm(a, axis=-1, keepdims=True)
     return a, np.cross(v, a)
+
+
+def microfacet_geometry(n, wi, wo, n_dot_l):
+    """The half-vector geometry of the microfacet models (microfacet.glsl): Cook-Torrance's and glTF's.
+
+    Parameters
+    ----------
+    n, wi, wo : (..., 3) ndarray
+        Unit normal, directions toward the light and the viewer.
+    n_dot_l : (...) ndarray
+
+    Returns
+    -------
+    valid : (...) bool ndarray
+        ``l + v`` normalises, ``n.v > 0`` and ``n.l > 0``.
+    n_dot_v, n_dot_h, h_dot_l, tan2 : (...) ndarray
+        ``n.v``; ``n.h = (n.l + n.v)/|l + v|``; ``h.l = |l + v|/2``; ``tan^2(theta_h) = delta (2 - delta)
+        / (n.h)^2`` with ``delta = |h - n|^2 / 2``.  1, 1, 1 and 0 where not valid.
+    """
+
+    ok, h, h_len = safe_normalize(wi + wo)
+    dtype = h.dtype
+    one = dtype.type(1)
+    nv = np.sum(n * wo, axis=-1).astype(dtype)
+    n_dot_l = np.asarray(n_dot_l).astype(dtype)
+    valid = ok & (nv > 0) & (n_dot_l > 0)
+    length = np.where(valid, h_len, one).astype(dtype)
+    with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
+        nh = np.where(valid, (n_dot_l + nv) / length, one).astype(dtype)
+        e = h - n
+        delta = (dtype.type(0.5) * np.sum(e * e, axis=-1)).astype(dtype)
+        sin2 = np.maximum(delta * (dtype.type(2) - delta), dtype.type(0)).astype(dtype)
+        tan2 = np.where(valid, sin2 / (nh * nh), dtype.type(0)).astype(dtype)
+    return valid, np.where(valid, nv, one).astype(dtype), nh, (dtype.type(0.5) * length).astype(dtype), tan2

@@ -13,14 +13,8 @@
 //   relative sensitivity to it is 2 tan(theta_h) / m^2: the relative error within three decades of the
 //   peak is about 4e-7 / m (measured 5e-4 at m = 1e-3, the smallest m that stays within 1e-3, to a factor 2).
 //
-// cook_torrance_geometry(n, wi, wo, n_dot_l, out n_dot_v, out n_dot_h, out h_dot_l, out tan2) -> valid
-//   h by scaled normalisation of l + v; valid is false (and the lobe 0) where l + v does not
-//   normalise (l = -v), n.v <= 0 or n.l <= 0.  Stable forms:
-//   h.l = |l + v| / 2            (= h.l = h.v for unit l, v; symmetric, no cancellation of dot(h, l) as l -> -v)
-//   n.h = (n.l + n.v) / |l + v|  (positive, relatively accurate also for grazing h)
-//   tan2 = delta (2 - delta) / (n.h)^2,  delta = |h - n|^2 / 2   (= (1 - (n.h)^2) / (n.h)^2 from the chord:
-//          no 1 - (n.h)^2 cancellation at the peak; Inf, not NaN, where (n.h)^2 underflows).
-//   Where not valid: n_dot_v = n_dot_h = h_dot_l = 1, tan2 = 0 (every later factor finite).
+// microfacet_geometry(n, wi, wo, n_dot_l, ...) (library chunk microfacet.glsl): n.v, n.h, h.l = |l + v|/2 and
+//   tan^2(theta_h) from the chord; valid is false (and the lobe 0) where l = -v, n.v <= 0 or n.l <= 0.
 // cook_torrance_beckmann(tan2, m) -> D' = pi D = exp(-tan2 / m^2) (1 + tan2)^2 / m^2      [1/sr x pi]
 //   1 / cos^4 is formed as (1 + tan^2)^2; tan2 is clamped to 104 m^2 before use and D' is 0 beyond it
 //   (exp(-104) is below the smallest float32 subnormal): exp underflows cleanly to 0 for n.h -> 0,
@@ -41,26 +35,6 @@
 
 const float COOK_TORRANCE_INV_PI = 0.3183098861837907;
 const float COOK_TORRANCE_EXP_LIMIT = 104.0;  // exp(-104) rounds to 0 in float32
-
-bool cook_torrance_geometry(vec3 n, vec3 wi, vec3 wo, float n_dot_l, out float n_dot_v, out float n_dot_h,
-                            out float h_dot_l, out float tan2)
-{
-    vec3 h;
-    float h_len;
-    bool ok = safe_normalize(wi + wo, h, h_len);
-    float nv = dot(n, wo);
-    bool valid = ok && nv > 0.0 && n_dot_l > 0.0;
-    float len = valid ? h_len : 1.0;
-    float nh = valid ? (n_dot_l + nv) / len : 1.0;
-    vec3 e = h - n;
-    float delta = 0.5 * dot(e, e);
-    float sin2 = max(delta * (2.0 - delta), 0.0);
-    n_dot_v = valid ? nv : 1.0;
-    n_dot_h = nh;
-    h_dot_l = 0.5 * len;
-    tan2 = valid ? sin2 / (nh * nh) : 0.0;
-    return valid;
-}
 
 float cook_torrance_beckmann(float tan2, float m)
 {
@@ -104,7 +78,7 @@ vec3 cook_torrance_lobe_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l
 vec3 cook_torrance_lobe_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
 {
     float n_dot_v, n_dot_h, h_dot_l, tan2;
-    bool valid = cook_torrance_geometry(f.n, wi, wo, n_dot_l, n_dot_v, n_dot_h, h_dot_l, tan2);
+    bool valid = microfacet_geometry(f.n, wi, wo, n_dot_l, n_dot_v, n_dot_h, h_dot_l, tan2);
     float d = cook_torrance_beckmann(tan2, u_cook_torrance_lobe_m);
     float g = cook_torrance_masking(n_dot_l, n_dot_v, n_dot_h, h_dot_l);
     float s = min(d * (g * COOK_TORRANCE_SCALE), FLT_MAX);

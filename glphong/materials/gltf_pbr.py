@@ -1,0 +1,211 @@
+"""The model 'gltf_pbr' and the material `GltfPBR`: glTF 2.0's metallic-roughness material exactly as the
+specification's Appendix B writes it (docs/design.md section 9; GLSL: ``glsl/materials/gltf_pbr.glsl``)::
+
+    alpha = roughness^2,  x = (1 - |v.h|)^5
+    D = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2)                                   GGX
+    V = 1 / (2 (|n.v| sqrt(alpha^2 + (1 - alpha^2)(n.l)^2) + |n.l| sqrt(alpha^2 + (1 - alpha^2)(n.v)^2)))
+    metal = (c + (1 - c) x) V D
+    dielectric = mix(c / pi, V D, 0.04 + 0.96 x)
+    f_r = mix(dielectric, metal, metallic)                                              [1/sr]
+
+=========== ====== ======= ======================================================================
+parameter   kind   range   meaning
+=========== ====== ======= ======================================================================
+base_color  rgb    [0, 1]  ``baseColorFactor``: the diffuse colour of a dielectric, ``f0`` of a metal
+metallic    scalar [0, 1]  ``metallicFactor``: mixes the dielectric (0) and the metal (1)
+roughness   scalar [0, 1]  ``roughnessFactor``: ``alpha = roughness^2``
+=========== ====== ======= ======================================================================
+
+Numerics (float32, branchless, never NaN or Inf; see the GLSL header): the half-vector geometry is the library chunk
+``microfacet.glsl`` (`glphong.twin.functions.microfacet_geometry`, shared with Cook-Torrance: ``tan^2(theta_h)`` from
+the chord), and D is divided through by ``(n.h)^4``: ``D = (alpha^2 r) r / pi``, ``r = 1 + (1 - alpha^2)/(alpha^2 +
+tan^2)``, a sum of positive terms (at the peak ``alpha^2 + tan^2 = alpha^2``: 1e-16 at roughness 1e-4), ``r`` saturated;
+``V (n.l)`` is formed with the response's ``n.l`` cancelled against V's.  Roughness 0 is a mirror: D is a delta
+at ``h = n`` that a point light meets with zero measure, so the program reflects 0 there (and everywhere else
+the specification's D is 0 too); no NaN.
+
+Properties: non-negative, reciprocal (D, V and the Fresnel factor of ``|v.h| = |l.h|`` are symmetric in l and v),
+isotropic.  Energy: not declared here (issue 26 measures it: the specification says the Fresnel mix does not
+conserve energy).
+"""
+import numpy as np
+
+from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
+from glphong.materials.cook_torrance import oracle_half_vector
+from glphong.materials.model import MaterialModel, Param, Properties
+from glphong.materials.params import GlslFile
+from glphong.twin.band import EPS
+from glphong.twin.functions import microfacet_geometry
+
+__all__ = ["GltfPBR", "gltf_pbr_ggx", "gltf_pbr_visibility_cos"]
+
+_FLT_MAX = float(np.finfo(np.float32).max)
+_BASE_COLOR = Param("base_color", "rgb", low=0.0, high=1.0, default=1.0, unit="",
+                    doc="baseColorFactor: a dielectric's diffuse colour, a metal's f0")
+_METALLIC = Param("metallic", "scalar", low=0.0, high=1.0, default=1.0, unit="", doc="metallicFactor")
+_ROUGHNESS = Param("roughness", "scalar", low=0.0, high=1.0, default=1.0, unit="",
+                   doc="roughnessFactor (alpha = roughness^2)")
+
+
+def _dot(a, b):
+    return np.sum(a * b, axis=-1)
+
+
+def gltf_pbr_ggx(tan2, a2):
+    """GGX ``D = (a2 r) r / pi``, ``r = 1 + (1 - a2)/(a2 + tan2)`` (gltf_pbr.glsl), ``r`` and ``D`` at most FLT_MAX;
+    0 where ``a2 + tan2 = 0``."""
+    tan2 = np.asarray(tan2)
+    dtype = tan2.dtype
+    a2 = dtype.type(a2)
+    big = dtype.type(_FLT_MAX)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        s = (a2 + tan2).astype(dtype)
+        r = (dtype.type(1) + (dtype.type(1) - a2) / s).astype(dtype)
+        value = ((a2 * r) * (np.minimum(r, big) * dtype.type(1 / np.pi))).astype(dtype)
+        return np.where(s > 0, np.minimum(value, big), dtype.type(0)).astype(dtype)
+
+
+def gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2):
+    """``V (n.l) = n.l / (2 (n.v r_l + n.l r_v))``, ``r_x = sqrt((n.x)^2 + a2 (1 - (n.x)^2))`` (gltf_pbr.glsl)."""
+    n_dot_l = np.asarray(n_dot_l)
+    dtype = np.result_type(n_dot_l, n_dot_v)
+    n_dot_l, n_dot_v, a2 = n_dot_l.astype(dtype), np.asarray(n_dot_v).astype(dtype), dtype.type(a2)
+    one = dtype.type(1)
+    r_l = np.sqrt(n_dot_l * n_dot_l + a2 * (one - n_dot_l * n_dot_l))
+    r_v = np.sqrt(n_dot_v * n_dot_v + a2 * (one - n_dot_v * n_dot_v))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return (n_dot_l / (dtype.type(2) * (n_dot_v * r_l + n_dot_l * r_v))).astype(dtype)
+
+
+class GltfPBR(MaterialModel):
+    """glTF 2.0's metallic-roughness material, as the specification's Appendix B writes it (module docstring).
+
+    Parameters
+    ----------
+    base_color : float or (3,) array_like
+        ``baseColorFactor`` (linear RGB) in [0, 1].
+    metallic : float
+        ``metallicFactor`` in [0, 1].
+    roughness : float
+        ``roughnessFactor`` in [0, 1]; ``alpha = roughness^2``.
+    """
+
+    name = "gltf_pbr"
+    params = (_BASE_COLOR, _METALLIC, _ROUGHNESS)
+    needs = ("view",)
+    glsl = GlslFile("materials/gltf_pbr.glsl")
+    uses = ("microfacet",)
+    vanishes_with = ()
+    properties = Properties(reciprocal=True, isotropic=True, energy_conserving=None, non_negative=True)
+
+    def _parts(self, f, wi, wo, n_dot_l, p):
+        """``(valid, diffuse (N, 3), fresnel (N, 3), specular (N,), tan2, a2, v_dot_h)``: the response is ``diffuse +
+        fresnel * specular`` where valid, ``specular = D V (n.l)`` (gltf_pbr.glsl's order)."""
+        valid, n_dot_v, _, v_dot_h, tan2 = microfacet_geometry(f.n, wi, wo, n_dot_l)
+        dtype = tan2.dtype
+        n_dot_l = np.asarray(n_dot_l).astype(dtype)
+        alpha = dtype.type(p.roughness) * dtype.type(p.roughness)
+        a2 = alpha * alpha
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            specular = np.minimum(gltf_pbr_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2),
+                                  dtype.type(_FLT_MAX)).astype(dtype)
+            x1 = np.maximum(dtype.type(1) - v_dot_h, dtype.type(0))
+            x = ((x1 * x1) * (x1 * x1) * x1).astype(dtype)
+            c = np.asarray(p.base_color, dtype)
+            fd = (dtype.type(0.04) + dtype.type(0.96) * x).astype(dtype)
+            m = dtype.type(p.metallic)
+            diffuse = (c * (dtype.type(1 / np.pi) * n_dot_l)[..., None]) * (dtype.type(1) - fd)[..., None] \
+                * (dtype.type(1) - m)
+            fresnel = fd[..., None] * (dtype.type(1) - m) + (c + (dtype.type(1) - c) * x[..., None]) * m
+        return valid, diffuse, fresnel, specular, tan2, a2, v_dot_h
+
+    def response(self, f, wi, wo, n_dot_l, p):
+        valid, diffuse, fresnel, specular, _, _, _ = self._parts(f, wi, wo, n_dot_l, p)
+        dtype = specular.dtype
+        with np.errstate(over="ignore", invalid="ignore"):
+            value = diffuse + fresnel * specular[..., None]
+        return np.where(valid[..., None], value, dtype.type(0)).astype(dtype)
+
+    def band(self, f, wi, wo, n_dot_l, p, constants):
+        """The generic band, widened by D over the half vector's angular uncertainty: ``theta_h`` is known to
+        ``delta = 2 D eps / (v.h)`` (l, v and n rounded to float32, h from their sum), and D falls monotonically
+        with ``theta_h``, so the specular part lies between its values at ``theta_h + delta`` and at
+        ``max(theta_h - delta, 0)``.  What matters where the lobe (``alpha = roughness^2`` rad wide) is narrower
+        than float32 resolves directions: roughness below about 3e-4, off the exact peak."""
+        low, high = super().band(f, wi, wo, n_dot_l, p, constants)
+        valid, _, fresnel, specular, tan2, a2, v_dot_h = self._parts(f, wi, wo, n_dot_l, p)
+        theta = np.arctan(np.sqrt(tan2))
+        delta = 2 * constants.D * EPS / np.maximum(v_dot_h, 1e-30)
+
+        def ggx(t):
+            with np.errstate(over="ignore"):
+                return gltf_pbr_ggx(np.tan(np.clip(t, 0.0, np.pi / 2)) ** 2, a2)
+
+        d = gltf_pbr_ggx(tan2, a2)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            ratio_high = np.where(d > 0, ggx(theta - delta) / d, 1.0)
+            ratio_low = np.where(d > 0, ggx(theta + delta) / d, 1.0)
+            part = np.where(valid, specular, 0.0)[..., None] * fresnel
+            high = high + np.nan_to_num(part * np.maximum(ratio_high - 1, 0.0)[..., None], posinf=_FLT_MAX)
+            low = low - np.nan_to_num(part * np.maximum(1 - ratio_low, 0.0)[..., None])
+        return low, high
+
+    def oracle(self, f, wi, wo, n_dot_l, p):
+        """Appendix B in mpmath, as the specification writes it: ``h`` from ``l + v``, ``D`` with the denominator
+        ``(n.h)^2 (alpha^2 - 1) + 1``, ``V`` with its ``|n.l|``, then times ``n.l``; 0 where ``n.v <= 0`` or
+        ``l = -v``, and where roughness is 0 at the exact mirror direction (the delta, module docstring)."""
+        import mpmath  # noqa: PLC0415 - the stability suite's, kept out of import time
+
+        dot, n_dot_v, h = oracle_half_vector(f, wi, wo, n_dot_l)
+        if h is None:
+            return [mpmath.mpf(0)] * 3
+        n_dot_h, v_dot_h = dot(f.n, h), abs(dot(wo, h))
+        alpha = p.roughness * p.roughness
+        a2 = alpha * alpha
+        denominator = n_dot_h * n_dot_h * (a2 - 1) + 1
+        if denominator == 0:
+            return [mpmath.mpf(0)] * 3
+        d = a2 / (mpmath.pi * denominator * denominator)
+        v = 1 / (2 * (abs(n_dot_v) * mpmath.sqrt(a2 + (1 - a2) * n_dot_l ** 2)
+                      + abs(n_dot_l) * mpmath.sqrt(a2 + (1 - a2) * n_dot_v ** 2)))
+        x = (1 - v_dot_h) ** 5
+        out = []
+        for c in p.base_color:
+            metal = (c + (1 - c) * x) * v * d
+            fd = mpmath.mpf("0.04") + mpmath.mpf("0.96") * x
+            dielectric = (c / mpmath.pi) * (1 - fd) + v * d * fd
+            out.append(((1 - p.metallic) * dielectric + p.metallic * metal) * n_dot_l)
+        return out
+
+    def pbr_roughness(self):
+        """pyrender's roughness: the same parameter."""
+        return float(self.roughness)
+
+    @classmethod
+    def stability_cases(cls):
+        return _stability_cases()
+
+
+def _stability_cases():
+    """Generic geometry plus the glTF extremes: roughness from 0 to 1 (1e-4 included) at the peak and off it, for a
+    dielectric and a metal; grazing light and view; a black and a white base colour."""
+    e_one = 4 * np.pi  # a point light at 1 m: E = 1 W/m^2
+    light = _unit(30.0)
+    cases = generic_cases("gltf_pbr", GltfPBR(0.5, 0.0, 0.5)) + generic_cases("gltf_pbr metal", GltfPBR(0.9, 1.0, 0.3))
+    for metallic in (0.0, 1.0):
+        for roughness in (1e-4, 1e-2, 0.1, 0.5, 1.0):
+            offsets = (("peak", 0.0), ("near", 0.5 * roughness ** 2), ("tail", 3.0 * roughness ** 2))
+            for where, theta_h in offsets if roughness < 0.5 else (("peak", 0.0), ("theta_h=0.5", 0.5)):
+                cases.append(Case(f"gltf_pbr metallic={metallic:g} roughness={roughness:g} {where}", "gltf peak",
+                                  GltfPBR((0.8, 0.5, 0.2), metallic, roughness), eye=_mirror_eye(30.0, 2 * theta_h),
+                                  lights=(("point", light, e_one),), note=f"theta_h = {theta_h:.3g} rad"))
+    cases.append(Case("gltf_pbr roughness=0 off the mirror", "gltf peak", GltfPBR(0.8, 0.0, 0.0),
+                      eye=_mirror_eye(30.0, 0.2), lights=(("point", light, e_one),), note="D = 0: the diffuse part only"))
+    for nv in (1e-3, 1e-8, 1e-20):
+        cases.append(Case(f"gltf_pbr grazing view n.v={nv:g}", "gltf grazing", GltfPBR(0.5, 0.5, 0.3),
+                          eye=(-float(np.sqrt(1.0 - nv * nv)), 0.0, nv), lights=(("point", _unit(40.0), e_one),),
+                          note="V (n.l) <= 1/(2 r_v): finite"))
+    for color in (0.0, 1.0):
+        cases.append(Case(f"gltf_pbr base colour {color:g}", "gltf colour", GltfPBR(color, 0.3, 0.4),
+                          eye=_mirror_eye(30.0, 0.3), lights=(("point", light, e_one),)))
+    return cases

@@ -1,0 +1,107 @@
+"""glTF 2.0's metallic-roughness material (glphong.GltfPBR) against an independent float64 implementation of the
+specification's Appendix B, written here from its formulas and sharing nothing with glphong:
+
+``D = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2)``, ``V = 1 / (2 (|n.v| sqrt(alpha^2 + (1 - alpha^2)(n.l)^2) +
+|n.l| sqrt(alpha^2 + (1 - alpha^2)(n.v)^2)))``, ``metal = (c + (1 - c)(1 - |v.h|)^5) V D``, ``dielectric = mix(c/pi,
+V D, 0.04 + 0.96 (1 - |v.h|)^5)``, ``f_r = mix(dielectric, metal, metallic)``, ``alpha = roughness^2``.
+"""
+import numpy as np
+import pytest
+
+import glphong
+from glphong.materials import ShadingFrame
+from glphong.testing import assert_twin_matches, evaluate
+
+Z = np.array([0.0, 0.0, 1.0])
+
+
+def appendix_b(n, l, v, base_color, metallic, roughness):
+    """f_r (n.l) by the specification's formulas, float64, (N, 3)."""
+    h = l + v
+    h = h / np.linalg.norm(h, axis=-1, keepdims=True)
+    nl, nv, nh, vh = (np.sum(a * b, -1) for a, b in ((n, l), (n, v), (n, h), (v, h)))
+    alpha = roughness ** 2
+    a2 = alpha ** 2
+    d = a2 / (np.pi * (nh ** 2 * (a2 - 1) + 1) ** 2)
+    vis = 1 / (2 * (np.abs(nv) * np.sqrt(a2 + (1 - a2) * nl ** 2) + np.abs(nl) * np.sqrt(a2 + (1 - a2) * nv ** 2)))
+    x = (1 - np.abs(vh)) ** 5
+    c = np.asarray(base_color, np.float64)[None, :]
+    metal = (c + (1 - c) * x[:, None]) * (vis * d)[:, None]
+    fd = (0.04 + 0.96 * x)[:, None]
+    dielectric = (c / np.pi) * (1 - fd) + (vis * d)[:, None] * fd
+    return ((1 - metallic) * dielectric + metallic * metal) * nl[:, None]
+
+
+def _pairs(count, seed, max_angle=1.45):
+    rng = np.random.default_rng(seed)
+
+    def direction():
+        t, p = rng.uniform(0, max_angle, count), rng.uniform(0, 2 * np.pi, count)
+        return np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
+
+    return direction(), direction()
+
+
+def _twin(material, l, v):
+    n = np.broadcast_to(Z, l.shape).astype(np.float64)
+    term = material.components[0]
+    return term.response(ShadingFrame(n), l, v, np.sum(n * l, -1), term.values())
+
+
+@pytest.mark.parametrize("metallic", [0.0, 0.4, 1.0])
+@pytest.mark.parametrize("roughness", [0.05, 0.3, 0.7, 1.0])
+def test_twin_equals_the_specification_in_float64(metallic, roughness):
+    color = (0.9, 0.5, 0.1)
+    material = glphong.GltfPBR(base_color=color, metallic=metallic, roughness=roughness)
+    l, v = _pairs(500, seed=int(100 * roughness) + int(10 * metallic))
+    expected = appendix_b(np.broadcast_to(Z, l.shape), l, v, np.float32(color).astype(float),
+                          float(np.float32(metallic)), float(np.float32(roughness)))
+    np.testing.assert_allclose(_twin(material, l, v), expected, rtol=1e-11, atol=1e-300)
+
+
+@pytest.mark.parametrize("roughness", [0.05, 0.3, 1.0])
+def test_gpu_equals_the_specification(roughness, glphong_backend):
+    material = glphong.GltfPBR(base_color=(0.9, 0.5, 0.1), metallic=0.5, roughness=roughness)
+    l, v = _pairs(400, seed=7, max_angle=1.3)
+    l32, v32 = l.astype(np.float32).astype(float), v.astype(np.float32).astype(float)
+    l32 /= np.linalg.norm(l32, axis=1, keepdims=True)
+    v32 /= np.linalg.norm(v32, axis=1, keepdims=True)
+    gpu = evaluate(material, l, v, backend=glphong_backend).astype(np.float64)
+    expected = appendix_b(np.broadcast_to(Z, l.shape), l32, v32, np.float32((0.9, 0.5, 0.1)).astype(float), 0.5,
+                          float(np.float32(roughness)))
+    rel = np.abs(gpu - expected) / np.max(expected, axis=1, keepdims=True)
+    assert np.all(np.isfinite(gpu)) and rel.max() < {0.05: 2e-3, 0.3: 2e-5, 1.0: 1e-5}[roughness], rel.max()
+    assert_twin_matches(material, n=500, backend=glphong_backend)
+
+
+def test_roughness_zero_and_tiny_are_finite(glphong_backend):
+    """Roughness 0: D is 0 off the mirror direction and at it (the delta, which a point light meets with zero
+    measure); 1e-4: the peak D = 1/(pi alpha^2) = 3.2e15 is finite.  Never NaN."""
+    l = np.array([[0.5, 0.0, np.sqrt(0.75)], [0.5, 0.0, np.sqrt(0.75)]])
+    v = np.array([[-0.5, 0.0, np.sqrt(0.75)], [-0.45, 0.1, np.sqrt(1 - 0.45 ** 2 - 0.01)]])
+    for roughness in (0.0, 1e-4):
+        material = glphong.GltfPBR(base_color=0.5, metallic=1.0, roughness=roughness)
+        twin = _twin(material, l, v)
+        gpu = evaluate(material, l, v, backend=glphong_backend)
+        assert np.all(np.isfinite(twin)) and np.all(np.isfinite(gpu))
+        if roughness == 0.0:
+            assert np.all(twin == 0) and np.all(gpu == 0)  # a metal reflects only its specular part
+    # at the mirror direction h = n: D = 1/(pi alpha^2), V (n.l) = 1/(4 n.v), F = 1 for a white metal (the
+    # specification's denominator (n.h)^2 (alpha^2 - 1) + 1 cancels to alpha^2 = 1e-16 there: float64 cannot form
+    # it from a rounded n.h, the closed form can)
+    a2 = float(np.float32(1e-4)) ** 4
+    expected = 1 / (np.pi * a2) / (4 * np.sqrt(0.75))
+    peak = _twin(glphong.GltfPBR(base_color=1.0, metallic=1.0, roughness=1e-4), l[:1], v[:1])
+    np.testing.assert_allclose(peak, expected, rtol=1e-12)
+    gpu = evaluate(glphong.GltfPBR(base_color=1.0, metallic=1.0, roughness=1e-4), l[:1], v[:1], backend=glphong_backend)
+    np.testing.assert_allclose(gpu, expected, rtol=1e-5)
+
+
+def test_declaration():
+    material = glphong.GltfPBR(base_color=(0.2, 0.3, 0.4), metallic=0.25, roughness=0.5)
+    assert material.components[0].name == "gltf_pbr"
+    assert glphong.GltfPBR().metallic == 1.0 and glphong.GltfPBR().roughness == 1.0  # glTF's defaults
+    with pytest.raises(ValueError, match="roughness"):
+        glphong.GltfPBR(roughness=1.5)
+    with pytest.raises(ValueError, match="base_color"):
+        glphong.GltfPBR(base_color=(2.0, 0.0, 0.0))
