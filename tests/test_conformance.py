@@ -77,7 +77,7 @@ import glphong.materials
 from glphong import analysis
 from glphong.shaders.key import program_key, response_key
 from glphong.materials import (AshikhminShirley, BlinnLobe, CookTorrance, CookTorranceLobe, DielectricFresnel, Diffuse,
-                               Lafortune, LafortuneLobes, Lambert, MaterialModel, MaterialSum, MeasuredBRDF, MtlPhong,
+                               GltfPBR, Lafortune, LafortuneLobes, Lambert, MaterialModel, MaterialSum, MeasuredBRDF, MtlPhong,
                                NormalizedBlinnLobe, NormalizedBlinnPhong, NormalizedPhong, NormalizedPhongLobe,
                                OrenNayar, PhongLobe, SchlickFresnel, WardLobe, registered_models)
 from glphong.materials.model import MATERIAL_KEYWORDS, NEEDS
@@ -316,6 +316,12 @@ EXAMPLES = {
     "cook_torrance_lobe": _cook_torrance(),
     "lafortune_lobes": _lafortune(),
     "oren_nayar": _oren_nayar(),
+    # a white dielectric (whose Fresnel mix exceeds albedo 1 at oblique incidence: 1.29 at 85 deg, roughness 0.3), a
+    # coloured metal, and a half-metallic rough mix; the band alone (the twin check's figures in test_gltf_pbr.py)
+    "gltf_pbr": [Example("white dielectric roughness=0.3", functools.partial(GltfPBR, 1.0, 0.0, 0.3)),
+                 Example("copper metal roughness=0.2", functools.partial(GltfPBR, (0.95, 0.64, 0.54), 1.0, 0.2)),
+                 Example("half metal roughness=0.8", functools.partial(GltfPBR, (0.5, 0.1, 0.0), 0.5, 0.8), seed=1,
+                         normal=tuple(TILTED))],
     "ward_lobe": _ward(),
     "ashikhmin_shirley": _ashikhmin_shirley(),
     # nearest: the same bin on both sides (measured 6e-8); trilinear: float32 weights of steep neighbouring
