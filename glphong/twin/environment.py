@@ -10,9 +10,9 @@ from +z (row 0 at the zenith), column ``j`` the azimuth ``phi`` in ``[2 pi j / W
 - `texel_moments`: ``M = integral w dw`` = ``((sin phi1 - sin phi0) T, (cos phi0 - cos phi1) T, (phi1 - phi0) S)`` with
   ``T = [theta/2 - sin(2 theta)/4]`` and ``S = [sin^2(theta)/2]`` between ``theta0`` and ``theta1``.
 - `irradiance`: ``E(n) = sum_k L_k integral_texel (n.w)^+ dw``.  A texel wholly above the surface's horizon
-  contributes ``L_k (n . M_k)`` exactly; one wholly below, 0.  A texel whose angular radius ``r`` (a bound on how far
-  its points are from its centre) does not decide it (``|n . w_centre| <= r``) is integrated over its part above the
-  horizon: in closed form in ``theta``, by Gauss-Legendre in ``phi`` on the pieces over which that is smooth.
+  contributes ``L_k (n . M_k)`` exactly (each row's such texels are one run of columns, summed from prefix sums); one
+  wholly below, 0.  A texel the horizon crosses is integrated over its part above it: in closed form in ``theta``, by
+  Gauss-Legendre in ``phi`` on the pieces over which that is smooth.
 """
 import numpy as np
 
@@ -57,13 +57,6 @@ def texel_directions(height, width):
     """Each texel centre's unit direction, (H, W, 3) float64."""
     theta, phi = texel_edges(height, width)
     return _direction(0.5 * (theta[:-1, None] + theta[1:, None]), 0.5 * (phi[None, :-1] + phi[None, 1:]))
-
-
-def _radius(t0, t1, p0, p1):
-    """A bound on the angle between a lat-long rectangle's centre and any of its points [rad]: half its polar extent
-    plus half its azimuthal extent times the largest sine over it."""
-    largest_sine = np.where((t0 <= np.pi / 2) & (t1 >= np.pi / 2), 1.0, np.maximum(np.sin(t0), np.sin(t1)))
-    return 0.5 * (t1 - t0) + 0.5 * (p1 - p0) * largest_sine
 
 
 def irradiance(radiance, normals, nodes=12, rtol=1e-12):
@@ -390,7 +383,7 @@ def downsample(radiance, rows):
 
 #: environment_horizon's 24-point Gauss-Legendre nodes and weights on [0, 1], rounded to float32 as the GLSL holds them
 HORIZON_NODES, HORIZON_WEIGHTS = (np.float32(0.5 * a).astype(np.float64) for a in
-                                  (np.polynomial.legendre.leggauss(24)[0] + 1.0, np.polynomial.legendre.leggauss(24)[1]))
+                                  np.polynomial.legendre.leggauss(24) + np.array([[1.0], [0.0]]))
 
 
 def environment_log1p(x):

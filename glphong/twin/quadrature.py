@@ -204,6 +204,17 @@ def _radiance(radiance):
     return radiance
 
 
+def _round_emitter(x, normals, center, radius, radiance, clip, rtol, max_depth):
+    """The checked arguments of a sphere or a disk: ``(x, center, radius, radiance, rtol, max_depth, planes)``."""
+    x, normals = _points(x, normals)
+    center = np.asarray(center, dtype=np.float64)
+    radius = float(radius)
+    if center.shape != (3,) or not np.all(np.isfinite(center)) or not (np.isfinite(radius) and radius > 0):
+        raise ValueError("center must be (3,) and radius a positive number")
+    rtol, max_depth = _check_budget(rtol, max_depth)
+    return x, center, radius, _radiance(radiance), rtol, max_depth, _planes(normals, clip)
+
+
 def _check_budget(rtol, max_depth):
     if not (np.isfinite(rtol) and rtol > 0):
         raise ValueError("rtol must be a positive number")
@@ -691,14 +702,8 @@ def sphere_integral(x, normals, center, radius, radiance, integrand, clip=(), rt
     converged : (N,) bool ndarray
         Whether the error is within ``rtol`` times the integral (as for `polygon_integral`).
     """
-    x, normals = _points(x, normals)
-    center = np.asarray(center, dtype=np.float64)
-    radius = float(radius)
-    if center.shape != (3,) or not np.all(np.isfinite(center)) or not (np.isfinite(radius) and radius > 0):
-        raise ValueError("center must be (3,) and radius a positive number")
-    radiance = _radiance(radiance)
-    rtol, max_depth = _check_budget(rtol, max_depth)
-    planes = _planes(normals, clip)
+    x, center, radius, radiance, rtol, max_depth, planes = _round_emitter(x, normals, center, radius, radiance, clip,
+                                                                           rtol, max_depth)
     offset = center - x
     d = _norm(offset)
     outside = d > radius
@@ -721,48 +726,21 @@ def disk_integral(x, normals, center, normal, radius, radiance, integrand, clip=
 
     Parameters
     ----------
-    x : (N, 3) array_like
-        Surface points [m].
-    normals : (N, 3) or (3,) array_like
-        Unit surface normals (normalised here).
-    center : (3,) array_like
-        The disk's centre [m].
+    x, normals, center, radius, radiance, integrand, clip, rtol, max_depth
+        As for `sphere_integral` (the disk's centre, radius and radiance).
     normal : (3,) array_like
         The side the disk emits toward (normalised here).  A point behind the disk's plane or on it gets 0.
-    radius : float
-        The disk's radius [m], positive.
-    radiance : (3,) array_like
-        The disk's uniform radiance ``L`` [W/(m^2 sr)], RGB.
-    integrand : callable
-        ``integrand(index, w) -> (M, C)``, as for `polygon_integral`.
-    clip : tuple of (N, 3) or (3,) array_like
-        Extra planes through each ``x`` (``c.w >= 0`` counts); the horizon ``n.w >= 0`` is always applied.
-    rtol : float
-        Relative tolerance on each point's integral (its largest channel).
-    max_depth : int
-        Levels of 2 x 2 subdivision of a patch at most.
 
     Returns
     -------
-    value : (N, 3) float64 ndarray
-        ``L`` times the integral (as for `polygon_integral`).
-    error : (N,) float64 ndarray
-        Estimated absolute error of ``value`` (its largest channel); as for `polygon_integral` it grows like
-        ``1/distance`` as ``x`` nears the rim.
-    converged : (N,) bool ndarray
-        Whether the error is within ``rtol`` times the integral (as for `polygon_integral`).
+    value, error, converged
+        As for `sphere_integral`; the error grows like ``1/distance`` as ``x`` nears the rim (`polygon_integral`).
     """
-    x, normals = _points(x, normals)
-    center = np.asarray(center, dtype=np.float64)
-    radius = float(radius)
-    if center.shape != (3,) or not np.all(np.isfinite(center)) or not (np.isfinite(radius) and radius > 0):
-        raise ValueError("center must be (3,) and radius a positive number")
+    x, center, radius, radiance, rtol, max_depth, planes = _round_emitter(x, normals, center, radius, radiance, clip,
+                                                                           rtol, max_depth)
     normal = _unit(normal, "normal")
     if normal.shape != (3,):
         raise ValueError("normal must be (3,)")
-    radiance = _radiance(radiance)
-    rtol, max_depth = _check_budget(rtol, max_depth)
-    planes = _planes(normals, clip)
     N = len(x)
     O = center - x
     seen = -(O @ normal) > 0.0
