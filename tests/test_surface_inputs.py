@@ -107,9 +107,22 @@ def test_parameters_check_textures_and_vertex_colours():
         glphong.Diffuse(rho_d=glphong.Texture(NOISE, scale=2.0))
     with pytest.raises(ValueError, match="scale"):
         glphong.Lambert(kd=glphong.VertexColors(scale=-1.0))
-    with pytest.raises(glphong.materials.MaterialDefinitionError, match="only rgb parameters can be textureable"):
-        glphong.Param("q", "scalar", low=0.0, textureable=True)
+    with pytest.raises(glphong.materials.MaterialDefinitionError, match="only rgb and scalar parameters can be"):
+        glphong.Param("d", "direction", low=-np.inf, textureable=True)
     assert glphong.Diffuse(rho_d=glphong.Texture(NOISE)).rho_d.texture == TextureImage(NOISE)
+    # a scalar parameter reads one channel, an rgb one all three
+    with pytest.raises(ValueError, match="roughness is a scalar: .* need the channel"):
+        glphong.GltfPBR(0.5, 0.0, glphong.Texture(NOISE, srgb=False))
+    with pytest.raises(ValueError, match="base_color is rgb"):
+        glphong.GltfPBR(glphong.Texture(NOISE, channel="g"), 0.0, 0.5)
+    with pytest.raises(ValueError, match="channel must be one of"):
+        glphong.Texture(NOISE, channel="a")
+    with pytest.raises(ValueError, match=r"roughness must be in \[0, 1\] everywhere"):
+        glphong.GltfPBR(0.5, 0.0, glphong.Texture(NOISE, scale=1.5, srgb=False, channel="g"))
+    one_channel = np.zeros((2, 2, 3), np.uint8)
+    one_channel[..., 1] = 255  # green full, the others 0: its range is the green channel's
+    assert glphong.Texture(one_channel, srgb=False, channel="g").value_range() == (1.0, 1.0)
+    assert glphong.Texture(one_channel, srgb=False, channel="b").value_range() == (0.0, 0.0)
 
 
 # --------------------------------------------------------------------------- GPU against the twin
@@ -125,6 +138,12 @@ CASES = {
     "mtl kd and ks, 16-bit": lambda: (
         glphong.MtlPhong(kd=glphong.Texture((NOISE.astype(np.uint16) * 257), scale=0.3),
                          ks=glphong.Texture(NOISE[::-1], scale=0.2), q=30.0, kamb=0.1), _plane()),
+    # scalar parameters read one channel: glTF's metallic-roughness texture (metallic blue, roughness green)
+    "gltf metallic-roughness texture": lambda: (
+        glphong.GltfPBR(glphong.Texture(NOISE, 0.9), glphong.Texture(NOISE[::-1], srgb=False, channel="b"),
+                        glphong.Texture(NOISE[::-1], 0.8, srgb=False, channel="g")), _sphere()),
+    "gltf roughness times vertex colours": lambda: (
+        glphong.GltfPBR(0.7, 0.2, glphong.Texture(NOISE, 0.9, srgb=False, channel="r", vertex_colors=True)), _sphere()),
 }
 
 
@@ -143,6 +162,18 @@ def test_ambient_only_texture_verifies(glphong_backend, glphong_make_renderer):
     key = renderer.program_key(scene, scene.objects[0])
     assert key.num_lights == 0 and key.inputs == (("lambert", "kd", "texture"),)
     assert glphong.verify(scene, renderer).passed
+
+
+def test_the_band_catches_a_twin_that_reads_the_wrong_channel(monkeypatch, glphong_make_renderer):
+    """A twin that reads the red channel where the program reads green is outside the band on most pixels."""
+    from glphong.checks import reference
+
+    scene = _oblique_scene(glphong.GltfPBR(0.8, glphong.Texture(NOISE, srgb=False, channel="g"), 0.5), _sphere())
+    renderer = glphong_make_renderer(160, 120, "egl")
+    assert glphong.verify(scene, renderer).passed
+    monkeypatch.setattr(reference, "_channel_of", lambda mode: lambda rgb: rgb[..., 0] if ":" in mode else rgb)
+    report = glphong.verify(scene, renderer)
+    assert report.outside_count > 0.3 * report.covered_pixels, report.summary()
 
 
 @pytest.mark.parametrize("mutation", ["half a texel off", "a level too far", "v flipped"])

@@ -133,21 +133,31 @@ def material_inputs(uv, color, lod, key, uniforms, sample=None):
     Returns
     -------
     dict of str to (N, 3) (or (k, N, 3)) float64 ndarray
-        By uniform name; empty where the key has no surface input.
+        By uniform name; empty where the key has no surface input.  A scalar's input (one channel) is (N,)
+        (or (k, N)).
     """
     sample = surface_texture if sample is None else sample
     out = {}
     textured = list(key.textured_inputs)
     for term, param, mode in key.inputs:
         name = f"u_{term}_{param}"
+        pick = _channel_of(mode)
         value = np.asarray(uniforms[f"{name}_scale"], dtype=np.float64)
         if "texture" in mode:
-            value = value * sample(uniforms[f"{name}_texture"], uv, lod[:, textured.index((term, param))])
+            value = value * pick(sample(uniforms[f"{name}_texture"], uv, lod[:, textured.index((term, param))]))
         if "vertex" in mode:
-            value = value * color
+            value = value * pick(color)
         n = len(uv) if uv is not None else len(color)
-        out[name] = np.broadcast_to(value, np.broadcast_shapes(np.shape(value), (n, 3)))
+        out[name] = np.broadcast_to(value, np.broadcast_shapes(np.shape(value), (n, 3) if ":" not in mode else (n,)))
     return out
+
+
+def _channel_of(mode):
+    """What an input of ``mode`` reads of an rgb value (..., 3): all of it, or the one channel after the ':'."""
+    if ":" not in mode:
+        return lambda rgb: rgb
+    index = "rgb".index(mode.split(":")[1])
+    return lambda rgb: rgb[..., index]
 
 
 def input_bounds(uv, color, lod, key, u, band=BAND):
@@ -167,8 +177,10 @@ def input_bounds(uv, color, lod, key, u, band=BAND):
     stacked = material_inputs(uv, color, lod, key, u,
                                   sample=lambda image, at, level: np.stack(surface_texture_band(image, at, level, band)))
     values, bounds = {}, {}
-    for name, v in stacked.items():
-        value, low, high = v if v.ndim == 3 else (v, v, v)  # (value, low, high), or exact (no texture)
+    for term, param, mode in key.inputs:
+        name = f"u_{term}_{param}"
+        v = stacked[name]
+        value, low, high = v if "texture" in mode else (v, v, v)  # (value, low, high), or exact (no texture)
         values[name], bounds[name] = value, (low * (1 - 2 * EPS), high * (1 + 2 * EPS))
     return values, bounds
 

@@ -39,6 +39,27 @@ def _input_ends(f):
     return {k: lo for k, (lo, _) in bounds.items()}, {k: hi for k, (_, hi) in bounds.items()}
 
 
+def _textured_band(term, f, wi, wo, n_dot_l, u, band):
+    """The band of a term with surface inputs: its band at the inputs' values, widened by the response's change as
+    each input moves to either end of its interval alone (first order: the deviations add up worst-case, as the
+    generic band's do; a product of two inputs, base colour times metallic, and a response that is not monotone in
+    one, GGX in roughness, are bounded to first order over intervals a few texel steps of ``T`` wide)."""
+    values = term.values_from_uniforms(u, inputs=f.inputs)
+    low, high = term.band(f, wi, wo, n_dot_l, values, band)
+    if f.input_bounds is None:
+        return low, high
+    at = np.maximum(n_dot_l, np.finfo(np.float64).tiny)
+    base = np.asarray(term.response(f, wi, wo, at, values), dtype=np.float64)
+    for name in (term.uniform_name(param) for param in term.surface_inputs()):
+        up, down = np.zeros_like(base), np.zeros_like(base)
+        for end in f.input_bounds[name]:
+            moved = term.values_from_uniforms(u, inputs={**f.inputs, name: end})
+            delta = np.nan_to_num(np.asarray(term.response(f, wi, wo, at, moved), dtype=np.float64) - base, nan=0.0)
+            up, down = np.maximum(up, delta), np.minimum(down, delta)
+        low, high = low + down, high + up
+    return low, high
+
+
 def point_band(key, u, position, n, n_valid, material, band=BAND):
     """Interval the GPU's ``shade_point()`` must return at given points.
 
@@ -173,10 +194,8 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND, term_keys=Non
     for term_key in term_keys:
         term = models[term_key.name]
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
-            if term.surface_inputs():  # the band at both ends of the inputs' intervals (first order inside)
-                ends = [term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u, inputs=inputs), band)
-                        for inputs in _input_ends(f)]
-                t_lo, t_hi = np.minimum(ends[0][0], ends[1][0]), np.maximum(ends[0][1], ends[1][1])
+            if term.surface_inputs():
+                t_lo, t_hi = _textured_band(term, f, wi, wo, n_dot_l, u, band)
             else:
                 t_lo, t_hi = term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u), band)
         # a term's float32 result below FLT_MIN in magnitude may be flushed to 0 (e.g. ks * lobe with

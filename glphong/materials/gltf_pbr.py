@@ -53,10 +53,11 @@ from glphong.twin.functions import microfacet_geometry
 __all__ = ["GltfPBR", "gltf_pbr_ggx", "gltf_pbr_visibility_cos"]
 
 _FLT_MAX = float(np.finfo(np.float32).max)
-_BASE_COLOR = Param("base_color", "rgb", low=0.0, high=1.0, default=1.0, unit="",
+_BASE_COLOR = Param("base_color", "rgb", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
                     doc="baseColorFactor: a dielectric's diffuse colour, a metal's f0")
-_METALLIC = Param("metallic", "scalar", low=0.0, high=1.0, default=1.0, unit="", doc="metallicFactor")
-_ROUGHNESS = Param("roughness", "scalar", low=0.0, high=1.0, default=1.0, unit="",
+_METALLIC = Param("metallic", "scalar", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
+                  doc="metallicFactor")
+_ROUGHNESS = Param("roughness", "scalar", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
                    doc="roughnessFactor (alpha = roughness^2)")
 
 
@@ -69,7 +70,7 @@ def gltf_pbr_ggx(tan2, a2):
     0 where ``a2 + tan2 = 0``."""
     tan2 = np.asarray(tan2)
     dtype = tan2.dtype
-    a2 = dtype.type(a2)
+    a2 = np.asarray(a2).astype(dtype)
     big = dtype.type(_FLT_MAX)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
         s = (a2 + tan2).astype(dtype)
@@ -82,7 +83,7 @@ def gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2):
     """``V (n.l) = n.l / (2 (n.v r_l + n.l r_v))``, ``r_x = sqrt((n.x)^2 + a2 (1 - (n.x)^2))`` (gltf_pbr.glsl)."""
     n_dot_l = np.asarray(n_dot_l)
     dtype = np.result_type(n_dot_l, n_dot_v)
-    n_dot_l, n_dot_v, a2 = n_dot_l.astype(dtype), np.asarray(n_dot_v).astype(dtype), dtype.type(a2)
+    n_dot_l, n_dot_v, a2 = n_dot_l.astype(dtype), np.asarray(n_dot_v).astype(dtype), np.asarray(a2).astype(dtype)
     one = dtype.type(1)
     r_l = np.sqrt(n_dot_l * n_dot_l + a2 * (one - n_dot_l * n_dot_l))
     r_v = np.sqrt(n_dot_v * n_dot_v + a2 * (one - n_dot_v * n_dot_v))
@@ -95,12 +96,14 @@ class GltfPBR(MaterialModel):
 
     Parameters
     ----------
-    base_color : float or (3,) array_like
-        ``baseColorFactor`` (linear RGB) in [0, 1].
-    metallic : float
-        ``metallicFactor`` in [0, 1].
-    roughness : float
-        ``roughnessFactor`` in [0, 1]; ``alpha = roughness^2``.
+    base_color : float or (3,) array_like or glphong.materials.surface.SurfaceInput
+        ``baseColorFactor`` (linear RGB) in [0, 1]; times the base-colour texture and ``COLOR_0`` where given
+        (`glphong.Texture`, sRGB).
+    metallic : float or SurfaceInput
+        ``metallicFactor`` in [0, 1]; times the metallic-roughness texture's blue channel where given
+        (``glphong.Texture(image, metallic, srgb=False, channel='b')``).
+    roughness : float or SurfaceInput
+        ``roughnessFactor`` in [0, 1]; times that texture's green channel (``channel='g'``); ``alpha = roughness^2``.
     """
 
     name = "gltf_pbr"
@@ -119,7 +122,8 @@ class GltfPBR(MaterialModel):
         valid, n_dot_v, _, v_dot_h, tan2 = microfacet_geometry(f.n, wi, wo, n_dot_l)
         dtype = tan2.dtype
         n_dot_l = np.asarray(n_dot_l).astype(dtype)
-        alpha = dtype.type(p.roughness) * dtype.type(p.roughness)
+        roughness = np.asarray(p.roughness).astype(dtype)  # a constant, or (N,) where textured
+        alpha = roughness * roughness
         a2 = alpha * alpha
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
             specular = np.minimum(gltf_pbr_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2),
@@ -128,7 +132,7 @@ class GltfPBR(MaterialModel):
             x = ((x1 * x1) * (x1 * x1) * x1).astype(dtype)
             c = np.asarray(p.base_color, dtype)
             fd = (dtype.type(0.04) + dtype.type(0.96) * x).astype(dtype)
-            m = dtype.type(p.metallic)
+            m = np.asarray(p.metallic).astype(dtype)[..., None]
             diffuse = (c * (dtype.type(1 / np.pi) * n_dot_l)[..., None]) * (dtype.type(1) - fd)[..., None] \
                 * (dtype.type(1) - m)
             fresnel = fd[..., None] * (dtype.type(1) - m) + (c + (dtype.type(1) - c) * x[..., None]) * m

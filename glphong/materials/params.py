@@ -84,7 +84,8 @@ class Param:
         The parameter also takes a `glphong.materials.surface.SurfaceInput` (a texture, vertex
         colours or both, `glphong.Texture`, `glphong.VertexColors`): its value then varies over the
         surface, and the model's GLSL reads ``u_<model>_<name>`` unchanged (glphong sets it per fragment
-        before the response is called).  rgb parameters only.
+        before the response is called).  rgb and scalar parameters; a scalar's input reads one channel
+        (``channel='r'``, ``'g'`` or ``'b'``).
     optional : bool
         None is a valid value, and the default (a light's ``range=None``: no range).  The definition
         says what its uniform holds then (`glphong.lights.LightModel.uniform_value`).
@@ -107,9 +108,9 @@ class Param:
         if self.kind not in KINDS:
             raise MaterialDefinitionError(f"Param {self.name!r}: kind must be one of {', '.join(map(repr, KINDS))} "
                                           f"(got {self.kind!r})")
-        if self.textureable and self.kind != "rgb":
-            raise MaterialDefinitionError(f"Param {self.name!r}: only rgb parameters can be textureable (a texture "
-                                          "gives rgb per fragment)")
+        if self.textureable and self.kind not in ("rgb", "scalar"):
+            raise MaterialDefinitionError(f"Param {self.name!r}: only rgb and scalar parameters can be textureable (a "
+                                          "texture gives rgb per fragment, or one channel of it)")
         if self.low is None and self.high is None:
             raise MaterialDefinitionError(
                 f"Param {self.name!r} has no range: give low= and/or high= (for example low=0.0); "
@@ -172,6 +173,11 @@ class Param:
         if not self.textureable:
             raise TypeError(f"{self.name} takes a constant ({self.kind} in {self.interval}), not a texture or vertex "
                             "colours: the model does not declare it textureable")
+        if self.kind == "scalar" and value.channel is None:
+            raise ValueError(f"{self.name} is a scalar: its texture or vertex colours need the channel it reads "
+                             f"(channel='r', 'g' or 'b'; got {value!r})")
+        if self.kind == "rgb" and value.channel is not None:
+            raise ValueError(f"{self.name} is rgb: it reads all three channels (give channel=None; got {value!r})")
         low, high = value.value_range()
         below = self.low > -np.inf and (np.any(low < self.low) or not self.low_inclusive and np.any(low == self.low))
         above = self.high < np.inf and (np.any(high > self.high) or not self.high_inclusive and np.any(high == self.high))

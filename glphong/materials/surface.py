@@ -1,9 +1,14 @@
 """Surface inputs: values of a textureable parameter that vary over a mesh (textures, vertex colours).
 
-A parameter declared ``Param(..., textureable=True)`` (an rgb parameter) takes, besides a constant,
-a `SurfaceInput`, whose value at a fragment is
+A parameter declared ``Param(..., textureable=True)`` takes, besides a constant, a `SurfaceInput`,
+whose value at a fragment is
 
     value = scale * T(uv) * C            (per channel; glsl/surface.glsl, `material_inputs`)
+
+for an rgb parameter, and for a scalar parameter one channel ``c`` of each (``channel='b'``: glTF's
+metallic is the blue channel of its metallic-roughness texture, roughness the green one):
+
+    value = scale * T(uv).c * C.c        (scale a scalar)
 
     T(uv)  the texture's linear rgb filtered at the fragment's uv (GLSL ``texture()``: trilinear over
            glphong's own mip pyramid, or bilinear), 1 without a texture;
@@ -37,12 +42,14 @@ from glphong.core.imaging import encode_srgb8, srgb_decode
 from glphong.twin.band import EPS
 
 __all__ = ["SurfaceInput", "Texture", "VertexColors", "TextureImage", "surface_texture", "surface_texture_band",
-           "WRAPS", "FILTERS", "MAX_TEXTURE_SIZE"]
+           "WRAPS", "FILTERS", "CHANNELS", "MAX_TEXTURE_SIZE"]
 
 #: texture wrap modes: GL_REPEAT, GL_CLAMP_TO_EDGE (moderngl's textures offer no mirrored repeat)
 WRAPS = ("repeat", "clamp")
 #: filters: trilinear (GL_LINEAR_MIPMAP_LINEAR, mip pyramid) or bilinear (GL_LINEAR, level 0 only)
 FILTERS = ("trilinear", "bilinear")
+#: the channels a scalar parameter's surface input may read
+CHANNELS = ("r", "g", "b")
 #: the largest side glphong uploads (GL 4.5 guarantees 16384)
 MAX_TEXTURE_SIZE = 16384
 
@@ -229,18 +236,27 @@ class SurfaceInput:
     Parameters
     ----------
     scale : float or (3,) array_like
-        Constant factor per channel (>= 0); the parameter's range applies to the product.
+        Constant factor per channel (>= 0); the parameter's range applies to the product.  A float where
+        ``channel`` is given.
     texture : TextureImage or None
     vertex_colors : bool
         Multiply by the mesh's vertex colours (the mesh must have ``colors``).
+    channel : {None, 'r', 'g', 'b'}
+        The one channel a scalar parameter reads (None: the rgb of an rgb parameter).
     """
 
     scale: tuple = (1.0, 1.0, 1.0)
     texture: TextureImage = None
     vertex_colors: bool = False
+    channel: str = None
 
     def __post_init__(self):
-        object.__setattr__(self, "scale", _validate.rgb("scale", self.scale))
+        if self.channel is not None and self.channel not in CHANNELS:
+            raise ValueError(f"channel must be one of {', '.join(map(repr, CHANNELS))} or None (got {self.channel!r})")
+        if self.channel is None:
+            object.__setattr__(self, "scale", _validate.rgb("scale", self.scale))
+        else:
+            object.__setattr__(self, "scale", _validate.scalar("scale", self.scale, low=0.0, high=_validate.FLT_MAX))
         if self.texture is not None and not isinstance(self.texture, TextureImage):
             raise TypeError(f"texture must be a glphong TextureImage or None (got {type(self.texture).__name__})")
         if not isinstance(self.vertex_colors, (bool, np.bool_)):
@@ -250,20 +266,30 @@ class SurfaceInput:
 
     @property
     def mode(self):
-        """``'texture'``, ``'vertex'`` or ``'texture*vertex'``: what the program computes (part of its key)."""
-        return "texture*vertex" if self.texture is not None and self.vertex_colors else \
+        """``'texture'``, ``'vertex'`` or ``'texture*vertex'``, followed by ``':<channel>'`` for a scalar's input: what
+        the program computes (part of its key)."""
+        mode = "texture*vertex" if self.texture is not None and self.vertex_colors else \
             "texture" if self.texture is not None else "vertex"
+        return mode if self.channel is None else f"{mode}:{self.channel}"
 
     def value_range(self):
-        """``(low, high)``, each (3,): the bounds of the value over any surface (vertex colours in [0, 1])."""
+        """``(low, high)``, each (3,) (floats for a channel): the bounds of the value over any surface (vertex colours
+        in [0, 1])."""
         s = np.asarray(self.scale)
-        lo, hi = (self.texture.low, self.texture.high) if self.texture is not None else (1.0, 1.0)
+        if self.texture is None:
+            lo, hi = 1.0, 1.0
+        elif self.channel is None:
+            lo, hi = self.texture.low, self.texture.high
+        else:
+            base = self.texture.levels[0][..., CHANNELS.index(self.channel)]
+            lo, hi = float(base.min()), float(base.max())
         if self.vertex_colors:
             lo, hi = min(lo, 0.0), max(hi, 0.0)
         return s * lo, s * hi
 
     def __repr__(self):
-        parts = [] if self.scale == (1.0, 1.0, 1.0) else [f"scale={self.scale}"]
+        parts = [] if self.scale in ((1.0, 1.0, 1.0), 1.0) else [f"scale={self.scale}"]
+        parts += [] if self.channel is None else [f"channel={self.channel!r}"]
         kind = "VertexColors" if self.texture is None else "Texture"
         if self.texture is not None:
             parts.insert(0, repr(self.texture))
@@ -271,9 +297,9 @@ class SurfaceInput:
         return f"{kind}({', '.join(parts)})"
 
 
-def Texture(image, scale=1.0, srgb=None, wrap="repeat", filter="trilinear", vertex_colors=False):
+def Texture(image, scale=1.0, srgb=None, wrap="repeat", filter="trilinear", vertex_colors=False, channel=None):
     """A textureable parameter's value from an image: ``scale * T(uv)`` (times the vertex colours with
-    ``vertex_colors=True``).
+    ``vertex_colors=True``); for a scalar parameter, one channel of it: ``scale * T(uv).c``.
 
     Parameters
     ----------
@@ -286,6 +312,9 @@ def Texture(image, scale=1.0, srgb=None, wrap="repeat", filter="trilinear", vert
     wrap : {'repeat', 'clamp'}
     filter : {'trilinear', 'bilinear'}
     vertex_colors : bool
+    channel : {None, 'r', 'g', 'b'}
+        The channel a scalar parameter reads (glTF: metallic 'b', roughness 'g' of the metallic-roughness
+        texture, occlusion 'r'); None for an rgb parameter.
 
     Returns
     -------
@@ -298,17 +327,18 @@ def Texture(image, scale=1.0, srgb=None, wrap="repeat", filter="trilinear", vert
     >>> material = glphong.Lambert(kd=glphong.Texture(checker, scale=1 / np.pi))
     """
     texture = image if isinstance(image, TextureImage) else TextureImage(image, srgb, wrap, filter)
-    return SurfaceInput(scale=scale, texture=texture, vertex_colors=vertex_colors)
+    return SurfaceInput(scale=scale, texture=texture, vertex_colors=vertex_colors, channel=channel)
 
 
-def VertexColors(scale=1.0):
-    """A textureable parameter's value from the mesh's vertex colours: ``scale * C``.
+def VertexColors(scale=1.0, channel=None):
+    """A textureable parameter's value from the mesh's vertex colours: ``scale * C`` (``scale * C.c`` with a
+    ``channel``, for a scalar parameter).
 
     Returns
     -------
     SurfaceInput
     """
-    return SurfaceInput(scale=scale, vertex_colors=True)
+    return SurfaceInput(scale=scale, vertex_colors=True, channel=channel)
 
 
 # --------------------------------------------------------------------------- the twin of surface.glsl

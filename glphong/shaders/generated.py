@@ -68,16 +68,18 @@ def material_chunk(key):
         lines.append(_switch(key, f"u_use_{t.name}", f"response += {t.name}_response(f, wi, {view}, n_dot_l);"))
     lines += ["    return response;", "}"]
     if key.inputs:
-        lines += ["", "// surface inputs (glsl/surface.glsl): u_<model>_<param> = scale * texture(uv) * vertex colour"]
+        lines += ["", "// surface inputs (glsl/surface.glsl): u_<model>_<param> = scale * texture(uv) * vertex colour",
+                  "// (a scalar parameter: one channel c of each, scale * texture(uv).c * colour.c)"]
         for term, param, mode in key.inputs:
-            lines.append(f"uniform vec3 u_{term}_{param}_scale;")
+            lines.append(f"uniform {'vec3' if ':' not in mode else 'float'} u_{term}_{param}_scale;")
             if "texture" in mode:
                 lines.append(f"uniform sampler2D u_{term}_{param}_texture;")
         lines += ["", "void material_inputs(vec2 uv, vec3 color)", "{"]
         for term, param, mode in key.inputs:
+            channel = "." + mode.split(":")[1] if ":" in mode else ""
             factors = [f"u_{term}_{param}_scale"]
-            factors += [f"surface_texture(u_{term}_{param}_texture, uv)"] if "texture" in mode else []
-            factors += ["color"] if "vertex" in mode else []
+            factors += [f"surface_texture(u_{term}_{param}_texture, uv){channel}"] if "texture" in mode else []
+            factors += [f"color{channel}"] if "vertex" in mode else []
             lines.append(f"    u_{term}_{param} = {' * '.join(factors)};")
         lines.append("}")
     return "\n".join(lines) + "\n"

@@ -59,7 +59,8 @@ class TermKey:
         The answer is ``ambient_scale * k * L_a`` (``1/pi`` for an albedo ``rho``: ``rho/pi L_a``).
     inputs : tuple of (str, str)
         The parameters the program sets per fragment (surface inputs, glsl/surface.glsl) and how:
-        ``(param, mode)`` with mode ``'texture'``, ``'vertex'`` or ``'texture*vertex'``.
+        ``(param, mode)`` with mode ``'texture'``, ``'vertex'`` or ``'texture*vertex'``, followed by ``':r'``,
+        ``':g'`` or ``':b'`` where a scalar parameter reads one channel.
     integral : glphong.materials.model.Integral or None
         How the term reflects an extended light in closed form, where the program has one (else sampled).
     """
@@ -344,7 +345,8 @@ class ProgramKey:
                 out += [(f"{upper}_{name}", value) for name, value in light.defines]
             for term in self.terms:  # a model's structural defines, prefixed with its name
                 out += [(f"{term.name.upper()}_{name}", value) for name, value in term.defines]
-                out += [(surface_define(term.name, param), str(INPUT_MODES.index(mode) + 1)) for param, mode in term.inputs]
+                out += [(surface_define(term.name, param), str(INPUT_MODES.index(mode.split(":")[0]) + 1))
+                        for param, mode in term.inputs]
         return out
 
     def library_chunks(self):
