@@ -321,7 +321,8 @@ EXAMPLES = {
     "gltf_pbr": [Example("white dielectric roughness=0.3", functools.partial(GltfPBR, 1.0, 0.0, 0.3)),
                  Example("copper metal roughness=0.2", functools.partial(GltfPBR, (0.95, 0.64, 0.54), 1.0, 0.2)),
                  Example("half metal roughness=0.8", functools.partial(GltfPBR, (0.5, 0.1, 0.0), 0.5, 0.8), seed=1,
-                         normal=tuple(TILTED))],
+                         normal=tuple(TILTED)),
+                 Example("emissive, occluded", functools.partial(GltfPBR, 0.7, 0.2, 0.5, (0.2, 0.1, 0.0), 0.4), seed=2)],
     "ward_lobe": _ward(),
     "ashikhmin_shirley": _ashikhmin_shirley(),
     # nearest: the same bin on both sides (measured 6e-8); trilinear: float32 weights of steep neighbouring
@@ -536,9 +537,20 @@ def _check_vanishing_and_ambient(model, m, values):
     if answers:
         assert [(t.name, t.lit, t.ambient, t.ambient_param, t.ambient_scale) for t in ambient.terms] == [
             (model.name, False, True, model.ambient, model.ambient_scale)]
-        assert m.uniform_values(ambient).keys() == {model.uniform_name(model.ambient)}
-    else:
+        occluded = {model.uniform_name(model.occluded_by)} if model.occluded_by else set()
+        occluded |= {model.uniform_name(model.emission)} if m.emits() else set()
+        assert m.uniform_values(ambient).keys() == {model.uniform_name(model.ambient)} | occluded
+        assert ambient.terms[0].occlusion == model.occluded_by
+    elif not m.emits():
         assert ambient.terms == ()
+    # what a term emits: in every program where it is not zero (lights or none), nowhere where it is zero
+    emits = model.emission is not None and bool(np.any(getattr(m, model.emission)))
+    assert m.emits() == emits
+    dark = program_key(m, {}, None)
+    assert [t.emission for t in dark.terms] == ([model.emission] if emits else [])
+    if emits:
+        assert m.uniform_values(dark).keys() == {model.uniform_name(model.emission)}
+    assert all(t.emission is None for t in response_key(m).terms)  # a response program emits nothing
 
 
 def _check_key(model, m):
@@ -549,9 +561,12 @@ def _check_key(model, m):
     assert ("in_tangent" in key.attributes()) == ("tangent" in model.needs)
     assert set(key.library_chunks()) == set(m.library_uses()) >= set(model.uses)
     uniforms = m.uniform_values(key)
-    assert uniforms.keys() == {model.uniform_name(p.name) for p in m.active_params()} | \
+    # the emission and the occlusion are read by generated code, only where the key has them
+    generated = {model.emission if not key.terms[0].emission else None, model.occluded_by} - {None}
+    read = [p for p in m.active_params() if p.name not in generated]
+    assert uniforms.keys() == {model.uniform_name(p.name) for p in read} | \
         {model.uniform_name(t.name) for t in model.tables}
-    for p in m.active_params():
+    for p in read:
         value = uniforms[model.uniform_name(p.name)]
         assert value.dtype == np.float32 and value.shape == ((3,) if p.kind == "rgb" else ())
         if not p.name.startswith("fresnel_"):

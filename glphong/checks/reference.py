@@ -97,17 +97,23 @@ def _terms(material):
 
 
 def material_emission(key, uniforms, shape, dtype, material=None, inputs=None):
-    """``k_a + sum_terms k L_a`` (the generated material chunk's ``material_emission``), broadcast to ``shape``;
+    """``k_a + sum_terms (o k L_a + e)`` (the generated material chunk's ``material_emission``: ``o`` a term's
+    occlusion, ``e`` what it emits), broadcast to ``shape``;
     ``inputs`` the per-fragment values of surface inputs (`material_inputs`), where the key has them."""
+    def value(name, rgb=True):
+        v = inputs[name] if inputs is not None and name in inputs else uniforms[name]
+        return v[..., None] if not rgb and np.ndim(v) == 1 else v  # a scalar per fragment, (N,), against rgb
+
     radiance = np.zeros(shape, dtype)
     if key.has_ka:
         radiance = radiance + uniforms["u_ka"]
     for term in key.terms:
         if term.ambient:
             scale = np.float32(term.ambient_scale).astype(dtype)
-            name = f"u_{term.name}_{term.ambient_param}"
-            k = inputs[name] if inputs is not None and name in inputs else uniforms[name]
-            radiance = radiance + k * (scale * uniforms["u_ambient"])
+            answer = value(f"u_{term.name}_{term.ambient_param}") * (scale * uniforms["u_ambient"])
+            radiance = radiance + (value(f"u_{term.name}_{term.occlusion}", False) * answer if term.occlusion else answer)
+        if term.emission:
+            radiance = radiance + value(f"u_{term.name}_{term.emission}")
     return radiance
 
 

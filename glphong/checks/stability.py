@@ -190,7 +190,11 @@ def oracle(scene, normal, point=(0.0, 0.0, 0.0), digits=60, tangent=(1.0, 0.0, 0
             if term.ambient is not None:
                 k = vec(getattr(term, term.ambient))
                 scale = mpmath.mpf(term.ambient_scale)
-                out = [o + scale * a * la for o, a, la in zip(out, k, vec(scene.ambient.radiance))]
+                occlusion = f(getattr(term, term.occluded_by)) if term.occluded_by else mpmath.mpf(1)
+                out = [o + occlusion * scale * a * la for o, a, la in zip(out, k, vec(scene.ambient.radiance))]
+    for term in material.components:
+        if term.emission is not None:
+            out = [o + e for o, e in zip(out, vec(getattr(term, term.emission)))]
     raw_n = np.asarray(normal, dtype=np.float32)
     if not np.all(np.isfinite(raw_n)) or not np.any(raw_n):
         return np.array([float(o) for o in out])

@@ -50,7 +50,8 @@ def _textured_band(term, f, wi, wo, n_dot_l, u, band):
         return low, high
     at = np.maximum(n_dot_l, np.finfo(np.float64).tiny)
     base = np.asarray(term.response(f, wi, wo, at, values), dtype=np.float64)
-    for name in (term.uniform_name(param) for param in term.surface_inputs()):
+    read = [term.uniform_name(param) for param in term.surface_inputs() if param not in (term.emission, term.occluded_by)]
+    for name in (name for name in read if name in f.input_bounds):  # the response's own inputs
         up, down = np.zeros_like(base), np.zeros_like(base)
         for end in f.input_bounds[name]:
             moved = term.values_from_uniforms(u, inputs={**f.inputs, name: end})
@@ -89,7 +90,7 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
     low_inputs, high_inputs = _input_ends(f)
     lo = ref.material_emission(key, u, position.shape, np.float64, inputs=low_inputs) * (1 - band.A * EPS)
     hi = ref.material_emission(key, u, position.shape, np.float64, inputs=high_inputs) * (1 + band.A * EPS)
-    terms = int(key.has_ka) + sum(1 for t in key.terms if t.ambient)
+    terms = int(key.has_ka) + sum(1 for t in key.terms if t.ambient) + sum(1 for t in key.terms if t.emission)
     if key.num_lights:
         wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
         tol = band.D * EPS

@@ -39,7 +39,8 @@ def _check_glsl(cls, text):
             f"{cls.__qualname__}.glsl reads {', '.join(f'u_{name}_{x}' for x in sorted(read - declared))}, "
             f"which no Param or Table declares (params and tables: {', '.join(sorted(declared)) or 'none'})")
     # the Fresnel slot's uniforms and the ambient parameter are read by generated code
-    unread = declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]} - {cls.ambient}
+    unread = declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]} \
+        - {cls.ambient, cls.emission, cls.occluded_by}
     if unread:
         raise MaterialDefinitionError(
             f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(unread))}: "
@@ -160,6 +161,13 @@ def check_definition(cls, base):
     if cls.ambient is not None and cls.ambient not in rgb:
         raise MaterialDefinitionError(f"{cls.__qualname__}.ambient must be None or the name of an rgb Param "
                                       f"({', '.join(sorted(rgb)) or 'none'}) (got {cls.ambient!r})")
+    if cls.emission is not None and cls.emission not in rgb:
+        raise MaterialDefinitionError(f"{cls.__qualname__}.emission must be None or the name of an rgb Param "
+                                      f"({', '.join(sorted(rgb)) or 'none'}) (got {cls.emission!r})")
+    fractions = {p.name for p in params if p.kind == "scalar" and p.low == 0.0 and p.high == 1.0}
+    if cls.occluded_by is not None and cls.occluded_by not in fractions:
+        raise MaterialDefinitionError(f"{cls.__qualname__}.occluded_by must be None or the name of a scalar Param in "
+                                      f"[0, 1] ({', '.join(sorted(fractions)) or 'none'}) (got {cls.occluded_by!r})")
     if not set(cls.vanishes_with) <= set(names):
         raise MaterialDefinitionError(f"{cls.__qualname__}.vanishes_with names {sorted(set(cls.vanishes_with) - set(names))}, "
                                       "which are not params")

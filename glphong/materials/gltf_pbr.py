@@ -59,6 +59,10 @@ _METALLIC = Param("metallic", "scalar", low=0.0, high=1.0, default=1.0, unit="",
                   doc="metallicFactor")
 _ROUGHNESS = Param("roughness", "scalar", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
                    doc="roughnessFactor (alpha = roughness^2)")
+_EMISSIVE = Param("emissive", "rgb", low=0.0, default=0.0, unit="W/(m^2 sr)", textureable=True,
+                  doc="emissiveFactor (times KHR_materials_emissive_strength): radiance emitted")
+_OCCLUSION = Param("occlusion", "scalar", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
+                   doc="the occlusion texture's 1 + strength (R - 1): scales the ambient answer only")
 
 
 def _dot(a, b):
@@ -104,11 +108,21 @@ class GltfPBR(MaterialModel):
         (``glphong.Texture(image, metallic, srgb=False, channel='b')``).
     roughness : float or SurfaceInput
         ``roughnessFactor`` in [0, 1]; times that texture's green channel (``channel='g'``); ``alpha = roughness^2``.
+    emissive : float or (3,) array_like or SurfaceInput
+        ``emissiveFactor`` times ``KHR_materials_emissive_strength`` [W/(m^2 sr)], >= 0: radiance the surface emits
+        whatever the lights; times the emissive texture (sRGB) where given.
+    occlusion : float or SurfaceInput
+        In [0, 1]: multiplies the answer to the ambient light ``base_color / pi L_a`` (and to an environment light),
+        never a point, spot, directional or area light's; glTF's ``1 + strength (R - 1)`` of its occlusion texture.
     """
 
     name = "gltf_pbr"
-    params = (_BASE_COLOR, _METALLIC, _ROUGHNESS)
+    params = (_BASE_COLOR, _METALLIC, _ROUGHNESS, _EMISSIVE, _OCCLUSION)
     needs = ("view",)
+    ambient = "base_color"
+    ambient_scale = 1.0 / np.pi
+    emission = "emissive"
+    occluded_by = "occlusion"
     glsl = GlslFile("materials/gltf_pbr.glsl")
     uses = ("microfacet",)
     vanishes_with = ()

@@ -99,7 +99,10 @@ class Material:
             term = by_name.get(term_key.name)
             if term is None:
                 continue  # the uber-shader's terms this material does not have: the caller fills zeros
-            params = term.active_params() if term_key.lit else [p for p in term.params if p.name == term.ambient]
+            unlit = {term_key.ambient_param if term_key.ambient else None, term_key.emission, term_key.occlusion}
+            generated = {term.emission, term.occluded_by} - unlit  # read by material_emission only, where the key has them
+            params = [p for p in term.active_params() if p.name not in generated] if term_key.lit else \
+                [p for p in term.params if p.name in unlit]
             surface = term.surface_inputs()
             for p in params:
                 if p.name in surface:  # scale * texture * vertex colour, per fragment (material_inputs)
@@ -231,6 +234,13 @@ class MaterialModel(Material):
         (``atan2_first_quadrant``), ``'microfacet'`` (``microfacet_geometry``).
     ambient : str or None
         The rgb parameter ``k`` of the model's answer ``k L_a`` to the ambient light, or None.
+    emission : str or None
+        The rgb parameter the term emits as radiance [W/(m^2 sr)] (glTF's emissive), added to every fragment
+        whatever the lights, or None.  Read by generated code only (``material_emission``).
+    occluded_by : str or None
+        The scalar parameter in [0, 1] (glTF's occlusion) that multiplies the term's answer to the ambient light and
+        its reflection of the lights whose kind is `occludable` (the environment), not of punctual or area lights;
+        or None.  Read by generated code only.
     vanishes_with : tuple of str
         Parameters that scale the whole term: where any of them is zero in every channel the term
         is left out of the program.
@@ -271,6 +281,8 @@ class MaterialModel(Material):
     glsl = None
     uses = ()
     ambient = None
+    emission = None
+    occluded_by = None
     vanishes_with = ()
     properties = Properties()
     choices = ()
@@ -427,6 +439,10 @@ class MaterialModel(Material):
         """True where the model answers ``L_a`` with a non-zero ``k``."""
         return self.ambient is not None and bool(np.any(_constant_part(getattr(self, self.ambient))))
 
+    def emits(self):
+        """True where the model declares an `emission` parameter and it is not zero in every channel."""
+        return self.emission is not None and bool(np.any(_constant_part(getattr(self, self.emission))))
+
     def surface_inputs(self):
         """The parameters given a `SurfaceInput` (a texture or vertex colours), by name (dict)."""
 
@@ -438,8 +454,11 @@ class MaterialModel(Material):
 
         ``names`` limits them (an ambient-only term has only its ambient parameter).  ``inputs`` maps
         the uniform name of each surface input to its per-fragment values, (N, 3) (the twin's
-        `glphong.reference.material_inputs`); those parameters are (N, 3) arrays."""
-        params = [p for p in self.uniform_params() if names is None or p.name in names]
+        `glphong.reference.material_inputs`); those parameters are (N, 3) arrays.  The `emission` and `occluded_by`
+        parameters, which only generated code reads, are left out where the program has neither."""
+        given = set(uniforms) | set(inputs or ())
+        params = [p for p in self.uniform_params() if (names is None or p.name in names) and not
+                  (p.name in (self.emission, self.occluded_by) and self.uniform_name(p.name) not in given)]
         surface = self.surface_inputs()
         if surface and inputs is None:
             raise ValueError(f"{type(self).__name__}: {', '.join(surface)} vary over the surface (a texture or vertex "
@@ -534,8 +553,8 @@ class MaterialModel(Material):
             with np.errstate(all="ignore"):
                 add(self.response(f, wi, wo, moved, p))
         for param in self.uniform_params():
-            if param.kind != "scalar" or param.name == "fresnel_form":  # an index, not a measured value
-                continue
+            if param.kind != "scalar" or param.name == "fresnel_form" or param.name not in p.__dict__:
+                continue  # an index, not a measured value; or a parameter the response does not read
             for sign in (1.0, -1.0):
                 scaled = ParamValues({**p.__dict__, param.name: p.__dict__[param.name] * (1.0 + sign * constants.A * EPS)})
                 with np.errstate(all="ignore"):

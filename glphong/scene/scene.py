@@ -323,6 +323,8 @@ class Scene:
             flags[f"u_use_{term.name}"] = term.name in active and active[term.name].lit
             if term.ambient:
                 flags[f"u_use_{term.name}_ambient"] = term.name in active and active[term.name].ambient
+            if term.emission:
+                flags[f"u_use_{term.name}_emission"] = term.name in active and bool(active[term.name].emission)
         values.update({name: np.float32(v) for name, v in flags.items()})
         return values
 

@@ -38,16 +38,19 @@ def _glsl_float(value):
 def material_chunk(key):
     """The generated GLSL that sums the key's terms (label ``generated:material``).
 
-    ``material_emission() = k_a + sum_terms k_term L_a`` and
+    ``material_emission() = k_a + sum_terms (o_term k_term L_a + e_term)`` (``o`` a term's occlusion, 1 without;
+    ``e`` what it emits, 0 without) and
     ``material_response(f, wi, wo, n_dot_l) = sum_lit_terms <model>_response(f, wi, wo, n_dot_l)``;
     in the uber-shader every term is behind a ``SWITCH(u_use_<model>)`` uniform flag.
     """
     lines = ["// material (generated from the program key) -- the material as a sum of its terms (docs/design.md section 8):",
-             "//   material_emission() = k_a + sum_terms k L_a                          [W/(m^2 sr)]",
+             "//   material_emission() = k_a + sum_terms (o k L_a + e)                  [W/(m^2 sr)]",
+             "//     (o a term's occlusion, e the radiance it emits, where it declares them)",
              "//   material_response(f, wi, wo, n_dot_l) = sum_terms <model>_response    [1/sr], times cos"]
     if key.uber:
         lines += ["uniform float u_use_ka;"] + [f"uniform float u_use_{t.name};" for t in key.lit_terms]
         lines += [f"uniform float u_use_{t.name}_ambient;" for t in key.terms if t.ambient]
+        lines += [f"uniform float u_use_{t.name}_emission;" for t in key.terms if t.emission]
         lines += [f"uniform float u_{light.name}_count;" for light in key.lights]
     if key.has_ka:
         lines.append("uniform vec3 u_ka;                 // k_a [W/(m^2 sr)]")
@@ -59,7 +62,11 @@ def material_chunk(key):
     for t in key.terms:
         if t.ambient:
             scaled = "u_ambient" if t.ambient_scale == 1.0 else f"({_glsl_float(t.ambient_scale)} * u_ambient)"
-            lines.append(_switch(key, f"u_use_{t.name}_ambient", f"radiance += u_{t.name}_{t.ambient_param} * {scaled};"))
+            answer = f"u_{t.name}_{t.ambient_param} * {scaled}"
+            answer = f"u_{t.name}_{t.occlusion} * ({answer})" if t.occlusion else answer
+            lines.append(_switch(key, f"u_use_{t.name}_ambient", f"radiance += {answer};"))
+        if t.emission:
+            lines.append(_switch(key, f"u_use_{t.name}_emission", f"radiance += u_{t.name}_{t.emission};"))
     lines += ["    return radiance;", "}", "",
               "vec3 material_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)", "{",
               "    vec3 response = vec3(0.0);"]

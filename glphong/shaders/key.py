@@ -63,6 +63,11 @@ class TermKey:
         ``':g'`` or ``':b'`` where a scalar parameter reads one channel.
     integral : glphong.materials.model.Integral or None
         How the term reflects an extended light in closed form, where the program has one (else sampled).
+    emission : str or None
+        The rgb parameter the term emits (`glphong.materials.MaterialModel.emission`), where it is not zero.
+    occlusion : str or None
+        The scalar parameter that multiplies the term's answer to ``L_a`` (`glphong.materials.MaterialModel.occluded_by`),
+        where the term answers it.
     """
 
     name: str
@@ -76,6 +81,8 @@ class TermKey:
     ambient_scale: float = 1.0
     inputs: tuple = ()
     integral: object = None
+    emission: str = None
+    occlusion: str = None
 
     @property
     def chunk(self):
@@ -84,7 +91,8 @@ class TermKey:
         return f"model:{self.name}@{self.source_hash}"
 
     def describe(self):
-        flags = [f for f, on in (("lit", self.lit), ("ambient", self.ambient)) if on]
+        flags = [f for f, on in (("lit", self.lit), ("ambient", self.ambient), ("emission", self.emission),
+                                 ("occlusion", self.occlusion)) if on]
         flags += [f"{param}={mode}" for param, mode in self.inputs]
         return f"{self.name}[{','.join(flags)}]"
 
@@ -488,32 +496,39 @@ def _ambient_present(ambient_radiance):
     return ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance)
 
 
-def _term_key(term, lit, ambient, uber=False, extended=False):
+def _term_key(term, lit, ambient, uber=False, extended=False, emits=False):
     surface = term.surface_inputs()
-    inputs = tuple((p.name, surface[p.name].mode) for p in term.params
-                   if p.name in surface and (lit or (ambient and p.name == term.ambient)))
+    emission = term.emission if emits else None
+    occlusion = term.occluded_by if ambient else None
+    read = ({p.name for p in term.params} - {term.emission, term.occluded_by} if lit else set()) \
+        | {term.ambient if ambient else None, emission, occlusion}  # by the response, or by material_emission
+    inputs = tuple((p.name, surface[p.name].mode) for p in term.params if p.name in surface and p.name in read)
     return TermKey(term.name, term.source_hash(), tuple(term.needs), lit=lit, ambient=ambient,
                    uses=term.library_uses(uber), defines=term.structural_defines(uber), ambient_param=term.ambient,
-                   ambient_scale=float(term.ambient_scale), inputs=inputs, integral=term.integral_form() if lit and extended else None)
+                   ambient_scale=float(term.ambient_scale), inputs=inputs,
+                   integral=term.integral_form() if lit and extended else None, emission=emission, occlusion=occlusion)
 
 
-def term_keys(material, lit, ambient_present, extended=False):
+def term_keys(material, lit, ambient_present, extended=False, emission=True):
     """The `TermKey` of each term of ``material`` that a program evaluates; ``extended``: the program has an
-    extended light (each lit term's closed form, `TermKey.integral`, is part of the key)."""
+    extended light (each lit term's closed form, `TermKey.integral`, is part of the key); ``emission``: the program
+    adds what the terms emit (not a response program)."""
     out = []
     for term in material.components:
-        if term.vanishes():
+        emits = emission and term.emits()
+        if term.vanishes() and not emits:
             continue
-        answers = ambient_present and term.answers_ambient()
-        if lit or answers:
-            out.append(_term_key(term, lit=lit, ambient=answers, extended=extended))
+        answers = ambient_present and term.answers_ambient() and not term.vanishes()
+        reflects = lit and not term.vanishes()
+        if reflects or answers or emits:
+            out.append(_term_key(term, lit=reflects, ambient=answers, extended=extended, emits=emits))
     return tuple(out)
 
 
 def response_key(material):
     """The key of a program that evaluates ``material``'s response at direction pairs (`glphong.testing`):
     every term that does not vanish, in the light loop's place, no light, no emission."""
-    terms = tuple(t for t in term_keys(material, True, False))
+    terms = tuple(t for t in term_keys(material, True, False, emission=False))
     _refuse_surface_inputs(terms, "glphong.testing evaluates a material's response at given directions, with "
                                   "constant parameters")
     needs = {n for t in terms for n in t.needs}
@@ -632,7 +647,8 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
     # (computing F for every fragment and light would cost the lecture's models whatever the scene)
     with_fresnel = {t.name for t in drawn if getattr(t, "fresnel", None) is not None}
     for term in _uber_builtins() + drawn:
-        key = _term_key(term, lit=True, ambient=term.ambient is not None, uber=term.name in with_fresnel)
+        key = _term_key(term, lit=True, ambient=term.ambient is not None, uber=term.name in with_fresnel,
+                        emits=term.emission is not None)
         known = terms.setdefault(term.name, key)
         if known != key:
             raise ValueError(f"the uber-shader holds one variant of each model, but the scene has two of "

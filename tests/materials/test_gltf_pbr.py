@@ -105,3 +105,74 @@ def test_declaration():
         glphong.GltfPBR(roughness=1.5)
     with pytest.raises(ValueError, match="base_color"):
         glphong.GltfPBR(base_color=(2.0, 0.0, 0.0))
+
+
+# --------------------------------------------------------------------------- emission, occlusion, textures
+def _front_scene(material, lights=(), ambient=None, size=(64, 48)):
+    """A plane facing the camera, filling the view; returns (scene, renderer, covered pixels' radiance)."""
+    from glphong import primitives
+    from glphong.scene.geometry import MeshData
+
+    plane = primitives.plane(size=4.0, segments=2)
+    mesh = MeshData(plane.positions, plane.normals, plane.indices, uvs=plane.uvs)
+    camera = glphong.PerspectiveCamera.look_at((0.0, 0.0, 3.0), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0), yfov=0.6)
+    scene = glphong.Scene(camera, list(lights), ambient=None if ambient is None else glphong.AmbientLight(ambient))
+    scene.add(mesh, material)
+    return scene
+
+
+def test_emission_alone_is_the_emissive_radiance(glphong_backend, glphong_make_renderer):
+    """No light, no ambient: every covered pixel is emissiveFactor times its strength, exactly (float32)."""
+    emissive = (0.25, 1.5, 3.0)  # a strength above 1 (KHR_materials_emissive_strength)
+    scene = _front_scene(glphong.GltfPBR(0.5, 0.0, 0.5, emissive=emissive))
+    renderer = glphong_make_renderer(64, 48, glphong_backend)
+    frame = renderer.render(scene)
+    covered = frame.mask
+    assert covered.sum() > 1000
+    np.testing.assert_array_equal(frame.radiance[covered], np.broadcast_to(np.float32(emissive), (covered.sum(), 3)))
+    key = renderer.program_key(scene, scene.objects[0])
+    assert key.num_lights == 0 and key.terms[0].emission == "emissive" and not key.terms[0].lit
+
+
+def test_occlusion_scales_the_ambient_answer_only(glphong_backend, glphong_make_renderer):
+    """Ambient only: L = occlusion base_color / pi L_a (pyrender's base_color ambient, glphong's irradiance
+    convention); a point light's term is not occluded."""
+    base, occlusion, la = np.array([0.8, 0.4, 0.2]), 0.25, 2.0
+    renderer = glphong_make_renderer(64, 48, glphong_backend)
+    ambient_only = renderer.render(_front_scene(glphong.GltfPBR(base, 0.0, 0.5, occlusion=occlusion), ambient=la))
+    expected = occlusion * np.float32(base) / np.pi * la
+    covered = ambient_only.mask
+    np.testing.assert_allclose(ambient_only.radiance[covered], np.broadcast_to(expected, (covered.sum(), 3)), rtol=1e-6)
+    light = glphong.PointLight((0.3, 0.2, 2.0), 50.0)
+    occluded = renderer.render(_front_scene(glphong.GltfPBR(base, 0.0, 0.5, occlusion=occlusion), [light]))
+    clear = renderer.render(_front_scene(glphong.GltfPBR(base, 0.0, 0.5), [light]))
+    np.testing.assert_array_equal(occluded.radiance, clear.radiance)
+
+
+def test_what_a_scene_does_not_need_is_left_out():
+    """Emission only where it is not zero; occlusion only where the term answers an ambient light."""
+    from glphong.shaders.key import program_key
+
+    lights = [glphong.PointLight((0.0, 0.0, 2.0), 10.0)]
+    plain = program_key(glphong.GltfPBR(0.5, 0.0, 0.5, occlusion=0.5), lights, None).terms[0]
+    assert plain.emission is None and plain.occlusion is None and plain.lit
+    both = program_key(glphong.GltfPBR(0.5, 0.0, 0.5, emissive=0.1, occlusion=0.5), lights, (0.1,) * 3).terms[0]
+    assert both.emission == "emissive" and both.occlusion == "occlusion" and both.ambient
+    texture = glphong.Texture(np.full((2, 2), 128, np.uint8), srgb=False, channel="r")
+    unlit = program_key(glphong.GltfPBR(0.5, 0.0, 0.5, occlusion=texture), lights, None).terms[0]
+    assert unlit.inputs == ()  # the occlusion texture is neither sampled nor bound without an ambient light
+
+
+@pytest.mark.parametrize("inputs", ["metallic-roughness", "occlusion and emissive"])
+def test_textured_gltf_material_verifies(inputs, glphong_backend, glphong_make_renderer):
+    rng = np.random.default_rng(3)
+    image = rng.integers(0, 256, (24, 24, 3), dtype=np.uint8)
+    if inputs == "metallic-roughness":
+        material = glphong.GltfPBR(glphong.Texture(image, 0.9), glphong.Texture(image, srgb=False, channel="b"),
+                                   glphong.Texture(image, 0.9, srgb=False, channel="g"))
+    else:
+        material = glphong.GltfPBR(0.6, 0.3, 0.5, emissive=glphong.Texture(image, 0.2),
+                                   occlusion=glphong.Texture(image[::-1], srgb=False, channel="r"))
+    scene = _front_scene(material, [glphong.PointLight((0.5, 0.5, 1.5), 20.0)], ambient=0.5)
+    report = glphong.verify(scene, glphong_make_renderer(96, 72, glphong_backend))
+    assert report.covered_pixels > 3000 and report.passed, report.summary()
