@@ -73,7 +73,13 @@ def test_camera_lights_and_material(tmp_path, glphong_backend, glphong_make_rend
     np.testing.assert_allclose(sun.irradiance, [0.5, 0.5, 0.5], rtol=1e-15)
     np.testing.assert_allclose(sun.direction, [0.0, -1.0, 0.0], atol=1e-12)  # -Z turned by -90 degrees about x
     (ball,) = scene.objects
-    assert ball.material.rho_d == tuple(BASE[:3]) and ball.material.m == 0.25
+    assert isinstance(ball.material, glphong.GltfPBR)  # the specification's BRDF, by default
+    assert ball.material.base_color == tuple(BASE[:3]) and ball.material.metallic == 0.0
+    assert ball.material.roughness == 0.5 and ball.material.emissive == (0.0, 0.0, 0.0)
+    approximation = glphong.load_scene(path, light_units="photometric", materials="cook_torrance").objects[0].material
+    assert approximation.rho_d == tuple(BASE[:3]) and approximation.m == 0.25
+    with pytest.raises(ValueError, match="the one name load_scene takes is 'cook_torrance'"):
+        glphong.load_scene(path, light_units="photometric", materials="ggx")
     radiometric = glphong.load_scene(path, light_units="radiometric")
     power = next(light.power for light in radiometric.lights if hasattr(light, "power"))
     np.testing.assert_allclose(power, 4 * math.pi * 683.0 * np.array([1.0, 0.5, 0.25]), rtol=1e-15)

@@ -72,7 +72,7 @@ def test_gltf_base_colour_texture_and_vertex_colours(tmp_path, glphong_make_rend
     assert "TEXCOORD_0" in glphong.formats.read_gltf_json(path)["meshes"][0]["primitives"][0]["attributes"]
     camera = glphong.PerspectiveCamera.look_at((0.0, 0.0, 3.0), (0.0, 0.0, 0.0), yfov=0.8)
     scene = glphong.load_scene(path, camera=camera, lights=[], ambient=glphong.AmbientLight(1.0))
-    rho = scene.objects[0].material.rho_d
+    rho = scene.objects[0].material.base_color
     assert rho.texture is not None and not rho.vertex_colors
     frame = glphong_make_renderer(64, 64, "egl").render(scene)
     rows = frame.mask.any(axis=1).nonzero()[0]
@@ -82,7 +82,7 @@ def test_gltf_base_colour_texture_and_vertex_colours(tmp_path, glphong_make_rend
     coloured = glphong.load_scene(_marker_gltf(tmp_path, with_colors=True), camera=camera, lights=[],
                                   ambient=glphong.AmbientLight(1.0))
     obj = coloured.objects[0]
-    assert obj.material.rho_d.vertex_colors
+    assert obj.material.base_color.vertex_colors
     accessor = glphong.formats.read_gltf_json(tmp_path / "marker.glb")["accessors"]
     assert any(a.get("componentType") == 5121 for a in accessor)  # COLOR_0 as normalised bytes: linear, not sRGB
     np.testing.assert_array_equal(obj.mesh.colors, np.float32([[128 / 255, 1.0, 1.0]] * len(obj.mesh.colors)))

@@ -11,6 +11,7 @@ from glphong.core.radiometry import LUMENS_PER_WATT
 from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, read_gltf_primitives, texture_sampling
 from glphong.materials import Material, Texture, TextureImage, VertexColors
 from glphong.materials.cook_torrance import CookTorrance
+from glphong.materials.gltf_pbr import GltfPBR
 from glphong.materials.fresnel import SchlickFresnel
 from glphong.formats.overrides import chosen_material
 from glphong.materials.as_json import material_from_json
@@ -19,7 +20,7 @@ from glphong.scene.from_trimesh import _trimesh_material, default_view, empty_sc
 from glphong.lights import AmbientLight, registered_lights
 from glphong.scene.scene import Scene
 
-__all__ = ["read_gltf_json", "gltf_view", "gltf_material", "material_from_extras", "load_gltf"]
+__all__ = ["read_gltf_json", "gltf_view", "gltf_material", "gltf_pbr_material", "material_from_extras", "load_gltf"]
 
 
 def read_gltf_json(path, limits=None):
@@ -150,14 +151,15 @@ _GLTF_KINDS = {kind.gltf_type: kind for kind in registered_lights() if kind.gltf
 
 
 def gltf_material(entry, base_color_texture=None, vertex_colors=False):
-    """glphong's approximation of a glTF metallic-roughness material (JSON ``materials`` entry): Cook-Torrance
-    with Beckmann slope ``m = roughness^2`` (glTF's GGX ``alpha``, at least 1e-3), diffuse albedo
-    ``baseColor (1 - metallic)`` and Schlick's Fresnel with ``f0 = 0.04 (1 - metallic) + baseColorFactor metallic``.
-    The lobes differ (Beckmann against GGX, no coupling of diffuse and specular): an approximation.
+    """The Cook-Torrance approximation of a glTF metallic-roughness material (JSON ``materials`` entry), which
+    ``load_scene(..., materials='cook_torrance')`` still gives (the default is `gltf_pbr_material`, the
+    specification's own BRDF): Cook-Torrance with Beckmann slope ``m = roughness^2`` (glTF's GGX ``alpha``, at least
+    1e-3), diffuse albedo ``baseColor (1 - metallic)`` and Schlick's Fresnel with ``f0 = 0.04 (1 - metallic) +
+    baseColorFactor metallic``.  The lobes differ (Beckmann against GGX, no coupling of diffuse and specular).
 
     ``baseColor`` is ``baseColorFactor`` times the base-colour texture (``base_color_texture``, an image
     array, sRGB, or a `glphong.materials.TextureImage`) times the mesh's ``COLOR_0`` (``vertex_colors``), as glTF defines it; the texture and the
-    colours vary the diffuse albedo only (the metallic-roughness texture is not read)."""
+    colours vary the diffuse albedo only (no other texture is read)."""
 
     pbr = entry.get("pbrMetallicRoughness", {})
     base = np.clip(np.asarray(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3], dtype=np.float64), 0.0, 1.0)
@@ -172,12 +174,101 @@ def gltf_material(entry, base_color_texture=None, vertex_colors=False):
     return CookTorrance(rho_d, max(roughness * roughness, 1e-3), fresnel=SchlickFresnel(tuple(np.clip(f0, 0.0, 1.0))))
 
 
-def _gltf_object_material(gltf, entries, materials, made, name, mesh, index):
-    """The material of one glTF primitive: the user's, the stored glphong one, or `gltf_material`."""
+def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1.0):
+    """A glTF metallic-roughness material (JSON ``materials`` entry) as `glphong.GltfPBR`, the specification's
+    Appendix B, with its textures (docs/formats.md):
+
+    - ``base_color = baseColorFactor.rgb * baseColorTexture (sRGB) * COLOR_0``;
+    - ``metallic = metallicFactor * metallicRoughnessTexture.b``, ``roughness = roughnessFactor *
+      metallicRoughnessTexture.g`` (linear; factors above 1 clamped to 1);
+    - ``emissive = emissiveFactor * KHR_materials_emissive_strength * emissiveTexture (sRGB) * emissive_scale``;
+    - ``occlusion = 1 + strength (occlusionTexture.r - 1)`` (linear), on the ambient and environment answers only.
+
+    Parameters
+    ----------
+    entry : dict
+        The validated JSON entry.
+    texture : callable, optional
+        ``texture(info, srgb)``: the `glphong.materials.TextureImage` of a ``textureInfo`` object, or None where it
+        cannot be read (the texture is then left out); default: no texture is read.
+    vertex_colors : bool
+        The mesh has ``COLOR_0``.
+    emissive_scale : float
+        Converts the file's emissive values to radiance [W/(m^2 sr)]: 1/683 where the file's lights are read as
+        photometric (glphong's luminous efficacy, as for the lights), 1 otherwise.
+
+    Returns
+    -------
+    glphong.GltfPBR
+    """
+    texture = texture or (lambda info, srgb: None)
+    pbr = entry.get("pbrMetallicRoughness", {})
+
+    def image(info_key, srgb, holder=None):
+        holder = entry if holder is None else holder
+        return texture(holder[info_key], srgb) if info_key in holder else None
+
+    base = tuple(np.clip(np.asarray(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[:3], np.float64), 0.0, 1.0))
+    base_image = image("baseColorTexture", True, pbr)
+    base_color = Texture(base_image, scale=base, vertex_colors=vertex_colors) if base_image is not None else \
+        VertexColors(scale=base) if vertex_colors else base
+    metallic = min(float(pbr.get("metallicFactor", 1.0)), 1.0)
+    roughness = min(float(pbr.get("roughnessFactor", 1.0)), 1.0)
+    mr_image = image("metallicRoughnessTexture", False, pbr)
+    if mr_image is not None:
+        metallic = Texture(mr_image, scale=metallic, channel="b")
+        roughness = Texture(mr_image, scale=roughness, channel="g")
+    strength = entry.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get("emissiveStrength", 1.0)
+    emissive = tuple(np.asarray(entry.get("emissiveFactor", (0.0, 0.0, 0.0)), np.float64) * strength * emissive_scale)
+    emissive_image = image("emissiveTexture", True) if any(emissive) else None
+    emissive = Texture(emissive_image, scale=emissive) if emissive_image is not None else emissive
+    occlusion = 1.0
+    occlusion_image = image("occlusionTexture", False)
+    if occlusion_image is not None:
+        weight = float(entry["occlusionTexture"].get("strength", 1.0))
+        if weight != 1.0:  # 1 + s (R - 1), filtered linearly as R is: a float texture of its values
+            red = occlusion_image.levels[0][::-1, :, 0].astype(np.float64)
+            occlusion_image = TextureImage(np.repeat((1.0 - weight + weight * red)[..., None], 3, axis=2),
+                                           wrap=occlusion_image.wrap, filter=occlusion_image.filter)
+        occlusion = Texture(occlusion_image, channel="r")
+    return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion)
+
+
+def _texture_reader(gltf, where):
+    """``texture(info, srgb)`` for `gltf_pbr_material`: the `TextureImage` of a ``textureInfo`` of ``gltf``, or None
+    (with a warning once per file) where it names a second set of texture coordinates or an image glphong does not
+    decode."""
+
+    def texture(info, srgb):
+        if info.get("texCoord", 0) != 0:
+            gltf.warn_once("texCoord", f"{where}: a texture reads TEXCOORD_{info['texCoord']}; glphong reads "
+                           "TEXCOORD_0 only: drawn without that texture")
+            return None
+        if "KHR_texture_transform" in info.get("extensions", {}):
+            gltf.warn_once("KHR_texture_transform", f"{where}: KHR_texture_transform is not applied (textures are "
+                           "sampled at the mesh's own coordinates)")
+        pixels = read_gltf_image(gltf, info["index"])
+        if pixels is None:
+            return None
+        wrap, filter_ = texture_sampling(gltf.document, info["index"])
+        return TextureImage(pixels, srgb=srgb, wrap=wrap, filter=filter_)
+
+    return texture
+
+
+def _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale):
+    """The material of one glTF primitive: the user's, the stored glphong one, or `gltf_pbr_material`
+    (`gltf_material` where ``materials='cook_torrance'``)."""
 
     entry = entries[index] if index is not None else None
     material_name = entry.get("name") if entry is not None else None
-    if callable(materials):
+    approximate = isinstance(materials, str)
+    if approximate and materials != "cook_torrance":
+        raise ValueError(f"materials={materials!r}: the one name load_scene takes is 'cook_torrance' (glTF's "
+                         "metallic-roughness read as the earlier Cook-Torrance approximation)")
+    if approximate:
+        chosen = None
+    elif callable(materials):
         chosen = chosen_material(materials, material_name or name, entry)
     else:
         chosen = next((chosen_material(materials, k, entry) for k in (material_name, name)
@@ -186,26 +277,28 @@ def _gltf_object_material(gltf, entries, materials, made, name, mesh, index):
         return chosen
     if entry is None:
         return _trimesh_material(None)
-    textured = "baseColorTexture" in entry.get("pbrMetallicRoughness", {}) and mesh.uvs is not None
-    key = (index, textured, mesh.colors is not None)
+    key = (index, mesh.uvs is not None, mesh.colors is not None)
     if key not in made:
         stored = material_from_extras(entry, gltf, f"materials[{index}]")
         if stored is None:
-            texture = None
-            if textured:
-                reference = entry["pbrMetallicRoughness"]["baseColorTexture"]["index"]
-                pixels = read_gltf_image(gltf, reference)
-                if pixels is not None:
-                    wrap, filter_ = texture_sampling(gltf.document, reference)
-                    texture = TextureImage(pixels, srgb=True, wrap=wrap, filter=filter_)
-            stored = gltf_material(entry, texture, mesh.colors is not None)
+            where = f"materials[{index}]"
+            texture = _texture_reader(gltf, where) if mesh.uvs is not None else None
+            if entry.get("normalTexture") is not None and mesh.uvs is not None:
+                gltf.warn_once("normalTexture", f"{where}: normal textures are not applied yet (the mesh's normals "
+                               "are shaded)")
+            if approximate:
+                info = entry.get("pbrMetallicRoughness", {}).get("baseColorTexture")
+                stored = gltf_material(entry, texture(info, True) if texture and info else None, mesh.colors is not None)
+            else:
+                stored = gltf_pbr_material(entry, texture, mesh.colors is not None, emissive_scale)
         made[key] = stored
     return made[key]
 
 
 def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name, allow_outside, limits):
     """A glTF file's scene: its own arrays (`glphong.formats.gltf_data`), nodes in file order, materials from the
-    user's ``materials``, else the stored glphong material (``extras``), else `gltf_material`."""
+    user's ``materials``, else the stored glphong material (``extras``), else `gltf_pbr_material` (`gltf_material`
+    with ``materials='cook_torrance'``)."""
 
     gltf = GltfFile(path, limits, allow_outside)
     document = gltf.document
@@ -222,8 +315,10 @@ def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name
     chosen_camera = camera if camera is not None else file_camera
     scene = empty_scene(Scene, chosen_camera, lights, ambient)
     entries, made = document.get("materials", []), {}
+    emissive_scale = 1.0 / LUMENS_PER_WATT if light_units == "photometric" else 1.0
     for name, mesh, world, index in read_gltf_primitives(gltf):
-        scene.add(mesh, _gltf_object_material(gltf, entries, materials, made, name, mesh, index), pose=world, name=name)
+        scene.add(mesh, _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale),
+                  pose=world, name=name)
     if lights is None:  # a file without lights is not drawn black by accident
         _, view_lights, view_ambient = default_view(scene)
         warnings.warn(f"{path} has no lights: glphong adds its default point light and ambient light (give "

@@ -255,6 +255,18 @@ def _check_materials(c):
             c.numbers(material["emissiveFactor"], f"{where}.emissiveFactor", 3, 0.0)
         if "alphaMode" in material:
             c.enum(material["alphaMode"], f"{where}.alphaMode", ("OPAQUE", "MASK", "BLEND"))
+        if "alphaCutoff" in material:
+            c.number(material["alphaCutoff"], f"{where}.alphaCutoff", 0.0)
+        if "strength" in material.get("occlusionTexture", {}):
+            c.number(material["occlusionTexture"]["strength"], f"{where}.occlusionTexture.strength", 0.0, 1.0)
+        if "scale" in material.get("normalTexture", {}):
+            c.number(material["normalTexture"]["scale"], f"{where}.normalTexture.scale")
+        extensions = c.obj(material.get("extensions", {}), f"{where}.extensions")
+        strength = extensions.get("KHR_materials_emissive_strength")
+        if strength is not None:
+            c.obj(strength, f"{where}.extensions.KHR_materials_emissive_strength")
+            c.number(strength.get("emissiveStrength", 1.0),
+                     f"{where}.extensions.KHR_materials_emissive_strength.emissiveStrength", 0.0)
 
 
 def _check_meshes(c):

@@ -15,14 +15,16 @@ from pathlib import Path
 
 from glphong.core.filesafety import SceneFileError, read_text, resolve_reference
 from glphong.core.radiometry import LUMENS_PER_WATT
-from glphong.formats.gltf_scene import gltf_material, gltf_view, load_gltf, material_from_extras, read_gltf_json
+from glphong.formats.gltf_scene import (gltf_material, gltf_pbr_material, gltf_view, load_gltf, material_from_extras,
+                                        read_gltf_json)
 from glphong.formats.mtl import material_from_mtl, parse_mtl
 from glphong.formats.obj import read_obj
 from glphong.formats.overrides import chosen_material
 from glphong.scene.from_trimesh import default_view, empty_scene, scene_bounds, with_default_view
 from glphong.scene.scene import Scene
 
-__all__ = ["load_scene", "FORMATS", "read_obj", "read_gltf_json", "gltf_view", "gltf_material", "material_from_extras",
+__all__ = ["load_scene", "FORMATS", "read_obj", "read_gltf_json", "gltf_view", "gltf_material", "gltf_pbr_material",
+           "material_from_extras",
            "scene_from_trimesh", "parse_mtl", "material_from_mtl", "default_view", "scene_bounds", "LUMENS_PER_WATT"]
 
 #: formats `load_scene` reads
@@ -51,9 +53,11 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None, lig
         As in `scene_from_trimesh`; default: the file's (glTF: `gltf_view`), else `default_view`'s.  A
         file with no light gets `default_view`'s light and ambient light, with a warning (``lights=[]``
         keeps it dark on purpose).
-    materials : dict of str to Material, or callable, optional
+    materials : dict of str to Material, callable, or 'cook_torrance', optional
         Overrides the file's materials by material name; a callable gets ``(name, MTL or glTF entry or
-        None)`` and returns a Material (or None for the file's).
+        None)`` and returns a Material (or None for the file's).  glTF: ``'cook_torrance'`` reads every
+        metallic-roughness material as the earlier Cook-Torrance approximation (`gltf_material`) instead of
+        the specification's BRDF (`gltf_pbr_material`, the default).
     light_units : {'photometric', 'radiometric'}, optional
         Required where a glTF file has lights (`gltf_view`).
     camera_name : str, optional
