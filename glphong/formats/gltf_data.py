@@ -34,7 +34,7 @@ from glphong.formats.gltf_validate import COMPONENT_BYTES, TYPE_WIDTHS, validate
 from glphong.scene.geometry import MeshData
 
 __all__ = ["GltfFile", "glb_chunks", "node_matrices", "read_accessor", "read_gltf_primitives", "read_gltf_image",
-           "texture_sampling", "REQUIRED_OK", "APPEARANCE_ONLY"]
+           "texture_sampling", "gl_sampling", "REQUIRED_OK", "APPEARANCE_ONLY"]
 
 _DTYPES = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32, 5126: np.float32}
 _TRIANGLES, _STRIP, _FAN = 4, 5, 6
@@ -514,12 +514,18 @@ def _decode_gltf_image(gltf, source):
 
 
 def texture_sampling(document, index):
-    """``(wrap, filter)`` of glTF texture ``index``: its sampler's ``wrapS`` (10497 repeat, 33071 clamp;
-    mirrored repeat is read as repeat, with a warning) and ``minFilter`` (a mipmapped or absent one:
-    'trilinear'; 9728/9729: 'bilinear')."""
+    """``(wrap, filter)`` of glTF texture ``index``: its sampler's ``wrapS`` and ``minFilter`` (`gl_sampling`)."""
     sampler = document.get("samplers", [])[document["textures"][index]["sampler"]] \
         if "sampler" in document["textures"][index] else {}
-    wrap = {10497: "repeat", 33071: "clamp", 33648: "repeat"}.get(sampler.get("wrapS", 10497), "repeat")
-    if sampler.get("wrapS") == 33648:
+    return gl_sampling(sampler.get("wrapS"), sampler.get("minFilter"))
+
+
+def gl_sampling(wrap_s, min_filter):
+    """``(wrap, filter)`` of a glTF or pyrender sampler's GL ``wrapS`` and ``minFilter`` (None: the glTF defaults):
+    10497 'repeat', 33071 'clamp' (mirrored repeat, 33648, is read as repeat, with a warning); a mipmapped or absent
+    minification filter 'trilinear', 9728/9729 'bilinear'."""
+    wrap_s = 10497 if wrap_s is None else int(wrap_s)
+    wrap = {10497: "repeat", 33071: "clamp", 33648: "repeat"}.get(wrap_s, "repeat")
+    if wrap_s == 33648:
         warnings.warn("a glTF sampler's MIRRORED_REPEAT is read as REPEAT (glphong has repeat and clamp)", stacklevel=3)
-    return wrap, "bilinear" if sampler.get("minFilter") in (9728, 9729) else "trilinear"
+    return wrap, "bilinear" if min_filter in (9728, 9729) else "trilinear"

@@ -36,6 +36,7 @@ pyrender 0.1.45's OSMesa platform needs PyOpenGL >= 3.1.5 (``pip install --no-de
 """
 import os
 import threading
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -43,17 +44,18 @@ import pyrender
 from pyrender.constants import ProgramFlags, RenderFlags
 from pyrender.renderer import Renderer as _PyrenderRenderer
 
+from glphong.formats.gltf_data import gl_sampling
 from glphong.lights import AmbientLight, registered_lights
 from glphong.core.validate import scalar
 from glphong.scene.camera import PerspectiveCamera
 from glphong.gpu.contexts import attach_current
 from glphong.scene.geometry import MeshData
 from glphong.shaders.key import program_key
-from glphong.materials import Material
+from glphong.materials import GltfPBR, Material, Texture, TextureImage
 from glphong.gpu.programs import ProgramCache
 from glphong.scene.scene import Scene
 
-__all__ = ["GlphongMaterial", "enable", "glphong_lights_of", "scene_from_pyrender"]
+__all__ = ["GlphongMaterial", "enable", "glphong_lights_of", "scene_from_pyrender", "gltf_pbr_of"]
 
 
 class GlphongMaterial(pyrender.Material):
@@ -78,6 +80,12 @@ class GlphongMaterial(pyrender.Material):
     def __repr__(self):
         return f"GlphongMaterial({self.glphong!r}, exposure={self.exposure:g})"
 
+    @classmethod
+    def from_pyrender(cls, material, exposure=1.0):
+        """The `GlphongMaterial` of a ``pyrender.MetallicRoughnessMaterial``: `gltf_pbr_of` it (glTF's Appendix B with
+        its textures), to swap into a pyrender scene."""
+        return cls(gltf_pbr_of(material), exposure=exposure, name=material.name)
+
     @property
     def tex_flags(self):
         """pyrender reads this while drawing the primitive: only a renderer `enable` d may draw it."""
@@ -91,6 +99,54 @@ class GlphongMaterial(pyrender.Material):
 
 #: set while an enabled renderer draws (per thread)
 _DRAWING = threading.local()
+
+
+def gltf_pbr_of(material):
+    """The `glphong.GltfPBR` of a ``pyrender.MetallicRoughnessMaterial`` (glTF's metallic-roughness, as pyrender holds
+    it): ``baseColorFactor`` (rgb) times ``baseColorTexture`` (sRGB); ``metallicFactor`` and ``roughnessFactor``
+    times the metallic-roughness texture's blue and green channels (pyrender keeps them as its two channels 'GB');
+    ``emissiveFactor`` times ``emissiveTexture`` (sRGB); ``occlusionTexture``'s red channel; each texture's sampler
+    (`glphong.formats.gltf_data.gl_sampling`); ``doubleSided`` as ``two_sided``.  The normal texture is not applied
+    (a warning says so), and neither is alpha.
+
+    Raises
+    ------
+    TypeError
+        Another kind of pyrender material (a ``SpecularGlossinessMaterial``).
+    """
+    if not isinstance(material, pyrender.MetallicRoughnessMaterial):
+        raise TypeError(f"glphong converts pyrender.MetallicRoughnessMaterial (glTF's metallic-roughness), not "
+                        f"{type(material).__name__}")
+
+    def image(texture, channels, srgb):
+        if texture is None:
+            return None
+        pixels = np.asarray(texture.source)
+        pixels = pixels[..., None] if pixels.ndim == 2 else pixels
+        rgb = np.zeros(pixels.shape[:2] + (3,), pixels.dtype)
+        for source, target in enumerate(channels):  # pyrender's channels, back in the places glTF gives them
+            rgb[..., "rgb".index(target)] = pixels[..., source]
+        wrap, filter_ = gl_sampling(texture.sampler.wrapS, texture.sampler.minFilter)
+        return TextureImage(rgb, srgb=srgb, wrap=wrap, filter=filter_)
+
+    base = tuple(np.clip(np.asarray(material.baseColorFactor, np.float64)[:3], 0.0, 1.0))
+    texture = image(material.baseColorTexture, "rgb", True)
+    base_color = Texture(texture, scale=base) if texture is not None else base
+    metallic = min(float(material.metallicFactor), 1.0)
+    roughness = min(float(material.roughnessFactor), 1.0)
+    texture = image(material.metallicRoughnessTexture, "gb", False)
+    if texture is not None:
+        metallic, roughness = Texture(texture, metallic, channel="b"), Texture(texture, roughness, channel="g")
+    emissive = tuple(np.asarray(material.emissiveFactor, np.float64))
+    texture = image(material.emissiveTexture, "rgb", True) if any(emissive) else None
+    emissive = Texture(texture, scale=emissive) if texture is not None else emissive
+    texture = image(material.occlusionTexture, "r", False)
+    occlusion = Texture(texture, channel="r") if texture is not None else 1.0
+    if material.normalTexture is not None:
+        warnings.warn(f"pyrender material {material.name!r}: its normal texture is not applied (the mesh's normals are "
+                      "shaded)", stacklevel=2)
+    return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion,
+                   two_sided=bool(material.doubleSided))
 
 
 def glphong_lights_of(scene):
@@ -123,22 +179,27 @@ def _glphong_camera(scene):
                              znear=camera.znear, zfar=camera.zfar if camera.zfar is not None else 1e6)
 
 
-def scene_from_pyrender(scene):
+def scene_from_pyrender(scene, convert=False):
     """The glphong `Scene` of a pyrender scene's `GlphongMaterial` meshes, camera and lights.
 
-    For rendering the same scene with `glphong.Renderer` (comparison, verification).
+    For rendering the same scene with `glphong.Renderer` (comparison, verification).  ``convert``: the meshes
+    with a ``pyrender.MetallicRoughnessMaterial`` too, as `gltf_pbr_of` it (a mesh from a glTF file or a trimesh
+    with a PBR material).
     """
     lights, ambient = glphong_lights_of(scene)
     out = Scene(_glphong_camera(scene), lights=lights, ambient=ambient)
     for node in scene.mesh_nodes:
         for primitive in node.mesh.primitives:
-            if isinstance(primitive.material, GlphongMaterial):
+            material = primitive.material
+            if convert and isinstance(material, pyrender.MetallicRoughnessMaterial) and primitive.normals is not None:
+                material = GlphongMaterial.from_pyrender(material)
+            if isinstance(material, GlphongMaterial):
                 # pyrender keeps indices as float32 (exact below 2^24 vertices)
                 indices = np.rint(np.asarray(primitive.indices, dtype=np.float64)).astype(np.int64).reshape(-1, 3)
                 colors = None if primitive.color_0 is None else np.asarray(primitive.color_0, dtype=np.float64)[:, :3]
                 data = MeshData(primitive.positions, primitive.normals, indices, uvs=primitive.texcoord_0,
                                 tangents=primitive.tangents, colors=colors)
-                out.add(data, primitive.material.glphong, pose=scene.get_pose(node), name=node.name)
+                out.add(data, material.glphong, pose=scene.get_pose(node), name=node.name)
     return out
 
 
