@@ -94,6 +94,7 @@ def main(platform):
         "directional_irradiance": list(directional.irradiance),
         "ambient": list(ambient.radiance),
     }
+    result["converted"] = _converted(platform, renderer, width, height)
     # refusals
     spot = pyrender.Scene()
     spot.add(pyrender.SpotLight(color=[1.0, 0.5, 0.25], intensity=2.0, innerConeAngle=0.2, outerConeAngle=0.7),
@@ -124,6 +125,48 @@ def main(platform):
         result["not_enabled"] = str(exc)
     plain.delete()
     print(json.dumps(result))
+
+
+def _converted(platform, renderer, width, height):
+    """A pyrender MetallicRoughnessMaterial with every texture, converted (gltf_pbr_of): what each input became, and
+    the converted sphere drawn inside pyrender (GlphongMaterial.from_pyrender) against glphong's renderer."""
+    from glphong.integrations.pyrender import gltf_pbr_of
+
+    rng = np.random.default_rng(2)
+    mr = rng.integers(0, 256, (8, 8, 3), dtype=np.uint8)
+    base = rng.integers(0, 256, (8, 8, 3), dtype=np.uint8)
+    occlusion = rng.integers(0, 256, (8, 8, 3), dtype=np.uint8)
+    material = pyrender.MetallicRoughnessMaterial(
+        baseColorFactor=[0.5, 0.25, 1.0, 1.0], metallicFactor=0.75, roughnessFactor=0.5, baseColorTexture=base,
+        metallicRoughnessTexture=mr, occlusionTexture=occlusion, emissiveFactor=[0.1, 0.2, 0.3], doubleSided=True)
+    pbr = gltf_pbr_of(material)
+    out = {"type": type(pbr).__name__, "two_sided": pbr.two_sided,
+           "metallic": [pbr.metallic.channel, pbr.metallic.scale], "roughness": [pbr.roughness.channel, pbr.roughness.scale],
+           "emissive": list(pbr.emissive), "base_scale": list(pbr.base_color.scale),
+           # level 0 is stored bottom row first, as float16: compare with the source's channels
+           "metallic_texels": bool(np.array_equal(pbr.metallic.texture.levels[0][::-1, :, 2],
+                                                  (mr[..., 2] / 255.0).astype(np.float16))),
+           "roughness_texels": bool(np.array_equal(pbr.roughness.texture.levels[0][::-1, :, 1],
+                                                   (mr[..., 1] / 255.0).astype(np.float16))),
+           "occlusion_texels": bool(np.array_equal(pbr.occlusion.texture.levels[0][::-1, :, 0],
+                                                   (occlusion[..., 0] / 255.0).astype(np.float16))),
+           "base_srgb": pbr.base_color.texture.encoding}
+    scene = pyrender.Scene(ambient_light=[0.0, 0.0, 0.0])
+    sphere = trimesh.creation.icosphere(3)
+    uv = np.stack([0.5 + np.arctan2(sphere.vertices[:, 1], sphere.vertices[:, 0]) / (2 * np.pi),
+                   0.5 + 0.5 * sphere.vertices[:, 2]], axis=1)
+    sphere.visual = trimesh.visual.TextureVisuals(uv=uv)
+    scene.add(pyrender.Mesh.from_trimesh(sphere, material=GlphongMaterial.from_pyrender(material)))
+    scene.add(pyrender.PerspectiveCamera(yfov=0.8, aspectRatio=width / height), pose=translation(0, 0, 3))
+    scene.add(pyrender.PointLight(intensity=3.0), pose=translation(1, 1, 3))
+    color, _ = renderer.render(scene)  # the enabled renderer (a second one at once fails on EGL)
+    with glphong.Renderer(width, height, backend=platform, samples=4 if platform == "egl" else 1) as g:
+        ours = g.render_srgb8(scene_from_pyrender(scene))
+        interior = g.render(scene_from_pyrender(scene)).coverage == 1.0
+    interior[1:-1, 1:-1] &= interior[:-2, 1:-1] & interior[2:, 1:-1] & interior[1:-1, :-2] & interior[1:-1, 2:]
+    diff = np.abs(ours.astype(int) - color.astype(int)).max(axis=-1)[interior]
+    out["embedded_pixels"], out["embedded_within_one"] = int(interior.sum()), float(np.mean(diff <= 1))
+    return out
 
 
 def _single(material_class):

@@ -79,3 +79,19 @@ def test_refusals_name_the_problem(measured):
     _, m = measured
     assert "cannot be instanced" in m["instanced"]
     assert "not enabled on" in m["not_enabled"] and "enable(renderer)" in m["not_enabled"]
+
+
+def test_metallic_roughness_material_converts_to_gltf_pbr(measured):
+    """gltf_pbr_of: the factors as given; metallic and roughness read the blue and green channels pyrender keeps
+    (its 'GB' texture), occlusion the red; the base colour sRGB; drawn inside pyrender as a GlphongMaterial, it
+    agrees with glphong's renderer on the interior."""
+    _, m = measured
+    c = m["converted"]
+    assert c["type"] == "GltfPBR" and c["two_sided"] is True
+    assert c["metallic"] == ["b", 0.75] and c["roughness"] == ["g", 0.5]
+    assert c["metallic_texels"] and c["roughness_texels"] and c["occlusion_texels"]
+    np.testing.assert_allclose(c["emissive"], [0.1, 0.2, 0.3], rtol=1e-7)
+    np.testing.assert_allclose(c["base_scale"], [0.5, 0.25, 1.0])
+    assert c["base_srgb"] == "srgb8"
+    assert c["embedded_pixels"] > 2000 and c["embedded_within_one"] > 0.9, c
+
