@@ -301,7 +301,7 @@ vec3 five_inputs_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
         return (p.c0 + p.c1 + p.c2 + p.c3 + p.c4) * n_dot_l[:, None]
 
 
-def test_a_users_model_textures_four_parameters_and_is_refused_a_fifth(glphong_make_renderer):
+def test_a_users_model_textures_four_sizes_and_is_refused_a_fifth(glphong_make_renderer):
     images = [RNG.integers(0, 256, (8 + i, 12, 3), dtype=np.uint8) for i in range(5)]
     four = FiveInputs(**{f"c{i}": glphong.Texture(images[i], 0.05) for i in range(4)}, c4=glphong.VertexColors(0.05))
     scene = _oblique_scene(four, _plane(colors=RNG.random((len(_plane().positions), 3))))
@@ -310,8 +310,15 @@ def test_a_users_model_textures_four_parameters_and_is_refused_a_fifth(glphong_m
     assert report.passed and report.covered_pixels > 3000
     assert renderer.gbuffer(scene).lod.shape == (90, 120, 4)
     five = FiveInputs(**{f"c{i}": glphong.Texture(images[i], 0.05) for i in range(5)})
-    with pytest.raises(ValueError, match="at most 4 parameters .* textures 5"):
+    with pytest.raises(ValueError, match="at most 4 sizes .* has 5"):
         renderer.gbuffer(_oblique_scene(five))
+    # five textures of one size share one level of detail (textureQueryLOD depends on the size, not the texels)
+    alike = FiveInputs(**{f"c{i}": glphong.Texture(images[0][::1 if i % 2 else -1, ::1 if i < 3 else -1], 0.05)
+                          for i in range(5)})
+    scene = _oblique_scene(alike)
+    assert renderer.program_key(scene, scene.objects[0], "gbuffer").lod_textures == 1
+    report = glphong.verify(scene, renderer)
+    assert report.passed and report.covered_pixels > 3000, report.summary()
 
 
 @pytest.mark.parametrize("scale", [1e-8, 1e8])

@@ -32,6 +32,7 @@ from glphong.checks.shadows import shadow_visibility
 from glphong.twin.area import (area_angle, area_clip, area_clipped_cosine, area_clipped_lobe, area_edge_powers,  # noqa: F401
                                area_polygon_cosine, area_polygon_lobe, area_solid_angle, area_triangle_sample)
 from glphong.shaders.generated import closed_form
+from glphong.shaders.key import lod_slots
 from glphong.lights import light_for_key
 from glphong.materials import registered_models
 
@@ -127,7 +128,7 @@ def material_inputs(uv, color, lod, key, uniforms, sample=None):
     color : (N, 3) ndarray or None
         The interpolated vertex colour (the G-buffer's), where an input reads it.
     lod : (N, 4) ndarray or None
-        The level of detail of each textured input, in `ProgramKey.textured_inputs` order.
+        The G-buffer's levels of detail, one per texture size (`glphong.shaders.key.lod_slots`).
     key : glphong.shaders.key.ProgramKey
     uniforms : dict
         The program's uniforms (``u_<model>_<param>_scale`` and ``_texture``).
@@ -145,12 +146,13 @@ def material_inputs(uv, color, lod, key, uniforms, sample=None):
     sample = surface_texture if sample is None else sample
     out = {}
     textured = list(key.textured_inputs)
+    slots, _ = lod_slots([uniforms[f"u_{t}_{p}_texture"] for t, p in textured])
     for term, param, mode in key.inputs:
         name = f"u_{term}_{param}"
         pick = _channel_of(mode)
         value = np.asarray(uniforms[f"{name}_scale"], dtype=np.float64)
         if "texture" in mode:
-            value = value * pick(sample(uniforms[f"{name}_texture"], uv, lod[:, textured.index((term, param))]))
+            value = value * pick(sample(uniforms[f"{name}_texture"], uv, lod[:, slots[textured.index((term, param))]]))
         if "vertex" in mode:
             value = value * pick(color)
         n = len(uv) if uv is not None else len(color)

@@ -93,8 +93,8 @@ class GBuffer:
     color : (H, W, 3) float32 ndarray or None
         The interpolated linear vertex colour, where a parameter takes vertex colours; else None.
     lod : (H, W, 4) float32 ndarray or None
-        Per pixel, the level of detail the GPU used for each texture of the object's material, in the
-        order of `glphong.shaders.key.ProgramKey.textured_inputs` (0 beyond), where a parameter is textured.
+        Per pixel, the level of detail the GPU used for the textures of the object's material, one per texture
+        size in the order of `glphong.shaders.key.lod_slots` (0 beyond), where a parameter is textured.
     face : (H, W, 3) float32 ndarray or None
         The covered triangle's own unit normal (either orientation), where a light casts shadows (the shadow
         bias's slope, docs/design.md section 12).

@@ -12,7 +12,7 @@ from glphong.scene.camera import Camera
 from glphong.scene.geometry import MeshData
 from glphong.scene.from_trimesh import build_from_trimesh
 from glphong.scene.shadows import shadow_setups
-from glphong.shaders.key import GBUFFER_PLANES, light_keys, program_key
+from glphong.shaders.key import GBUFFER_PLANES, light_keys, lod_slots, program_key
 from glphong.lights import AmbientLight, LightModel, light_named
 from glphong.materials import Material
 from glphong.materials.surface import TextureImage
@@ -278,8 +278,9 @@ class Scene:
             if key.lod_textures:  # the radiance program's textures, whose levels of detail the G-buffer records
                 spec = self.program_key(obj)
                 textures = obj.material.uniform_values(spec)
-                for i, (term, param) in enumerate(spec.textured_inputs):
-                    values[f"u_lod_texture{i}"] = textures[f"u_{term}_{param}_texture"]
+                images = [textures[f"u_{term}_{param}_texture"] for term, param in spec.textured_inputs]
+                for slot, i in enumerate(lod_slots(images)[1]):  # one texture per size (`lod_slots`)
+                    values[f"u_lod_texture{slot}"] = images[i]
         else:
             values.update(obj.material.uniform_values(key))
         return {name: v if isinstance(v, (TableData, TextureImage)) else _validate.float32_uniform(v)

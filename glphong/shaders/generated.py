@@ -190,10 +190,10 @@ def _extended_loop(key, light):
 
 def lod_chunk(key):
     """The generated GLSL of a G-buffer program with textures (label ``generated:levels_of_detail``): one
-    sampler per textured input of the object's material, ``u_lod_texture<i>``, and
+    sampler per texture size of the object's material (`glphong.shaders.key.lod_slots`), ``u_lod_texture<i>``, and
     ``gbuffer_levels_of_detail(uv)``, their ``surface_texture_lod`` in x, y, z, w (0 beyond)."""
     lines = ["// levels of detail (generated from the program key): what texture() used for each of the object's",
-             "// textures, in ProgramKey.textured_inputs order; the twin blends the same levels (surface.glsl)"]
+             "// textures, one per texture size (key.py lod_slots); the twin blends the same levels (surface.glsl)"]
     lines += [f"uniform sampler2D u_lod_texture{i};" for i in range(key.lod_textures)]
     lines += ["", "vec4 gbuffer_levels_of_detail(vec2 uv)", "{", "    vec4 lod = vec4(0.0);"]
     lines += [f"    lod.{'xyzw'[i]} = surface_texture_lod(u_lod_texture{i}, uv);" for i in range(key.lod_textures)]

@@ -556,11 +556,13 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
     ProgramKey
     """
     if output == "gbuffer":
-        textured = program_key(material, lights, ambient_radiance).textured_inputs
-        if len(textured) > MAX_TEXTURED_INPUTS:
-            raise ValueError(f"a material may texture at most {MAX_TEXTURED_INPUTS} parameters (the G-buffer holds one "
-                             f"level of detail per texture); {type(material).__name__} textures {len(textured)}")
-        return gbuffer_key(material, gbuffer_needs or (), len(textured))
+        spec = program_key(material, lights, ambient_radiance)
+        values = material.uniform_values(spec) if spec.textured_inputs else {}
+        _, shown = lod_slots([values[f"u_{t}_{p}_texture"] for t, p in spec.textured_inputs])
+        if len(shown) > MAX_TEXTURED_INPUTS:
+            raise ValueError(f"a material's textures may have at most {MAX_TEXTURED_INPUTS} sizes (the G-buffer holds "
+                             f"one level of detail per size); {type(material).__name__} has {len(shown)}")
+        return gbuffer_key(material, gbuffer_needs or (), len(shown))
     # lights matter only to a material with a term that reflects them
     lights = _as_light_keys(lights)
     lit = bool(lights) and any(not t.vanishes() for t in material.components)
@@ -700,6 +702,22 @@ class EncodeKey:
 def shadow_key(shadow_pass):
     """The key of a shadow pass (a caster's distance from the light, glsl/shadow_fragment.glsl): 'cube' or 'ortho'."""
     return ProgramKey(output="shadow", has_normal=False, two_sided=False, shadow_pass=shadow_pass)
+
+
+def lod_slots(images):
+    """Where the G-buffer keeps the level of detail of each of a program's textures: ``(slots, shown)``, ``slots[i]``
+    the slot of ``images[i]`` (the `TextureImage` of ``ProgramKey.textured_inputs[i]``) and ``shown[k]`` the index of
+    the image the G-buffer program samples for slot ``k``.  ``textureQueryLOD`` depends on the uv derivatives and the
+    texture's size and number of levels only, so textures alike in those share a slot (glTF's textures mostly are:
+    base colour, metallic-roughness, occlusion and emissive at one size take one slot)."""
+    slots, shown, seen = [], [], {}
+    for i, image in enumerate(images):
+        shape = (image.size, len(image.levels))
+        if shape not in seen:
+            seen[shape] = len(shown)
+            shown.append(i)
+        slots.append(seen[shape])
+    return tuple(slots), tuple(shown)
 
 
 def gbuffer_key(material, needs=(), lod_textures=0):

@@ -176,3 +176,21 @@ def test_textured_gltf_material_verifies(inputs, glphong_backend, glphong_make_r
     scene = _front_scene(material, [glphong.PointLight((0.5, 0.5, 1.5), 20.0)], ambient=0.5)
     report = glphong.verify(scene, glphong_make_renderer(96, 72, glphong_backend))
     assert report.covered_pixels > 3000 and report.passed, report.summary()
+
+
+def test_every_gltf_texture_verifies_with_one_level_of_detail_per_size(glphong_backend, glphong_make_renderer):
+    """Five textured inputs (base colour, metallic, roughness, emissive, occlusion) from four images of two sizes:
+    the G-buffer records two levels of detail, and every pixel is inside the band."""
+    from glphong.shaders.key import program_key
+
+    rng = np.random.default_rng(4)
+    big, small = (rng.integers(0, 256, (n, n, 3), dtype=np.uint8) for n in (32, 16))
+    material = glphong.GltfPBR(glphong.Texture(big, 0.9), glphong.Texture(small, srgb=False, channel="b"),
+                               glphong.Texture(small, 0.9, srgb=False, channel="g"),
+                               emissive=glphong.Texture(big[::-1], 0.1), occlusion=glphong.Texture(small[::-1], srgb=False, channel="r"))
+    scene = _front_scene(material, [glphong.PointLight((0.5, 0.5, 1.5), 20.0)], ambient=0.5)
+    lights, ambient = scene.light_keys(), scene.ambient_radiance
+    assert len(program_key(material, lights, ambient).textured_inputs) == 5
+    assert program_key(material, lights, ambient, output="gbuffer", gbuffer_needs={"uv", "lod"}).lod_textures == 2
+    report = glphong.verify(scene, glphong_make_renderer(96, 72, glphong_backend))
+    assert report.covered_pixels > 3000 and report.passed, report.summary()
