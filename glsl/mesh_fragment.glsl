@@ -14,8 +14,10 @@
 //   material_inputs();
 //   locations 0 position, 1 normal, then the extra planes at GBUFFER_<PLANE>_LOCATION (key.py packs them).
 // HAS_INPUTS: material_inputs(uv, colour) sets the surface inputs (the generated material chunk) before shading.
+// NORMAL_MAP: n = surface_normal(shading_frame(n, tangent, uv), texture(u_normal_map_texture, uv).rgb, scale)
+//   (normal_map.glsl) where n is valid, before the G-buffer is written and before shading: both see the mapped normal.
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, NUM_LOD_TEXTURES,
-// GBUFFER_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW,
+// GBUFFER_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP,
 // RUNTIME_SWITCHES, SWITCH(flag).
 
 invariant in vec3 v_position;
@@ -42,6 +44,10 @@ invariant in vec3 v_color;
 #endif
 #if TWO_SIDED && RUNTIME_SWITCHES
 uniform float u_two_sided;
+#endif
+#if NORMAL_MAP
+uniform sampler2D u_normal_map_texture;
+uniform float u_normal_map_scale;
 #endif
 #if OUTPUT_GBUFFER
 uniform float u_object_id;
@@ -97,6 +103,11 @@ void main()
     vec3 color = vec3(1.0);
 #if HAS_COLOR
     color = v_color;
+#endif
+#if NORMAL_MAP
+    vec3 texel = surface_texture(u_normal_map_texture, uv);  // in uniform control flow: implicit derivatives
+    ShadingFrame geometric = shading_frame(n, tangent, uv);
+    n = n_valid ? surface_normal(geometric.n, geometric.t, geometric.b, texel, u_normal_map_scale) : n;
 #endif
 #if HAS_FACE
     // the triangle's own normal, from the derivatives of the interpolated position (the plane the shadow map

@@ -27,7 +27,7 @@ __all__ = ["Signature", "signatures", "twin_of", "evaluate", "shade_points"]
 
 _WIDTH = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4, "bool": 1}
 #: library chunks whose functions can be probed, in include order
-LIBRARY = ("common", "lights") + LIBRARY_CHUNKS + ("area",)
+LIBRARY = ("common", "lights") + LIBRARY_CHUNKS + ("area", "normal_map")
 #: defines every probe source carries (the key's switches at their defaults)
 _PROBE_DEFINES = (("NAIVE", "0"), ("HAS_TANGENT", "0"), ("HAS_UV", "0"))
 

@@ -9,7 +9,7 @@ import numpy as np
 from glphong.core.filesafety import SceneFileError
 from glphong.core.radiometry import LUMENS_PER_WATT
 from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, read_gltf_primitives, texture_sampling
-from glphong.materials import Material, Texture, TextureImage, VertexColors
+from glphong.materials import Material, NormalMap, Texture, TextureImage, VertexColors
 from glphong.materials.cook_torrance import CookTorrance
 from glphong.materials.gltf_pbr import GltfPBR
 from glphong.materials.fresnel import SchlickFresnel
@@ -182,7 +182,10 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
     - ``metallic = metallicFactor * metallicRoughnessTexture.b``, ``roughness = roughnessFactor *
       metallicRoughnessTexture.g`` (linear; factors above 1 clamped to 1);
     - ``emissive = emissiveFactor * KHR_materials_emissive_strength * emissiveTexture (sRGB) * emissive_scale``;
-    - ``occlusion = 1 + strength (occlusionTexture.r - 1)`` (linear), on the ambient and environment answers only.
+    - ``occlusion = 1 + strength (occlusionTexture.r - 1)`` (linear), on the ambient and environment answers only;
+    - ``normalTexture`` (linear) as a `glphong.NormalMap` with its ``scale`` (the mesh's ``TANGENT``, or tangents
+      derived from its UVs);
+    - ``doubleSided`` as ``two_sided``.
 
     Parameters
     ----------
@@ -231,7 +234,11 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
             occlusion_image = TextureImage(np.repeat((1.0 - weight + weight * red)[..., None], 3, axis=2),
                                            wrap=occlusion_image.wrap, filter=occlusion_image.filter)
         occlusion = Texture(occlusion_image, channel="r")
-    return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion)
+    normal_image = image("normalTexture", False)
+    normal_map = NormalMap(normal_image, float(entry["normalTexture"].get("scale", 1.0))) \
+        if normal_image is not None else None
+    return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion,
+                   two_sided=bool(entry.get("doubleSided", False)), normal_map=normal_map)
 
 
 def _texture_reader(gltf, where):
@@ -283,9 +290,6 @@ def _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emi
         if stored is None:
             where = f"materials[{index}]"
             texture = _texture_reader(gltf, where) if mesh.uvs is not None else None
-            if entry.get("normalTexture") is not None and mesh.uvs is not None:
-                gltf.warn_once("normalTexture", f"{where}: normal textures are not applied yet (the mesh's normals "
-                               "are shaded)")
             if approximate:
                 info = entry.get("pbrMetallicRoughness", {}).get("baseColorTexture")
                 stored = gltf_material(entry, texture(info, True) if texture and info else None, mesh.colors is not None)

@@ -373,6 +373,9 @@ class Renderer:
             raise ValueError(f"object {obj.name!r}: {', '.join(f'{t}.{p}' for t, p in key.textured_inputs)} "
                              "are textured, which needs per-pixel shading (a vertex has no texture footprint): "
                              "use Renderer(shading='pixel')")
+        if per_vertex and key.normal_map:
+            raise ValueError(f"object {obj.name!r}: its material has a normal map, which needs per-pixel shading (a "
+                             "vertex has no texture footprint): use Renderer(shading='pixel')")
         if key.formulation != self.formulation or key.shade_per_vertex != per_vertex:
             key = replace(key, formulation=self.formulation, shade_per_vertex=per_vertex)
         return key

@@ -36,7 +36,6 @@ pyrender 0.1.45's OSMesa platform needs PyOpenGL >= 3.1.5 (``pip install --no-de
 """
 import os
 import threading
-import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -51,7 +50,7 @@ from glphong.scene.camera import PerspectiveCamera
 from glphong.gpu.contexts import attach_current
 from glphong.scene.geometry import MeshData
 from glphong.shaders.key import program_key
-from glphong.materials import GltfPBR, Material, Texture, TextureImage
+from glphong.materials import GltfPBR, Material, NormalMap, Texture, TextureImage
 from glphong.gpu.programs import ProgramCache
 from glphong.scene.scene import Scene
 
@@ -106,8 +105,8 @@ def gltf_pbr_of(material):
     it): ``baseColorFactor`` (rgb) times ``baseColorTexture`` (sRGB); ``metallicFactor`` and ``roughnessFactor``
     times the metallic-roughness texture's blue and green channels (pyrender keeps them as its two channels 'GB');
     ``emissiveFactor`` times ``emissiveTexture`` (sRGB); ``occlusionTexture``'s red channel; each texture's sampler
-    (`glphong.formats.gltf_data.gl_sampling`); ``doubleSided`` as ``two_sided``.  The normal texture is not applied
-    (a warning says so), and neither is alpha.
+    (`glphong.formats.gltf_data.gl_sampling`); ``doubleSided`` as ``two_sided``; ``normalTexture`` as a
+    `glphong.NormalMap` (pyrender keeps no normal scale: 1).  Alpha is not applied.
 
     Raises
     ------
@@ -142,11 +141,9 @@ def gltf_pbr_of(material):
     emissive = Texture(texture, scale=emissive) if texture is not None else emissive
     texture = image(material.occlusionTexture, "r", False)
     occlusion = Texture(texture, channel="r") if texture is not None else 1.0
-    if material.normalTexture is not None:
-        warnings.warn(f"pyrender material {material.name!r}: its normal texture is not applied (the mesh's normals are "
-                      "shaded)", stacklevel=2)
+    texture = image(material.normalTexture, "rgb", False)
     return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion,
-                   two_sided=bool(material.doubleSided))
+                   two_sided=bool(material.doubleSided), normal_map=NormalMap(texture) if texture is not None else None)
 
 
 def glphong_lights_of(scene):

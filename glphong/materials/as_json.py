@@ -17,7 +17,7 @@ found among the defined materials by module and name (a user's module must have 
 
 from glphong.materials.fresnel import Fresnel
 from glphong.materials.model import Choice, Material, Param
-from glphong.materials.surface import SurfaceInput
+from glphong.materials.surface import NormalMap, SurfaceInput
 from glphong.materials.table import Table
 __all__ = ["material_to_json", "material_from_json"]
 
@@ -53,6 +53,7 @@ def material_to_json(material, texture_index=None):
             raise ValueError(f"{cls.__name__}.{argument.name} is a table, which glphong does not store as JSON")
         if isinstance(value, SurfaceInput):
             surface = {"scale": _plain(value.scale), "vertex_colors": bool(value.vertex_colors)}
+            surface.update({"channel": value.channel} if value.channel is not None else {})
             if value.texture is not None:
                 if texture_index is None:
                     raise ValueError(f"{cls.__name__}.{argument.name} is textured: give texture_index to store it")
@@ -63,8 +64,15 @@ def material_to_json(material, texture_index=None):
             arguments[argument.name] = {"class": type(value).__name__, value.field: _plain(getattr(value, value.field))}
         elif isinstance(argument, (Param, Choice)) or value is None:
             arguments[argument.name] = value if isinstance(value, str) or value is None else _plain(value)
-    return {"version": VERSION, "class": cls.__name__, "module": cls.__module__, "arguments": arguments,
-            "ka": _plain(material.ka), "two_sided": bool(material.two_sided)}
+    out = {"version": VERSION, "class": cls.__name__, "module": cls.__module__, "arguments": arguments,
+           "ka": _plain(material.ka), "two_sided": bool(material.two_sided)}
+    if material.normal_map is not None:
+        if texture_index is None:
+            raise ValueError(f"{cls.__name__} has a normal map: give texture_index to store it")
+        texture = material.normal_map.texture
+        out["normal_map"] = {"texture": int(texture_index(texture)), "wrap": texture.wrap, "filter": texture.filter,
+                             "scale": material.normal_map.scale}
+    return out
 
 
 def _subclasses(base):
@@ -129,7 +137,8 @@ def material_from_json(data, textures=None):
                 if textures is None:
                     raise ValueError(f"{cls.__name__}.{name} is textured, but no textures were given")
                 texture = textures(s["texture"], s.get("wrap", "repeat"), s.get("filter", "trilinear"), s.get("srgb", True))
-            value = SurfaceInput(tuple(s["scale"]), texture, bool(s.get("vertex_colors", False)))
+            scale = tuple(s["scale"]) if isinstance(s["scale"], list) else s["scale"]
+            value = SurfaceInput(scale, texture, bool(s.get("vertex_colors", False)), s.get("channel"))
         elif isinstance(value, dict) and "class" in value:
             factor = factors.get(value["class"]) if isinstance(value["class"], str) else None
             if factor is None:
@@ -140,4 +149,12 @@ def material_from_json(data, textures=None):
             value = tuple(value)
         arguments[name] = value
     ka = data.get("ka", 0.0)
-    return cls(**arguments, ka=tuple(ka) if isinstance(ka, list) else float(ka), two_sided=bool(data.get("two_sided", True)))
+    normal_map = None
+    if data.get("normal_map") is not None:
+        n = data["normal_map"]
+        if not isinstance(n, dict) or textures is None:
+            raise ValueError(f"{cls.__name__}: 'normal_map' must be an object naming a texture, and textures must be given")
+        normal_map = NormalMap(textures(n["texture"], n.get("wrap", "repeat"), n.get("filter", "trilinear"), False),
+                               n.get("scale", 1.0))
+    return cls(**arguments, ka=tuple(ka) if isinstance(ka, list) else float(ka), two_sided=bool(data.get("two_sided", True)),
+               normal_map=normal_map)

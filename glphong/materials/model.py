@@ -14,7 +14,7 @@ twin (`MaterialModel.band`; a generic default) and its extreme cases for the sta
 
 A material is a sum of terms: a `MaterialModel` instance is a material of one term, a
 `MaterialSum` subclass names several (``terms = (Lambert, PhongLobe)``).  Every material takes
-the keywords ``ka`` (a constant radiance ``k_a`` [W/(m^2 sr)]) and ``two_sided``.  The built-in
+the keywords ``ka`` (a constant radiance ``k_a`` [W/(m^2 sr)]), ``two_sided`` and ``normal_map``.  The built-in
 models use exactly this mechanism; a definition is checked when its class is created, so a
 missing twin, a GLSL function of the wrong name or signature, a parameter without a range or a
 name that clashes fails there, with a message saying what is wrong.
@@ -31,7 +31,7 @@ from glphong.materials.registry import _REGISTRY, _is_builtin, model_named, mode
 from glphong.materials.table import Table, TableData
 from glphong.materials.cases import generic_cases
 from glphong.materials.fresnel import FRESNEL_PARAMS, fresnel_uniform_values
-from glphong.materials.surface import SurfaceInput
+from glphong.materials.surface import NormalMap, SurfaceInput
 from glphong.twin.band import EPS
 from glphong.twin.functions import perpendiculars
 
@@ -51,6 +51,8 @@ class Material:
         Constant radiance ``k_a`` [W/(m^2 sr)] (the lecture's ambient term), >= 0.
     two_sided : bool
         Shade back faces with the normal flipped toward the viewer.
+    normal_map : glphong.NormalMap or None
+        A tangent-space normal map: every term shades with the mapped normal.
     """
 
     #: display name; a model's name is also its GLSL prefix
@@ -58,11 +60,14 @@ class Material:
     #: declared BRDF properties (for a sum: derived from its terms unless declared)
     properties = Properties()
 
-    def _set_common(self, ka, two_sided):
+    def _set_common(self, ka, two_sided, normal_map=None):
         object.__setattr__(self, "ka", _validate.rgb("ka", ka))
         if not isinstance(two_sided, (bool, np.bool_)):
             raise TypeError(f"two_sided must be a bool, True or False (got {two_sided!r})")
         object.__setattr__(self, "two_sided", bool(two_sided))
+        if normal_map is not None and not isinstance(normal_map, NormalMap):
+            raise TypeError(f"normal_map must be a glphong.NormalMap or None (got {type(normal_map).__name__})")
+        object.__setattr__(self, "normal_map", normal_map)
 
     @property
     def components(self):
@@ -74,7 +79,7 @@ class Material:
         out = {}
         for term in self.components:
             out.update({a.name: getattr(term, a.name) for a in term.arguments()})
-        out.update(ka=self.ka, two_sided=self.two_sided)
+        out.update(ka=self.ka, two_sided=self.two_sided, normal_map=self.normal_map)
         return out
 
     def uniform_values(self, key):
@@ -94,6 +99,9 @@ class Material:
         values = {}
         if key.has_ka:
             values["u_ka"] = _validate.float32_uniform(self.ka)
+        if key.normal_map:
+            values["u_normal_map_texture"] = self.normal_map.texture
+            values["u_normal_map_scale"] = _validate.float32_uniform(self.normal_map.scale)
         by_name = {term.name: term for term in self.components}
         for term_key in key.terms:
             term = by_name.get(term_key.name)
@@ -133,6 +141,8 @@ class Material:
             shown.append(f"ka={_short(values['ka'])}")
         if not values["two_sided"]:
             shown.append("two_sided=False")
+        if values["normal_map"] is not None:
+            shown.append(f"normal_map={values['normal_map']!r}")
         return f"{type(self).__name__}({', '.join(shown)})"
 
 
@@ -319,12 +329,12 @@ class MaterialModel(Material):
         """How this term reflects an extended light in closed form (`Integral`), or None: sampled (default)."""
         return None
 
-    def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
+    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, **kwargs):
         if type(self).name is None:
             raise TypeError(f"{type(self).__name__} is not a material model (it has no name)")
         for name, value in bind_arguments(type(self), self.arguments(), args, kwargs).items():
             object.__setattr__(self, name, value)
-        self._set_common(ka, two_sided)
+        self._set_common(ka, two_sided, normal_map)
 
     @classmethod
     def arguments(cls):
@@ -635,13 +645,13 @@ class MaterialSum(Material):
         slots = [t.fresnel_slot for t in cls.terms if t.fresnel_slot is not None]
         return cls.all_params() + tuple(slots[:1]) + tuple(c for t in cls.terms for c in t.choices)
 
-    def __init__(self, *args, ka=0.0, two_sided=True, **kwargs):
+    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, **kwargs):
         if not type(self).terms:
             raise TypeError(f"{type(self).__name__} has no terms")
         values = bind_arguments(type(self), self.arguments(), args, kwargs)
         parts = tuple(t(**{a.name: values[a.name] for a in t.arguments()}, two_sided=two_sided) for t in self.terms)
         object.__setattr__(self, "_parts", parts)
-        self._set_common(ka, two_sided)
+        self._set_common(ka, two_sided, normal_map)
 
     @property
     def components(self):

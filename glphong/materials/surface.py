@@ -41,7 +41,7 @@ from glphong.core.filesafety import LIMITS, decode_image, read_bytes
 from glphong.core.imaging import encode_srgb8, srgb_decode
 from glphong.twin.band import EPS
 
-__all__ = ["SurfaceInput", "Texture", "VertexColors", "TextureImage", "surface_texture", "surface_texture_band",
+__all__ = ["SurfaceInput", "Texture", "VertexColors", "TextureImage", "NormalMap", "surface_texture", "surface_texture_band",
            "WRAPS", "FILTERS", "CHANNELS", "MAX_TEXTURE_SIZE"]
 
 #: texture wrap modes: GL_REPEAT, GL_CLAMP_TO_EDGE (moderngl's textures offer no mirrored repeat)
@@ -339,6 +339,48 @@ def VertexColors(scale=1.0, channel=None):
     SurfaceInput
     """
     return SurfaceInput(scale=scale, vertex_colors=True, channel=channel)
+
+
+class NormalMap:
+    """A tangent-space normal map: the shading normal at a fragment is ``normalize(t (s m.x) + b (s m.y) + n m.z)``,
+    ``m = 2 T(uv) - 1`` (glTF 2.0's ``normalTexture``; glsl/normal_map.glsl, `glphong.reference.surface_normal`).
+
+    Given to any material as ``normal_map=``; every term then shades with the mapped normal.  The mesh needs UVs and
+    a tangent frame (tangents from the file, or derived from the UVs).
+
+    Parameters
+    ----------
+    image : array_like, str, pathlib.Path or TextureImage
+        The normal texture, linear (8-bit values scaled to [0, 1], never sRGB-decoded).
+    scale : float
+        glTF's ``normalTexture.scale``: multiplies ``m.x`` and ``m.y`` (finite; negative flips them).
+    wrap : {'repeat', 'clamp'}
+    filter : {'trilinear', 'bilinear'}
+    """
+
+    __slots__ = ("texture", "scale")
+
+    def __init__(self, image, scale=1.0, wrap="repeat", filter="trilinear"):
+        texture = image if isinstance(image, TextureImage) else TextureImage(image, srgb=False, wrap=wrap, filter=filter)
+        if texture.encoding.startswith("srgb"):
+            raise ValueError("a normal map is linear data: make its TextureImage with srgb=False")
+        object.__setattr__(self, "texture", texture)
+        object.__setattr__(self, "scale", _validate.scalar("scale", scale, low=-_validate.FLT_MAX))
+
+    def __setattr__(self, name, value):
+        raise AttributeError("NormalMap is immutable")
+
+    def __eq__(self, other):
+        return isinstance(other, NormalMap) and (other.texture, other.scale) == (self.texture, self.scale)
+
+    def __hash__(self):
+        return hash((self.texture, self.scale))
+
+    def __repr__(self):
+        return f"NormalMap({self.texture!r}{'' if self.scale == 1.0 else f', scale={self.scale:g}'})"
+
+    def __reduce__(self):
+        return NormalMap, (self.texture, self.scale)
 
 
 # --------------------------------------------------------------------------- the twin of surface.glsl

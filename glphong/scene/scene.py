@@ -275,6 +275,9 @@ class Scene:
             values["u_normal_matrix"] = obj.normal_matrix
         if key.output == "gbuffer":
             values["u_object_id"] = float(index)
+            if key.normal_map:  # the G-buffer writes the mapped normal
+                values["u_normal_map_texture"] = obj.material.normal_map.texture
+                values["u_normal_map_scale"] = obj.material.normal_map.scale
             if key.lod_textures:  # the radiance program's textures, whose levels of detail the G-buffer records
                 spec = self.program_key(obj)
                 textures = obj.material.uniform_values(spec)
@@ -331,7 +334,10 @@ class Scene:
 
 
 def _check_mesh_serves(mesh, material, name):
-    """A mesh must carry what the material's terms need (tangents or UVs)."""
+    """A mesh must carry what the material's terms and its normal map need (tangents or UVs)."""
+    if material.normal_map is not None and (mesh.uvs is None or not mesh.has_tangents):
+        raise ValueError(f"object {name!r}: the material has a normal map, which needs the mesh's UVs and a tangent "
+                         "frame: give MeshData uvs= (tangents are then derived) or tangents=, or use glphong.primitives")
     for term in material.components:
         if term.vanishes():
             continue  # left out of every program: it needs nothing

@@ -18,7 +18,7 @@ __all__ = [
     "ShadingFrame", "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "perpendiculars", "log_one_minus",
     "lobe_from_delta", "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
     "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "microfacet_geometry", "light_term", "FLT_MAX",
-    "FRAME_PARALLEL_LIMIT",
+    "FRAME_PARALLEL_LIMIT", "surface_normal",
 ]
 
 
@@ -143,6 +143,34 @@ def shading_frame(n, tangent=None, uv=None, key=None):
         t, b = frame_from_tangent(n, tangent)
         return ShadingFrame(n, t, b, uv if key.has_uv else None)
     return ShadingFrame(n, None, None, uv if key is not None and key.has_uv else None)
+
+
+# --------------------------------------------------------------------------- normal_map.glsl
+def surface_normal(n, t, b, texel, scale):
+    """The normal-mapped normal (normal_map.glsl): ``normalize(t (s m.x) + b (s m.y) + n m.z)``, ``m = 2 texel - 1``;
+    ``n`` where that does not normalise.
+
+    Parameters
+    ----------
+    n, t, b : (N, 3) ndarray
+        The shading frame (`shading_frame`).
+    texel : (N, 3) ndarray
+        The normal texture's filtered linear value in [0, 1].
+    scale : float or (N,) ndarray
+        glTF's ``normalTexture.scale``.
+
+    Returns
+    -------
+    (N, 3) ndarray
+        Unit normals.
+    """
+    n = np.asarray(n)
+    dtype = n.dtype
+    m = (np.asarray(texel, dtype) * dtype.type(2) - dtype.type(1)).astype(dtype)
+    s = np.asarray(scale, dtype)[..., None] if np.ndim(scale) else dtype.type(scale)
+    p = (t * (m[..., 0:1] * s) + b * (m[..., 1:2] * s) + n * m[..., 2:3]).astype(dtype)
+    valid, mapped, _ = safe_normalize(p)
+    return np.where(valid[..., None], mapped, n).astype(dtype)
 
 
 # --------------------------------------------------------------------------- lights.glsl
