@@ -1,5 +1,11 @@
-// microfacet.glsl -- the half-vector geometry of the microfacet models (library chunk; docs/design.md section 9):
-// Cook-Torrance's lobe and glTF's metallic-roughness material.
+// microfacet.glsl -- the half-vector geometry of the microfacet models and the GGX distribution (library chunk;
+// docs/design.md section 9): Cook-Torrance's lobe and glTF's metallic-roughness material.
+//
+// microfacet_ggx(tan2, a2) -> GGX (Trowbridge-Reitz) D = (a2 r) r / pi [1/sr],  r = 1 + (1 - a2)/(a2 + tan2)
+//   = (1 + tan2)/(a2 + tan2): alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2) divided through by (n.h)^4 = 1/(1 + tan2)^2,
+//   a sum of positive terms (at the peak a2 + tan2 = a2, 1e-16 at alpha 1e-8); r saturated at FLT_MAX, D at most
+//   FLT_MAX, a2/pi where tan2 is Inf; 0 where a2 + tan2 = 0 (alpha 0 at the exact peak: a delta that no point light
+//   meets with nonzero measure).  a2 = alpha^2 >= 0.
 //
 // microfacet_geometry(n, wi, wo, n_dot_l, out n_dot_v, out n_dot_h, out h_dot_l, out tan2) -> valid
 //   h by scaled normalisation of l + v; valid is false where l + v does not normalise (l = -v), n.v <= 0 or
@@ -29,4 +35,14 @@ bool microfacet_geometry(vec3 n, vec3 wi, vec3 wo, float n_dot_l, out float n_do
     h_dot_l = 0.5 * len;
     tan2 = valid ? sin2 / (nh * nh) : 0.0;
     return valid;
+}
+
+const float MICROFACET_INV_PI = 0.3183098861837907;
+
+float microfacet_ggx(float tan2, float a2)
+{
+    float s = a2 + tan2;
+    float r = 1.0 + (1.0 - a2) / s;
+    float value = (a2 * r) * (min(r, FLT_MAX) * MICROFACET_INV_PI);
+    return s > 0.0 ? min(value, FLT_MAX) : 0.0;
 }

@@ -92,7 +92,7 @@ from glphong.materials.fresnel import DielectricFresnel, FresnelSlot, SchlickFre
 from glphong.materials.model import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
 from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
 from glphong.materials.fresnel import fresnel_oracle
-from glphong.twin.functions import microfacet_geometry
+from glphong.twin.functions import microfacet_geometry, microfacet_ggx
 
 __all__ = ["CookTorranceLobe", "CookTorrance", "cook_torrance_geometry", "cook_torrance_beckmann",
            "cook_torrance_masking", "COOK_TORRANCE_EXP_LIMIT", "COOK_TORRANCE_FORM_RATIO"]
@@ -110,7 +110,10 @@ _FLT_MAX = float(np.finfo(np.float32).max)
 _FLT_MIN = float(np.finfo(np.float32).tiny)
 
 _M = Param("m", "scalar", low=1e-3, high=10.0, unit="",
-           doc="rms slope of the microfacets (Beckmann); float32 resolves the peak down to 1e-3")
+           doc="rms slope of the microfacets (Beckmann), GGX's alpha; float32 resolves the peak down to 1e-3")
+_DISTRIBUTION = Choice("distribution", ("beckmann", "ggx"), default="beckmann",
+                       doc="the microfacet distribution D: the paper's Beckmann (slope m), or GGX (Trowbridge-Reitz) "
+                           "with alpha = m; the masking stays Cook-Torrance's")
 _FORM = Choice("form", ("microfacet", "1982"), default="microfacet",
                doc="'microfacet': F D G / (4 (n.l)(n.v)); '1982': the paper's F D' G / (pi (n.l)(n.v)), "
                    "D' = pi D, exactly 4 times the microfacet form")
@@ -136,6 +139,16 @@ def cook_torrance_beckmann(tan2, m):
     with np.errstate(under="ignore"):
         value = ((root * ((sec2 * sec2) / m2)) * root).astype(dtype)
     return np.where(tan2 < limit, value, dtype.type(0)).astype(dtype)
+
+
+def _distribution(tan2, m, distribution):
+    """``D' = pi D`` of cook_torrance_lobe.glsl: Beckmann's (`cook_torrance_beckmann`), or ``pi`` times GGX's with
+    ``alpha = m`` (`glphong.twin.functions.microfacet_ggx`)."""
+    if distribution == "ggx":
+        tan2 = np.asarray(tan2)
+        m = tan2.dtype.type(m)
+        return (tan2.dtype.type(np.pi) * microfacet_ggx(tan2, m * m)).astype(tan2.dtype)
+    return cook_torrance_beckmann(tan2, m)
 
 
 def cook_torrance_masking(n_dot_l, n_dot_v, n_dot_h, h_dot_l):
@@ -175,6 +188,8 @@ class CookTorranceLobe(MaterialModel):
     fresnel : SchlickFresnel, DielectricFresnel or None
         The Fresnel factor ``F(h.l)`` (default ``SchlickFresnel(0.04)``; None: ``F = 1``).
     form : {'microfacet', '1982'}
+    distribution : {'beckmann', 'ggx'}
+        The paper's Beckmann distribution of slope ``m``, or GGX with ``alpha = m`` (the masking stays the paper's).
     """
 
     name = "cook_torrance_lobe"
@@ -183,7 +198,7 @@ class CookTorranceLobe(MaterialModel):
     glsl = GlslFile("materials/cook_torrance_lobe.glsl")
     uses = ("microfacet",)
     vanishes_with = ()
-    choices = (_FORM,)
+    choices = (_FORM, _DISTRIBUTION)
     fresnel_slot = FresnelSlot(cosine="h.l", default=SchlickFresnel(0.04))
     properties = Properties(reciprocal=True, isotropic=True, energy_conserving=True,
                             condition="form='microfacet' and F <= 1 (the specular albedo is at most max F); "
@@ -192,7 +207,7 @@ class CookTorranceLobe(MaterialModel):
     def response(self, f, wi, wo, n_dot_l, p):
         valid, n_dot_v, n_dot_h, h_dot_l, tan2 = cook_torrance_geometry(f.n, wi, wo, n_dot_l)
         dtype = tan2.dtype
-        d = cook_torrance_beckmann(tan2, p.m)
+        d = _distribution(tan2, p.m, p.distribution)
         g = cook_torrance_masking(np.asarray(n_dot_l).astype(dtype), n_dot_v, n_dot_h, h_dot_l)
         with np.errstate(over="ignore", under="ignore"):
             s = np.minimum(d * (g * dtype.type(_SCALE[p.form])), dtype.type(_FLT_MAX)).astype(dtype)
@@ -207,7 +222,7 @@ class CookTorranceLobe(MaterialModel):
         low, high = super().band(f, wi, wo, n_dot_l, p, constants)
         n_dot_l = np.maximum(n_dot_l, np.finfo(np.float64).tiny)
         _, _, _, _, tan2 = cook_torrance_geometry(f.n, wi, wo, n_dot_l)
-        flushed = cook_torrance_beckmann(tan2, p.m) < 2 * _FLT_MIN
+        flushed = _distribution(tan2, p.m, p.distribution) < 2 * _FLT_MIN
         return np.where(flushed[..., None], np.minimum(low, 0.0), low), high
 
     def oracle(self, f, wi, wo, n_dot_l, p):
@@ -223,7 +238,10 @@ class CookTorranceLobe(MaterialModel):
         cos2 = n_dot_h * n_dot_h
         tan2 = (1 - cos2) / cos2
         m2 = p.m * p.m
-        d = mpmath.exp(-tan2 / m2) / (mpmath.pi * m2 * cos2 * cos2)
+        if p.distribution == "ggx":  # GGX with alpha = m, as Walter et al. write it
+            d = m2 / (mpmath.pi * (cos2 * (m2 - 1) + 1) ** 2)
+        else:
+            d = mpmath.exp(-tan2 / m2) / (mpmath.pi * m2 * cos2 * cos2)
         g = min(mpmath.mpf(1), 2 * n_dot_h * n_dot_v / v_dot_h, 2 * n_dot_h * n_dot_l / v_dot_h)
         if p.form == "1982":
             f_r = [F * (mpmath.pi * d) * g / (mpmath.pi * n_dot_l * n_dot_v) for F in fresnel_oracle(p, dot(h, wi))]
@@ -254,6 +272,8 @@ class CookTorrance(MaterialSum):
     fresnel : SchlickFresnel, DielectricFresnel or None
         ``F(h.l)`` of the specular term (default ``SchlickFresnel(0.04)``; None: ``F = 1``).
     form : {'microfacet', '1982'}
+    distribution : {'beckmann', 'ggx'}
+        Beckmann (the paper's), or GGX with ``alpha = m``.
     ka : float or (3,) array_like, optional
         Constant term [W/(m^2 sr)], >= 0.
     two_sided : bool, optional
@@ -323,6 +343,16 @@ def _stability_cases():
                               note=f"theta_h = {theta_h:.3g} rad"))
     cases.append(Case("cook_torrance 1982 m=1e-3 peak", "cook-torrance peak", CookTorrance(0.1, 1e-3, form="1982"),
                       eye=_mirror_eye(30.0, 0.0), lights=(("point", light, e_one),)))
+    # the GGX option: its peak (a2 + tan2 = a2: 1e-12 at m = 1e-3), its long tail, grazing view
+    for m in (1e-3, 0.05, 0.5, 10.0):
+        for where, theta_h in (("peak", 0.0), ("tail", min(30.0 * m, 1.2))):
+            cases.append(Case(f"cook_torrance ggx m={m:g} {where}", "cook-torrance ggx",
+                              CookTorrance(0.1, m, distribution="ggx"), eye=_mirror_eye(30.0, 2 * theta_h),
+                              lights=(("point", light, e_one),), note=f"theta_h = {theta_h:.3g} rad"))
+    for nv in (1e-3, 1e-20):
+        cases.append(Case(f"cook_torrance ggx grazing view n.v={nv:g}", "cook-torrance ggx",
+                          CookTorrance(0.0, 0.3, distribution="ggx"), eye=(-float(np.sqrt(1.0 - nv * nv)), 0.0, nv),
+                          lights=(("point", _unit(40.0), e_one),)))
     # v.h near 0: l almost opposite to v, both grazing (l = -v itself is not lit: n.v < 0 there)
     for c, gap in ((1e-2, 1e-3), (1e-4, 1e-5), (1e-6, 1e-7)):
         r = float(np.sqrt(1.0 - c * c))

@@ -18,7 +18,7 @@ roughness   scalar [0, 1]  ``roughnessFactor``: ``alpha = roughness^2``
 
 Numerics (float32, branchless, never NaN or Inf; see the GLSL header): the half-vector geometry is the library chunk
 ``microfacet.glsl`` (`glphong.twin.functions.microfacet_geometry`, shared with Cook-Torrance: ``tan^2(theta_h)`` from
-the chord), and D is divided through by ``(n.h)^4``: ``D = (alpha^2 r) r / pi``, ``r = 1 + (1 - alpha^2)/(alpha^2 +
+the chord), and D (``microfacet_ggx``, shared with Cook-Torrance's GGX option) is divided through by ``(n.h)^4``: ``D = (alpha^2 r) r / pi``, ``r = 1 + (1 - alpha^2)/(alpha^2 +
 tan^2)``, a sum of positive terms (at the peak ``alpha^2 + tan^2 = alpha^2``: 1e-16 at roughness 1e-4), ``r`` saturated;
 ``V (n.l)`` is formed with the response's ``n.l`` cancelled against V's.  Roughness 0 is a mirror: D is a delta
 at ``h = n`` that a point light meets with zero measure, so the program reflects 0 there (and everywhere else
@@ -48,7 +48,7 @@ from glphong.materials.cook_torrance import oracle_half_vector
 from glphong.materials.model import MaterialModel, Param, Properties
 from glphong.materials.params import GlslFile
 from glphong.twin.band import EPS
-from glphong.twin.functions import microfacet_geometry
+from glphong.twin.functions import microfacet_geometry, microfacet_ggx
 
 __all__ = ["GltfPBR", "gltf_pbr_ggx", "gltf_pbr_visibility_cos"]
 
@@ -69,18 +69,8 @@ def _dot(a, b):
     return np.sum(a * b, axis=-1)
 
 
-def gltf_pbr_ggx(tan2, a2):
-    """GGX ``D = (a2 r) r / pi``, ``r = 1 + (1 - a2)/(a2 + tan2)`` (gltf_pbr.glsl), ``r`` and ``D`` at most FLT_MAX;
-    0 where ``a2 + tan2 = 0``."""
-    tan2 = np.asarray(tan2)
-    dtype = tan2.dtype
-    a2 = np.asarray(a2).astype(dtype)
-    big = dtype.type(_FLT_MAX)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-        s = (a2 + tan2).astype(dtype)
-        r = (dtype.type(1) + (dtype.type(1) - a2) / s).astype(dtype)
-        value = ((a2 * r) * (np.minimum(r, big) * dtype.type(1 / np.pi))).astype(dtype)
-        return np.where(s > 0, np.minimum(value, big), dtype.type(0)).astype(dtype)
+#: GGX D, the library chunk microfacet.glsl's (`glphong.twin.functions.microfacet_ggx`); this name is kept
+gltf_pbr_ggx = microfacet_ggx
 
 
 def gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2):

@@ -17,7 +17,7 @@ import numpy as np
 __all__ = [
     "ShadingFrame", "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "perpendiculars", "log_one_minus",
     "lobe_from_delta", "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
-    "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "microfacet_geometry", "light_term", "FLT_MAX",
+    "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "microfacet_geometry", "microfacet_ggx", "light_term", "FLT_MAX",
     "FRAME_PARALLEL_LIMIT", "surface_normal",
 ]
 
@@ -401,3 +401,17 @@ def microfacet_geometry(n, wi, wo, n_dot_l):
         sin2 = np.maximum(delta * (dtype.type(2) - delta), dtype.type(0)).astype(dtype)
         tan2 = np.where(valid, sin2 / (nh * nh), dtype.type(0)).astype(dtype)
     return valid, np.where(valid, nv, one).astype(dtype), nh, (dtype.type(0.5) * length).astype(dtype), tan2
+
+
+def microfacet_ggx(tan2, a2):
+    """GGX ``D = (a2 r) r / pi`` [1/sr], ``r = 1 + (1 - a2)/(a2 + tan2)`` (microfacet.glsl), ``r`` and ``D`` at most
+    FLT_MAX; 0 where ``a2 + tan2 = 0``.  ``tan2`` (...) >= 0 (may be Inf), ``a2 = alpha^2`` (...) >= 0."""
+    tan2 = np.asarray(tan2)
+    dtype = tan2.dtype
+    a2 = np.asarray(a2).astype(dtype)
+    big = dtype.type(FLT_MAX)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        s = (a2 + tan2).astype(dtype)
+        r = (dtype.type(1) + (dtype.type(1) - a2) / s).astype(dtype)
+        value = ((a2 * r) * (np.minimum(r, big) * dtype.type(1 / np.pi))).astype(dtype)
+        return np.where(s > 0, np.minimum(value, big), dtype.type(0)).astype(dtype)

@@ -1,5 +1,5 @@
 // materials/cook_torrance_lobe.glsl -- the model 'cook_torrance_lobe': the Cook-Torrance specular term
-// (Cook and Torrance 1982, docs/design.md section 9), Beckmann distribution, Torrance-Sparrow masking,
+// (Cook and Torrance 1982, docs/design.md section 9), Beckmann (or GGX) distribution, Torrance-Sparrow masking,
 // branchless, never NaN or Inf for valid input.
 //
 //   form "microfacet" (COOK_TORRANCE_LOBE_FORM == 0):  f_r = F D G / (4 (n.l)(n.v))
@@ -31,9 +31,14 @@
 //   cos^4 and tan^2 by subtraction, divided by 4 (n.l)(n.v).
 // Uniforms (declared by glphong from the model's params): u_cook_torrance_lobe_m, and the Fresnel
 // factor's u_cook_torrance_lobe_fresnel_f0, u_cook_torrance_lobe_fresnel_ior.
-// Key defines read here: COOK_TORRANCE_LOBE_FORM (0 microfacet, 1 1982), NAIVE.
+// distribution "ggx" (COOK_TORRANCE_LOBE_DISTRIBUTION == 1): D' = pi microfacet_ggx(tan2, m^2) (library chunk
+//   microfacet.glsl: GGX with alpha = m, divided through by (n.h)^4), in place of Beckmann's; G stays the V-cavity
+//   masking above (Cook-Torrance's), F stays F(h.l).
+// Key defines read here: COOK_TORRANCE_LOBE_FORM (0 microfacet, 1 1982), COOK_TORRANCE_LOBE_DISTRIBUTION
+// (0 beckmann, 1 ggx), NAIVE.
 
 const float COOK_TORRANCE_INV_PI = 0.3183098861837907;
+const float COOK_TORRANCE_PI = 3.141592653589793;
 const float COOK_TORRANCE_EXP_LIMIT = 104.0;  // exp(-104) rounds to 0 in float32
 
 float cook_torrance_beckmann(float tan2, float m)
@@ -69,7 +74,12 @@ vec3 cook_torrance_lobe_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l
     float v_dot_h = dot(wo, h);
     float m2 = u_cook_torrance_lobe_m * u_cook_torrance_lobe_m;
     float c2 = n_dot_h * n_dot_h;
+#if COOK_TORRANCE_LOBE_DISTRIBUTION == 1
+    float ggx = c2 * (m2 - 1.0) + 1.0;                // GGX, alpha = m: D' = pi D = alpha^2 / (...)^2
+    float d = m2 / (ggx * ggx);
+#else
     float d = exp(-((1.0 - c2) / c2) / m2) / (m2 * c2 * c2);
+#endif
     float g = min(1.0, min(2.0 * n_dot_h * n_dot_v / v_dot_h, 2.0 * n_dot_h * n_dot_l / v_dot_h));
     vec3 value = cook_torrance_lobe_fresnel(v_dot_h) * (d * g * COOK_TORRANCE_SCALE / (n_dot_l * n_dot_v)) * n_dot_l;
     return n_dot_v > 0.0 ? value : vec3(0.0);
@@ -79,7 +89,11 @@ vec3 cook_torrance_lobe_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l
 {
     float n_dot_v, n_dot_h, h_dot_l, tan2;
     bool valid = microfacet_geometry(f.n, wi, wo, n_dot_l, n_dot_v, n_dot_h, h_dot_l, tan2);
+#if COOK_TORRANCE_LOBE_DISTRIBUTION == 1
+    float d = COOK_TORRANCE_PI * microfacet_ggx(tan2, u_cook_torrance_lobe_m * u_cook_torrance_lobe_m);
+#else
     float d = cook_torrance_beckmann(tan2, u_cook_torrance_lobe_m);
+#endif
     float g = cook_torrance_masking(n_dot_l, n_dot_v, n_dot_h, h_dot_l);
     float s = min(d * (g * COOK_TORRANCE_SCALE), FLT_MAX);
     vec3 value = cook_torrance_lobe_fresnel(h_dot_l) * s;

@@ -10,11 +10,9 @@
 //
 // microfacet_geometry (library chunk microfacet.glsl): valid, n.v, n.h, v.h = |l + v|/2, tan2 = tan^2(theta_h) from the
 //   chord (no 1 - (n.h)^2 cancellation at the peak); invalid where l = -v, n.v <= 0 or n.l <= 0 (the response is 0).
-// gltf_pbr_ggx(tan2, a2) -> D = (a2 r) r / pi,  r = 1 + (1 - a2)/(a2 + tan2) = (1 + tan2)/(a2 + tan2): the
-//   specification's alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2) divided through by (n.h)^4 = 1/(1 + tan2)^2, a sum of
-//   positive terms (at the peak a2 + tan2 = a2, 1e-16 at roughness 1e-4); r saturated at FLT_MAX, D at most FLT_MAX,
-//   a2/pi where tan2 is Inf; 0 where a2 + tan2 = 0 (roughness 0 at the exact mirror direction: a delta that no point
-//   light meets with nonzero measure, so this program reflects none of it).
+// microfacet_ggx(tan2, a2) (library chunk microfacet.glsl) -> GGX D = (a2 r) r / pi, r = (1 + tan2)/(a2 + tan2): the
+//   specification's D divided through by (n.h)^4; 0 where a2 + tan2 = 0 (roughness 0 at the exact mirror direction:
+//   a delta that no point light meets with nonzero measure, so this program reflects none of it).
 // gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2) -> V (n.l) = n.l / (2 (n.v r_l + n.l r_v)),
 //   r_x = sqrt((n.x)^2 + a2 (1 - (n.x)^2)): the response's n.l cancels the 1/(n.l) of V, so a grazing light
 //   never forms 1/(n.l); at most 1 / (4 n.v) for roughness 0.
@@ -22,14 +20,6 @@
 // u_gltf_pbr_roughness.  Key defines read here: none.
 
 const float GLTF_PBR_INV_PI = 0.3183098861837907;
-
-float gltf_pbr_ggx(float tan2, float a2)
-{
-    float s = a2 + tan2;
-    float r = 1.0 + (1.0 - a2) / s;
-    float value = (a2 * r) * (min(r, FLT_MAX) * GLTF_PBR_INV_PI);
-    return s > 0.0 ? min(value, FLT_MAX) : 0.0;
-}
 
 float gltf_pbr_visibility_cos(float n_dot_l, float n_dot_v, float a2)
 {
@@ -44,7 +34,7 @@ vec3 gltf_pbr_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
     bool valid = microfacet_geometry(f.n, wi, wo, n_dot_l, n_dot_v, n_dot_h, v_dot_h, tan2);
     float alpha = u_gltf_pbr_roughness * u_gltf_pbr_roughness;
     float a2 = alpha * alpha;
-    float specular = min(gltf_pbr_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2), FLT_MAX);
+    float specular = min(microfacet_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2), FLT_MAX);
     float x1 = max(1.0 - v_dot_h, 0.0);                   // v.h = |l + v|/2 may round above 1
     float x = (x1 * x1) * (x1 * x1) * x1;
     vec3 c = u_gltf_pbr_base_color;

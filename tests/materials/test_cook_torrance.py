@@ -331,11 +331,14 @@ def test_specular_albedo(m):
 # --------------------------------------------------------------------------- stability
 def test_the_stability_cases_and_the_saturating_one(glphong_backend):
     cases = cases_for(CookTorranceLobe)
-    assert len(cases) == 59
+    assert len(cases) == 69
     saturated = [c for c in cases if not c.in_range]
     assert [c.name for c in saturated] == ["cook_torrance mirrored grazing n.l=n.v=1e-36 m=1e-3"]
     report = run_stability(backend=glphong_backend, cases=saturated)
     assert report.passed_count == 1 and report.rows[0].gpu == [FLT_MAX] * 3
+    ggx = [c for c in cases if c.group == "cook-torrance ggx"]  # the GGX option: peak to m = 1e-3, tails, grazing
+    report = run_stability(backend=glphong_backend, cases=ggx)
+    assert len(ggx) == 10 and report.passed_count == 10, [(r.case, r.relative_error) for r in report.rows if not r.passed]
 
 
 # --------------------------------------------------------------------------- the declaration
@@ -344,13 +347,15 @@ def test_declaration():
     assert CookTorrance.terms == (Diffuse, CookTorranceLobe)
     (m,) = CookTorranceLobe.params
     assert (m.name, m.kind, m.glsl_type, m.interval, m.default) == ("m", "scalar", "float", "[0.001, 10]", None)
-    assert [a.name for a in CookTorrance.arguments()] == ["rho_d", "m", "fresnel", "form"]
+    assert [a.name for a in CookTorrance.arguments()] == ["rho_d", "m", "fresnel", "form", "distribution"]
     assert CookTorranceLobe.needs == ("view",) and CookTorranceLobe.ambient is None
     assert CookTorranceLobe.vanishes_with == ()
     assert CookTorranceLobe.fresnel_slot.cosine == "h.l"
     assert CookTorranceLobe.fresnel_slot.default == SchlickFresnel(0.04)
-    (form,) = CookTorranceLobe.choices
+    form, distribution = CookTorranceLobe.choices
     assert (form.name, form.values, form.default) == ("form", ("microfacet", "1982"), "microfacet")
+    assert (distribution.name, distribution.values, distribution.default) == ("distribution", ("beckmann", "ggx"),
+                                                                             "beckmann")
     p = CookTorranceLobe.properties
     assert (p.reciprocal, p.isotropic, p.energy_conserving, p.non_negative) == (True, True, True, True)
     assert "1982" in p.condition and "microfacet" in CookTorrance.properties.condition
@@ -370,3 +375,35 @@ def test_render_matches(glphong_renderer):
     assert report.gpu[..., 0].max() > 1.0  # the highlight is in the picture
     covered = report.mask[..., None] & (report.reference >= 2.0 ** -100)
     assert report.relative_error[covered].max() < 1e-4  # measured 3.7e-5
+
+
+# --------------------------------------------------------------------------- the GGX option
+def _ggx_closed_form(n, l, v, m, f0=0.04):
+    """Cook-Torrance with Walter et al.'s GGX (alpha = m) in float64, written here: F(h.l) D G / (4 (n.l)(n.v))."""
+    h = (l + v) / np.linalg.norm(l + v, axis=-1, keepdims=True)
+    nl, nv, nh, hl = (np.sum(a * b, -1) for a, b in ((n, l), (n, v), (n, h), (h, l)))
+    a2 = m ** 2  # alpha = m
+    d = a2 / (np.pi * (nh ** 2 * (a2 - 1) + 1) ** 2)
+    g = np.minimum(1.0, np.minimum(2 * nh * nv / hl, 2 * nh * nl / hl))
+    f = f0 + (1 - f0) * (1 - hl) ** 5
+    return (f * d * g / (4 * nl * nv) * nl)[:, None] * np.ones(3)
+
+
+@pytest.mark.parametrize("m", [0.01, 0.3, 2.0])
+def test_ggx_option_against_its_closed_form(m, glphong_backend):
+    rng = np.random.default_rng(int(100 * m))
+    count = 400
+    t, p = rng.uniform(0, 1.4, (2, count)), rng.uniform(0, 2 * np.pi, (2, count))
+    l, v = (np.stack([np.sin(t[i]) * np.cos(p[i]), np.sin(t[i]) * np.sin(p[i]), np.cos(t[i])], -1) for i in (0, 1))
+    n = np.broadcast_to([0.0, 0.0, 1.0], l.shape)
+    lobe = CookTorranceLobe(m, distribution="ggx")
+    term = lobe.components[0]
+    expected = _ggx_closed_form(n, l, v, float(np.float32(m)), f0=float(np.float32(0.04)))  # the float32 parameters
+    twin = term.response(ShadingFrame(n), l, v, np.sum(n * l, -1), term.values())
+    np.testing.assert_allclose(twin, expected, rtol=1e-11, atol=0)
+    gpu = evaluate(lobe, wi=l, wo=v, backend=glphong_backend)
+    big = expected[:, 0] > 1e-6 * expected[:, 0].max()
+    np.testing.assert_allclose(gpu[big], expected[big], rtol=2e-4)
+    # GGX is not Beckmann: the tails differ by orders of magnitude
+    beckmann = CookTorranceLobe(m).components[0]
+    assert not np.allclose(beckmann.response(ShadingFrame(n), l, v, np.sum(n * l, -1), beckmann.values()), twin, rtol=0.1)
