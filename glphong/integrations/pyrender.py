@@ -50,7 +50,7 @@ from glphong.scene.camera import PerspectiveCamera
 from glphong.gpu.contexts import attach_current
 from glphong.scene.geometry import MeshData
 from glphong.shaders.key import program_key
-from glphong.materials import GltfPBR, Material, NormalMap, Texture, TextureImage
+from glphong.materials import GltfPBR, Material, NormalMap, Texture, TextureImage, VertexColors
 from glphong.gpu.programs import ProgramCache
 from glphong.scene.scene import Scene
 
@@ -80,10 +80,10 @@ class GlphongMaterial(pyrender.Material):
         return f"GlphongMaterial({self.glphong!r}, exposure={self.exposure:g})"
 
     @classmethod
-    def from_pyrender(cls, material, exposure=1.0):
+    def from_pyrender(cls, material, exposure=1.0, vertex_colors=False):
         """The `GlphongMaterial` of a ``pyrender.MetallicRoughnessMaterial``: `gltf_pbr_of` it (glTF's Appendix B with
         its textures), to swap into a pyrender scene."""
-        return cls(gltf_pbr_of(material), exposure=exposure, name=material.name)
+        return cls(gltf_pbr_of(material, vertex_colors), exposure=exposure, name=material.name)
 
     @property
     def tex_flags(self):
@@ -100,9 +100,10 @@ class GlphongMaterial(pyrender.Material):
 _DRAWING = threading.local()
 
 
-def gltf_pbr_of(material):
+def gltf_pbr_of(material, vertex_colors=False):
     """The `glphong.GltfPBR` of a ``pyrender.MetallicRoughnessMaterial`` (glTF's metallic-roughness, as pyrender holds
-    it): ``baseColorFactor`` (rgb) times ``baseColorTexture`` (sRGB); ``metallicFactor`` and ``roughnessFactor``
+    it): ``baseColorFactor`` (rgb) times ``baseColorTexture`` (sRGB) times ``COLOR_0`` (``vertex_colors``: the
+    primitive has them; glTF's rule, where pyrender 0.1.45 multiplies its whole result); ``metallicFactor`` and ``roughnessFactor``
     times the metallic-roughness texture's blue and green channels (pyrender keeps them as its two channels 'GB');
     ``emissiveFactor`` times ``emissiveTexture`` (sRGB); ``occlusionTexture``'s red channel; each texture's sampler
     (`glphong.formats.gltf_data.gl_sampling`); ``doubleSided`` as ``two_sided``; ``normalTexture`` as a
@@ -130,7 +131,8 @@ def gltf_pbr_of(material):
 
     base = tuple(np.clip(np.asarray(material.baseColorFactor, np.float64)[:3], 0.0, 1.0))
     texture = image(material.baseColorTexture, "rgb", True)
-    base_color = Texture(texture, scale=base) if texture is not None else base
+    base_color = Texture(texture, scale=base, vertex_colors=vertex_colors) if texture is not None else \
+        VertexColors(scale=base) if vertex_colors else base
     metallic = min(float(material.metallicFactor), 1.0)
     roughness = min(float(material.roughnessFactor), 1.0)
     texture = image(material.metallicRoughnessTexture, "gb", False)
@@ -189,7 +191,7 @@ def scene_from_pyrender(scene, convert=False):
         for primitive in node.mesh.primitives:
             material = primitive.material
             if convert and isinstance(material, pyrender.MetallicRoughnessMaterial) and primitive.normals is not None:
-                material = GlphongMaterial.from_pyrender(material)
+                material = GlphongMaterial.from_pyrender(material, vertex_colors=primitive.color_0 is not None)
             if isinstance(material, GlphongMaterial):
                 # pyrender keeps indices as float32 (exact below 2^24 vertices)
                 indices = np.rint(np.asarray(primitive.indices, dtype=np.float64)).astype(np.int64).reshape(-1, 3)
