@@ -14,19 +14,40 @@
 //   material_inputs();
 //   locations 0 position, 1 normal, then the extra planes at GBUFFER_<PLANE>_LOCATION (key.py packs them).
 // HAS_INPUTS: material_inputs(uv, colour) sets the surface inputs (the generated material chunk) before shading.
+// ALPHA_MASK (1 constant, 2 textured alpha): fragments with alpha below the cutoff are discarded, in every program
+//   that draws the object's surface (radiance, G-buffer, per-vertex), so the G-buffer covers what the radiance does.
 // NORMAL_MAP: n = surface_normal(shading_frame(n, tangent, uv), texture(u_normal_map_texture, uv).rgb, scale)
 //   (normal_map.glsl) where n is valid, before the G-buffer is written and before shading: both see the mapped normal.
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, NUM_LOD_TEXTURES,
-// GBUFFER_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP,
+// GBUFFER_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
 // RUNTIME_SWITCHES, SWITCH(flag).
 
 invariant in vec3 v_position;
 #if SHADE_PER_VERTEX
 in vec3 v_radiance;
 layout(location = 0) out vec4 out_radiance;
+#if ALPHA_MASK == 2
+invariant in vec2 v_uv;
+#endif
+#if ALPHA_MASK
+uniform float u_alpha_mask_cutoff;
+uniform float u_alpha_mask_scale;
+#endif
+#if ALPHA_MASK == 2
+uniform sampler2D u_alpha_mask_texture;
+#endif
 
 void main()
 {
+#if ALPHA_MASK
+    float alpha = u_alpha_mask_scale;
+#if ALPHA_MASK == 2
+    alpha *= surface_texture(u_alpha_mask_texture, v_uv).r;
+#endif
+    if (alpha < u_alpha_mask_cutoff) {
+        discard;
+    }
+#endif
     out_radiance = vec4(v_radiance, 1.0);
 }
 #else
@@ -48,6 +69,26 @@ uniform float u_two_sided;
 #if NORMAL_MAP
 uniform sampler2D u_normal_map_texture;
 uniform float u_normal_map_scale;
+#endif
+#if ALPHA_MASK
+uniform float u_alpha_mask_cutoff;
+uniform float u_alpha_mask_scale;
+#endif
+#if ALPHA_MASK == 2
+uniform sampler2D u_alpha_mask_texture;
+#endif
+
+#if ALPHA_MASK
+// the alpha test (glTF alphaMode MASK): alpha = scale (times texture(u_alpha_mask_texture, uv).r); the caller
+// discards the fragment where alpha < cutoff (the texture sampled in uniform control flow, before any discard)
+bool alpha_masked(vec2 uv)
+{
+    float alpha = u_alpha_mask_scale;
+#if ALPHA_MASK == 2
+    alpha *= surface_texture(u_alpha_mask_texture, uv).r;
+#endif
+    return alpha < u_alpha_mask_cutoff;
+}
 #endif
 #if OUTPUT_GBUFFER
 uniform float u_object_id;
@@ -103,6 +144,11 @@ void main()
     vec3 color = vec3(1.0);
 #if HAS_COLOR
     color = v_color;
+#endif
+#if ALPHA_MASK
+    if (alpha_masked(uv)) {
+        discard;
+    }
 #endif
 #if NORMAL_MAP
     vec3 texel = surface_texture(u_normal_map_texture, uv);  // in uniform control flow: implicit derivatives

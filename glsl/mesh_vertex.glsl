@@ -13,7 +13,7 @@
 // vertex colour: HAS_COLOR, a surface input reads it; material_inputs() runs here when shading per vertex):
 // 2, 3 and 5 in glphong's own draws, pyrender's packed order inside pyrender (the key says which).
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
-// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, *_LOCATION, SHADE_PER_VERTEX,
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, *_LOCATION, SHADE_PER_VERTEX, ALPHA_MASK,
 // TWO_SIDED, NEEDS_VIEW, SWITCH(flag).
 
 const float GOURAUD_MAX = 1.2676506002282294e30;  // 2^100: per-vertex radiance saturates here
@@ -44,6 +44,9 @@ const vec4 u_eye = vec4(0.0);  // nothing reads the eye
 #endif
 #if TWO_SIDED && RUNTIME_SWITCHES
 uniform float u_two_sided;
+#endif
+#if ALPHA_MASK == 2
+invariant out vec2 v_uv;  // the fragment stage's alpha test reads the texture at the interpolated uv
 #endif
 #else
 #if HAS_NORMAL
@@ -94,6 +97,9 @@ void main()
     // saturated at GOURAUD_MAX: interpolating Inf (or values near FLT_MAX, which the perspective-correct
     // interpolation scales by 1/w and subtracts) would give Inf and NaN inside the triangle
     v_radiance = min(shade_point(world.xyz, shading_frame(n, tangent, uv), n_valid, u_eye), vec3(GOURAUD_MAX));
+#if ALPHA_MASK == 2
+    v_uv = uv;
+#endif
 #else
 #if HAS_NORMAL
     v_normal = u_normal_matrix * in_normal;

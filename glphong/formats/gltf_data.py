@@ -475,7 +475,7 @@ _IMAGE_TYPES = {"image/png": "PNG", "image/jpeg": "JPEG"}
 
 
 def read_gltf_image(gltf, index):
-    """The pixels (H, W, 3) uint8 of glTF texture ``index``, or None where the texture has no
+    """The pixels (H, W, 4) uint8 (rgba) of glTF texture ``index``, or None where the texture has no
     image glphong decodes (a KTX2 or WebP source only; warned once).
 
     The image comes from a buffer view, a base64 data URI, or a file inside the document's folder; it is
@@ -507,7 +507,7 @@ def _decode_gltf_image(gltf, source):
     else:
         target = resolve_reference(gltf.path, image["uri"], f"{where}.uri", gltf.allow_outside)
         payload = read_bytes(target, gltf.limits, gltf.path, f"{where}.uri")
-    pixels = decode_image(payload, gltf.limits, gltf.path, where, mode="RGB")
+    pixels = decode_image(payload, gltf.limits, gltf.path, where, mode="RGBA")  # alpha: an alpha mask's
     gltf.charge(pixels.size * 8 * 4 // 3, where)
     pixels.flags.writeable = False  # shared by every texture that names the image
     return pixels

@@ -9,7 +9,7 @@ import numpy as np
 from glphong.core.filesafety import SceneFileError
 from glphong.core.radiometry import LUMENS_PER_WATT
 from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, read_gltf_primitives, texture_sampling
-from glphong.materials import Material, NormalMap, Texture, TextureImage, VertexColors
+from glphong.materials import AlphaMask, Material, NormalMap, Texture, TextureImage, VertexColors
 from glphong.materials.cook_torrance import CookTorrance
 from glphong.materials.gltf_pbr import GltfPBR
 from glphong.materials.fresnel import SchlickFresnel
@@ -185,15 +185,18 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
     - ``occlusion = 1 + strength (occlusionTexture.r - 1)`` (linear), on the ambient and environment answers only;
     - ``normalTexture`` (linear) as a `glphong.NormalMap` with its ``scale`` (the mesh's ``TANGENT``, or tangents
       derived from its UVs);
-    - ``doubleSided`` as ``two_sided``.
+    - ``doubleSided`` as ``two_sided``;
+    - ``alphaMode``: OPAQUE; MASK as a `glphong.AlphaMask` of ``alphaCutoff`` and ``baseColorFactor.a`` times the
+      base-colour texture's alpha (COLOR_0's alpha is not read: a warning says so); BLEND is refused (ValueError).
 
     Parameters
     ----------
     entry : dict
         The validated JSON entry.
     texture : callable, optional
-        ``texture(info, srgb)``: the `glphong.materials.TextureImage` of a ``textureInfo`` object, or None where it
-        cannot be read (the texture is then left out); default: no texture is read.
+        ``texture(info, srgb, alpha=False)``: the `glphong.materials.TextureImage` of a ``textureInfo`` object (of its
+        alpha channel with ``alpha``), or None where it cannot be read (the texture is then left out); default: no
+        texture is read.
     vertex_colors : bool
         The mesh has ``COLOR_0``.
     emissive_scale : float
@@ -204,7 +207,7 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
     -------
     glphong.GltfPBR
     """
-    texture = texture or (lambda info, srgb: None)
+    texture = texture or (lambda info, srgb, alpha=False: None)
     pbr = entry.get("pbrMetallicRoughness", {})
 
     def image(info_key, srgb, holder=None):
@@ -234,19 +237,33 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
             occlusion_image = TextureImage(np.repeat((1.0 - weight + weight * red)[..., None], 3, axis=2),
                                            wrap=occlusion_image.wrap, filter=occlusion_image.filter)
         occlusion = Texture(occlusion_image, channel="r")
+    alpha_mask = None
+    mode = entry.get("alphaMode", "OPAQUE")
+    if mode == "BLEND":
+        raise ValueError("alphaMode BLEND: glphong draws opaque and alpha-masked surfaces, not blended ones (give this "
+                         "material with load_scene(..., materials=...), or set its alphaMode to MASK or OPAQUE)")
+    if mode == "MASK":
+        factor = float(np.clip(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[3], 0.0, 1.0))
+        info = pbr.get("baseColorTexture")
+        alpha = texture(info, False, True) if info is not None else None
+        alpha_mask = AlphaMask(float(entry.get("alphaCutoff", 0.5)),
+                               Texture(alpha, factor, channel="r") if alpha is not None else factor)
+        if vertex_colors:
+            warnings.warn("COLOR_0's alpha is not read: the alpha mask is the base colour's", stacklevel=3)
     normal_image = image("normalTexture", False)
     normal_map = NormalMap(normal_image, float(entry["normalTexture"].get("scale", 1.0))) \
         if normal_image is not None else None
     return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion,
-                   two_sided=bool(entry.get("doubleSided", False)), normal_map=normal_map)
+                   two_sided=bool(entry.get("doubleSided", False)), normal_map=normal_map, alpha_mask=alpha_mask)
 
 
 def _texture_reader(gltf, where):
-    """``texture(info, srgb)`` for `gltf_pbr_material`: the `TextureImage` of a ``textureInfo`` of ``gltf``, or None
+    """``texture(info, srgb, alpha=False)`` for `gltf_pbr_material`: the `TextureImage` of a ``textureInfo`` of ``gltf``
+    (of its alpha channel alone, as grey, with ``alpha``), or None
     (with a warning once per file) where it names a second set of texture coordinates or an image glphong does not
     decode."""
 
-    def texture(info, srgb):
+    def texture(info, srgb, alpha=False):
         if info.get("texCoord", 0) != 0:
             gltf.warn_once("texCoord", f"{where}: a texture reads TEXCOORD_{info['texCoord']}; glphong reads "
                            "TEXCOORD_0 only: drawn without that texture")
@@ -258,7 +275,7 @@ def _texture_reader(gltf, where):
         if pixels is None:
             return None
         wrap, filter_ = texture_sampling(gltf.document, info["index"])
-        return TextureImage(pixels, srgb=srgb, wrap=wrap, filter=filter_)
+        return TextureImage(pixels[..., 3] if alpha else pixels, srgb=srgb, wrap=wrap, filter=filter_)
 
     return texture
 
@@ -294,7 +311,10 @@ def _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emi
                 info = entry.get("pbrMetallicRoughness", {}).get("baseColorTexture")
                 stored = gltf_material(entry, texture(info, True) if texture and info else None, mesh.colors is not None)
             else:
-                stored = gltf_pbr_material(entry, texture, mesh.colors is not None, emissive_scale)
+                try:
+                    stored = gltf_pbr_material(entry, texture, mesh.colors is not None, emissive_scale)
+                except ValueError as exc:  # alphaMode BLEND
+                    raise SceneFileError(gltf.path, str(exc), f"{where}.alphaMode") from None
         made[key] = stored
     return made[key]
 

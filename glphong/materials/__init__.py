@@ -33,12 +33,12 @@ import importlib as _importlib
 import pkgutil as _pkgutil
 
 from glphong.materials.model import Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues, Properties, ShadingFrame, model_named, registered_models
-from glphong.materials.surface import NormalMap, SurfaceInput, Texture, TextureImage, VertexColors
+from glphong.materials.surface import AlphaMask, NormalMap, SurfaceInput, Texture, TextureImage, VertexColors
 from glphong.materials.table import Table, TableData
 
 __all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "Table", "TableData", "ParamValues",
            "Properties", "ShadingFrame", "MaterialDefinitionError", "GlslFile", "registered_models", "model_named",
-           "SurfaceInput", "Texture", "TextureImage", "VertexColors", "NormalMap"]
+           "SurfaceInput", "Texture", "TextureImage", "VertexColors", "NormalMap", "AlphaMask"]
 
 # every module of this package but the mechanism is one model: importing it registers the model, and
 # the material classes it exports are this package's, so a new model is one file here (with its GLSL

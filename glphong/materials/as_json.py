@@ -17,7 +17,7 @@ found among the defined materials by module and name (a user's module must have 
 
 from glphong.materials.fresnel import Fresnel
 from glphong.materials.model import Choice, Material, Param
-from glphong.materials.surface import NormalMap, SurfaceInput
+from glphong.materials.surface import AlphaMask, NormalMap, SurfaceInput
 from glphong.materials.table import Table
 __all__ = ["material_to_json", "material_from_json"]
 
@@ -66,6 +66,14 @@ def material_to_json(material, texture_index=None):
             arguments[argument.name] = value if isinstance(value, str) or value is None else _plain(value)
     out = {"version": VERSION, "class": cls.__name__, "module": cls.__module__, "arguments": arguments,
            "ka": _plain(material.ka), "two_sided": bool(material.two_sided)}
+    mask = material.alpha_mask
+    if mask is not None:
+        if mask.textured and texture_index is None:
+            raise ValueError(f"{cls.__name__} has a textured alpha mask: give texture_index to store it")
+        alpha = {"texture": int(texture_index(mask.alpha.texture)), "wrap": mask.alpha.texture.wrap,
+                 "filter": mask.alpha.texture.filter, "scale": mask.alpha.scale, "channel": mask.alpha.channel} \
+            if mask.textured else mask.alpha
+        out["alpha_mask"] = {"cutoff": mask.cutoff, "alpha": alpha}
     if material.normal_map is not None:
         if texture_index is None:
             raise ValueError(f"{cls.__name__} has a normal map: give texture_index to store it")
@@ -156,5 +164,18 @@ def material_from_json(data, textures=None):
             raise ValueError(f"{cls.__name__}: 'normal_map' must be an object naming a texture, and textures must be given")
         normal_map = NormalMap(textures(n["texture"], n.get("wrap", "repeat"), n.get("filter", "trilinear"), False),
                                n.get("scale", 1.0))
+    alpha_mask = None
+    if data.get("alpha_mask") is not None:
+        a = data["alpha_mask"]
+        alpha = a.get("alpha", 1.0) if isinstance(a, dict) else None
+        if isinstance(alpha, dict):
+            if textures is None:
+                raise ValueError(f"{cls.__name__}: its alpha mask is textured, but no textures were given")
+            alpha = SurfaceInput(alpha.get("scale", 1.0), textures(alpha["texture"], alpha.get("wrap", "repeat"),
+                                                                   alpha.get("filter", "trilinear"), False),
+                                 channel=alpha.get("channel", "r"))
+        if not isinstance(a, dict) or not isinstance(alpha, (int, float, SurfaceInput)) or isinstance(alpha, bool):
+            raise ValueError(f"{cls.__name__}: 'alpha_mask' must be an object with a cutoff and an alpha")
+        alpha_mask = AlphaMask(a.get("cutoff", 0.5), alpha)
     return cls(**arguments, ka=tuple(ka) if isinstance(ka, list) else float(ka), two_sided=bool(data.get("two_sided", True)),
-               normal_map=normal_map)
+               normal_map=normal_map, alpha_mask=alpha_mask)

@@ -14,7 +14,7 @@ twin (`MaterialModel.band`; a generic default) and its extreme cases for the sta
 
 A material is a sum of terms: a `MaterialModel` instance is a material of one term, a
 `MaterialSum` subclass names several (``terms = (Lambert, PhongLobe)``).  Every material takes
-the keywords ``ka`` (a constant radiance ``k_a`` [W/(m^2 sr)]), ``two_sided`` and ``normal_map``.  The built-in
+the keywords ``ka`` (a constant radiance ``k_a`` [W/(m^2 sr)]), ``two_sided``, ``normal_map`` and ``alpha_mask``.  The built-in
 models use exactly this mechanism; a definition is checked when its class is created, so a
 missing twin, a GLSL function of the wrong name or signature, a parameter without a range or a
 name that clashes fails there, with a message saying what is wrong.
@@ -31,7 +31,7 @@ from glphong.materials.registry import _REGISTRY, _is_builtin, model_named, mode
 from glphong.materials.table import Table, TableData
 from glphong.materials.cases import generic_cases
 from glphong.materials.fresnel import FRESNEL_PARAMS, fresnel_uniform_values
-from glphong.materials.surface import NormalMap, SurfaceInput
+from glphong.materials.surface import AlphaMask, NormalMap, SurfaceInput
 from glphong.twin.band import EPS
 from glphong.twin.functions import perpendiculars
 
@@ -53,6 +53,8 @@ class Material:
         Shade back faces with the normal flipped toward the viewer.
     normal_map : glphong.NormalMap or None
         A tangent-space normal map: every term shades with the mapped normal.
+    alpha_mask : glphong.AlphaMask or None
+        Alpha testing: fragments whose alpha is below the cutoff are not drawn.
     """
 
     #: display name; a model's name is also its GLSL prefix
@@ -60,7 +62,7 @@ class Material:
     #: declared BRDF properties (for a sum: derived from its terms unless declared)
     properties = Properties()
 
-    def _set_common(self, ka, two_sided, normal_map=None):
+    def _set_common(self, ka, two_sided, normal_map=None, alpha_mask=None):
         object.__setattr__(self, "ka", _validate.rgb("ka", ka))
         if not isinstance(two_sided, (bool, np.bool_)):
             raise TypeError(f"two_sided must be a bool, True or False (got {two_sided!r})")
@@ -68,6 +70,9 @@ class Material:
         if normal_map is not None and not isinstance(normal_map, NormalMap):
             raise TypeError(f"normal_map must be a glphong.NormalMap or None (got {type(normal_map).__name__})")
         object.__setattr__(self, "normal_map", normal_map)
+        if alpha_mask is not None and not isinstance(alpha_mask, AlphaMask):
+            raise TypeError(f"alpha_mask must be a glphong.AlphaMask or None (got {type(alpha_mask).__name__})")
+        object.__setattr__(self, "alpha_mask", alpha_mask)
 
     @property
     def components(self):
@@ -79,7 +84,7 @@ class Material:
         out = {}
         for term in self.components:
             out.update({a.name: getattr(term, a.name) for a in term.arguments()})
-        out.update(ka=self.ka, two_sided=self.two_sided, normal_map=self.normal_map)
+        out.update(ka=self.ka, two_sided=self.two_sided, normal_map=self.normal_map, alpha_mask=self.alpha_mask)
         return out
 
     def uniform_values(self, key):
@@ -99,9 +104,7 @@ class Material:
         values = {}
         if key.has_ka:
             values["u_ka"] = _validate.float32_uniform(self.ka)
-        if key.normal_map:
-            values["u_normal_map_texture"] = self.normal_map.texture
-            values["u_normal_map_scale"] = _validate.float32_uniform(self.normal_map.scale)
+        values.update(self.surface_uniform_values(key))
         by_name = {term.name: term for term in self.components}
         for term_key in key.terms:
             term = by_name.get(term_key.name)
@@ -123,6 +126,22 @@ class Material:
                 values.update({term.uniform_name(t.name): getattr(term, t.name) for t in term.tables})
         return values
 
+    def surface_uniform_values(self, key):
+        """The uniforms of the material's normal map and alpha mask that program ``key`` reads (radiance and
+        G-buffer programs alike): ``u_normal_map_texture``, ``u_normal_map_scale``, ``u_alpha_mask_cutoff``,
+        ``u_alpha_mask_scale`` and ``u_alpha_mask_texture``."""
+        values = {}
+        if key.normal_map:
+            values["u_normal_map_texture"] = self.normal_map.texture
+            values["u_normal_map_scale"] = _validate.float32_uniform(self.normal_map.scale)
+        if key.alpha_mask:
+            mask = self.alpha_mask
+            values["u_alpha_mask_cutoff"] = _validate.float32_uniform(mask.cutoff)
+            values["u_alpha_mask_scale"] = _validate.float32_uniform(mask.alpha.scale if mask.textured else mask.alpha)
+            if mask.textured:
+                values["u_alpha_mask_texture"] = mask.alpha.texture
+        return values
+
     def __setattr__(self, name, value):
         raise AttributeError(f"{type(self).__name__} is immutable: make a new material instead of setting {name!r}")
 
@@ -141,8 +160,7 @@ class Material:
             shown.append(f"ka={_short(values['ka'])}")
         if not values["two_sided"]:
             shown.append("two_sided=False")
-        if values["normal_map"] is not None:
-            shown.append(f"normal_map={values['normal_map']!r}")
+        shown += [f"{k}={values[k]!r}" for k in ("normal_map", "alpha_mask") if values[k] is not None]
         return f"{type(self).__name__}({', '.join(shown)})"
 
 
@@ -329,12 +347,12 @@ class MaterialModel(Material):
         """How this term reflects an extended light in closed form (`Integral`), or None: sampled (default)."""
         return None
 
-    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, **kwargs):
+    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, **kwargs):
         if type(self).name is None:
             raise TypeError(f"{type(self).__name__} is not a material model (it has no name)")
         for name, value in bind_arguments(type(self), self.arguments(), args, kwargs).items():
             object.__setattr__(self, name, value)
-        self._set_common(ka, two_sided, normal_map)
+        self._set_common(ka, two_sided, normal_map, alpha_mask)
 
     @classmethod
     def arguments(cls):
@@ -645,13 +663,13 @@ class MaterialSum(Material):
         slots = [t.fresnel_slot for t in cls.terms if t.fresnel_slot is not None]
         return cls.all_params() + tuple(slots[:1]) + tuple(c for t in cls.terms for c in t.choices)
 
-    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, **kwargs):
+    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, **kwargs):
         if not type(self).terms:
             raise TypeError(f"{type(self).__name__} has no terms")
         values = bind_arguments(type(self), self.arguments(), args, kwargs)
         parts = tuple(t(**{a.name: values[a.name] for a in t.arguments()}, two_sided=two_sided) for t in self.terms)
         object.__setattr__(self, "_parts", parts)
-        self._set_common(ka, two_sided, normal_map)
+        self._set_common(ka, two_sided, normal_map, alpha_mask)
 
     @property
     def components(self):

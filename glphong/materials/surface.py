@@ -41,7 +41,7 @@ from glphong.core.filesafety import LIMITS, decode_image, read_bytes
 from glphong.core.imaging import encode_srgb8, srgb_decode
 from glphong.twin.band import EPS
 
-__all__ = ["SurfaceInput", "Texture", "VertexColors", "TextureImage", "NormalMap", "surface_texture", "surface_texture_band",
+__all__ = ["SurfaceInput", "Texture", "VertexColors", "TextureImage", "NormalMap", "AlphaMask", "surface_texture", "surface_texture_band",
            "WRAPS", "FILTERS", "CHANNELS", "MAX_TEXTURE_SIZE"]
 
 #: texture wrap modes: GL_REPEAT, GL_CLAMP_TO_EDGE (moderngl's textures offer no mirrored repeat)
@@ -381,6 +381,57 @@ class NormalMap:
 
     def __reduce__(self):
         return NormalMap, (self.texture, self.scale)
+
+
+class AlphaMask:
+    """Alpha testing (glTF's ``alphaMode: MASK``): a fragment whose alpha is below ``cutoff`` is not drawn (in the
+    radiance and in the G-buffer alike, so the twin shades exactly the fragments the GPU drew); the others are opaque.
+
+    Given to any material as ``alpha_mask=``.  Alpha is a constant, or one channel of a texture times a constant
+    (glTF: ``baseColorFactor.a`` times the base-colour texture's alpha, ``glphong.Texture(alpha, scale,
+    srgb=False, channel='r')``).  Shadow maps are drawn without the mask (a masked surface casts its whole shadow).
+
+    Parameters
+    ----------
+    cutoff : float
+        glTF's ``alphaCutoff`` (default 0.5), >= 0.
+    alpha : float or SurfaceInput
+        In [0, 1]; a `SurfaceInput` needs a ``channel`` and no vertex colours.
+    """
+
+    __slots__ = ("cutoff", "alpha")
+
+    def __init__(self, cutoff=0.5, alpha=1.0):
+        object.__setattr__(self, "cutoff", _validate.scalar("cutoff", cutoff, low=0.0))
+        if isinstance(alpha, SurfaceInput):
+            if alpha.channel is None or alpha.vertex_colors or alpha.texture is None:
+                raise ValueError("an alpha mask's alpha is one channel of a texture (channel='r', no vertex colours)")
+            low, high = alpha.value_range()
+            if low < 0.0 or high > 1.0:
+                raise ValueError(f"alpha must be in [0, 1] everywhere; {alpha!r} spans [{low:g}, {high:g}]")
+        else:
+            alpha = _validate.scalar("alpha", alpha, low=0.0, high=1.0)
+        object.__setattr__(self, "alpha", alpha)
+
+    @property
+    def textured(self):
+        """Whether alpha varies over the surface."""
+        return isinstance(self.alpha, SurfaceInput)
+
+    def __setattr__(self, name, value):
+        raise AttributeError("AlphaMask is immutable")
+
+    def __eq__(self, other):
+        return isinstance(other, AlphaMask) and (other.cutoff, other.alpha) == (self.cutoff, self.alpha)
+
+    def __hash__(self):
+        return hash((self.cutoff, self.alpha))
+
+    def __repr__(self):
+        return f"AlphaMask(cutoff={self.cutoff:g}, alpha={self.alpha!r})"
+
+    def __reduce__(self):
+        return AlphaMask, (self.cutoff, self.alpha)
 
 
 # --------------------------------------------------------------------------- the twin of surface.glsl

@@ -275,9 +275,7 @@ class Scene:
             values["u_normal_matrix"] = obj.normal_matrix
         if key.output == "gbuffer":
             values["u_object_id"] = float(index)
-            if key.normal_map:  # the G-buffer writes the mapped normal
-                values["u_normal_map_texture"] = obj.material.normal_map.texture
-                values["u_normal_map_scale"] = obj.material.normal_map.scale
+            values.update(obj.material.surface_uniform_values(key))  # the mapped normal, the alpha test
             if key.lod_textures:  # the radiance program's textures, whose levels of detail the G-buffer records
                 spec = self.program_key(obj)
                 textures = obj.material.uniform_values(spec)

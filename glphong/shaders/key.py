@@ -215,6 +215,9 @@ class ProgramKey:
     lod_textures : int
         G-buffer programs only: how many textures' levels of detail it writes there (``textureQueryLOD``,
         one per textured surface input of the object's material, at most 4; the rest are 0).
+    alpha_mask : int
+        0: no alpha test; 1: a constant alpha; 2: alpha from a texture (glsl/mesh_fragment.glsl discards the fragments
+        below the cutoff, in the radiance and the G-buffer programs alike).
     normal_map : bool
         The material's tangent-space normal map perturbs the shading normal in the fragment stage
         (glsl/normal_map.glsl); for a G-buffer program: the normal it writes is the mapped one.
@@ -248,6 +251,7 @@ class ProgramKey:
     has_lod: bool = False
     lod_textures: int = 0
     normal_map: bool = False
+    alpha_mask: int = 0
     has_face: bool = False
     shadow_size: int = 0
     shadow_filter: int = 0
@@ -332,6 +336,7 @@ class ProgramKey:
             ("HAS_LOD", b(self.has_lod)),
             ("HAS_FACE", b(self.has_face)),
             ("NORMAL_MAP", b(self.normal_map)),
+            ("ALPHA_MASK", str(self.alpha_mask)),
             *((f"{name.upper()}_LOCATION", str(where)) for name, where in
               ({"tangent": 2, "uv": 3, "color": 5} | dict(self.attribute_locations)).items()),
             ("NUM_LOD_TEXTURES", str(self.lod_textures)),
@@ -374,7 +379,7 @@ class ProgramKey:
         """Chunks that define ``shade_point()`` and what it calls: only those the key needs."""
         chunks = ["common"]
         chunks += self.light_library_chunks() + self.library_chunks()
-        chunks += ["surface"] if self.textured_inputs or self.normal_map else []
+        chunks += ["surface"] if self.textured_inputs or self.normal_map or self.alpha_mask == 2 else []
         chunks += ["normal_map"] if self.normal_map else []
         chunks += [t.chunk for t in self.terms]
         chunks += ["shadows"] if self.shadow_slots else []
@@ -402,10 +407,10 @@ class ProgramKey:
         if self.output == "shadow":
             return ("common", "shadow_fragment")
         if self.output == "gbuffer":
-            return ("common",) + (("surface",) if self.lod_textures or self.normal_map else ()) + \
+            return ("common",) + (("surface",) if self.lod_textures or self.normal_map or self.alpha_mask == 2 else ()) + \
                 (("normal_map",) if self.normal_map else ()) + ((LOD_CHUNK,) if self.lod_textures else ()) + ("mesh_fragment",)
         if self.shade_per_vertex:
-            return ("mesh_fragment",)
+            return ("mesh_fragment",) if self.alpha_mask != 2 else ("surface", "mesh_fragment")
         if self.output == "display":
             return self.shading_chunks() + ("srgb", "mesh_fragment")
         return self.shading_chunks() + ("mesh_fragment",)
@@ -481,6 +486,8 @@ class ProgramKey:
             out.append("surface.glsl, texture samplers and material_inputs() (no parameter is textured)")
         if not self.normal_map:
             out.append("normal_map.glsl and its sampler (the material has no normal map)")
+        if not self.alpha_mask:
+            out.append("the alpha test (the material has no alpha mask)")
         out.append("G-buffer outputs (they exist only in the G-buffer program)")
         return out
 
@@ -571,7 +578,8 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
         if len(shown) > MAX_TEXTURED_INPUTS:
             raise ValueError(f"a material's textures may have at most {MAX_TEXTURED_INPUTS} sizes (the G-buffer holds "
                              f"one level of detail per size); {type(material).__name__} has {len(shown)}")
-        return replace(gbuffer_key(material, gbuffer_needs or (), len(shown)), normal_map=spec.normal_map)
+        return replace(gbuffer_key(material, gbuffer_needs or (), len(shown)), normal_map=spec.normal_map,
+                       alpha_mask=spec.alpha_mask)
     # lights matter only to a material with a term that reflects them
     lights = _as_light_keys(lights)
     lit = bool(lights) and any(not t.vanishes() for t in material.components)
@@ -580,6 +588,8 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
     needs = {n for t in terms if t.lit for n in t.needs}
     modes = [mode for t in terms for _, mode in t.inputs]
     normal_map = lit and material.normal_map is not None
+    mask = material.alpha_mask
+    alpha_mask = 0 if mask is None else 2 if mask.textured else 1
     if output == "points":
         _refuse_surface_inputs(terms, "shading at given points has no texture coordinates or vertex colours")
         if normal_map:
@@ -593,10 +603,11 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
         has_face=lit and any(k.shadowed for k in lights),
         has_normal=lit,
         has_tangent="tangent" in needs or normal_map,
-        has_uv="uv" in needs or any("texture" in m for m in modes) or normal_map,
+        has_uv="uv" in needs or any("texture" in m for m in modes) or normal_map or alpha_mask == 2,
         two_sided=material.two_sided and lit,
         has_color=any("vertex" in m for m in modes),
         normal_map=normal_map,
+        alpha_mask=alpha_mask,
     )
 
 
@@ -657,6 +668,7 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
     drawn = [term for material in materials for term in material.components]
     textured = [f"{t.name}.{name}" for t in drawn for name in t.surface_inputs()]
     textured += [f"{type(m).__name__}'s normal map" for m in materials if m.normal_map is not None]
+    textured += [f"{type(m).__name__}'s alpha mask" for m in materials if m.alpha_mask is not None]
     if textured:
         raise ValueError(f"the uber-shader holds constant parameters only, but {', '.join(textured)} vary over the "
                          "surface (a texture or vertex colours): render it with specialise=True")
