@@ -174,3 +174,45 @@ def test_from_trimesh_keeps_material_images_as_textures():
     np.testing.assert_allclose(kd.scale, np.array([255, 128, 64]) / 255 / np.pi)
     box.visual = trimesh.visual.TextureVisuals(material=trimesh.visual.material.PBRMaterial(baseColorTexture=image))
     assert isinstance(glphong.Scene.from_trimesh(trimesh.Scene(box)).objects[0].material.kd, tuple)  # no UVs: the colour
+
+
+def test_gltf_texture_transform_moves_the_uvs(tmp_path):
+    """KHR_texture_transform (offset, rotation, scale) applied to the mesh's uvs, in glTF's uv space, written here
+    from the extension's definition: u' = sx cos(r) u + sy sin(r) v + ox, v' = -sx sin(r) u + sy cos(r) v + oy."""
+    import json
+
+    path = _marker_gltf(tmp_path, with_colors=False)
+    gltf = tmp_path / "moved.gltf"
+    document, binary = _glb_parts(path)
+    (tmp_path / "moved.bin").write_bytes(binary)
+    document["buffers"][0]["uri"] = "moved.bin"
+    plain = tmp_path / "plain.gltf"
+    plain.write_text(json.dumps(document))
+    ox, oy, sx, sy, r = 0.25, -0.5, 2.0, 3.0, 0.3
+    info = document["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]
+    info["extensions"] = {"KHR_texture_transform": {"offset": [ox, oy], "scale": [sx, sy], "rotation": r}}
+    document["extensionsUsed"] = ["KHR_texture_transform"]
+    gltf.write_text(json.dumps(document))
+    before = glphong.load_scene(plain, lights=[]).objects[0].mesh.uvs.astype(np.float64)
+    after = glphong.load_scene(gltf, lights=[]).objects[0].mesh.uvs.astype(np.float64)
+    u, v = before[:, 0], 1.0 - before[:, 1]  # glTF's v points down
+    expected_u = sx * np.cos(r) * u + sy * np.sin(r) * v + ox
+    expected_v = -sx * np.sin(r) * u + sy * np.cos(r) * v + oy
+    np.testing.assert_allclose(after[:, 0], expected_u, atol=1e-6)
+    np.testing.assert_allclose(1.0 - after[:, 1], expected_v, atol=1e-6)
+    info["extensions"]["KHR_texture_transform"]["rotation"] = "a lot"
+    gltf.write_text(json.dumps(document))
+    with pytest.raises(glphong.filesafety.SceneFileError, match="KHR_texture_transform"):
+        glphong.load_scene(gltf, lights=[])
+
+
+def _glb_parts(path):
+    """The JSON document and the binary chunk of a .glb file (written by trimesh)."""
+    import json
+    import struct
+
+    data = path.read_bytes()
+    length = struct.unpack_from("<I", data, 12)[0]
+    document = json.loads(data[20:20 + length])
+    binary = data[20 + length + 8:]
+    return document, binary

@@ -15,12 +15,14 @@ from glphong.materials.gltf_pbr import GltfPBR
 from glphong.materials.fresnel import SchlickFresnel
 from glphong.formats.overrides import chosen_material
 from glphong.materials.as_json import material_from_json
+from glphong.scene.geometry import MeshData
 from glphong.scene.camera import OrthographicCamera, PerspectiveCamera
 from glphong.scene.from_trimesh import _trimesh_material, default_view, empty_scene, with_default_view
 from glphong.lights import AmbientLight, registered_lights
 from glphong.scene.scene import Scene
 
-__all__ = ["read_gltf_json", "gltf_view", "gltf_material", "gltf_pbr_material", "material_from_extras", "load_gltf"]
+__all__ = ["read_gltf_json", "gltf_view", "gltf_material", "gltf_pbr_material", "material_from_extras", "load_gltf",
+           "texture_transform", "transformed_uvs"]
 
 
 def read_gltf_json(path, limits=None):
@@ -268,9 +270,6 @@ def _texture_reader(gltf, where):
             gltf.warn_once("texCoord", f"{where}: a texture reads TEXCOORD_{info['texCoord']}; glphong reads "
                            "TEXCOORD_0 only: drawn without that texture")
             return None
-        if "KHR_texture_transform" in info.get("extensions", {}):
-            gltf.warn_once("KHR_texture_transform", f"{where}: KHR_texture_transform is not applied (textures are "
-                           "sampled at the mesh's own coordinates)")
         pixels = read_gltf_image(gltf, info["index"])
         if pixels is None:
             return None
@@ -278,6 +277,66 @@ def _texture_reader(gltf, where):
         return TextureImage(pixels[..., 3] if alpha else pixels, srgb=srgb, wrap=wrap, filter=filter_)
 
     return texture
+
+
+def texture_transform(entry, gltf=None, where=""):
+    """The ``KHR_texture_transform`` of a glTF material's textures as one 3x3 matrix in glTF's uv space (``T R S``:
+    offset, rotation by ``-rotation`` about the origin, scale, as the extension defines it), or None.
+
+    glphong's textures share the mesh's coordinates, so the transform is applied to them (`transformed_uvs`): where
+    the material's textures carry different transforms, or one names its own ``texCoord``, none is applied and a
+    warning says so (``gltf``: the file that warns once).
+
+    Raises
+    ------
+    glphong.filesafety.SceneFileError
+        A transform whose offset, rotation or scale is not finite numbers (with ``gltf``).
+    """
+    pbr = entry.get("pbrMetallicRoughness", {})
+    infos = [holder[key] for holder, key in ((pbr, "baseColorTexture"), (pbr, "metallicRoughnessTexture"),
+                                             (entry, "normalTexture"), (entry, "occlusionTexture"),
+                                             (entry, "emissiveTexture")) if isinstance(holder.get(key), dict)]
+    transforms = [info.get("extensions", {}).get("KHR_texture_transform") for info in infos]
+    if not any(t is not None for t in transforms):
+        return None
+    matrices = []
+    for t in transforms:
+        t = t or {}
+        try:
+            ox, oy = (float(x) for x in t.get("offset", (0.0, 0.0)))
+            sx, sy = (float(x) for x in t.get("scale", (1.0, 1.0)))
+            r = float(t.get("rotation", 0.0))
+            values = np.array([ox, oy, sx, sy, r])
+            if not np.all(np.isfinite(values)) or isinstance(t.get("texCoord", 0), bool):
+                raise ValueError
+        except (TypeError, ValueError):
+            if gltf is None:
+                raise ValueError(f"{where}: KHR_texture_transform needs finite numbers") from None
+            raise SceneFileError(gltf.path, "KHR_texture_transform needs a finite offset [2], scale [2] and rotation",
+                                 f"{where}.extensions.KHR_texture_transform") from None
+        if t.get("texCoord", 0) != 0:
+            matrices = None
+            break
+        c, s = np.cos(r), np.sin(r)
+        matrices.append(np.array([[1, 0, ox], [0, 1, oy], [0, 0, 1.0]]) @ np.array([[c, s, 0], [-s, c, 0], [0, 0, 1.0]])
+                        @ np.diag([sx, sy, 1.0]))
+    if matrices is None or any(not np.array_equal(m, matrices[0]) for m in matrices[1:]):
+        if gltf is not None:
+            gltf.warn_once(("KHR_texture_transform", where), f"{where}: its textures carry different "
+                           "KHR_texture_transforms (or their own texCoord): none is applied")
+        return None
+    return matrices[0]
+
+
+def transformed_uvs(mesh, matrix):
+    """``mesh`` with its uvs moved by a `texture_transform` matrix (glTF's uv space, v down: glphong's v is ``1 - v``);
+    the tangents derived from the new uvs where the mesh has none of its own."""
+    if matrix is None or mesh.uvs is None:
+        return mesh
+    uv = np.stack([mesh.uvs[:, 0], 1.0 - mesh.uvs[:, 1], np.ones(len(mesh.uvs))], axis=1).astype(np.float64)
+    moved = uv @ matrix.T
+    uvs = np.stack([moved[:, 0], 1.0 - moved[:, 1]], axis=1)
+    return MeshData(mesh.positions, mesh.normals, mesh.indices, uvs=uvs, tangents=mesh.given_tangents, colors=mesh.colors)
 
 
 def _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale):
@@ -341,8 +400,10 @@ def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name
     entries, made = document.get("materials", []), {}
     emissive_scale = 1.0 / LUMENS_PER_WATT if light_units == "photometric" else 1.0
     for name, mesh, world, index in read_gltf_primitives(gltf):
-        scene.add(mesh, _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale),
-                  pose=world, name=name)
+        material = _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale)
+        if isinstance(material, GltfPBR) and index is not None and materials is None:  # the file's own material
+            mesh = transformed_uvs(mesh, texture_transform(entries[index], gltf, f"materials[{index}]"))
+        scene.add(mesh, material, pose=world, name=name)
     if lights is None:  # a file without lights is not drawn black by accident
         _, view_lights, view_ambient = default_view(scene)
         warnings.warn(f"{path} has no lights: glphong adds its default point light and ambient light (give "

@@ -77,6 +77,7 @@ class MeshData:
         if self._tangents is not None and self._tangents.shape[1] == 3:
             self._tangents = np.ascontiguousarray(np.concatenate(
                 [self._tangents, np.ones((len(positions), 1), np.float32)], axis=1))
+        self._supplied = self._tangents
         for a in (self.positions, self.normals, self.indices, self.uvs, self._tangents, self.colors):
             if a is not None:
                 a.setflags(write=False)
@@ -85,6 +86,11 @@ class MeshData:
     def has_tangents(self):
         """True when the mesh supplies tangents or UVs to derive them from."""
         return self._tangents is not None or self.uvs is not None
+
+    @property
+    def given_tangents(self):
+        """The tangents the mesh was made with (V, 4) float32, or None where they are derived (or absent)."""
+        return self._supplied
 
     @property
     def tangents(self):
