@@ -21,11 +21,14 @@ import glphong
 from glphong import analysis
 from glphong.analysis.gallery import GALLERY
 
-#: parameters that meet a model's stated energy condition where the gallery tile's do not
+#: parameters that meet a model's stated energy condition where the gallery tile's do not, or that show where a
+#: model declared not energy-conserving gains energy
 #: (the tiles share a diffuse albedo of 0.6, which with a Fresnel factor reaching 1 exceeds 1)
 EXTRA = (
     ("Cook-Torrance m=0.25, rho_d=0, F=1", lambda: glphong.CookTorrance(0.0, 0.25, fresnel=None)),
     ("Ward bounded, rho_d=0.3, rho_s=0.6", lambda: glphong.Ward(0.3, 0.6, 0.3, 0.06, normalization="bounded")),
+    # where glTF's Fresnel mix gains energy (the specification says it does not conserve it): a white dielectric
+    ("glTF white dielectric roughness 0.3", lambda: glphong.GltfPBR(1.0, 0.0, 0.3)),
 )
 
 

@@ -129,3 +129,24 @@ def test_cli_render_gltf(tmp_path, capsys):
     assert "PASS" in capsys.readouterr().out
     assert main(["render", str(path), "--out", str(tmp_path / "h.png")]) == 2
     assert "light_units" in capsys.readouterr().err
+
+
+def test_material_extensions_ior_and_emissive_strength(tmp_path):
+    """KHR_materials_ior becomes GltfPBR's ior; KHR_materials_emissive_strength multiplies emissiveFactor (photometric
+    files: divided by 683, as their lights are); both validated with their JSON paths."""
+    path = _document(tmp_path)
+    document = json.loads(path.read_text())
+    material = document["materials"][0]
+    material["emissiveFactor"] = [0.5, 0.25, 1.0]
+    material["extensions"] = {"KHR_materials_ior": {"ior": 1.33},
+                              "KHR_materials_emissive_strength": {"emissiveStrength": 6.83}}
+    path.write_text(json.dumps(document))
+    loaded = glphong.load_scene(path, light_units="radiometric").objects[0].material
+    assert loaded.ior == 1.33
+    np.testing.assert_allclose(loaded.emissive, np.array([0.5, 0.25, 1.0]) * 6.83, rtol=1e-12)
+    photometric = glphong.load_scene(path, light_units="photometric").objects[0].material
+    np.testing.assert_allclose(photometric.emissive, np.array([0.5, 0.25, 1.0]) * 6.83 / 683.0, rtol=1e-12)
+    material["extensions"]["KHR_materials_ior"]["ior"] = "glass"
+    path.write_text(json.dumps(document))
+    with pytest.raises(glphong.filesafety.SceneFileError, match=r"materials\[0\]\.extensions\.KHR_materials_ior\.ior"):
+        glphong.load_scene(path, light_units="radiometric")

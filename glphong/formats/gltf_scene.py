@@ -188,6 +188,7 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
     - ``normalTexture`` (linear) as a `glphong.NormalMap` with its ``scale`` (the mesh's ``TANGENT``, or tangents
       derived from its UVs);
     - ``doubleSided`` as ``two_sided``;
+    - ``KHR_materials_ior``'s ``ior`` (the dielectric's ``f0``);
     - ``alphaMode``: OPAQUE; MASK as a `glphong.AlphaMask` of ``alphaCutoff`` and ``baseColorFactor.a`` times the
       base-colour texture's alpha (COLOR_0's alpha is not read: a warning says so); BLEND is refused (ValueError).
 
@@ -255,7 +256,11 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
     normal_image = image("normalTexture", False)
     normal_map = NormalMap(normal_image, float(entry["normalTexture"].get("scale", 1.0))) \
         if normal_image is not None else None
-    return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion,
+    ior = entry.get("extensions", {}).get("KHR_materials_ior", {}).get("ior", 1.5)
+    if not 1.0 <= ior <= 1e4:  # validated >= 0; 0 (a "perfect reflector" in some exporters) is not a dielectric
+        warnings.warn(f"KHR_materials_ior {ior!r}: glphong takes an ior in [1, 1e4]; 1.5 is used", stacklevel=3)
+        ior = 1.5
+    return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion, ior=float(ior),
                    two_sided=bool(entry.get("doubleSided", False)), normal_map=normal_map, alpha_mask=alpha_mask)
 
 

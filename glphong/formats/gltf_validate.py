@@ -262,6 +262,10 @@ def _check_materials(c):
         if "scale" in material.get("normalTexture", {}):
             c.number(material["normalTexture"]["scale"], f"{where}.normalTexture.scale")
         extensions = c.obj(material.get("extensions", {}), f"{where}.extensions")
+        ior = extensions.get("KHR_materials_ior")
+        if ior is not None:
+            c.obj(ior, f"{where}.extensions.KHR_materials_ior")
+            c.number(ior.get("ior", 1.5), f"{where}.extensions.KHR_materials_ior.ior", 0.0)
         strength = extensions.get("KHR_materials_emissive_strength")
         if strength is not None:
             c.obj(strength, f"{where}.extensions.KHR_materials_emissive_strength")

@@ -5,7 +5,7 @@ specification's Appendix B writes it (docs/design.md section 9; GLSL: ``glsl/mat
     D = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2)                                   GGX
     V = 1 / (2 (|n.v| sqrt(alpha^2 + (1 - alpha^2)(n.l)^2) + |n.l| sqrt(alpha^2 + (1 - alpha^2)(n.v)^2)))
     metal = (c + (1 - c) x) V D
-    dielectric = mix(c / pi, V D, 0.04 + 0.96 x)
+    dielectric = mix(c / pi, V D, f0 + (1 - f0) x),  f0 = ((ior - 1)/(ior + 1))^2 = 0.04 for ior 1.5
     f_r = mix(dielectric, metal, metallic)                                              [1/sr]
 
 =========== ====== ======= ======================================================================
@@ -63,6 +63,8 @@ _EMISSIVE = Param("emissive", "rgb", low=0.0, default=0.0, unit="W/(m^2 sr)", te
                   doc="emissiveFactor (times KHR_materials_emissive_strength): radiance emitted")
 _OCCLUSION = Param("occlusion", "scalar", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
                    doc="the occlusion texture's 1 + strength (R - 1): scales the ambient answer only")
+_IOR = Param("ior", "scalar", low=1.0, high=1e4, default=1.5, unit="",
+             doc="KHR_materials_ior: the dielectric's f0 = ((ior - 1)/(ior + 1))^2 (1.5: 0.04, the core's)")
 
 
 def _dot(a, b):
@@ -102,12 +104,15 @@ class GltfPBR(MaterialModel):
         ``emissiveFactor`` times ``KHR_materials_emissive_strength`` [W/(m^2 sr)], >= 0: radiance the surface emits
         whatever the lights; times the emissive texture (sRGB) where given.
     occlusion : float or SurfaceInput
-        In [0, 1]: multiplies the answer to the ambient light ``base_color / pi L_a`` (and to an environment light),
-        never a point, spot, directional or area light's; glTF's ``1 + strength (R - 1)`` of its occlusion texture.
+        In [0, 1]: multiplies the answer to the ambient light ``base_color / pi L_a``, never a point, spot,
+        directional, area or environment light's; glTF's ``1 + strength (R - 1)`` of its occlusion texture.
+    ior : float
+        ``KHR_materials_ior``, in [1, 1e4]: the dielectric's Fresnel ``f0 = ((ior - 1)/(ior + 1))^2`` (the core
+        specification's 1.5 gives 0.04).
     """
 
     name = "gltf_pbr"
-    params = (_BASE_COLOR, _METALLIC, _ROUGHNESS, _EMISSIVE, _OCCLUSION)
+    params = (_BASE_COLOR, _METALLIC, _ROUGHNESS, _EMISSIVE, _OCCLUSION, _IOR)
     needs = ("view",)
     ambient = "base_color"
     ambient_scale = 1.0 / np.pi
@@ -135,7 +140,10 @@ class GltfPBR(MaterialModel):
             x1 = np.maximum(dtype.type(1) - v_dot_h, dtype.type(0))
             x = ((x1 * x1) * (x1 * x1) * x1).astype(dtype)
             c = np.asarray(p.base_color, dtype)
-            fd = (dtype.type(0.04) + dtype.type(0.96) * x).astype(dtype)
+            ior = np.asarray(p.ior).astype(dtype)
+            r = ((ior - dtype.type(1)) / (ior + dtype.type(1))).astype(dtype)
+            f0 = (r * r).astype(dtype)
+            fd = (f0 + (dtype.type(1) - f0) * x).astype(dtype)
             m = np.asarray(p.metallic).astype(dtype)[..., None]
             diffuse = (c * (dtype.type(1 / np.pi) * n_dot_l)[..., None]) * (dtype.type(1) - fd)[..., None] \
                 * (dtype.type(1) - m)
@@ -195,7 +203,8 @@ class GltfPBR(MaterialModel):
         out = []
         for c in p.base_color:
             metal = (c + (1 - c) * x) * v * d
-            fd = mpmath.mpf("0.04") + mpmath.mpf("0.96") * x
+            f0 = ((p.ior - 1) / (p.ior + 1)) ** 2
+            fd = f0 + (1 - f0) * x
             dielectric = (c / mpmath.pi) * (1 - fd) + v * d * fd
             out.append(((1 - p.metallic) * dielectric + p.metallic * metal) * n_dot_l)
         return out

@@ -5,7 +5,8 @@
 //   D = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2)                                   GGX (Trowbridge-Reitz)
 //   V = 1 / (2 (|n.v| sqrt(alpha^2 + (1 - alpha^2)(n.l)^2) + |n.l| sqrt(alpha^2 + (1 - alpha^2)(n.v)^2)))
 //                                                                                   height-correlated Smith
-//   metal = (c + (1 - c) x) V D;   dielectric = mix(c/pi, V D, 0.04 + 0.96 x);   c = base_color
+//   metal = (c + (1 - c) x) V D;   dielectric = mix(c/pi, V D, f0 + (1 - f0) x);   c = base_color
+//   f0 = ((ior - 1)/(ior + 1))^2 (KHR_materials_ior; the core specification's ior 1.5 gives 0.04)
 //   f_r = mix(dielectric, metal, metallic);   response = f_r (n.l)
 //
 // microfacet_geometry (library chunk microfacet.glsl): valid, n.v, n.h, v.h = |l + v|/2, tan2 = tan^2(theta_h) from the
@@ -17,7 +18,7 @@
 //   r_x = sqrt((n.x)^2 + a2 (1 - (n.x)^2)): the response's n.l cancels the 1/(n.l) of V, so a grazing light
 //   never forms 1/(n.l); at most 1 / (4 n.v) for roughness 0.
 // Uniforms (declared by glphong from the model's params): u_gltf_pbr_base_color, u_gltf_pbr_metallic,
-// u_gltf_pbr_roughness.  Key defines read here: none.
+// u_gltf_pbr_roughness, u_gltf_pbr_ior (u_gltf_pbr_emissive and u_gltf_pbr_occlusion are read by generated code).  Key defines read here: none.
 
 const float GLTF_PBR_INV_PI = 0.3183098861837907;
 
@@ -39,7 +40,9 @@ vec3 gltf_pbr_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
     float x = (x1 * x1) * (x1 * x1) * x1;
     vec3 c = u_gltf_pbr_base_color;
     float m = u_gltf_pbr_metallic;
-    float fd = 0.04 + 0.96 * x;
+    float r = (u_gltf_pbr_ior - 1.0) / (u_gltf_pbr_ior + 1.0);  // KHR_materials_ior: f0 = ((ior - 1)/(ior + 1))^2
+    float f0 = r * r;
+    float fd = f0 + (1.0 - f0) * x;
     // mix(dielectric, metal, m) = (c/pi)(n.l)(1 - fd)(1 - m) + [fd (1 - m) + (c + (1 - c) x) m] V D (n.l)
     vec3 diffuse = (c * (GLTF_PBR_INV_PI * n_dot_l)) * (1.0 - fd) * (1.0 - m);
     vec3 fresnel = fd * (1.0 - m) + (c + (1.0 - c) * x) * m;

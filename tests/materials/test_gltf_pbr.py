@@ -15,8 +15,8 @@ from glphong.testing import assert_twin_matches, evaluate
 Z = np.array([0.0, 0.0, 1.0])
 
 
-def appendix_b(n, l, v, base_color, metallic, roughness):
-    """f_r (n.l) by the specification's formulas, float64, (N, 3)."""
+def appendix_b(n, l, v, base_color, metallic, roughness, f0=0.04):
+    """f_r (n.l) by the specification's formulas, float64, (N, 3); ``f0`` the dielectric's (KHR_materials_ior)."""
     h = l + v
     h = h / np.linalg.norm(h, axis=-1, keepdims=True)
     nl, nv, nh, vh = (np.sum(a * b, -1) for a, b in ((n, l), (n, v), (n, h), (v, h)))
@@ -27,7 +27,7 @@ def appendix_b(n, l, v, base_color, metallic, roughness):
     x = (1 - np.abs(vh)) ** 5
     c = np.asarray(base_color, np.float64)[None, :]
     metal = (c + (1 - c) * x[:, None]) * (vis * d)[:, None]
-    fd = (0.04 + 0.96 * x)[:, None]
+    fd = (f0 + (1 - f0) * x)[:, None]
     dielectric = (c / np.pi) * (1 - fd) + (vis * d)[:, None] * fd
     return ((1 - metallic) * dielectric + metallic * metal) * nl[:, None]
 
@@ -194,3 +194,15 @@ def test_every_gltf_texture_verifies_with_one_level_of_detail_per_size(glphong_b
     assert program_key(material, lights, ambient, output="gbuffer", gbuffer_needs={"uv", "lod"}).lod_textures == 2
     report = glphong.verify(scene, glphong_make_renderer(96, 72, glphong_backend))
     assert report.covered_pixels > 3000 and report.passed, report.summary()
+
+
+@pytest.mark.parametrize("ior", [1.5, 1.33, 2.4])
+def test_ior_sets_the_dielectric_f0(ior):
+    """KHR_materials_ior: f0 = ((ior - 1)/(ior + 1))^2 in the Fresnel mix (1.5 is the core's 0.04)."""
+    material = glphong.GltfPBR(base_color=(0.3, 0.6, 0.9), metallic=0.2, roughness=0.4, ior=ior)
+    l, v = _pairs(300, seed=int(10 * ior))
+    ior32 = float(np.float32(ior))
+    expected = appendix_b(np.broadcast_to(Z, l.shape), l, v, np.float32((0.3, 0.6, 0.9)).astype(float),
+                          float(np.float32(0.2)), float(np.float32(0.4)), f0=((ior32 - 1) / (ior32 + 1)) ** 2)
+    np.testing.assert_allclose(_twin(material, l, v), expected, rtol=1e-11, atol=1e-300)
+
