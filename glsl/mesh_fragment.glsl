@@ -23,12 +23,6 @@
 // RUNTIME_SWITCHES, SWITCH(flag).
 
 invariant in vec3 v_position;
-#if SHADE_PER_VERTEX
-in vec3 v_radiance;
-layout(location = 0) out vec4 out_radiance;
-#if ALPHA_MASK == 2
-invariant in vec2 v_uv;
-#endif
 #if ALPHA_MASK
 uniform float u_alpha_mask_cutoff;
 uniform float u_alpha_mask_scale;
@@ -37,14 +31,34 @@ uniform float u_alpha_mask_scale;
 uniform sampler2D u_alpha_mask_texture;
 #endif
 
-void main()
-{
 #if ALPHA_MASK
+// the alpha test (glTF alphaMode MASK): alpha = scale (times texture(u_alpha_mask_texture, uv).r); the caller
+// discards the fragment where alpha < cutoff (the texture sampled in uniform control flow, before any discard)
+bool alpha_masked(vec2 uv)
+{
     float alpha = u_alpha_mask_scale;
 #if ALPHA_MASK == 2
-    alpha *= surface_texture(u_alpha_mask_texture, v_uv).r;
+    alpha *= surface_texture(u_alpha_mask_texture, uv).r;
 #endif
-    if (alpha < u_alpha_mask_cutoff) {
+    return alpha < u_alpha_mask_cutoff;
+}
+#endif
+
+#if SHADE_PER_VERTEX
+in vec3 v_radiance;
+layout(location = 0) out vec4 out_radiance;
+#if ALPHA_MASK == 2
+invariant in vec2 v_uv;
+#endif
+
+void main()
+{
+#if ALPHA_MASK == 2
+    if (alpha_masked(v_uv)) {
+        discard;
+    }
+#elif ALPHA_MASK
+    if (alpha_masked(vec2(0.0))) {
         discard;
     }
 #endif
@@ -69,26 +83,6 @@ uniform float u_two_sided;
 #if NORMAL_MAP
 uniform sampler2D u_normal_map_texture;
 uniform float u_normal_map_scale;
-#endif
-#if ALPHA_MASK
-uniform float u_alpha_mask_cutoff;
-uniform float u_alpha_mask_scale;
-#endif
-#if ALPHA_MASK == 2
-uniform sampler2D u_alpha_mask_texture;
-#endif
-
-#if ALPHA_MASK
-// the alpha test (glTF alphaMode MASK): alpha = scale (times texture(u_alpha_mask_texture, uv).r); the caller
-// discards the fragment where alpha < cutoff (the texture sampled in uniform control flow, before any discard)
-bool alpha_masked(vec2 uv)
-{
-    float alpha = u_alpha_mask_scale;
-#if ALPHA_MASK == 2
-    alpha *= surface_texture(u_alpha_mask_texture, uv).r;
-#endif
-    return alpha < u_alpha_mask_cutoff;
-}
 #endif
 #if OUTPUT_GBUFFER
 uniform float u_object_id;

@@ -304,7 +304,7 @@ def extended_reflection(position, f, wo, lit, key, uniforms, material):
                 e = twin.irradiance(position, f.n, p)
             for t in closed:
                 values = terms[t.name].values_from_uniforms(uniforms, dtype=position.dtype, inputs=f.inputs)
-                k = getattr(values, t.integral.scale)
+                k = getattr(values, t.integral.scale) * occlusion_factor(t, values, light_key.occludable)
                 if t.integral.form == "irradiance":
                     reflected = reflected + k * (np.float32(t.integral.factor).astype(position.dtype) * e)
                 else:
@@ -318,7 +318,7 @@ def extended_reflection(position, f, wo, lit, key, uniforms, material):
                     g = f.select(gate)
                     term = np.zeros_like(position)
                     term[gate] = light_term(terms_response(g, wi[gate], wo[gate], n_dot_l[gate], sampled, uniforms,
-                                                           terms), irradiance[gate])
+                                                           terms, light_key.occludable), irradiance[gate])
                     reflected = reflected + term
         out = out + np.where(lit[:, None], reflected, 0.0)
     return out
@@ -344,7 +344,8 @@ def exact_reflection(position, f, wo, lit, key, uniforms, material, lights=None)
         def integrand(index, w):
             g = f.select(index)
             with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                return terms_response(g, w, wo[index], _dot(g.n, w), key.lit_terms, uniforms, terms)
+                return terms_response(g, w, wo[index], _dot(g.n, w), key.lit_terms, uniforms, terms,
+                                      light_key.occludable)
 
         value, err, _ = twin.exact(position, f.n, p, integrand)
         out = out + np.where(lit[:, None], value, 0.0)
@@ -352,15 +353,26 @@ def exact_reflection(position, f, wo, lit, key, uniforms, material, lights=None)
     return out, error
 
 
-def terms_response(f, wi, wo, n_dot_l, term_keys, uniforms, terms):
+def terms_response(f, wi, wo, n_dot_l, term_keys, uniforms, terms, occluded=False):
     """The sum of ``term_keys``' twins (`material_response`; ``material_response_<kind>`` where they are the terms an
-    extended kind samples), (N, 3); a term that does not need the view gets v = 0, as in the GLSL."""
+    extended kind samples), (N, 3); a term that does not need the view gets v = 0, as in the GLSL; ``occluded``: each
+    term's times its occlusion (an occludable kind's, `occlusion_factor`)."""
     out = np.zeros(np.shape(wi), np.result_type(f.n, wi))
     for term_key in term_keys:
         term = terms[term_key.name]
         p = term.values_from_uniforms(uniforms, dtype=out.dtype, inputs=f.inputs)
-        out = out + term.response(f, wi, wo if "view" in term.needs else np.zeros_like(wi), n_dot_l, p)
+        response = term.response(f, wi, wo if "view" in term.needs else np.zeros_like(wi), n_dot_l, p)
+        out = out + occlusion_factor(term_key, p, occluded) * response
     return out
+
+
+def occlusion_factor(term_key, p, occluded):
+    """The factor an occludable light's reflection takes for a term: its occlusion (a constant, or (N, 1) per
+    fragment) where ``occluded`` and the key has one, else 1."""
+    if not (occluded and term_key.occlusion):
+        return 1.0
+    value = np.asarray(getattr(p, term_key.occlusion))
+    return value[..., None] if value.ndim else value
 
 
 # --------------------------------------------------------------------------- mesh_fragment.glsl

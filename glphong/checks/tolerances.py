@@ -138,7 +138,8 @@ def extended_band(key, u, position, f, wo, lit, material, band=BAND):
             if any(t.integral.form == "irradiance" for t in closed):
                 e_lo, e_hi = twin.irradiance_band(position, f.n, p, band)
             for t in closed:
-                k_lo, k_hi = (getattr(terms[t.name].values_from_uniforms(u, inputs=i), t.integral.scale) for i in ends)
+                k_lo, k_hi = (getattr(v, t.integral.scale) * ref.occlusion_factor(t, v, light_key.occludable) for v in
+                              (terms[t.name].values_from_uniforms(u, inputs=i) for i in ends))
                 factor = float(np.float32(t.integral.factor))
                 if t.integral.form == "irradiance":
                     c_lo, c_hi = e_lo, e_hi
@@ -157,7 +158,8 @@ def extended_band(key, u, position, f, wo, lit, material, band=BAND):
                 r_lo, r_hi = np.zeros_like(position), np.zeros_like(position)
                 if possible.any():
                     r_lo[possible], r_hi[possible] = response_band(key, u, f.select(possible), wi[possible], wo[possible],
-                                                                   n_dot_l[possible], material, band, sampled)
+                                                                   n_dot_l[possible], material, band, sampled,
+                                                                   light_key.occludable)
                 t_lo = np.nan_to_num(ref.light_term(r_lo, np.where(s_lo < FLT_MIN, 0.0, s_lo)) * (1 - band.A * EPS), nan=0.0)
                 t_hi = np.nan_to_num(ref.light_term(r_hi, s_hi) * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
                 lo = lo + np.where(certain, t_lo, 0.0)
@@ -166,7 +168,7 @@ def extended_band(key, u, position, f, wo, lit, material, band=BAND):
         yield (np.where(lit[:, None], lo * (1 - count * EPS), 0.0), np.where(lit[:, None], hi * (1 + count * EPS), 0.0))
 
 
-def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND, term_keys=None):
+def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND, term_keys=None, occluded=False):
     """Interval of the GLSL ``material_response()``: the sum of the lit terms' bands.
 
     Parameters
@@ -182,6 +184,8 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND, term_keys=Non
     band : BandConstants
     term_keys : sequence of TermKey, optional
         The terms summed (default the key's lit terms; an extended kind's sampled ones).
+    occluded : bool
+        Each term's band times its occlusion's interval (an occludable kind's samples).
 
     Returns
     -------
@@ -199,6 +203,11 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND, term_keys=Non
                 t_lo, t_hi = _textured_band(term, f, wi, wo, n_dot_l, u, band)
             else:
                 t_lo, t_hi = term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u), band)
+        if occluded and term_key.occlusion:  # an occludable light: the term's times its occlusion (>= 0), both ends
+            o_lo, o_hi = (ref.occlusion_factor(term_key, term.values_from_uniforms(u, inputs=i), True) for i in _input_ends(f)) \
+                if f.inputs else (ref.occlusion_factor(term_key, term.values_from_uniforms(u), True),) * 2
+            products = [t_lo * o_lo, t_lo * o_hi, t_hi * o_lo, t_hi * o_hi]
+            t_lo, t_hi = np.minimum.reduce(products) * (1 - EPS), np.maximum.reduce(products) * (1 + EPS)
         # a term's float32 result below FLT_MIN in magnitude may be flushed to 0 (e.g. ks * lobe with
         # the lobe just above FLT_MIN): the band then reaches 0
         t_lo = np.where((t_lo > 0) & (t_lo < FLT_MIN), 0.0, t_lo)

@@ -144,6 +144,7 @@ class EnvironmentLight(ExtendedLight):
     glsl = GlslFile("lights/environment.glsl")
     uses = ("angle",)
     integrals = ("irradiance", "lobe", "lobe_real")
+    occludable = True
     uniform_lengths = {"irradiance": "MAP_TEXELS", "sh": "SH_COEFFICIENTS", "frame": 3,
                        "sample_direction": "SAMPLE_TEXELS", "sample_irradiance": "SAMPLE_TEXELS"}
     conditional_uniforms = {"irradiance": "IRRADIANCE_MAP", "resolution": "IRRADIANCE_MAP", "sh": "SH", "frame": "SH",

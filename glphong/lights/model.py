@@ -195,6 +195,9 @@ class LightModel:
     shadow_map = None
     #: 'punctual' (one direction and irradiance per light and point) or 'extended' (`glphong.lights.ExtendedLight`)
     extent = "punctual"
+    #: the light is the surroundings (an environment), which a term's occlusion darkens as it does the ambient light
+    #: (glTF's occlusion texture; `glphong.materials.MaterialModel.occluded_by`)
+    occludable = False
     #: uniform name -> entries per light, for a uniform that holds several values per light (a polygon's vertices):
     #: declared ``u_<name>_<uniform>[NUM_<NAME>_LIGHTS * n]``, light j's entries at ``j * n + i``; ``n`` an int, or
     #: the name of one of the kind's structural defines whose value it is (an environment map's texels: each light's

@@ -104,8 +104,9 @@ class GltfPBR(MaterialModel):
         ``emissiveFactor`` times ``KHR_materials_emissive_strength`` [W/(m^2 sr)], >= 0: radiance the surface emits
         whatever the lights; times the emissive texture (sRGB) where given.
     occlusion : float or SurfaceInput
-        In [0, 1]: multiplies the answer to the ambient light ``base_color / pi L_a``, never a point, spot,
-        directional, area or environment light's; glTF's ``1 + strength (R - 1)`` of its occlusion texture.
+        In [0, 1]: multiplies the answer to the ambient light ``base_color / pi L_a`` and the reflection of an
+        environment light, never a point, spot, directional or area light's; glTF's ``1 + strength (R - 1)`` of its
+        occlusion texture.
     ior : float
         ``KHR_materials_ior``, in [1, 1e4]: the dielectric's Fresnel ``f0 = ((ior - 1)/(ior + 1))^2`` (the core
         specification's 1.5 gives 0.04).

@@ -266,8 +266,9 @@ class MaterialModel(Material):
         The rgb parameter the term emits as radiance [W/(m^2 sr)] (glTF's emissive), added to every fragment
         whatever the lights, or None.  Read by generated code only (``material_emission``).
     occluded_by : str or None
-        The scalar parameter in [0, 1] (glTF's occlusion) that multiplies the term's answer to the ambient light, not
-        its reflection of any light; or None.  Read by generated code only.
+        The scalar parameter in [0, 1] (glTF's occlusion) that multiplies the term's answer to the ambient light and
+        its reflection of the lights whose kind is `occludable` (the environment), not of punctual or area lights;
+        or None.  Read by generated code only.
     vanishes_with : tuple of str
         Parameters that scale the whole term: where any of them is zero in every channel the term
         is left out of the program.

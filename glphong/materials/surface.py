@@ -341,7 +341,28 @@ def VertexColors(scale=1.0, channel=None):
     return SurfaceInput(scale=scale, vertex_colors=True, channel=channel)
 
 
-class NormalMap:
+class _Frozen:
+    """An immutable value of a few fields (`NormalMap`, `AlphaMask`): equal, hashed and pickled by them."""
+
+    __slots__ = ()
+
+    def __setattr__(self, name, value):
+        raise AttributeError(f"{type(self).__name__} is immutable")
+
+    def _values(self):
+        return tuple(getattr(self, name) for name in self.__slots__)
+
+    def __eq__(self, other):
+        return type(other) is type(self) and other._values() == self._values()
+
+    def __hash__(self):
+        return hash((type(self).__name__,) + self._values())
+
+    def __reduce__(self):
+        return type(self), self._values()
+
+
+class NormalMap(_Frozen):
     """A tangent-space normal map: the shading normal at a fragment is ``normalize(t (s m.x) + b (s m.y) + n m.z)``,
     ``m = 2 T(uv) - 1`` (glTF 2.0's ``normalTexture``; glsl/normal_map.glsl, `glphong.reference.surface_normal`).
 
@@ -358,7 +379,7 @@ class NormalMap:
     filter : {'trilinear', 'bilinear'}
     """
 
-    __slots__ = ("texture", "scale")
+    __slots__ = ("texture", "scale")  # the constructor's order: pickled by them
 
     def __init__(self, image, scale=1.0, wrap="repeat", filter="trilinear"):
         texture = image if isinstance(image, TextureImage) else TextureImage(image, srgb=False, wrap=wrap, filter=filter)
@@ -367,23 +388,11 @@ class NormalMap:
         object.__setattr__(self, "texture", texture)
         object.__setattr__(self, "scale", _validate.scalar("scale", scale, low=-_validate.FLT_MAX))
 
-    def __setattr__(self, name, value):
-        raise AttributeError("NormalMap is immutable")
-
-    def __eq__(self, other):
-        return isinstance(other, NormalMap) and (other.texture, other.scale) == (self.texture, self.scale)
-
-    def __hash__(self):
-        return hash((self.texture, self.scale))
-
     def __repr__(self):
         return f"NormalMap({self.texture!r}{'' if self.scale == 1.0 else f', scale={self.scale:g}'})"
 
-    def __reduce__(self):
-        return NormalMap, (self.texture, self.scale)
 
-
-class AlphaMask:
+class AlphaMask(_Frozen):
     """Alpha testing (glTF's ``alphaMode: MASK``): a fragment whose alpha is below ``cutoff`` is not drawn (in the
     radiance and in the G-buffer alike, so the twin shades exactly the fragments the GPU drew); the others are opaque.
 
@@ -399,7 +408,7 @@ class AlphaMask:
         In [0, 1]; a `SurfaceInput` needs a ``channel`` and no vertex colours.
     """
 
-    __slots__ = ("cutoff", "alpha")
+    __slots__ = ("cutoff", "alpha")  # the constructor's order: pickled by them
 
     def __init__(self, cutoff=0.5, alpha=1.0):
         object.__setattr__(self, "cutoff", _validate.scalar("cutoff", cutoff, low=0.0))
@@ -418,20 +427,8 @@ class AlphaMask:
         """Whether alpha varies over the surface."""
         return isinstance(self.alpha, SurfaceInput)
 
-    def __setattr__(self, name, value):
-        raise AttributeError("AlphaMask is immutable")
-
-    def __eq__(self, other):
-        return isinstance(other, AlphaMask) and (other.cutoff, other.alpha) == (self.cutoff, self.alpha)
-
-    def __hash__(self):
-        return hash((self.cutoff, self.alpha))
-
     def __repr__(self):
         return f"AlphaMask(cutoff={self.cutoff:g}, alpha={self.alpha!r})"
-
-    def __reduce__(self):
-        return AlphaMask, (self.cutoff, self.alpha)
 
 
 # --------------------------------------------------------------------------- the twin of surface.glsl

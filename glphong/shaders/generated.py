@@ -158,14 +158,17 @@ def _sampled_response(key, light):
              "    vec3 response = vec3(0.0);"]
     for t in sampled:
         view = "wo" if "view" in t.needs else "vec3(0.0)"
-        lines.append(f"    response += {t.name}_response(f, wi, {view}, n_dot_l);")
+        call = f"{t.name}_response(f, wi, {view}, n_dot_l)"
+        call = f"u_{t.name}_{t.occlusion} * {call}" if light.occludable and t.occlusion else call  # the surroundings
+        lines.append(f"    response += {call};")
     return lines + ["    return response;", "}", ""]
 
 
 def _extended_loop(key, light):
     """The loop over an extended kind's lights (docs/design.md section 13): each closed-form term reflects the
     kind's integral (``k E(n)``, ``k_s`` times the lobe integral about ``r_v``), the others its weighted
-    directions; the sum is gated by ``lit`` once."""
+    directions; the sum is gated by ``lit`` once.  An occludable kind (the environment): each term's part times its
+    occlusion."""
     upper = light.name.upper()
     lines = [f"    for (int j = 0; j < {upper}_LIGHT_COUNT; ++j) {{", "        vec3 reflected = vec3(0.0);"]
     closed = [t for t in key.lit_terms if closed_form(t, light)]
@@ -174,6 +177,7 @@ def _extended_loop(key, light):
     for t in closed:
         k = f"u_{t.name}_{t.integral.scale}"
         k = k if t.integral.factor == 1.0 else f"({_glsl_float(t.integral.factor)} * {k})"
+        k = f"(u_{t.name}_{t.occlusion} * {k})" if light.occludable and t.occlusion else k  # occlusion darkens it
         if t.integral.form == "irradiance":
             lines.append(f"        reflected += {k} * e_extended;")
         else:

@@ -66,8 +66,9 @@ class TermKey:
     emission : str or None
         The rgb parameter the term emits (`glphong.materials.MaterialModel.emission`), where it is not zero.
     occlusion : str or None
-        The scalar parameter that multiplies the term's answer to ``L_a`` (`glphong.materials.MaterialModel.occluded_by`),
-        where the term answers it.
+        The scalar parameter that multiplies the term's answer to ``L_a`` and its reflection of the occludable lights
+        (`glphong.materials.MaterialModel.occluded_by`), where the term answers ``L_a`` or the program has such a
+        light.
     """
 
     name: str
@@ -118,6 +119,8 @@ class LightKey:
         map's visibility (docs/design.md section 12).
     shadow_map : {'cube', 'ortho'} or None
         The kind's `glphong.lights.LightModel.shadow_map`.
+    occludable : bool
+        The kind is the surroundings, which a term's occlusion darkens (`glphong.lights.LightModel.occludable`).
     integrals : tuple of str or None
         None for a punctual kind; for an extended kind (docs/design.md section 13) the closed forms its GLSL
         offers ('irradiance', 'lobe'); other terms are summed over its weighted directions.
@@ -131,6 +134,7 @@ class LightKey:
     shadowed: tuple = ()
     shadow_map: str = None
     integrals: tuple = None
+    occludable: bool = False
 
     @property
     def extended(self):
@@ -156,7 +160,7 @@ def light_keys(lights, casters=True):
         if mine:
             shadowed = tuple(j for j, light in enumerate(mine) if light.shadows) if casters else ()
             out.append(LightKey(kind.name, kind.source_hash(), len(mine), tuple(kind.structural_defines(mine)),
-                                tuple(kind.uses), shadowed, kind.shadow_map, kind.key_integrals(mine)))
+                                tuple(kind.uses), shadowed, kind.shadow_map, kind.key_integrals(mine), kind.occludable))
     return tuple(out)
 
 
@@ -164,7 +168,7 @@ def _as_light_keys(lights):
     """`light_keys` of light instances, or of a ``{kind name: count}`` dict (no structural defines), or the keys."""
     if isinstance(lights, dict):
         return tuple(LightKey(kind.name, kind.source_hash(), lights[kind.name], (), tuple(kind.uses),
-                              integrals=kind.key_integrals())
+                              integrals=kind.key_integrals(), occludable=kind.occludable)
                      for kind in registered_lights() if lights.get(kind.name, 0))
     lights = tuple(lights)
     if all(isinstance(light, LightKey) for light in lights):
@@ -512,10 +516,10 @@ def _ambient_present(ambient_radiance):
     return ambient_radiance is not None and any(c > 0.0 for c in ambient_radiance)
 
 
-def _term_key(term, lit, ambient, uber=False, extended=False, emits=False):
+def _term_key(term, lit, ambient, uber=False, extended=False, emits=False, occludable=False):
     surface = term.surface_inputs()
     emission = term.emission if emits else None
-    occlusion = term.occluded_by if ambient else None
+    occlusion = term.occluded_by if ambient or (lit and occludable) else None
     read = ({p.name for p in term.params} - {term.emission, term.occluded_by} if lit else set()) \
         | {term.ambient if ambient else None, emission, occlusion}  # by the response, or by material_emission
     inputs = tuple((p.name, surface[p.name].mode) for p in term.params if p.name in surface and p.name in read)
@@ -525,10 +529,10 @@ def _term_key(term, lit, ambient, uber=False, extended=False, emits=False):
                    integral=term.integral_form() if lit and extended else None, emission=emission, occlusion=occlusion)
 
 
-def term_keys(material, lit, ambient_present, extended=False, emission=True):
+def term_keys(material, lit, ambient_present, extended=False, emission=True, occludable=False):
     """The `TermKey` of each term of ``material`` that a program evaluates; ``extended``: the program has an
     extended light (each lit term's closed form, `TermKey.integral`, is part of the key); ``emission``: the program
-    adds what the terms emit (not a response program)."""
+    adds what the terms emit (not a response program); ``occludable``: it has a light its terms' occlusion darkens."""
     out = []
     for term in material.components:
         emits = emission and term.emits()
@@ -537,7 +541,8 @@ def term_keys(material, lit, ambient_present, extended=False, emission=True):
         answers = ambient_present and term.answers_ambient() and not term.vanishes()
         reflects = lit and not term.vanishes()
         if reflects or answers or emits:
-            out.append(_term_key(term, lit=reflects, ambient=answers, extended=extended, emits=emits))
+            out.append(_term_key(term, lit=reflects, ambient=answers, extended=extended, emits=emits,
+                                 occludable=occludable))
     return tuple(out)
 
 
@@ -583,7 +588,8 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
     # lights matter only to a material with a term that reflects them
     lights = _as_light_keys(lights)
     lit = bool(lights) and any(not t.vanishes() for t in material.components)
-    terms = term_keys(material, lit, _ambient_present(ambient_radiance), extended=any(k.extended for k in lights))
+    terms = term_keys(material, lit, _ambient_present(ambient_radiance), extended=any(k.extended for k in lights),
+                      occludable=any(k.occludable for k in lights))
     lights = tuple(_with_usage(k, terms) if k.extended else k for k in lights)
     needs = {n for t in terms if t.lit for n in t.needs}
     modes = [mode for t in terms for _, mode in t.inputs]

@@ -206,3 +206,31 @@ def test_ior_sets_the_dielectric_f0(ior):
                           float(np.float32(0.2)), float(np.float32(0.4)), f0=((ior32 - 1) / (ior32 + 1)) ** 2)
     np.testing.assert_allclose(_twin(material, l, v), expected, rtol=1e-11, atol=1e-300)
 
+
+
+def test_occlusion_darkens_the_environment_light(glphong_backend, glphong_make_renderer):
+    """The surroundings: an environment light's reflection is multiplied by the occlusion (a constant: the whole image
+    scales by it, bit for bit up to one rounding), a textured occlusion verifies; an area light's is not."""
+    from glphong.shaders.key import program_key
+
+    sky = np.ones((8, 16, 3)) * np.array([0.3, 0.5, 0.9])
+    sky[:2] = 3.0
+    renderer = glphong_make_renderer(64, 48, glphong_backend)
+
+    def frame(material, light):
+        return renderer.render(_front_scene(material, [light])).radiance
+
+    environment = glphong.EnvironmentLight(sky)
+    clear, dark = (frame(glphong.GltfPBR(0.7, 0.2, 0.5, occlusion=o), environment) for o in (1.0, 0.25))
+    np.testing.assert_allclose(dark, 0.25 * clear, rtol=2e-7, atol=0)
+    assert clear.max() > 0.05
+    rect = glphong.RectLight((0.0, 0.0, 2.0), (0.5, 0.0, 0.0), (0.0, -0.5, 0.0), radiance=20.0)
+    np.testing.assert_array_equal(frame(glphong.GltfPBR(0.7, 0.2, 0.5, occlusion=0.25), rect),
+                                  frame(glphong.GltfPBR(0.7, 0.2, 0.5), rect))
+    texture = glphong.Texture(np.random.default_rng(8).integers(0, 256, (16, 16, 3), dtype=np.uint8), srgb=False,
+                              channel="r")
+    scene = _front_scene(glphong.GltfPBR(0.7, 0.2, 0.5, occlusion=texture), [environment])
+    report = glphong.verify(scene, renderer, exact=False)  # the twin's band; the exact integral is not the point here
+    assert report.covered_pixels > 2000 and report.passed, report.summary()
+    assert program_key(glphong.GltfPBR(0.5, 0.0, 0.5, occlusion=0.5), [environment], None).terms[0].occlusion == "occlusion"
+    assert program_key(glphong.GltfPBR(0.5, 0.0, 0.5, occlusion=0.5), [rect], None).terms[0].occlusion is None
