@@ -9,7 +9,7 @@ import numpy as np
 from glphong.core.filesafety import SceneFileError
 from glphong.core.radiometry import LUMENS_PER_WATT
 from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, read_gltf_primitives, texture_sampling
-from glphong.materials import AlphaMask, Material, NormalMap, Texture, TextureImage, VertexColors
+from glphong.materials import AlphaMask, NormalMap, Texture, TextureImage, VertexColors
 from glphong.materials.cook_torrance import CookTorrance
 from glphong.materials.gltf_pbr import GltfPBR
 from glphong.materials.fresnel import SchlickFresnel
