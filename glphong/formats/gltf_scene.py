@@ -176,6 +176,11 @@ def gltf_material(entry, base_color_texture=None, vertex_colors=False):
     return CookTorrance(rho_d, max(roughness * roughness, 1e-3), fresnel=SchlickFresnel(tuple(np.clip(f0, 0.0, 1.0))))
 
 
+#: why a glTF material with alphaMode BLEND is refused
+BLEND_REFUSED = ("alphaMode BLEND: glphong draws opaque and alpha-masked surfaces, not blended ones (give this material "
+                 "with load_scene(..., materials=...), or set its alphaMode to MASK or OPAQUE)")
+
+
 def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1.0):
     """A glTF metallic-roughness material (JSON ``materials`` entry) as `glphong.GltfPBR`, the specification's
     Appendix B, with its textures (docs/formats.md):
@@ -243,8 +248,7 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
     alpha_mask = None
     mode = entry.get("alphaMode", "OPAQUE")
     if mode == "BLEND":
-        raise ValueError("alphaMode BLEND: glphong draws opaque and alpha-masked surfaces, not blended ones (give this "
-                         "material with load_scene(..., materials=...), or set its alphaMode to MASK or OPAQUE)")
+        raise ValueError(BLEND_REFUSED)
     if mode == "MASK":
         factor = float(np.clip(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[3], 0.0, 1.0))
         info = pbr.get("baseColorTexture")
@@ -375,10 +379,9 @@ def _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emi
                 info = entry.get("pbrMetallicRoughness", {}).get("baseColorTexture")
                 stored = gltf_material(entry, texture(info, True) if texture and info else None, mesh.colors is not None)
             else:
-                try:
-                    stored = gltf_pbr_material(entry, texture, mesh.colors is not None, emissive_scale)
-                except ValueError as exc:  # alphaMode BLEND
-                    raise SceneFileError(gltf.path, str(exc), f"{where}.alphaMode") from None
+                if entry.get("alphaMode") == "BLEND":
+                    raise SceneFileError(gltf.path, BLEND_REFUSED, f"{where}.alphaMode")
+                stored = gltf_pbr_material(entry, texture, mesh.colors is not None, emissive_scale)
         made[key] = stored
     return made[key]
 
