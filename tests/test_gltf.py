@@ -150,3 +150,37 @@ def test_material_extensions_ior_and_emissive_strength(tmp_path):
     path.write_text(json.dumps(document))
     with pytest.raises(glphong.filesafety.SceneFileError, match=r"materials\[0\]\.extensions\.KHR_materials_ior\.ior"):
         glphong.load_scene(path, light_units="radiometric")
+
+
+def test_gltf_pbr_material_reads_every_texture():
+    """gltf_pbr_material with a texture reader: base colour sRGB times COLOR_0; metallic blue, roughness green of one
+    linear image; emissive sRGB times factor and strength; occlusion 1 + strength (R - 1), baked linearly; the
+    normal texture linear with its scale."""
+    from glphong.formats import gltf_pbr_material
+    from glphong.materials import TextureImage
+
+    rng = np.random.default_rng(6)
+    images = {k: rng.integers(0, 256, (4, 4, 4), dtype=np.uint8) for k in range(5)}
+
+    def texture(info, srgb, alpha=False):
+        pixels = images[info["index"]]
+        return TextureImage(pixels[..., 3] if alpha else pixels, srgb=srgb)
+
+    entry = {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.5, 1.0, 1.0], "baseColorTexture": {"index": 0},
+                                      "metallicFactor": 0.5, "roughnessFactor": 0.8,
+                                      "metallicRoughnessTexture": {"index": 1}},
+             "emissiveFactor": [1.0, 0.5, 0.25], "emissiveTexture": {"index": 2},
+             "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 4.0}},
+             "occlusionTexture": {"index": 3, "strength": 0.5}, "normalTexture": {"index": 4, "scale": 0.7},
+             "doubleSided": True}
+    m = gltf_pbr_material(entry, texture, vertex_colors=True)
+    assert m.base_color.scale == (0.5, 0.5, 1.0) and m.base_color.vertex_colors
+    assert m.base_color.texture.encoding == "srgb8"
+    assert (m.metallic.channel, m.metallic.scale, m.roughness.channel, m.roughness.scale) == ("b", 0.5, "g", 0.8)
+    assert m.metallic.texture.encoding == "linear8" and m.metallic.texture is m.roughness.texture
+    assert m.emissive.scale == (4.0, 2.0, 1.0) and m.emissive.texture.encoding == "srgb8"
+    red = (images[3][..., 0] / 255.0).astype(np.float16).astype(np.float64)  # 8-bit texels are kept as float16
+    np.testing.assert_allclose(m.occlusion.texture.levels[0][::-1, :, 0], 0.5 + 0.5 * red, rtol=1e-7)
+    assert m.occlusion.channel == "r" and m.two_sided
+    assert m.normal_map.scale == 0.7 and m.normal_map.texture.encoding == "linear8"
+    assert gltf_pbr_material({"emissiveFactor": [0, 0, 0], "emissiveTexture": {"index": 2}}, texture).emissive == (0.0,) * 3
