@@ -117,3 +117,29 @@ def test_masked_and_normal_mapped_materials_survive_save_gltf(tmp_path):
     glphong.save_gltf(scene, tmp_path / "saved.glb")
     loaded = glphong.load_scene(tmp_path / "saved.glb").objects[0].material
     assert loaded == material
+
+
+def test_save_gltf_writes_the_gltf_material_for_other_viewers(tmp_path):
+    """A GltfPBR is written as glTF's own material (not only in extras): factors, the shared metallic-roughness
+    texture, emissive with its strength, the normal texture and the alpha mode; read without the extras, the file
+    gives the same factors."""
+    mr = np.zeros((4, 4, 3), np.uint8)
+    mr[..., 1], mr[..., 2] = 200, 100
+    image = glphong.materials.TextureImage(mr, srgb=False)
+    material = glphong.GltfPBR(0.5, glphong.Texture(image, 0.75, channel="b"), glphong.Texture(image, 0.5, channel="g"),
+                               emissive=(2.0, 1.0, 0.0), alpha_mask=glphong.AlphaMask(0.4, 0.9),
+                               normal_map=glphong.NormalMap(np.full((2, 2, 3), (128, 128, 255), np.uint8), 0.5))
+    glphong.save_gltf(_plane_scene(material), tmp_path / "out.gltf")
+    document = json.loads((tmp_path / "out.gltf").read_text())
+    (entry,) = document["materials"]
+    pbr = entry["pbrMetallicRoughness"]
+    assert (pbr["metallicFactor"], pbr["roughnessFactor"], pbr["baseColorFactor"][3]) == (0.75, 0.5, 0.9)
+    assert "metallicRoughnessTexture" in pbr and entry["normalTexture"]["scale"] == 0.5
+    assert entry["emissiveFactor"] == [1.0, 0.5, 0.0]
+    assert entry["extensions"]["KHR_materials_emissive_strength"]["emissiveStrength"] == 2.0
+    assert (entry["alphaMode"], entry["alphaCutoff"]) == ("MASK", 0.4)
+    del entry["extras"]  # what another viewer (and glphong without the stored material) reads
+    (tmp_path / "bare.gltf").write_text(json.dumps(document))
+    bare = glphong.load_scene(tmp_path / "bare.gltf", lights=[]).objects[0].material
+    assert (bare.metallic.scale, bare.roughness.scale, bare.emissive) == (0.75, 0.5, (2.0, 1.0, 0.0))
+    assert bare.alpha_mask.cutoff == pytest.approx(0.4) and bare.normal_map.scale == 0.5

@@ -6,7 +6,10 @@ What is written:
   tangents as ``TANGENT``; one glTF mesh per distinct MeshData);
 - every material as a glTF metallic-roughness material for other viewers (``baseColorFactor`` from the
   diffuse albedo ``rho_d``/``rho``, or ``pi kd`` clipped to 1, its texture as ``baseColorTexture``;
-  metallic 0, roughness 1: an approximation) and, exactly, in the material's
+  metallic 0, roughness 1: an approximation; a `GltfPBR` as itself: its base colour, metallic and roughness
+  factors, a metallic-roughness texture that both read (blue, green), its emissive with
+  ``KHR_materials_emissive_strength``; any material's normal map as ``normalTexture`` and alpha mask as
+  ``alphaMode`` MASK) and, exactly, in the material's
   ``extras: {"glphong": ...}`` (`glphong.materials.as_json`), which `load_scene` prefers;
 - textures as PNG images (8-bit sources, re-encoded losslessly) with their samplers;
 - the camera (perspective: ``yfov``, ``znear``, ``zfar``; orthographic: ``ymag``; an `IntrinsicsCamera`'s
@@ -106,7 +109,7 @@ def _base_color(material):
     """``(baseColorFactor rgb, TextureImage or None)`` of the PBR approximation (see the module)."""
 
     for term in material.components:
-        for name, scale in (("rho_d", 1.0), ("rho", 1.0), ("kd", np.pi)):
+        for name, scale in (("base_color", 1.0), ("rho_d", 1.0), ("rho", 1.0), ("kd", np.pi)):
             value = getattr(term, name, None) if name in {p.name for p in term.params} else None
             if value is None:
                 continue
@@ -122,8 +125,31 @@ def _material(builder, material, cache):
     pbr = {"baseColorFactor": [float(c) for c in base] + [1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}
     if texture is not None:
         pbr["baseColorTexture"] = {"index": _texture(builder, texture, cache)}
+    out = {}
+    (term,) = material.components if len(material.components) == 1 else (None,)
+    if getattr(term, "name", None) == "gltf_pbr":  # glTF's own material: its factors as they are, for other viewers
+        for key, value in (("metallicFactor", term.metallic), ("roughnessFactor", term.roughness)):
+            pbr[key] = float(getattr(value, "scale", value))
+        m, r = term.metallic, term.roughness
+        if isinstance(m, SurfaceInput) and isinstance(r, SurfaceInput) and m.texture is r.texture and \
+                (m.channel, r.channel) == ("b", "g"):
+            pbr["metallicRoughnessTexture"] = {"index": _texture(builder, m.texture, cache)}
+        emissive = np.asarray(getattr(term.emissive, "scale", term.emissive), np.float64)
+        if emissive.max() > 0:
+            out["emissiveFactor"] = [float(c) for c in emissive / max(emissive.max(), 1.0)]
+            if emissive.max() > 1.0:
+                out["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": float(emissive.max())}}
+            if isinstance(term.emissive, SurfaceInput) and term.emissive.texture is not None:
+                out["emissiveTexture"] = {"index": _texture(builder, term.emissive.texture, cache)}
+    if material.normal_map is not None:
+        out["normalTexture"] = {"index": _texture(builder, material.normal_map.texture, cache),
+                                "scale": float(material.normal_map.scale)}
+    if material.alpha_mask is not None:
+        out.update(alphaMode="MASK", alphaCutoff=float(material.alpha_mask.cutoff))
+        if not material.alpha_mask.textured:
+            pbr["baseColorFactor"][3] = float(material.alpha_mask.alpha)
     name = f"{type(material).__name__}{len(builder.doc.get('materials', []))}"  # unique: readers key materials by name
-    return {"name": name, "pbrMetallicRoughness": pbr, "extras": {"glphong": stored},
+    return {"name": name, "pbrMetallicRoughness": pbr, **out, "extras": {"glphong": stored},
             "doubleSided": bool(material.two_sided)}
 
 
@@ -193,6 +219,8 @@ def save_gltf(scene, path):
         nodes.append(_light_node(builder, light, index))
     if "extensions" in doc:
         doc["extensionsUsed"] = ["KHR_lights_punctual"]
+    if any("KHR_materials_emissive_strength" in m.get("extensions", {}) for m in doc.get("materials", [])):
+        doc["extensionsUsed"] = doc.get("extensionsUsed", []) + ["KHR_materials_emissive_strength"]
     doc["nodes"] = nodes
     doc["scenes"] = [{"nodes": list(range(len(nodes)))}]
     doc["scene"] = 0
