@@ -95,6 +95,7 @@ def main(platform):
         "ambient": list(ambient.radiance),
     }
     result["converted"] = _converted(platform, renderer, width, height)
+    result["non_indexed"] = _non_indexed(platform, renderer, width, height)
     # refusals
     spot = pyrender.Scene()
     spot.add(pyrender.SpotLight(color=[1.0, 0.5, 0.25], intensity=2.0, innerConeAngle=0.2, outerConeAngle=0.7),
@@ -103,17 +104,9 @@ def main(platform):
     result["spot"] = {"kind": type(mapped).__name__, "position": list(mapped.position),
                       "direction": list(mapped.direction), "intensity": list(mapped.intensity),
                       "cones": [mapped.inner_cone_angle, mapped.outer_cone_angle]}
-    instanced = pyrender.Scene()
     poses = np.stack([translation(0, 0, 0), translation(1, 0, 0)])
-    instanced.add(pyrender.Mesh.from_trimesh(trimesh.creation.box(), material=GlphongMaterial(glphong.Lambert(0.5)),
-                                             poses=poses))
-    instanced.add(pyrender.PerspectiveCamera(yfov=0.8), pose=translation(0, 0, 4))
-    instanced.add(pyrender.PointLight(intensity=1.0), pose=translation(0, 0, 4))
-    try:
-        renderer.render(instanced)
-        result["instanced"] = "accepted"
-    except ValueError as exc:
-        result["instanced"] = str(exc)
+    result["instanced"] = _refusal(renderer, pyrender.Mesh.from_trimesh(
+        trimesh.creation.box(), material=GlphongMaterial(glphong.Lambert(0.5)), poses=poses))
     renderer.delete()
     # a GlphongMaterial drawn by a renderer glphong was not enabled on: an error, not a black image
     # (after the first renderer is deleted: on EGL deleting one OffscreenRenderer ends the shared display)
@@ -167,6 +160,42 @@ def _converted(platform, renderer, width, height):
     diff = np.abs(ours.astype(int) - color.astype(int)).max(axis=-1)[interior]
     out["embedded_pixels"], out["embedded_within_one"] = int(interior.sum()), float(np.mean(diff <= 1))
     return out
+
+
+def _non_indexed(platform, renderer, width, height):
+    """Mesh.from_trimesh(..., smooth=False) keeps no indices: scene_from_pyrender takes consecutive triples, and the
+    embedded frame agrees with glphong's renderer; a vertex-colour material without color_0 names the fix."""
+    scene = pyrender.Scene(ambient_light=[0.0, 0.0, 0.0])
+    scene.add(pyrender.Mesh.from_trimesh(trimesh.creation.icosphere(2), smooth=False,
+                                         material=GlphongMaterial(glphong.Lambert(0.2))))
+    scene.add(pyrender.PerspectiveCamera(yfov=0.8, aspectRatio=width / height), pose=translation(0, 0, 3))
+    scene.add(pyrender.PointLight(intensity=3.0), pose=translation(1, 1, 3))
+    primitive = next(iter(scene.meshes)).primitives[0]
+    color, _ = renderer.render(scene)
+    ours_scene = scene_from_pyrender(scene)
+    with glphong.Renderer(width, height, backend=platform, samples=4 if platform == "egl" else 1) as g:
+        ours = g.render_srgb8(ours_scene)
+        interior = g.render(ours_scene).coverage == 1.0
+    interior[1:-1, 1:-1] &= interior[:-2, 1:-1] & interior[2:, 1:-1] & interior[1:-1, :-2] & interior[1:-1, 2:]
+    diff = np.abs(ours.astype(int) - color.astype(int)).max(axis=-1)[interior]
+    out = {"indices": primitive.indices is None, "triangles": len(ours_scene.objects[0].mesh.indices),
+           "pixels": int(interior.sum()), "within_one": float(np.mean(diff <= 1))}
+    out["vertex_colours"] = _refusal(renderer, pyrender.Mesh.from_trimesh(
+        trimesh.creation.icosphere(1), material=GlphongMaterial(glphong.Lambert(glphong.VertexColors(0.2)))))
+    return out
+
+
+def _refusal(renderer, mesh):
+    """What drawing ``mesh`` (seen from 4 m, lit beside the camera) says: its ValueError's message, or 'accepted'."""
+    scene = pyrender.Scene()
+    scene.add(mesh)
+    scene.add(pyrender.PerspectiveCamera(yfov=0.8), pose=translation(0, 0, 4))
+    scene.add(pyrender.PointLight(intensity=1.0), pose=translation(0, 0, 4))
+    try:
+        renderer.render(scene)
+        return "accepted"
+    except ValueError as exc:
+        return str(exc)
 
 
 def _single(material_class):

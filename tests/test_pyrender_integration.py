@@ -95,3 +95,14 @@ def test_metallic_roughness_material_converts_to_gltf_pbr(measured):
     assert c["base_srgb"] == "srgb8"
     assert c["embedded_pixels"] > 2000 and c["embedded_within_one"] > 0.9, c
 
+
+def test_non_indexed_primitives_and_the_vertex_colour_message(measured):
+    """Mesh.from_trimesh(..., smooth=False) has no indices: scene_from_pyrender draws consecutive triples (80
+    triangles of an icosphere), and the embedded frame agrees with glphong's renderer; a material that takes vertex
+    colours on a primitive pyrender built without them names the fix."""
+    _, m = measured
+    n = m["non_indexed"]
+    assert n["indices"] and n["triangles"] == 320
+    assert n["pixels"] > 2000 and n["within_one"] > 0.9, n
+    assert "color_0" in n["vertex_colours"] and "pyrender.Primitive(" in n["vertex_colours"]
+

@@ -193,13 +193,27 @@ def scene_from_pyrender(scene, convert=False):
             if convert and isinstance(material, pyrender.MetallicRoughnessMaterial) and primitive.normals is not None:
                 material = GlphongMaterial.from_pyrender(material, vertex_colors=primitive.color_0 is not None)
             if isinstance(material, GlphongMaterial):
-                # pyrender keeps indices as float32 (exact below 2^24 vertices)
-                indices = np.rint(np.asarray(primitive.indices, dtype=np.float64)).astype(np.int64).reshape(-1, 3)
+                indices = _triangles(primitive)
                 colors = None if primitive.color_0 is None else np.asarray(primitive.color_0, dtype=np.float64)[:, :3]
                 data = MeshData(primitive.positions, primitive.normals, indices, uvs=primitive.texcoord_0,
                                 tangents=primitive.tangents, colors=colors)
                 out.add(data, material.glphong, pose=scene.get_pose(node), name=node.name)
     return out
+
+
+def _triangles(primitive):
+    """A triangle primitive's (F, 3) vertex indices: its own (pyrender keeps them as float32, exact below 2^24
+    vertices), or consecutive triples where it has none (``Mesh.from_trimesh(..., smooth=False)``: every triangle's
+    own three vertices)."""
+    if primitive.mode != pyrender.constants.GLTF.TRIANGLES:
+        raise ValueError(f"glphong draws triangles; this primitive's mode is {primitive.mode} (points or lines: "
+                         "pyrender.Mesh.from_points has no surface to shade)")
+    if primitive.indices is None:
+        count = len(primitive.positions)
+        if count % 3:
+            raise ValueError(f"a non-indexed triangle primitive needs a multiple of 3 vertices (got {count})")
+        return np.arange(count, dtype=np.int64).reshape(-1, 3)
+    return np.rint(np.asarray(primitive.indices, dtype=np.float64)).astype(np.int64).reshape(-1, 3)
 
 
 class _ProgramAdapter:
@@ -303,7 +317,9 @@ class _GlphongRenderer(_PyrenderRenderer):
         # pyrender binds color_0 at location 5, where mesh_vertex.glsl reads the (linear) vertex colour
         if key.has_color and primitive.color_0 is None:
             raise ValueError("a primitive with a GlphongMaterial whose parameter takes vertex colours must have "
-                             "color_0 (linear, in [0, 1])")
+                             "color_0 (linear, in [0, 1]); pyrender.Mesh.from_trimesh drops a trimesh's vertex colours "
+                             "when it is given material=: build the primitive with pyrender.Primitive(positions=..., "
+                             "normals=..., indices=..., color_0=..., material=...)")
         if not hasattr(self, "_glphong_programs"):
             self._glphong_programs = ProgramCache(attach_current(os.environ.get("PYOPENGL_PLATFORM", "egl")))
             self._glphong_adapters = {}
