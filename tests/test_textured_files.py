@@ -200,10 +200,11 @@ def test_gltf_texture_transform_moves_the_uvs(tmp_path):
     expected_v = -sx * np.sin(r) * u + sy * np.cos(r) * v + oy
     np.testing.assert_allclose(after[:, 0], expected_u, atol=1e-6)
     np.testing.assert_allclose(1.0 - after[:, 1], expected_v, atol=1e-6)
-    info["extensions"]["KHR_texture_transform"]["rotation"] = "a lot"
-    gltf.write_text(json.dumps(document))
-    with pytest.raises(glphong.filesafety.SceneFileError, match="KHR_texture_transform"):
-        glphong.load_scene(gltf, lights=[])
+    for hostile in ({"rotation": "a lot"}, [1, 2], {"offset": {"a": 1, "b": 2}}):
+        info["extensions"]["KHR_texture_transform"] = hostile
+        gltf.write_text(json.dumps(document))
+        with pytest.raises(glphong.filesafety.SceneFileError, match="KHR_texture_transform"):
+            glphong.load_scene(gltf, lights=[])
 
 
 def _glb_parts(path):

@@ -310,8 +310,10 @@ def texture_transform(entry, gltf=None, where=""):
         return None
     matrices = []
     for t in transforms:
-        t = t or {}
+        t = {} if t is None else t
         try:
+            if not isinstance(t, dict):
+                raise TypeError
             ox, oy = (float(x) for x in t.get("offset", (0.0, 0.0)))
             sx, sy = (float(x) for x in t.get("scale", (1.0, 1.0)))
             r = float(t.get("rotation", 0.0))
