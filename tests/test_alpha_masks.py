@@ -143,3 +143,19 @@ def test_save_gltf_writes_the_gltf_material_for_other_viewers(tmp_path):
     bare = glphong.load_scene(tmp_path / "bare.gltf", lights=[]).objects[0].material
     assert (bare.metallic.scale, bare.roughness.scale, bare.emissive) == (0.75, 0.5, (2.0, 1.0, 0.0))
     assert bare.alpha_mask.cutoff == pytest.approx(0.4) and bare.normal_map.scale == 0.5
+
+
+def test_save_gltf_asks_the_model_for_its_gltf_fields(tmp_path, monkeypatch):
+    """The writer takes glTF's material from the model's own `gltf_fields` (no branch on a model's name): a model
+    without it is approximated by its base colour (Lambert: pi kd), and a model that answers is written as it says."""
+    glphong.save_gltf(_plane_scene(glphong.Lambert(0.2)), tmp_path / "phong.gltf")
+    (entry,) = json.loads((tmp_path / "phong.gltf").read_text())["materials"]
+    assert entry["pbrMetallicRoughness"]["baseColorFactor"][:3] == pytest.approx([0.2 * np.pi] * 3)
+    assert (entry["pbrMetallicRoughness"]["metallicFactor"], "emissiveFactor" in entry) == (0.0, False)
+    monkeypatch.setattr(glphong.Lambert, "gltf_fields", lambda self, texture_index: (
+        {"baseColorFactor": [0.1, 0.2, 0.3, 1.0], "roughnessFactor": 0.25}, {"emissiveFactor": [0.0, 0.5, 0.0]}),
+        raising=False)
+    glphong.save_gltf(_plane_scene(glphong.Lambert(0.2)), tmp_path / "asked.gltf")
+    (entry,) = json.loads((tmp_path / "asked.gltf").read_text())["materials"]
+    assert entry["pbrMetallicRoughness"] == {"baseColorFactor": [0.1, 0.2, 0.3, 1.0], "roughnessFactor": 0.25}
+    assert entry["emissiveFactor"] == [0.0, 0.5, 0.0]

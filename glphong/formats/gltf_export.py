@@ -121,26 +121,16 @@ def _base_color(material):
 
 def _material(builder, material, cache):
     stored = material_to_json(material, texture_index=lambda image: _texture(builder, image, cache))
-    base, texture = _base_color(material)
-    pbr = {"baseColorFactor": [float(c) for c in base] + [1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}
-    if texture is not None:
-        pbr["baseColorTexture"] = {"index": _texture(builder, texture, cache)}
-    out = {}
     (term,) = material.components if len(material.components) == 1 else (None,)
-    if getattr(term, "name", None) == "gltf_pbr":  # glTF's own material: its factors as they are, for other viewers
-        for key, value in (("metallicFactor", term.metallic), ("roughnessFactor", term.roughness)):
-            pbr[key] = float(getattr(value, "scale", value))
-        m, r = term.metallic, term.roughness
-        if isinstance(m, SurfaceInput) and isinstance(r, SurfaceInput) and m.texture is r.texture and \
-                (m.channel, r.channel) == ("b", "g"):
-            pbr["metallicRoughnessTexture"] = {"index": _texture(builder, m.texture, cache)}
-        emissive = np.asarray(getattr(term.emissive, "scale", term.emissive), np.float64)
-        if emissive.max() > 0:
-            out["emissiveFactor"] = [float(c) for c in emissive / max(emissive.max(), 1.0)]
-            if emissive.max() > 1.0:
-                out["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": float(emissive.max())}}
-            if isinstance(term.emissive, SurfaceInput) and term.emissive.texture is not None:
-                out["emissiveTexture"] = {"index": _texture(builder, term.emissive.texture, cache)}
+    fields = term.gltf_fields(lambda image: _texture(builder, image, cache)) if term is not None else None
+    if fields is not None:  # a glTF material (GltfPBR): its own fields, as they are, for other viewers
+        pbr, out = fields
+    else:
+        base, texture = _base_color(material)
+        pbr = {"baseColorFactor": [float(c) for c in base] + [1.0], "metallicFactor": 0.0, "roughnessFactor": 1.0}
+        if texture is not None:
+            pbr["baseColorTexture"] = {"index": _texture(builder, texture, cache)}
+        out = {}
     if material.normal_map is not None:
         out["normalTexture"] = {"index": _texture(builder, material.normal_map.texture, cache),
                                 "scale": float(material.normal_map.scale)}

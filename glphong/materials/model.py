@@ -471,6 +471,22 @@ class MaterialModel(Material):
         """True where the model declares an `emission` parameter and it is not zero in every channel."""
         return self.emission is not None and bool(np.any(_constant_part(getattr(self, self.emission))))
 
+    def gltf_fields(self, texture_index):
+        """glTF's own material fields for this term, where the model is a glTF material (`GltfPBR`); None otherwise,
+        and `glphong.save_gltf` writes an approximation (its base colour) for other viewers.
+
+        Parameters
+        ----------
+        texture_index : callable
+            ``texture_index(TextureImage) -> int``: the file's texture index of an image (written once).
+
+        Returns
+        -------
+        (dict, dict) or None
+            The ``pbrMetallicRoughness`` fields, and the material's other fields (``emissiveFactor``, extensions).
+        """
+        return None
+
     def surface_inputs(self):
         """The parameters given a `SurfaceInput` (a texture or vertex colours), by name (dict)."""
 
