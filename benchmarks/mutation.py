@@ -385,7 +385,7 @@ MUTATIONS = [
       "1.055 * np.power(x, 1.0 / 2.4) - 0.055", "1.055 * np.power(x, 1.0 / 2.42) - 0.055",
       "srgb_encode (numpy): exponent 1/2.42"),
     # ------------------------------------------------------------------ pyrender and glTF lights: each kind's
-    # from_pyrender / from_gltf (glphong/lights/<kind>.py); the ambient light in glphong/integrations/pyrender.py
+    # from_pyrender / from_gltf (glphong/lights/<kind>.py); the ambient light in glphong/integrations/pyrender/scenes.py
     M("point.py:pyrender-4pi-1.01", "glphong/lights/point.py",
       "return cls(pose[:3, 3], power_from_intensity(value))",
       "return cls(pose[:3, 3], 1.01 * power_from_intensity(value))",
@@ -405,7 +405,7 @@ MUTATIONS = [
       "return cls(tuple(pose[:3, 3]), tuple(-pose[:3, 2]), tuple(value),",
       "return cls(tuple(pose[:3, 3]), tuple(pose[:3, 2]), tuple(value),",
       "glTF spot light: points along +Z of its node"),
-    M("pyrender.py:ambient-1.01", "glphong/integrations/pyrender.py",
+    M("pyrender.py:ambient-1.01", "glphong/integrations/pyrender/scenes.py",
       "ambient = np.asarray(scene.ambient_light, dtype=np.float64)",
       "ambient = 1.01 * np.asarray(scene.ambient_light, dtype=np.float64)",
       "pyrender scene.ambient_light mapped to 1.01 L_a"),

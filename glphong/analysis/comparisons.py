@@ -49,7 +49,7 @@ from dataclasses import replace
 import moderngl
 import numpy as np
 
-from glphong.gpu.contexts import create_context
+from glphong.gpu.contexts import create_context, release_offscreen
 from glphong.shaders.assembly import assemble
 from glphong.scene.camera import IntrinsicsCamera, OrthographicCamera
 from glphong.scene.scene import Scene
@@ -418,20 +418,8 @@ class PyrenderRenderer:
         context is destroyed (this reaches into pyrender 0.1.45's private attributes).
         """
         offscreen, self._renderer = self._renderer, None
-        if offscreen is None:
-            return
-        if self.platform != "egl":
-            offscreen.delete()
-            return
-        from OpenGL.EGL import EGL_NO_CONTEXT, EGL_NO_SURFACE, eglDestroyContext, eglMakeCurrent
-
-        platform = offscreen._platform
-        platform.make_current()
-        offscreen._renderer.delete()
-        eglMakeCurrent(platform._egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT)
-        eglDestroyContext(platform._egl_display, platform._egl_context)
-        platform._egl_context = platform._egl_display = None
-        offscreen._renderer = offscreen._platform = None
+        if offscreen is not None:
+            release_offscreen(offscreen)
 
     def __enter__(self):
         return self

@@ -28,6 +28,7 @@ __all__ = [
     "SYSTEM_PACKAGES",
     "BackendUnavailableError",
     "EGLDisplayTerminatedError",
+    "release_offscreen",
     "GLContext",
     "available_backends",
     "create_context",
@@ -619,3 +620,34 @@ def attach_current(platform):
         raise ValueError(f"platform must be 'egl' or 'osmesa' (got {platform!r})")
     moderngl.init_context(_CurrentContextLoader(get_proc_address))
     return moderngl.get_context()
+
+
+def release_offscreen(offscreen):
+    """Delete a ``pyrender.OffscreenRenderer``'s GL objects and its context without ending the EGL display the
+    process shares; idempotent.
+
+    pyrender's own ``OffscreenRenderer.delete()`` (also when the garbage collector drops one) calls
+    ``eglTerminate`` on the device's display, which Mesa shares with every other EGL context on that device in the
+    process (glphong's, moderngl's, other pyrender renderers'), and so ends them all.  Here, on EGL, pyrender's
+    scene renderer deletes its GL objects and only its own context is destroyed (this reaches into pyrender
+    0.1.45's private attributes, the same in its forks ``pyrender2`` and ``pyrender-maintained``); on OSMesa
+    ``delete()`` is called, which ends nothing else.
+
+    Parameters
+    ----------
+    offscreen : pyrender.OffscreenRenderer
+    """
+    platform = getattr(offscreen, "_platform", None)
+    if platform is None:
+        return
+    if not hasattr(platform, "_egl_display"):
+        offscreen.delete()
+        return
+    from OpenGL.EGL import EGL_NO_CONTEXT, EGL_NO_SURFACE, eglDestroyContext, eglMakeCurrent
+
+    platform.make_current()
+    offscreen._renderer.delete()
+    eglMakeCurrent(platform._egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT)
+    eglDestroyContext(platform._egl_display, platform._egl_context)
+    platform._egl_context = platform._egl_display = None
+    offscreen._renderer = offscreen._platform = None
