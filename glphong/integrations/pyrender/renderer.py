@@ -313,7 +313,7 @@ def enable_everywhere(shadow_map_size=1024, shadow_filter_radius=0):
 
 
 def disable_everywhere(previous=_PyrenderRenderer):
-    """Undo `enable_everywhere`: ``OffscreenRenderer``s created from now on are pyrender's own (those already made
+    """Undo `enable_everywhere`: an ``OffscreenRenderer`` created from now on is pyrender's own (those already made
     keep what they have)."""
     with _LOCK:
         pyrender.offscreen.Renderer = previous
