@@ -40,8 +40,8 @@ class MtlPhong(MaterialModel):
     """
 
     name = "mtl_phong"
-    params = (Param("kd", "rgb", low=0.0, unit="1/sr", textureable=True, doc="MTL Kd, the lecture's k_d"),
-              Param("ks", "rgb", low=0.0, default=0.0, unit="1/sr", textureable=True, doc="MTL Ks, the lecture's k_s"),
+    params = (Param("kd", "rgb", low=0.0, unit="1/sr", textureable=True, doc="MTL Kd: Phong's diffuse k_d"),
+              Param("ks", "rgb", low=0.0, default=0.0, unit="1/sr", textureable=True, doc="MTL Ks: Phong's specular k_s"),
               Param("q", "scalar", low=0.0, default=1.0, doc="MTL Ns, the Phong exponent"),
               Param("kamb", "rgb", low=0.0, default=0.0, doc="MTL Ka: the ambient answer Ka L_a"))
     needs = ("view",)
