@@ -7,10 +7,16 @@
 - `assert_light_matches`: a light kind's GLSL against its twin at seeded points (`light_points`), through the
   real shader, under the tolerance band;
 - `assert_render_matches`: the image-level cross-check (`glphong.verify`) as an assertion;
+- any GLSL function, not only materials (docs/shader_tests.md): `glsl_function` compiles a user's GLSL (a string
+  or a ``.glsl`` file with ``#include`` s) and runs one function on numpy arrays, bit-exactly, in the vertex or the
+  fragment stage; `assert_glsl_matches` compares it with a numpy twin in ULPs, absolute, relative or a band, leaving
+  out the rows where GLSL is undefined (the twin written with `glsl`, GLSL's built-ins in numpy); `edge_inputs`
+  and the ``hypothesis`` strategies `glsl_values` / `glsl_inputs` make the inputs;
 - a pytest plugin: ``pytest_plugins = ["glphong.testing"]`` in a ``conftest.py`` gives the fixtures
   `glphong_backend` (each backend; a missing one skips with its reason unless
   ``GLPHONG_REQUIRE_BACKENDS=egl,osmesa`` asks for it, then it fails), `glphong_context`,
-  `glphong_renderer` (64 x 64) and `glphong_make_renderer` (a factory), all released at teardown.
+  `glphong_renderer` (64 x 64), `glphong_make_renderer` (a factory) and `glphong_glsl` (a factory of
+  `glsl_function` on each backend's pooled context), all released at teardown.
 
 Example
 -------
@@ -28,6 +34,11 @@ import numpy as np
 from glphong.checks.evaluate import (_gpu, _inputs, _twin, cosine_power_interval, direction,  # noqa: F401
                                      direction_sets, evaluate, float32_units, frame_around, rotate_toward)
 from glphong.checks import reference as ref
+from glphong.checks import glsl_builtins as glsl
+from glphong.checks.glsl_compare import GlslMismatch, GlslUndefinedWarning, assert_glsl_matches, ulp32, ulps_between
+from glphong.checks.glsl_function import GlslFunction, glsl_function
+from glphong.checks.glsl_inputs import edge_inputs, edge_values, glsl_inputs, glsl_values, unit_float32
+from glphong.checks.glsl_source import GlslSourceError
 from glphong.checks.probe import shade_points
 from glphong.checks.stability import case_inputs
 from glphong.checks.tolerances import BAND, EPS, point_band, response_band
@@ -42,7 +53,10 @@ from glphong.shaders.key import response_key
 __all__ = ["evaluate", "direction_sets", "assert_twin_matches", "assert_render_matches", "assert_light_matches",
            "light_points", "TwinMismatch",
            "frame_around", "direction", "rotate_toward", "float32_units", "cosine_power_interval",
-           "require_backend", "renderer_factory"]
+           "require_backend", "renderer_factory",
+           "glsl_function", "GlslFunction", "assert_glsl_matches", "GlslMismatch", "GlslUndefinedWarning",
+           "GlslSourceError", "glsl", "edge_values", "edge_inputs", "glsl_values", "glsl_inputs", "unit_float32",
+           "ulp32", "ulps_between"]
 
 class TwinMismatch(AssertionError):
     """The GPU's response left the tolerance band around the twin (`assert_twin_matches`)."""
@@ -316,3 +330,19 @@ if _pytest is not None:
     def glphong_renderer(glphong_backend, glphong_make_renderer):
         """A 64 x 64 `glphong.Renderer` on each backend (resize it as needed), released at teardown."""
         return glphong_make_renderer(64, 64, glphong_backend)
+
+    @_pytest.fixture
+    def glphong_glsl(glphong_backend):
+        """Factory ``glphong_glsl(source, name, **options)`` of `glsl_function` s on each backend (that backend's
+        pooled context: compiled per test, the context made once per process), released at teardown; a missing
+        backend skips with its reason (or fails where required)."""
+        made = []
+
+        def make(source, name, **options):
+            fn = glsl_function(source, name, backend=glphong_backend, **options)
+            made.append(fn)
+            return fn
+
+        yield make
+        for fn in made:
+            fn.release()

@@ -17,17 +17,15 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
-from glphong.materials.params import LIBRARY_CHUNKS
-from glphong.core.glsl_files import GLSL_VERSION, chunk_source
+from glphong.checks.glsl_function import glsl_function
+from glphong.checks.glsl_source import LIBRARY, functions
+from glphong.core.glsl_files import chunk_source
 from glphong.shaders.assembly import resolve_chunk
 from glphong.materials import registered_models
-from glphong.materials.registry import _strip_comments
 
 __all__ = ["Signature", "signatures", "twin_of", "evaluate", "shade_points"]
 
 _WIDTH = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4, "bool": 1}
-#: library chunks whose functions can be probed, in include order
-LIBRARY = ("common", "lights") + LIBRARY_CHUNKS + ("area", "normal_map")
 #: defines every probe source carries (the key's switches at their defaults)
 _PROBE_DEFINES = (("NAIVE", "0"), ("HAS_TANGENT", "0"), ("HAS_UV", "0"))
 
@@ -57,32 +55,20 @@ class Signature:
     twin_module: str = "glphong.reference"
 
 
-_FUNCTION = re.compile(r"^(float|vec2|vec3|vec4|bool|void)\s+([A-Za-z_]\w*)\s*\(([^)]*)\)\s*\{", re.M)
-
-
 def _parse(text, chunks, twin_module, uniforms=None):
-    """Pure functions of a chunk's text (those of float/vec/bool parameters that read no uniform)."""
-
-    code = _strip_comments(text)
+    """Pure functions of a chunk's text (those of float/vec/bool parameters that read no uniform), as
+    `glphong.checks.glsl_source.functions` finds them."""
     out = {}
-    for m in _FUNCTION.finditer(code):
-        depth, i = 1, m.end()
-        while depth and i < len(code):
-            depth += {"{": 1, "}": -1}.get(code[i], 0)
-            i += 1
-        body = code[m.end():i]
-        inputs, outputs, ok = [], [], True
-        for param in filter(None, (p.strip() for p in m.group(3).split(","))):
-            words = param.split()
-            qualifier = words[0] if words[0] in ("in", "out", "inout") else "in"
-            words = words[1:] if words[0] in ("in", "out", "inout") else words
-            if len(words) != 2 or words[0] not in _WIDTH or qualifier == "inout":
-                ok = False
-                break
-            (outputs if qualifier == "out" else inputs).append((words[1], words[0]))
-        reads = set(re.findall(r"\bu_\w+", body))  # a local named u_x is not a uniform where the names are known
-        if ok and not (reads & uniforms if uniforms is not None else reads):
-            out[m.group(2)] = Signature(tuple(chunks), tuple(inputs), tuple(outputs), m.group(1), twin_module)
+    for name, found in functions(text).items():
+        for sig in found:
+            if sig.returns not in (*_WIDTH, "void") or any(p.type not in _WIDTH or p.qualifier == "inout"
+                                                           for p in sig.parameters):
+                continue
+            reads = set(re.findall(r"\bu_\w+", sig.body))  # a local named u_x is not a uniform where the names are known
+            if not (reads & uniforms if uniforms is not None else reads):
+                inputs = tuple((p.name, p.type) for p in sig.parameters if p.qualifier == "in")
+                outputs = tuple((p.name, p.type) for p in sig.parameters if p.qualifier == "out")
+                out[name] = Signature(tuple(chunks), inputs, outputs, sig.returns, twin_module)
     return out
 
 
@@ -111,36 +97,19 @@ def twin_of(name):
     return getattr(importlib.import_module(signature.twin_module), name)
 
 
-def _exported(signature):
-    """``(name, type)`` of what a probe captures: the return value (unless void), then the outs."""
-    head = () if signature.returns == "void" else (("return", signature.returns),)
-    return head + signature.outputs
-
-
-def probe_source(name, signature):
-    """The vertex shader that calls ``name`` once per vertex and exports its results."""
-    lines = [GLSL_VERSION] + [f"#define {k} {v}" for k, v in _PROBE_DEFINES]
+def library_source(signature):
+    """The GLSL text of a probeable function's chunks (with the key's switches at their defaults), for
+    `glphong.testing.glsl_function`."""
+    lines = [f"#define {k} {v}" for k, v in _PROBE_DEFINES]
     for label in signature.chunks:
         chunk = resolve_chunk(label)
         lines += [chunk.prelude, chunk.text] if chunk.prelude else [chunk.text]
-    lines += [f"in {t} in_{p};" for p, t in signature.inputs]
-    exported = _exported(signature)
-    lines += [f"out {'float' if t == 'bool' else t} out_{p};" for p, t in exported]
-    lines.append("void main() {")
-    lines += [f"    {t} local_{p};" for p, t in signature.outputs]
-    args = [f"in_{p}" for p, _ in signature.inputs] + [f"local_{p}" for p, _ in signature.outputs]
-    if signature.returns == "void":
-        lines.append(f"    {name}({', '.join(args)});")
-    else:
-        lines.append(f"    {signature.returns} result = {name}({', '.join(args)});")
-        lines.append("    out_return = " + ("result ? 1.0 : 0.0;" if signature.returns == "bool" else "result;"))
-    lines += [f"    out_{p} = local_{p};" for p, _ in signature.outputs]
-    lines.append("}")
     return "\n".join(lines) + "\n"
 
 
 def evaluate(gl, name, **inputs):
-    """Call GLSL function ``name`` on rows of float32 inputs.
+    """Call GLSL function ``name`` of glphong's chunks on rows of float32 inputs, through the public
+    `glphong.testing.glsl_function`.
 
     Parameters
     ----------
@@ -163,34 +132,9 @@ def evaluate(gl, name, **inputs):
     names = [p for p, _ in signature.inputs]
     if sorted(inputs) != sorted(names):
         raise TypeError(f"{name} takes inputs {names} (got {sorted(inputs)})")
-    columns = [np.asarray(inputs[p], dtype=np.float32) for p in names]
-    count = max(c.shape[0] if c.ndim and (c.ndim == 2 or _WIDTH[t] == 1) else 1
-                for c, (_, t) in zip(columns, signature.inputs))
-    columns = [np.ascontiguousarray(np.broadcast_to(c, (count, _WIDTH[t]) if _WIDTH[t] > 1 else (count,)))
-               for c, (_, t) in zip(columns, signature.inputs)]
-    exported = _exported(signature)
-    mgl = gl.mgl
-    with gl:
-        program = mgl.program(vertex_shader=probe_source(name, signature), varyings=[f"out_{p}" for p, _ in exported])
-        buffers = [mgl.buffer(c.tobytes()) for c in columns]
-        stride = sum(_WIDTH[t] for _, t in exported)
-        result = mgl.buffer(reserve=count * stride * 4)
-        vao = mgl.vertex_array(program, [(b, f"{_WIDTH[t]}f", f"in_{p}") for b, (p, t) in zip(buffers, signature.inputs)])
-        try:
-            gl.bind_idle_framebuffer()
-            vao.transform(result, mode=moderngl.POINTS, vertices=count)
-            data = np.frombuffer(result.read(), dtype=np.float32).reshape(count, stride)
-            gl.check_error(f"probe of {name}")
-        finally:
-            for obj in (vao, result, *buffers, program):
-                obj.release()
-    out, at = {}, 0
-    for p, t in exported:
-        w = _WIDTH[t]
-        column = data[:, at:at + w] if w > 1 else data[:, at]
-        out[p] = column > 0.5 if t == "bool" else column.copy()
-        at += w
-    return out
+    with glsl_function(library_source(signature), name, context=gl) as fn:
+        out = fn(**inputs)
+    return out if isinstance(out, dict) else {"return": out}
 
 
 def shade_points(gl, programs, key, uniforms, positions, normals, drop_unused=False, tangents=None, uvs=None):
