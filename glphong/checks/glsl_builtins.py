@@ -116,9 +116,9 @@ def _f(x):
 
 def _quiet(fn):
     @functools.wraps(fn)
-    def wrapped(*args):
+    def wrapped(*args, **kwargs):
         with np.errstate(all="ignore"):
-            return fn(*args)
+            return fn(*args, **kwargs)
     return wrapped
 
 

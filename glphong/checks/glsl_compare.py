@@ -20,7 +20,7 @@ import warnings
 
 import numpy as np
 
-from glphong.checks.glsl_builtins import record_undefined
+from glphong.checks.glsl_builtins import UNDEFINED, record_undefined
 from glphong.checks.glsl_types import decode, glsl_type
 
 __all__ = ["GlslMismatch", "GlslUndefinedWarning", "assert_glsl_matches", "ulp32", "ulps_between", "FLT_MIN"]
@@ -220,8 +220,6 @@ def _float_ok(g, w, name, exact, ulps, atol, rtol, band, alternative, flush_subn
 
 
 def _undefined_words(counts):
-    from glphong.checks.glsl_builtins import UNDEFINED
-
     return ", ".join(f"{name} where {UNDEFINED.get(name, '?')} ({rows} rows)" for name, rows in counts.items())
 
 

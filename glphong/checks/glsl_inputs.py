@@ -144,12 +144,22 @@ def _hypothesis():
     return st, hnp
 
 
+def _float32_inward(bound, up):
+    """A bound as the nearest float32 inside it (hypothesis's width=32 floats take float32 bounds)."""
+    if bound is None:
+        return None
+    value = np.float32(bound)
+    if (up and float(value) < bound) or (not up and float(value) > bound):
+        value = np.nextafter(value, np.float32(np.inf if up else -np.inf))
+    return float(value)
+
+
 def glsl_values(type_name, rows=32, min_value=None, max_value=None, allow_nan=False, allow_infinity=False,
-                allow_subnormal=True, unit=False):
+                allow_subnormal=None, unit=False):
     """A ``hypothesis`` strategy of ``rows`` values of a GLSL type: an array ``(rows,) + row shape``.
 
-    Floats are float32 (``width=32``: every value a float32, subnormals included unless
-    ``allow_subnormal=False``), within ``[min_value, max_value]`` where given; ``unit=True`` draws unit vectors
+    Floats are float32 (``width=32``: every value a float32, subnormals included where the range holds them,
+    unless ``allow_subnormal=False``), within ``[min_value, max_value]`` where given (rounded inward to float32); ``unit=True`` draws unit vectors
     (float vectors) rounded to float32.  Integers span their type unless bounded; booleans both values.
     """
     st, hnp = _hypothesis()
@@ -170,8 +180,8 @@ def glsl_values(type_name, rows=32, min_value=None, max_value=None, allow_nan=Fa
         component = st.floats(-1.0, 1.0, width=32)
         return hnp.arrays(np.float32, shape, elements=component).filter(
             lambda a: np.all(np.linalg.norm(a.astype(np.float64), axis=-1) > 1e-3)).map(unit_float32)
-    elements = st.floats(min_value=min_value, max_value=max_value, allow_nan=allow_nan, allow_infinity=allow_infinity,
-                         allow_subnormal=allow_subnormal, width=32)
+    elements = st.floats(min_value=_float32_inward(min_value, up=True), max_value=_float32_inward(max_value, up=False),
+                         allow_nan=allow_nan, allow_infinity=allow_infinity, allow_subnormal=allow_subnormal, width=32)
     return hnp.arrays(np.float32, shape, elements=elements)
 
 

@@ -16,7 +16,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from glphong.checks.glsl_types import glsl_type
+from glphong.checks.glsl_types import TYPE_NAMES, glsl_type
 from glphong.core.glsl_files import chunk_source
 from glphong.materials.params import LIBRARY_CHUNKS
 
@@ -25,6 +25,8 @@ __all__ = ["GlslSourceError", "Expanded", "expand", "Parameter", "Signature", "f
 
 #: glphong's library chunks in include order (``#include <glphong/NAME>``)
 LIBRARY = ("common", "lights") + LIBRARY_CHUNKS + ("area", "normal_map")
+#: what ``#include <glphong/NAME>`` may name: the library, and the sRGB curve of display outputs
+INCLUDABLE = LIBRARY + ("srgb",)
 #: the expanded source's limit [bytes]
 MAX_SOURCE_BYTES = 1 << 20
 _MAX_DEPTH = 16
@@ -66,13 +68,13 @@ class Expanded:
 
 
 def _library(name, state, files, texts):
-    if name not in LIBRARY:
+    if name not in INCLUDABLE:
         raise GlslSourceError(f"#include <glphong/{name}>: glphong has no library chunk {name!r} "
-                              f"(it has: {', '.join(LIBRARY)})")
+                              f"(it has: {', '.join(INCLUDABLE)})")
     out = []
     if not state["library"]:
         out += [f"#define {k} {v}" for k, v in _LIBRARY_DEFINES]
-    for chunk in LIBRARY[:LIBRARY.index(name) + 1]:
+    for chunk in INCLUDABLE[:INCLUDABLE.index(name) + 1] if name in LIBRARY else (name,):
         if chunk not in state["library"]:
             state["library"].add(chunk)
             files.append(f"<glphong/{chunk}>")
@@ -259,8 +261,6 @@ def uniforms(text):
 
 def check_signature(signature):
     """Raise GlslSourceError where a parameter or the result has a type glphong cannot pass."""
-    from glphong.checks.glsl_types import TYPE_NAMES
-
     bad = [(p.name, p.type) for p in signature.parameters if glsl_type(p.type) is None or "[" in p.name]
     if signature.returns != "void" and glsl_type(signature.returns) is None:
         bad.append(("the result", signature.returns))
