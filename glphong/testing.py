@@ -36,7 +36,7 @@ from glphong.checks.evaluate import (_gpu, _inputs, _twin, cosine_power_interval
 from glphong.checks import reference as ref
 from glphong.checks import glsl_builtins as glsl
 from glphong.checks.glsl_compare import GlslMismatch, GlslUndefinedWarning, assert_glsl_matches, ulp32, ulps_between
-from glphong.checks.glsl_function import GlslFunction, glsl_function
+from glphong.checks.glsl_function import GlslFunction, glsl_function, subnormal_flushing
 from glphong.checks.glsl_inputs import edge_inputs, edge_values, glsl_inputs, glsl_values, unit_float32
 from glphong.checks.glsl_source import GlslSourceError
 from glphong.checks.probe import shade_points
@@ -56,7 +56,7 @@ __all__ = ["evaluate", "direction_sets", "assert_twin_matches", "assert_render_m
            "require_backend", "renderer_factory",
            "glsl_function", "GlslFunction", "assert_glsl_matches", "GlslMismatch", "GlslUndefinedWarning",
            "GlslSourceError", "glsl", "edge_values", "edge_inputs", "glsl_values", "glsl_inputs", "unit_float32",
-           "ulp32", "ulps_between"]
+           "ulp32", "ulps_between", "subnormal_flushing"]
 
 class TwinMismatch(AssertionError):
     """The GPU's response left the tolerance band around the twin (`assert_twin_matches`)."""

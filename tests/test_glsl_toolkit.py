@@ -268,6 +268,15 @@ def test_vector_builtins_mark_rows():
     assert record.counts() == {"normalize": 1, "inverse": 1} and record.rows.tolist() == [True, True, False]
 
 
+def test_the_drivers_flushing_is_reported(glphong_backend):
+    """subnormal_flushing says what the driver does with subnormal operands and results; passing through is exact
+    whatever it says (llvmpipe flushes both, measured)."""
+    from glphong.testing import subnormal_flushing
+
+    found = subnormal_flushing(backend=glphong_backend)
+    assert set(found) == {"inputs", "results"} and all(isinstance(v, bool) for v in found.values())
+
+
 def test_subnormal_flushing_is_accepted_and_counted(glphong_glsl):
     """GLSL may flush subnormals: a GPU that does is accepted against the twin and counted; one that does not
     matches the twin itself."""

@@ -30,7 +30,7 @@ from glphong.checks.glsl_source import (GlslSourceError, check_signature, expand
                                         uniforms as parse_uniforms)
 from glphong.checks.glsl_types import decode, encode, glsl_type
 
-__all__ = ["GlslFunction", "glsl_function", "VERTEX_CHUNK", "STAGES"]
+__all__ = ["GlslFunction", "glsl_function", "subnormal_flushing", "VERTEX_CHUNK", "STAGES"]
 
 #: rows per transform-feedback draw; a call with more rows is split into draws of this many
 VERTEX_CHUNK = 1 << 20
@@ -465,3 +465,20 @@ def glsl_function(source, name, overload=None, stage="vertex", version=330, defi
     return GlslFunction(source, name, overload=overload, stage=stage, version=version, defines=defines,
                         include_dir=include_dir, allow_outside=allow_outside, backend=backend, context=context,
                         grid_width=grid_width)
+
+
+def subnormal_flushing(backend="auto", context=None):
+    """What the driver does with subnormal float32 values in shader arithmetic (GLSL lets it flush them to zero).
+
+    Returns
+    -------
+    dict
+        ``{'inputs': bool, 'results': bool}``: whether a subnormal operand is read as zero (``x * one`` of
+        ``2^-149``), and whether a subnormal result is written as zero (``2^-126 * half``).  Values that only pass
+        through (`glsl_function`'s bit-exact transfer) are never flushed.
+    """
+    with GlslFunction("vec2 glphong_probe_subnormals(float tiny, float least_normal, float one, float half_) "
+                      "{ return vec2(tiny * one + 0.0, least_normal * half_); }", "glphong_probe_subnormals",
+                      backend=backend, context=context) as fn:  # the factors are inputs: nothing to fold away
+        out = fn(np.float32(2.0 ** -149), np.float32(2.0 ** -126), np.float32(1.0), np.float32(0.5))[0]
+    return {"inputs": bool(out[0] == 0), "results": bool(out[1] == 0)}
