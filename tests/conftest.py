@@ -1,4 +1,8 @@
 """Shared fixtures: OpenGL contexts on each backend, skipped where unavailable."""
+import json
+import os
+import subprocess
+import sys
 
 import pytest
 
@@ -99,3 +103,22 @@ def run_isolated():
     regresses into a hang or a memory blow-up fails its test instead of taking the machine down.  Returns
     the ``subprocess.CompletedProcess`` (text output; ``returncode`` -9 on timeout)."""
     return _isolated_runner
+
+
+@pytest.fixture(scope="session")
+def pyrender_check():
+    """``run(script, platform)``: run a pyrender check script in a subprocess (pyrender reads PYOPENGL_PLATFORM once
+    per process) and return the JSON object its last line prints; an unavailable platform skips, unless
+    ``GLPHONG_REQUIRE_BACKENDS`` names it."""
+
+    def run(script, platform, timeout=600):
+        env = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
+        out = subprocess.run([sys.executable, str(script), platform], capture_output=True, text=True, timeout=timeout,
+                             env=env)
+        if out.returncode != 0 and "BackendUnavailable" in out.stderr and platform not in os.environ.get(
+                "GLPHONG_REQUIRE_BACKENDS", ""):
+            pytest.skip(f"{platform} unavailable: {out.stderr.strip().splitlines()[-1]}")
+        assert out.returncode == 0, out.stderr[-3000:]
+        return json.loads(out.stdout.strip().splitlines()[-1])
+
+    return run

@@ -8,10 +8,6 @@ subprocess that reports its measurements as JSON.  Agreement is measured on the 
 render of `scene_from_pyrender` (silhouettes eroded by 2 px; pyrender multisamples on EGL only).
 """
 import importlib.util
-import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -23,14 +19,8 @@ CHECK = Path(__file__).with_name("pyrender_flags_check.py")
 
 
 @pytest.fixture(scope="module", params=("egl", "osmesa"))
-def measured(request):
-    env = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
-    out = subprocess.run([sys.executable, str(CHECK), request.param], capture_output=True, text=True, timeout=600, env=env)
-    if out.returncode != 0 and "BackendUnavailable" in out.stderr and request.param not in os.environ.get(
-            "GLPHONG_REQUIRE_BACKENDS", ""):
-        pytest.skip(f"{request.param} unavailable: {out.stderr.strip().splitlines()[-1]}")
-    assert out.returncode == 0, out.stderr[-3000:]
-    return request.param, json.loads(out.stdout.strip().splitlines()[-1])
+def measured(request, pyrender_check):
+    return request.param, pyrender_check(CHECK, request.param, timeout=600)
 
 
 def _agrees(m, platform, exact=0.999):

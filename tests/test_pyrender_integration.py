@@ -4,10 +4,6 @@ pyrender fixes its OpenGL platform once per process, so each platform runs
 `pyrender_embedding_check.py` in a subprocess that reports its measurements as JSON.
 """
 import importlib.util
-import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -20,14 +16,8 @@ CHECK = Path(__file__).with_name("pyrender_embedding_check.py")
 
 
 @pytest.fixture(scope="module", params=("egl", "osmesa"))
-def measured(request):
-    env = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
-    out = subprocess.run([sys.executable, str(CHECK), request.param], capture_output=True, text=True, timeout=300, env=env)
-    if out.returncode != 0 and "BackendUnavailable" in out.stderr and request.param not in os.environ.get(
-            "GLPHONG_REQUIRE_BACKENDS", ""):
-        pytest.skip(f"{request.param} unavailable: {out.stderr.strip().splitlines()[-1]}")
-    assert out.returncode == 0, out.stderr[-3000:]
-    return request.param, json.loads(out.stdout.strip().splitlines()[-1])
+def measured(request, pyrender_check):
+    return request.param, pyrender_check(CHECK, request.param, timeout=300)
 
 
 def test_image_agrees_with_glphong_renderer(measured):
