@@ -95,6 +95,10 @@ def test_chunks_give_the_same_rows(glphong_glsl, monkeypatch):
     monkeypatch.setattr("glphong.checks.glsl_function.VERTEX_CHUNK", 1000)
     np.testing.assert_array_equal(fn(x, k), whole)
     assert VERTEX_CHUNK == 1 << 20
+    # the fragment stage's grid is at most 4096 pixels high: a one-pixel-wide grid of 5000 rows takes two draws
+    where = glphong_glsl("float y(float x) { return gl_FragCoord.y + x; }", "y", stage="fragment", grid_width=1)
+    np.testing.assert_array_equal(where(np.zeros(5000)), np.concatenate([np.arange(4096), np.arange(904)]) + 0.5)
+    assert glphong_glsl("float one() { return 1.0; }", "one")().tolist() == [1.0]  # no inputs: one row
 
 
 def test_sources_with_includes_and_clear_errors(glphong_glsl, tmp_path):

@@ -95,9 +95,11 @@ class GlslFunction:
         self.stage, self.grid_width = stage, grid_width
         self.uniforms = parse_uniforms(self._expanded.text)
         self._defines = dict(defines or {})
-        for key in self._defines:
+        for key, value in self._defines.items():
             if not isinstance(key, str) or not key.isidentifier():
                 raise ValueError(f"defines: {key!r} is not a macro name")
+            if "\n" in str(value):
+                raise ValueError(f"defines: the value of {key} spans lines")
         if context is None:
             self._gl, _, self._lock = _pooled(backend)
         else:
@@ -296,7 +298,8 @@ class GlslFunction:
             self.set_uniform(name, value)
         encoded, count = self._rows(args, kwargs)
         words = {(n, k): [] for _, _, n, k in self._outputs}
-        chunk = VERTEX_CHUNK if self.stage == "vertex" else FRAGMENT_CHUNK
+        # a fragment draw's grid is at most 4096 rows of pixels high (textures of that size exist everywhere)
+        chunk = VERTEX_CHUNK if self.stage == "vertex" else min(FRAGMENT_CHUNK, self.grid_width * 4096)
         for start in range(0, count, chunk):
             stop = min(count, start + chunk)
             pieces = self._draw({key: [s[start:stop] for s in slots] for key, slots in encoded.items()}, stop - start)
