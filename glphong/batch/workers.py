@@ -15,7 +15,7 @@ import sys
 import tempfile
 import threading
 import time
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +26,8 @@ _PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 _PARENT_POLL_S = 0.5
 
 _WORKER = {}
+#: the writer thread of this process, by pid (a forked child makes its own)
+_WRITER = {}
 
 
 def _set_threads(threads):
@@ -132,9 +134,29 @@ def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options):
     renderer = _WORKER.get(key)
     if renderer is None or renderer.context is None:
         renderer = _WORKER[key] = Renderer(width, height, **options)
-    records = []
-    for index, spec in items:
-        frame = renderer.render(scene_fn(spec))
-        size, sha256 = _write_frame(frame, Path(out_dir) / _frame_name(index, fmt), out_dir, fmt)
-        records.append((index, size, sha256))
+    records, pending = [], None
+    try:
+        for index, spec in items:
+            frame = renderer.render(scene_fn(spec))
+            if pending is not None:  # the previous frame's file, written while this one rendered
+                records.append(pending.result())
+            pending = _writer().submit(_write_record, index, frame, out_dir, fmt)
+    finally:
+        if pending is not None:  # a frame being written is finished (or its error raised) before this returns
+            records.append(pending.result())
     return records, renderer.context.renderer_name
+
+
+def _write_record(index, frame, out_dir, fmt):
+    size, sha256 = _write_frame(frame, Path(out_dir) / _frame_name(index, fmt), out_dir, fmt)
+    return index, size, sha256
+
+
+def _writer():
+    """The worker's one writer thread: a frame is encoded and written while the next renders (the encode's numpy
+    passes and zlib release the GIL), one frame in flight at most."""
+    pool = _WRITER.get(os.getpid())
+    if pool is None:
+        _WRITER.clear()
+        pool = _WRITER[os.getpid()] = ThreadPoolExecutor(1, thread_name_prefix="glphong-writer")
+    return pool
