@@ -429,6 +429,20 @@ MUTATIONS = [
     M("generated.py:ambient-scale-dropped", "glphong/shaders/generated.py",
       'scaled = "u_ambient" if t.ambient_scale == 1.0 else', 'scaled = "u_ambient" if True else',
       "the albedo models answer L_a with rho L_a instead of rho/pi L_a"),
+    # ---- shader unit tests for any GLSL function and the PNG writer (issues 28, 29)
+    M("glsl_builtins.py:pow-domain", "glphong/checks/glsl_builtins.py",
+      'return _undefined("pow", (x < 0) | ((x == 0) & (y <= 0)), np.power(np.abs(x), y))',
+      'return _undefined("pow", (x < 0), np.power(np.abs(x), y))',
+      "glsl.pow forgets that pow(0, y <= 0) is undefined"),
+    M("glsl_inputs.py:no-negative-zero", "glphong/checks/glsl_inputs.py",
+      "FLOAT_EDGES = np.array([0.0, -0.0,", "FLOAT_EDGES = np.array([0.0, 0.0,",
+      "the float edge cases lose -0.0"),
+    M("glsl_types.py:int-from-bits", "glphong/checks/glsl_types.py",
+      'return f"int({names[0]})" if self.rows == 1 else f"i{vec}({names[0]})"',
+      'return f"int(uintBitsToFloat({names[0]}))" if self.rows == 1 else f"i{vec}({names[0]})"',
+      "an int parameter read as the float of its bits"),
+    M("png.py:filter-byte", "glphong/core/png.py", "rows[:, 0] = 1\n", "rows[:, 0] = 0\n",
+      "PNG rows filtered Sub but labelled None"),
 ]
 del M
 
