@@ -8,6 +8,9 @@ subprocess that reports its measurements as JSON.  Agreement is measured on the 
 render of `scene_from_pyrender` (silhouettes eroded by 2 px; pyrender multisamples on EGL only).
 """
 import importlib.util
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -105,3 +108,35 @@ def test_enable_everywhere_reaches_renderers_made_inside_third_party_code(measur
     platform, m = measured
     _agrees(m["everywhere"], platform)
     assert "not enabled on" in m["after_everywhere"] and "enable_everywhere()" in m["after_everywhere"]
+
+
+def test_a_suite_runs_with_the_embedding_everywhere(tmp_path):
+    """``pytest -p glphong.integrations.pyrender.everywhere`` runs a suite that knows nothing of glphong with every
+    renderer it makes enabled: its GlphongMaterial scene draws; without the plugin it refuses."""
+    from glphong.testing import require_backend
+
+    require_backend("osmesa").release()  # skips where OSMesa is missing (fails where it is required)
+    (tmp_path / "test_theirs.py").write_text(
+        "import os\nimport numpy as np, pyrender, trimesh, glphong\n"
+        "from glphong.integrations.pyrender import GlphongMaterial, release\n"
+        "def test_draws():\n"
+        "    scene = pyrender.Scene()\n"
+        "    scene.add(pyrender.Mesh.from_trimesh(trimesh.creation.icosphere(2), material=GlphongMaterial(glphong.Lambert(0.3))))\n"
+        "    pose = np.eye(4); pose[2, 3] = 3.0\n"
+        "    scene.add(pyrender.PerspectiveCamera(yfov=0.8), pose=pose)\n"
+        "    scene.add(pyrender.PointLight(intensity=5.0), pose=pose)\n"
+        "    r = pyrender.OffscreenRenderer(32, 32)\n"
+        "    try:\n"
+        "        color, _ = r.render(scene)\n"
+        "    finally:\n"
+        "        release(r)\n"
+        "    assert color.max() > 0\n")
+    env = {k: v for k, v in os.environ.items() if k != "PYTEST_ADDOPTS"}
+    env["PYOPENGL_PLATFORM"] = "osmesa"
+    results = {}
+    for name, plugin in (("with", ["-p", "glphong.integrations.pyrender.everywhere"]), ("without", [])):
+        out = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *plugin, str(tmp_path)],
+                             cwd=tmp_path, env=env, capture_output=True, text=True, timeout=300)
+        results[name] = (out.returncode, out.stdout[-2000:])
+    assert results["with"][0] == 0, results["with"][1]
+    assert results["without"][0] == 1 and "enable_everywhere()" in results["without"][1], results["without"][1]
