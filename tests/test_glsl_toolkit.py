@@ -122,6 +122,15 @@ def test_sources_with_includes_and_clear_errors(glphong_glsl, tmp_path):
         glphong_glsl('#include "escape.glsl"\nfloat h(float x) { return x; }', "h", include_dir=tmp_path / "lib")
     assert glphong_glsl('#include "escape.glsl"\nfloat h(float x) { return x; }', "h",
                         include_dir=tmp_path / "lib", allow_outside=True)(1.0)[0] == 1.0
+    # what is read is a regular file within the size limit, checked before a byte is read
+    os.mkfifo(tmp_path / "pipe.glsl")
+    with pytest.raises(GlslSourceError, match="not a regular file"):
+        glphong_glsl('#include "pipe.glsl"\nfloat h(float x) { return x; }', "h", include_dir=tmp_path)
+    with pytest.raises(GlslSourceError, match="not a regular file"):
+        glphong_glsl(tmp_path / "pipe.glsl", "h")
+    (tmp_path / "big.glsl").write_text("//" + "x" * (1 << 20) + "\n")
+    with pytest.raises(GlslSourceError, match="more than the limit of 1048576"):
+        glphong_glsl('#include "big.glsl"\nfloat h(float x) { return x; }', "h", include_dir=tmp_path)
     (tmp_path / "loop.glsl").write_text('#include "loop.glsl"\n')
     with pytest.raises(GlslSourceError, match="includes itself"):
         glphong_glsl(tmp_path / "loop.glsl", "f")

@@ -27,7 +27,7 @@ import numpy as np
 
 from glphong.checks.evaluate import _pooled
 from glphong.checks.glsl_source import (GlslSourceError, check_signature, expand, functions, log_locations, map_log,
-                                        uniforms as parse_uniforms)
+                                        read_source_file, uniforms as parse_uniforms)
 from glphong.checks.glsl_types import decode, encode, glsl_type
 
 __all__ = ["GlslFunction", "glsl_function", "subnormal_flushing", "VERTEX_CHUNK", "STAGES"]
@@ -50,10 +50,7 @@ def _read_source(source):
     if isinstance(source, Path) or (isinstance(source, str) and "\n" not in source
                                     and source.strip().endswith((".glsl", ".vert", ".frag", ".comp"))):
         path = Path(source)
-        try:
-            return path.read_text(encoding="utf-8"), path
-        except (OSError, UnicodeDecodeError) as exc:
-            raise GlslSourceError(f"cannot read the GLSL file {path}: {exc}") from None
+        return read_source_file(path), path
     if not isinstance(source, str):
         raise TypeError(f"source must be GLSL text or a path to a .glsl file (got {type(source).__name__})")
     return source, None

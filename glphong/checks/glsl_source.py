@@ -17,11 +17,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from glphong.checks.glsl_types import TYPE_NAMES, glsl_type
+from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
 from glphong.core.glsl_files import chunk_source
 from glphong.materials.params import LIBRARY_CHUNKS
 
 __all__ = ["GlslSourceError", "Expanded", "expand", "Parameter", "Signature", "functions", "uniforms",
-           "strip_comments", "map_log", "log_locations", "check_signature", "LIBRARY", "MAX_SOURCE_BYTES"]
+           "strip_comments", "read_source_file", "map_log", "log_locations", "check_signature", "LIBRARY", "MAX_SOURCE_BYTES"]
 
 #: glphong's library chunks in include order (``#include <glphong/NAME>``)
 LIBRARY = ("common", "lights") + LIBRARY_CHUNKS + ("area", "normal_map")
@@ -146,17 +147,10 @@ def expand(source, origin=None, include_dir=None, allow_outside=False):
         if path in state["stack"]:
             raise GlslSourceError(f"{where}: #include \"{relative}\" includes itself (through "
                                   f"{' -> '.join(p.name for p in state['stack'])})")
-        try:
-            data = path.read_bytes()
-        except OSError as exc:
-            raise GlslSourceError(f"{where}: #include \"{relative}\": cannot read {path} ({exc.strerror or exc})") from None
-        state["size"] += len(data)
+        text = read_source_file(path, MAX_SOURCE_BYTES - state["size"], f"{where}: #include \"{relative}\": ")
+        state["size"] += len(text.encode("utf-8"))
         if state["size"] > MAX_SOURCE_BYTES:
             raise GlslSourceError(f"{where}: the source with its includes exceeds {MAX_SOURCE_BYTES} bytes")
-        try:
-            text = data.decode("utf-8")
-        except UnicodeDecodeError as exc:
-            raise GlslSourceError(f"{path}: not UTF-8 text (byte {exc.start})") from None
         files.append(str(path))
         texts.append(text)
         state["stack"].append(path)
@@ -169,6 +163,18 @@ def expand(source, origin=None, include_dir=None, allow_outside=False):
         raise GlslSourceError(f"{files[0]}: larger than {MAX_SOURCE_BYTES} bytes")
     text = walk(source, 0, top, 0)
     return Expanded(text, tuple(files), tuple(texts))
+
+
+def read_source_file(path, limit=MAX_SOURCE_BYTES, prefix=""):
+    """The UTF-8 text of a GLSL file of at most ``limit`` bytes, read as `glphong.filesafety.read_bytes` reads
+    (a regular file only, its size checked before a byte is read); a GlslSourceError otherwise."""
+    try:
+        data = read_bytes(path, LIMITS.replace(file_bytes=max(int(limit), 1)))
+        return data.decode("utf-8")
+    except SceneFileError as exc:
+        raise GlslSourceError(f"{prefix}cannot read {path}: {exc}") from None
+    except UnicodeDecodeError as exc:
+        raise GlslSourceError(f"{prefix}{path}: not UTF-8 text (byte {exc.start})") from None
 
 
 def strip_comments(text):
