@@ -200,6 +200,11 @@ def test_gltf_texture_transform_moves_the_uvs(tmp_path):
     expected_v = -sx * np.sin(r) * u + sy * np.cos(r) * v + oy
     np.testing.assert_allclose(after[:, 0], expected_u, atol=1e-6)
     np.testing.assert_allclose(1.0 - after[:, 1], expected_v, atol=1e-6)
+    # the earlier approximation reads the same texture through the same transform; a material of the user's is theirs
+    approximated = glphong.load_scene(gltf, lights=[], materials="cook_torrance").objects[0].mesh.uvs
+    np.testing.assert_array_equal(approximated, after.astype(np.float32))
+    own = glphong.load_scene(gltf, lights=[], materials=lambda name, entry: glphong.Lambert(0.3)).objects[0].mesh.uvs
+    np.testing.assert_array_equal(own, before.astype(np.float32))
     for hostile in ({"rotation": "a lot"}, [1, 2], {"offset": {"a": 1, "b": 2}}):
         info["extensions"]["KHR_texture_transform"] = hostile
         gltf.write_text(json.dumps(document))

@@ -351,8 +351,9 @@ def transformed_uvs(mesh, matrix):
 
 
 def _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale):
-    """The material of one glTF primitive: the user's, the stored glphong one, or `gltf_pbr_material`
-    (`gltf_material` where ``materials='cook_torrance'``)."""
+    """``(material, uv transform)`` of one glTF primitive: the user's, the stored glphong one, or `gltf_pbr_material`
+    (`gltf_material` where ``materials='cook_torrance'``); the transform (`texture_transform`, read once per
+    material) is that of a material made from the file's own entry, whose textures it moves, else None."""
 
     entry = entries[index] if index is not None else None
     material_name = entry.get("name") if entry is not None else None
@@ -368,12 +369,12 @@ def _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emi
         chosen = next((chosen_material(materials, k, entry) for k in (material_name, name)
                        if k is not None and materials and k in materials), None)
     if chosen is not None:
-        return chosen
+        return chosen, None
     if entry is None:
-        return _trimesh_material(None)
+        return _trimesh_material(None), None
     key = (index, mesh.uvs is not None, mesh.colors is not None)
     if key not in made:
-        stored = material_from_extras(entry, gltf, f"materials[{index}]")
+        stored, transform = material_from_extras(entry, gltf, f"materials[{index}]"), None
         if stored is None:
             where = f"materials[{index}]"
             texture = _texture_reader(gltf, where) if mesh.uvs is not None else None
@@ -384,7 +385,8 @@ def _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emi
                 if entry.get("alphaMode") == "BLEND":
                     raise SceneFileError(gltf.path, BLEND_REFUSED, f"{where}.alphaMode")
                 stored = gltf_pbr_material(entry, texture, mesh.colors is not None, emissive_scale)
-        made[key] = stored
+            transform = texture_transform(entry, gltf, where)
+        made[key] = stored, transform
     return made[key]
 
 
@@ -410,10 +412,8 @@ def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name
     entries, made = document.get("materials", []), {}
     emissive_scale = 1.0 / LUMENS_PER_WATT if light_units == "photometric" else 1.0
     for name, mesh, world, index in read_gltf_primitives(gltf):
-        material = _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale)
-        if isinstance(material, GltfPBR) and index is not None and materials is None:  # the file's own material
-            mesh = transformed_uvs(mesh, texture_transform(entries[index], gltf, f"materials[{index}]"))
-        scene.add(mesh, material, pose=world, name=name)
+        material, transform = _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale)
+        scene.add(transformed_uvs(mesh, transform), material, pose=world, name=name)
     if lights is None:  # a file without lights is not drawn black by accident
         _, view_lights, view_ambient = default_view(scene)
         warnings.warn(f"{path} has no lights: glphong adds its default point light and ambient light (give "

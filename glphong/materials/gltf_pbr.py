@@ -45,7 +45,7 @@ import numpy as np
 
 from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
 from glphong.materials.cook_torrance import oracle_half_vector
-from glphong.materials.model import MaterialModel, Param, Properties
+from glphong.materials.model import MaterialModel, Param, Properties, _constant_part
 from glphong.materials.params import GlslFile
 from glphong.materials.surface import SurfaceInput
 from glphong.twin.band import EPS
@@ -131,8 +131,8 @@ class GltfPBR(MaterialModel):
         """glTF's fields as the file writes them: the factors as they are, the metallic-roughness texture where
         metallic and roughness read one image's blue and green, the emissive factor (its strength above 1 as
         ``KHR_materials_emissive_strength``) and texture (`MaterialModel.gltf_fields`)."""
-        pbr = {"baseColorFactor": [float(c) for c in np.broadcast_to(_scale_of(self.base_color), 3)] + [1.0],
-               "metallicFactor": float(_scale_of(self.metallic)), "roughnessFactor": float(_scale_of(self.roughness))}
+        pbr = {"baseColorFactor": [float(c) for c in np.broadcast_to(_constant_part(self.base_color), 3)] + [1.0],
+               "metallicFactor": float(_constant_part(self.metallic)), "roughnessFactor": float(_constant_part(self.roughness))}
         if isinstance(self.base_color, SurfaceInput) and self.base_color.texture is not None:
             pbr["baseColorTexture"] = {"index": texture_index(self.base_color.texture)}
         m, r = self.metallic, self.roughness
@@ -140,7 +140,7 @@ class GltfPBR(MaterialModel):
                 m.texture is not None and (m.channel, r.channel) == ("b", "g"):
             pbr["metallicRoughnessTexture"] = {"index": texture_index(m.texture)}
         out = {}
-        emissive = np.broadcast_to(np.asarray(_scale_of(self.emissive), np.float64), 3)
+        emissive = np.broadcast_to(np.asarray(_constant_part(self.emissive), np.float64), 3)
         if emissive.max() > 0:
             out["emissiveFactor"] = [float(c) for c in emissive / max(emissive.max(), 1.0)]
             if emissive.max() > 1.0:
@@ -265,8 +265,3 @@ def _stability_cases():
         cases.append(Case(f"gltf_pbr base colour {color:g}", "gltf colour", GltfPBR(color, 0.3, 0.4),
                           eye=_mirror_eye(30.0, 0.3), lights=(("point", light, e_one),)))
     return cases
-
-
-def _scale_of(value):
-    """A parameter's constant factor: a surface input's scale, or the value itself."""
-    return value.scale if isinstance(value, SurfaceInput) else value
