@@ -5,6 +5,7 @@ A light with ``shadows=True`` of a kind whose ``shadow_map`` is 'cube' gets six 
 (`ShadowSetup.face_matrices`, the face conventions of glsl/shadows.glsl); one of kind 'ortho' gets an orthographic
 map over the bounding box of every object of the scene, square, looking along its direction.
 """
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -102,12 +103,31 @@ class ShadowSetup:
         return values
 
 
+#: per mesh (immutable), the world bounds of its vertices under the poses it was last seen with
+_BOUNDS = weakref.WeakKeyDictionary()
+
+
+def _object_bounds(mesh, pose):
+    """``(low, high)`` of ``mesh``'s vertices under ``pose``, walked once per mesh and pose: a scene rebuilt every
+    frame from the same meshes (pyrender's, `glphong.integrations.pyrender.shadows`) does not walk them again."""
+    seen = _BOUNDS.get(mesh)
+    if seen is None:
+        seen = _BOUNDS[mesh] = {}
+    key = np.asarray(pose, dtype=np.float64).tobytes()
+    bounds = seen.get(key)
+    if bounds is None:
+        if len(seen) >= 16:  # a moving object: keep the last few poses only
+            seen.clear()
+        p = mesh.positions @ pose[:3, :3].T + pose[:3, 3]
+        bounds = seen[key] = (p.min(axis=0), p.max(axis=0))
+    return bounds
+
+
 def scene_bounds(scene):
     """``(low, high)`` (3,) float64: the world-space bounding box of every object of ``scene``."""
     corners = []
     for obj in scene.objects:
-        p = obj.mesh.positions @ obj.pose[:3, :3].T + obj.pose[:3, 3]
-        corners += [p.min(axis=0), p.max(axis=0)]
+        corners += list(_object_bounds(obj.mesh, obj.pose))
     if not corners:
         return np.zeros(3), np.zeros(3)
     return np.min(corners, axis=0), np.max(corners, axis=0)
