@@ -14,6 +14,7 @@ from PIL import Image
 
 import glphong
 from glphong import primitives
+from glphong.materials.surface import alpha_masked
 from glphong.scene.geometry import MeshData
 
 HALF = np.array([[255, 0]], np.uint8)  # one row: opaque, clear
@@ -40,6 +41,10 @@ def test_the_mask_is_where_alpha_reaches_the_cutoff(shading, glphong_backend, gl
     frame = (vertex or renderer).render(_plane_scene(masked))
     assert expected.sum() > 1000 and (plain.mask & ~expected).sum() > 1000
     np.testing.assert_array_equal(frame.mask[clear_cut], expected[clear_cut])
+    # the twin of the GLSL alpha test agrees with the formula written here, on the same G-buffer fragments
+    uv = plain.uv[plain.mask].astype(np.float64)
+    twin = ~alpha_masked(uv, np.zeros(len(uv)), masked.alpha_mask)
+    np.testing.assert_array_equal(twin[clear_cut[plain.mask]], expected[plain.mask][clear_cut[plain.mask]])
     if vertex is not None:
         vertex.release()
         return
@@ -60,6 +65,8 @@ def test_constant_alpha_draws_all_or_nothing(glphong_make_renderer):
 def test_refusals_and_program_keys():
     with pytest.raises(ValueError, match="one channel of a texture"):
         glphong.AlphaMask(0.5, glphong.Texture(HALF))
+    with pytest.raises(ValueError, match="channel='g'"):  # the GLSL reads red: another channel would be ignored
+        glphong.AlphaMask(0.5, glphong.Texture(HALF, srgb=False, channel="g"))
     with pytest.raises(ValueError, match="alpha"):
         glphong.AlphaMask(0.5, 1.5)
     with pytest.raises(TypeError, match="alpha_mask must be a glphong.AlphaMask"):

@@ -405,7 +405,7 @@ class AlphaMask(_Frozen):
     cutoff : float
         glTF's ``alphaCutoff`` (default 0.5), >= 0.
     alpha : float or SurfaceInput
-        In [0, 1]; a `SurfaceInput` needs a ``channel`` and no vertex colours.
+        In [0, 1]; a `SurfaceInput` reads its texture's red channel (``channel='r'``), without vertex colours.
     """
 
     __slots__ = ("cutoff", "alpha")  # the constructor's order: pickled by them
@@ -413,8 +413,9 @@ class AlphaMask(_Frozen):
     def __init__(self, cutoff=0.5, alpha=1.0):
         object.__setattr__(self, "cutoff", _validate.scalar("cutoff", cutoff, low=0.0))
         if isinstance(alpha, SurfaceInput):
-            if alpha.channel is None or alpha.vertex_colors or alpha.texture is None:
-                raise ValueError("an alpha mask's alpha is one channel of a texture (channel='r', no vertex colours)")
+            if alpha.channel != "r" or alpha.vertex_colors or alpha.texture is None:  # mesh_fragment.glsl reads .r
+                raise ValueError("an alpha mask's alpha is one channel of a texture, its red (channel='r', no vertex "
+                                 f"colours; got channel={alpha.channel!r}): move the alpha into the red channel")
             low, high = alpha.value_range()
             if low < 0.0 or high > 1.0:
                 raise ValueError(f"alpha must be in [0, 1] everywhere; {alpha!r} spans [{low:g}, {high:g}]")
@@ -492,6 +493,20 @@ def surface_texture(image, uv, lod):
         8.14 defines; ignored for 'bilinear'.
     """
     return _sample(image, uv, lod)[0]
+
+
+def alpha_masked(uv, lod, mask):
+    """The twin of mesh_fragment.glsl's ``alpha_masked(uv)``: whether a fragment is discarded, (N,) bool.
+
+    ``alpha = scale`` (times the red channel of `surface_texture` where the alpha is textured) ``< cutoff``, with the
+    float32 uniforms the GPU reads; ``uv`` (N, 2) and ``lod`` (N,) as `surface_texture` takes them; ``mask`` the
+    `AlphaMask`."""
+    uv = np.asarray(uv, dtype=np.float64)
+    scale = float(np.float32(mask.alpha.scale if mask.textured else mask.alpha))
+    alpha = np.full(len(uv), scale)
+    if mask.textured:
+        alpha = alpha * surface_texture(mask.alpha.texture, uv, lod)[:, 0]
+    return alpha < float(np.float32(mask.cutoff))
 
 
 def surface_texture_band(image, uv, lod, constants):
