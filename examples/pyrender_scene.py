@@ -66,7 +66,7 @@ def main(out="pyrender_scene.png"):
     # compared on the glphong meshes (the PBR sphere converted, so that it casts into glphong's maps too)
     converted = scene_from_pyrender(scene, convert=True, flags=FLAGS)
     pbr = [i for i, obj in enumerate(converted.objects) if obj.name == "pyrender pbr"]
-    with glphong.Renderer(width, height, backend=PLATFORM, samples=4 if PLATFORM == "egl" else 1) as own:
+    with glphong.Renderer(width, height, backend=PLATFORM, samples=4 if PLATFORM == "egl" else 1, numerics="stable") as own:
         ours = own.render_srgb8(converted)
         interior = (own.render(converted).coverage == 1.0) & ~np.isin(own.gbuffer(converted).object_index, pbr)
     for _ in range(2):  # 2 px away from silhouettes, which multisampling treats differently

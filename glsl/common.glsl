@@ -10,8 +10,14 @@
 //   |x|^2 is never formed from raw coordinates, so lengths from FLT_MIN to FLT_MAX (float32)
 //   neither underflow nor overflow.  On failure x_hat = 0 and len = 0.
 //   Units: len has the units of x; x_hat is dimensionless.
-//   NAIVE (the textbook formulation, for the stability report only): x_hat = normalize(x),
-//   len = length(x), always valid.
+//   NAIVE (the textbook formulation, for the stability report only): plain_normalize.
+// plain_normalize(x, out x_hat, out len) -> true
+//   x_hat = normalize(x), len = length(x): the textbook arithmetic, forming |x|^2 from the raw coordinates.
+//   Compiled at a site in place of safe_normalize only where the program key proves it (numerics='auto',
+//   docs/design.md section 3, "Stability where a scene needs it"): |x|^2 within [FLT_MIN / eps, FLT_MAX / 4]
+//   at every point the site can see, so that nothing under- or overflows and x is never zero.  Sites and
+//   their defines: the normal in mesh_fragment.glsl (NAIVE_NORMAL), the view vector in shade.glsl
+//   (NAIVE_VIEW), a point, spot or unattenuated light's direction in lights/*.glsl (NAIVE_LIGHT).
 //
 // ShadingFrame: the local frame a material's response reads (docs/design.md section 8):
 //   n the unit normal; t, b the unit tangent and bitangent (0 unless HAS_TANGENT); uv (0 unless HAS_UV).
@@ -24,16 +30,22 @@
 //   Duff et al. 2017 ("Building an orthonormal basis, revisited") around n.
 // shading_frame(n, tangent, uv) -> the ShadingFrame of a shading point (t, b only when HAS_TANGENT).
 // Key defines read here: NAIVE, HAS_TANGENT.
+//   (NAIVE_NORMAL, NAIVE_VIEW, NAIVE_LIGHT choose plain_normalize at their sites, see above.)
 
 const float FLT_MAX = 3.402823466e38;
 const float FRAME_PARALLEL_LIMIT = 0.0009765625;  // 2^-10: frame_from_tangent's test for a tangent along n
 
-#if NAIVE
-bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
+bool plain_normalize(vec3 x, out vec3 x_hat, out float len)
 {
     x_hat = normalize(x);
     len = length(x);
     return true;
+}
+
+#if NAIVE
+bool safe_normalize(vec3 x, out vec3 x_hat, out float len)
+{
+    return plain_normalize(x, x_hat, len);
 }
 #else
 bool safe_normalize(vec3 x, out vec3 x_hat, out float len)

@@ -7,16 +7,17 @@
 //   an irradiance beyond float32 saturates at FLT_MAX instead of becoming Inf (Inf times a zero
 //   coefficient channel would be NaN).
 //   intensity: vec3 [W/sr];  d: distance [m] (> 0);  E: vec3 [W/m^2].
-//   NAIVE (the textbook formulation, for the stability report only): I / (d * d).
+//   NAIVE_FALLOFF (the textbook formulation: with NAIVE, or where the key proves d^2 and I / d^2 within
+//   float32's normal range, docs/design.md section 3): I / (d * d).
 // range_window(d, range) -> w in [0, 1]     KHR_lights_punctual:  w = clamp(1 - (d / range)^4, 0, 1)
 //   (the specification's window, not its square as three.js and Filament use), evaluated as
 //   t = d / range;  w = clamp(((range - d) / range) (1 + t) (1 + t^2), 0, 1)
 //   since 1 - t^4 = (1 - t)(1 + t)(1 + t^2): range - d is exact where d is within a factor 2 of range
 //   (Sterbenz), so w keeps its relative accuracy as d -> range instead of cancelling in 1 - t^4.
 //   d, range: [m] (range > 0);  w dimensionless.
-// Key defines read here: NAIVE.
+// Key defines read here: NAIVE_FALLOFF.
 
-#if NAIVE
+#if NAIVE_FALLOFF
 vec3 point_irradiance(vec3 intensity, float d)
 {
     return intensity / (d * d);

@@ -1,16 +1,21 @@
 // lobe.glsl -- stable evaluation of a cosine-power lobe (docs/design.md section 3).
 //
-// log_one_minus(delta) -> ln(1 - delta),  0 <= delta < 1
-//   delta < 1/2:  -2 artanh(sigma),  sigma = delta / (2 - delta)  (2 sigma formed directly, so that
-//                 delta just above FLT_MIN does not pass through a subnormal sigma),
-//                 artanh(sigma) = sum_{k=0..7} sigma^(2k+1) / (2k+1)   (sigma <= 1/3: truncation < 2^-27)
-//   delta >= 1/2: log(1 - delta)   (1 - delta is exact there, Sterbenz)
+// log_one_minus_series(delta) -> ln(1 - delta) for 0 <= delta < 1/2
+//   -2 artanh(sigma),  sigma = delta / (2 - delta)  (2 sigma formed directly, so that delta just above
+//   FLT_MIN does not pass through a subnormal sigma),
+//   artanh(sigma) = sum_{k=0..7} sigma^(2k+1) / (2k+1)   (sigma <= 1/3: truncation < 2^-27)
 //   Accurate to a few ulp relative even for delta ~ 1e-30, where log(1.0 - delta) would return 0.
+// log_one_minus(delta) -> ln(1 - delta),  0 <= delta < 1
+//   delta < 1/2:  log_one_minus_series(delta);  delta >= 1/2: log(1 - delta)   (1 - delta is exact there, Sterbenz)
 //
 // lobe_from_delta(delta, q) -> (1 - delta)^q = cos^q
 //   delta = 1 - cos, the distance from the lobe peak (0 at the peak);  q >= 0 the exponent.
 //   q == 0: 1 (0^0 := 1);  delta >= 1 (cos <= 0): 0, the max(cos, 0) clamp;
 //   else exp(max(q ln(1 - delta), -104)).  Never NaN, never above 1.
+//   LOBE_TAIL_ZERO (numerics='auto', where every exponent of the program is at least LOBE_TAIL_Q = 151,
+//   docs/design.md section 3): delta >= 1/2 gives 0 and the log branch is left out.  The same bits: there
+//   q ln(1 - delta) <= 151 (ln(1/2) + 2^-21) < -104, so the full form returns exp(-104) ~ 6.8e-46, which
+//   float32 rounds (or flushes) to 0; below 1/2 both evaluate log_one_minus_series.
 //
 // The two cosine-power lobes of the lecture, shared by every model built on them (phong_lobe,
 // blinn_lobe, the normalised lobes).  n, wi (= l), wo (= v): unit vectors pointing away from the
@@ -27,22 +32,35 @@
 // blinn_lobe(n, wi, wo, q) -> max(n.h, 0)^q, 0 where blinn_delta is not valid.
 //   NAIVE: pow(max(dot(n, normalize(l + v)), 0), q).
 // half_cosine(wi, wo) -> h.l, 0 where l + v does not normalise (the cosine of a half-vector Fresnel factor).
-// Key defines read here: NAIVE (phong_lobe, blinn_lobe).
+// Key defines read here: NAIVE (phong_lobe, blinn_lobe), LOBE_TAIL_ZERO (lobe_from_delta).
 
-float log_one_minus(float delta)
+float log_one_minus_series(float delta)
 {
     float two_sigma = (2.0 * delta) / (2.0 - delta);
     float t = 0.25 * (two_sigma * two_sigma);
     float series = 1.0 + t * (1.0 / 3.0 + t * (1.0 / 5.0 + t * (1.0 / 7.0 + t * (1.0 / 9.0
                  + t * (1.0 / 11.0 + t * (1.0 / 13.0 + t * (1.0 / 15.0)))))));
-    return delta < 0.5 ? -two_sigma * series : log(1.0 - delta);
+    return -two_sigma * series;
 }
 
+float log_one_minus(float delta)
+{
+    return delta < 0.5 ? log_one_minus_series(delta) : log(1.0 - delta);
+}
+
+#if LOBE_TAIL_ZERO
+float lobe_from_delta(float delta, float q)
+{
+    float lobe = exp(max(q * log_one_minus_series(delta < 0.5 ? delta : 0.0), -104.0));
+    return q == 0.0 ? 1.0 : (delta < 0.5 ? lobe : 0.0);
+}
+#else
 float lobe_from_delta(float delta, float q)
 {
     float lobe = exp(max(q * log_one_minus(delta < 1.0 ? delta : 0.0), -104.0));
     return q == 0.0 ? 1.0 : (delta < 1.0 ? lobe : 0.0);
 }
+#endif
 
 float phong_delta(vec3 n, vec3 wi, vec3 wo)
 {

@@ -125,7 +125,11 @@ void main()
     n_raw = (SWITCH(u_two_sided) && !gl_FrontFacing) ? -n_raw : n_raw;
 #endif
     float n_len;
+#if NAIVE_NORMAL
+    n_valid = plain_normalize(n_raw, n, n_len);
+#else
     n_valid = safe_normalize(n_raw, n, n_len);
+#endif
 #endif
     vec4 tangent = vec4(0.0);
     vec2 uv = vec2(0.0);

@@ -43,7 +43,11 @@ vec3 shade_point(vec3 position, ShadingFrame f, bool n_valid, vec4 eye)
     vec3 wo = vec3(0.0);
 #if NEEDS_VIEW
     float view_distance;
+#if NAIVE_VIEW
+    lit = lit && plain_normalize(eye.xyz - position * eye.w, wo, view_distance);
+#else
     lit = lit && safe_normalize(eye.xyz - position * eye.w, wo, view_distance);
+#endif
 #endif
     add_lights(radiance, position, f, wo, lit);
 #endif

@@ -64,7 +64,7 @@ def main(platform):
     keys = [k for k in programs.keys()]
     glphong_scene = scene_from_pyrender(scene)
     samples = 4 if platform == "egl" else 1  # pyrender multisamples on EGL only
-    with glphong.Renderer(width, height, backend=platform, samples=samples) as g:
+    with glphong.Renderer(width, height, backend=platform, samples=samples, numerics="stable") as g:
         ours = g.render_srgb8(glphong_scene)
         frame = g.render(glphong_scene)
         own_chunks = [g.programs.get(glphong_scene.program_key(o)).key.fragment_chunks() for o in glphong_scene.objects]
@@ -153,7 +153,7 @@ def _converted(platform, renderer, width, height):
     scene.add(pyrender.PerspectiveCamera(yfov=0.8, aspectRatio=width / height), pose=translation(0, 0, 3))
     scene.add(pyrender.PointLight(intensity=3.0), pose=translation(1, 1, 3))
     color, _ = renderer.render(scene)  # the enabled renderer (a second one at once fails on EGL)
-    with glphong.Renderer(width, height, backend=platform, samples=4 if platform == "egl" else 1) as g:
+    with glphong.Renderer(width, height, backend=platform, samples=4 if platform == "egl" else 1, numerics="stable") as g:
         ours = g.render_srgb8(scene_from_pyrender(scene))
         interior = g.render(scene_from_pyrender(scene)).coverage == 1.0
     interior[1:-1, 1:-1] &= interior[:-2, 1:-1] & interior[2:, 1:-1] & interior[1:-1, :-2] & interior[1:-1, 2:]
@@ -173,7 +173,7 @@ def _non_indexed(platform, renderer, width, height):
     primitive = next(iter(scene.meshes)).primitives[0]
     color, _ = renderer.render(scene)
     ours_scene = scene_from_pyrender(scene)
-    with glphong.Renderer(width, height, backend=platform, samples=4 if platform == "egl" else 1) as g:
+    with glphong.Renderer(width, height, backend=platform, samples=4 if platform == "egl" else 1, numerics="stable") as g:
         ours = g.render_srgb8(ours_scene)
         interior = g.render(ours_scene).coverage == 1.0
     interior[1:-1, 1:-1] &= interior[:-2, 1:-1] & interior[2:, 1:-1] & interior[1:-1, :-2] & interior[1:-1, 2:]

@@ -87,7 +87,7 @@ def agreement(color, scene, width, height, flags=RenderFlags.NONE, **renderer_op
     """Where the embedded frame ``color`` and glphong's renderer of `scene_from_pyrender` differ, on the
     interior of glphong's coverage (8-bit steps)."""
     ours_scene = scene_from_pyrender(scene, flags=flags, viewport=(width, height))
-    with glphong.Renderer(width, height, backend=PLATFORM, samples=SAMPLES, **renderer_options) as g:
+    with glphong.Renderer(width, height, backend=PLATFORM, samples=SAMPLES, numerics="stable", **renderer_options) as g:
         ours = g.render_srgb8(ours_scene)
         interior = interior_of(g.render(ours_scene).coverage)
     diff = np.abs(ours.astype(int) - color[..., :3].astype(int)).max(axis=-1)[interior]

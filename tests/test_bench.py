@@ -86,7 +86,7 @@ def test_speed_report_in_process(tmp_path):
     report = run_speed(sizes=(32,), repeats=3, quick=True, pyrender=False, progress=False)
     assert [r["scene"] for r in report.rows] == list(SCENES)
     for row in report.rows:
-        assert set(row["ms"]) == {"glphong float", "naive floor", "glphong 4x 8-bit"}
+        assert set(row["ms"]) == {"glphong float", "glphong stable", "naive floor", "glphong 4x 8-bit"}
         assert all(v > 0 for v in row["ms"].values()) and all(v >= 0 for v in row["spread"].values())
     assert report.rows[SCENES.index("1000 objects")]["objects"] == 100  # the quick stand-in
     assert report.python_per_object["objects"] == 100 and report.png["save_ms"] > report.png["encode_ms"] > 0

@@ -256,7 +256,7 @@ def rss_mb():
 def scene(i):
     camera = glphong.PerspectiveCamera.look_at((0, 0.5 * (i % 3), 3), (0, 0, 0))
     s = glphong.Scene(camera, lights=[glphong.PointLight((1, 1, 2), 50.0 + i)] * (1 + i % 2))
-    s.add(primitives.sphere(2 + i % 2), [glphong.Lambert(0.3), glphong.Phong(0.2, 0.5, 20 + i)][i % 2])
+    s.add(primitives.sphere(2 + i % 2), [glphong.Lambert(0.3), glphong.Phong(0.2, 0.5, 20 + i % 100)][i % 2])
     return s
 
 backend = sys.argv[1]

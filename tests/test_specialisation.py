@@ -16,7 +16,9 @@ from glphong.materials import registered_models
 
 @pytest.fixture(scope="module", params=("egl", "osmesa"))
 def renderers(request, module_make_renderer):
-    return (module_make_renderer(96, 80, request.param),
+    # the specialised renderer with the uber-shader's arithmetic (the stable formulation everywhere), so that the two
+    # images differ by what specialisation leaves out alone
+    return (module_make_renderer(96, 80, request.param, numerics="stable"),
             module_make_renderer(96, 80, request.param, specialise=False))
 
 
@@ -74,7 +76,11 @@ def test_mixed_scene_compiles_one_program_per_distinct_key(renderers):
     specialised.render(scene)
     new = {k for k in specialised.programs.keys() if k.output == "radiance"} - before
     assert new <= distinct and {k for k in specialised.programs.keys()} >= distinct
-    assert len(describe(scene)) == 6
+    assert len(describe(scene, specialised)) == 6
+    # numerics='auto': the same six programs (the two lobes with exponents from 151, 1e5 and 400, were distinct
+    # already), those two without the lobes' log branch
+    auto = describe(scene)
+    assert len(auto) == 6 and sum("lobe_tail" in d.key.numerics for d in auto) == 2
 
 
 def test_unlit_scene_neither_uploads_nor_binds_normals(renderers):
@@ -145,7 +151,11 @@ def test_cli_describe_default_scene():
     out = subprocess.run([sys.executable, "-m", "glphong", "describe", "--gbuffer"], capture_output=True, text=True,
                          timeout=120)
     assert out.returncode == 0, out.stderr
-    assert "3 distinct program(s)" in out.stdout
+    # Phong and Blinn-Phong, each with exponents below and from 151 (numerics='auto': the lobes' log branch left out
+    # from 151 on), and the G-buffer
+    assert "5 distinct program(s)" in out.stdout
+    assert out.stdout.count("numerics=('falloff', 'light', 'lobe_tail', 'normal', 'view')") == 2
+    assert "lobe_tail: stable (phong_lobe's exponent q = 5 is below 151" in out.stdout, out.stdout
     assert "terms=lambert[lit,ambient]+phong_lobe[lit]" in out.stdout, out.stdout
     assert "terms=lambert[lit,ambient]+blinn_lobe[lit]" in out.stdout and "gbuffer" in out.stdout
     assert re.search(r"fragment chunks: common lights lobe model:lambert@\w{12} model:phong_lobe@\w{12} "

@@ -6,7 +6,8 @@
     `HandWrittenRenderer.prepare`, and `HandWrittenRenderer.render` only binds, writes
     precomputed uniform bytes, draws and reads back.  Its frame time is the floor that
     glphong's per-frame overhead (key computation, strict uniform binding, validation) is
-    measured against.  ``shader='textbook'`` draws with the naive formulation instead.
+    measured against: the keys of a default `glphong.Renderer` (``numerics='auto'``).  ``shader='textbook'`` draws
+    with the naive formulation instead.
 
 `to_pyrender`, `PyrenderRenderer`
     A glphong `Scene` as a ``pyrender.Scene``, for speed and quality comparisons with a
@@ -52,6 +53,7 @@ import numpy as np
 from glphong.gpu.contexts import create_context, release_offscreen
 from glphong.shaders.assembly import assemble
 from glphong.scene.camera import IntrinsicsCamera, OrthographicCamera
+from glphong.scene.numerics import with_numerics
 from glphong.scene.scene import Scene
 
 __all__ = ["HandWrittenRenderer", "PyrenderRenderer", "to_pyrender", "pyrender_roughness", "import_pyrender",
@@ -110,7 +112,7 @@ class HandWrittenRenderer:
     def key(self, scene, obj):
         """The `ProgramKey` this renderer draws ``obj`` with."""
         key = scene.program_key(obj)
-        return replace(key, formulation="naive") if self.shader == "textbook" else key
+        return replace(key, formulation="naive") if self.shader == "textbook" else with_numerics(key, scene, obj)
 
     def prepare(self, scene):
         """Compile, upload and pack everything ``scene`` needs; replaces a previous scene."""

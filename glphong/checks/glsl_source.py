@@ -20,9 +20,10 @@ from glphong.checks.glsl_types import TYPE_NAMES, glsl_type
 from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
 from glphong.core.glsl_files import chunk_source
 from glphong.materials.params import LIBRARY_CHUNKS
+from glphong.shaders.key import NUMERICS_DEFINES
 
 __all__ = ["GlslSourceError", "Expanded", "expand", "Parameter", "Signature", "functions", "uniforms",
-           "strip_comments", "read_source_file", "map_log", "log_locations", "check_signature", "LIBRARY", "MAX_SOURCE_BYTES"]
+           "strip_comments", "read_source_file", "map_log", "log_locations", "check_signature", "LIBRARY", "LIBRARY_DEFINES", "MAX_SOURCE_BYTES"]
 
 #: glphong's library chunks in include order (``#include <glphong/NAME>``)
 LIBRARY = ("common", "lights") + LIBRARY_CHUNKS + ("area", "normal_map")
@@ -33,7 +34,9 @@ MAX_SOURCE_BYTES = 1 << 20
 _MAX_DEPTH = 16
 _INCLUDE = re.compile(r'^\s*#\s*include\s+(?:<([^>\n]*)>|"([^"\n]*)")\s*$')
 _VERSION = re.compile(r"^\s*#\s*version\b")
-_LIBRARY_DEFINES = (("NAIVE", "0"), ("HAS_TANGENT", "0"), ("HAS_UV", "0"))
+#: defines every library chunk reads, at their defaults (the stable formulation, no tangent, no uv)
+LIBRARY_DEFINES = (("NAIVE", "0"), *((define, "0") for define in NUMERICS_DEFINES.values()),
+                   ("HAS_TANGENT", "0"), ("HAS_UV", "0"))
 
 
 class GlslSourceError(ValueError):
@@ -74,7 +77,7 @@ def _library(name, state, files, texts):
                               f"(it has: {', '.join(INCLUDABLE)})")
     out = []
     if not state["library"]:
-        out += [f"#define {k} {v}" for k, v in _LIBRARY_DEFINES]
+        out += [f"#define {k} {v}" for k, v in LIBRARY_DEFINES]
     for chunk in INCLUDABLE[:INCLUDABLE.index(name) + 1] if name in LIBRARY else (name,):
         if chunk not in state["library"]:
             state["library"].add(chunk)

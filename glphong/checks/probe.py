@@ -18,7 +18,7 @@ import moderngl
 import numpy as np
 
 from glphong.checks.glsl_function import glsl_function
-from glphong.checks.glsl_source import LIBRARY, functions
+from glphong.checks.glsl_source import LIBRARY, LIBRARY_DEFINES, functions
 from glphong.core.glsl_files import chunk_source
 from glphong.shaders.assembly import resolve_chunk
 from glphong.materials import registered_models
@@ -26,8 +26,6 @@ from glphong.materials import registered_models
 __all__ = ["Signature", "signatures", "twin_of", "evaluate", "shade_points"]
 
 _WIDTH = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4, "bool": 1}
-#: defines every probe source carries (the key's switches at their defaults)
-_PROBE_DEFINES = (("NAIVE", "0"), ("HAS_TANGENT", "0"), ("HAS_UV", "0"))
 
 
 @dataclass(frozen=True)
@@ -100,7 +98,7 @@ def twin_of(name):
 def library_source(signature):
     """The GLSL text of a probeable function's chunks (with the key's switches at their defaults), for
     `glphong.testing.glsl_function`."""
-    lines = [f"#define {k} {v}" for k, v in _PROBE_DEFINES]
+    lines = [f"#define {k} {v}" for k, v in LIBRARY_DEFINES]
     for label in signature.chunks:
         chunk = resolve_chunk(label)
         lines += [chunk.prelude, chunk.text] if chunk.prelude else [chunk.text]

@@ -25,7 +25,8 @@ from glphong.materials.table import uniform_as
 from glphong.twin.band import BAND, EPS
 from glphong.twin.functions import (BLINN_HALF_FLOOR, FLT_MAX, FRAME_PARALLEL_LIMIT, ShadingFrame, _dot,  # noqa: F401
                                     atan2_first_quadrant, blinn_delta, blinn_lobe, frame_from_tangent, fresnel_dielectric,
-                                    fresnel_schlick, half_cosine, light_term, lobe_from_delta, log_one_minus, microfacet_geometry, microfacet_ggx,
+                                    fresnel_schlick, half_cosine, light_term, lobe_from_delta, log_one_minus, log_one_minus_series,
+                                    microfacet_geometry, microfacet_ggx, plain_normalize,
                                     phong_delta, phong_lobe, point_irradiance, range_window, safe_normalize,
                                     shading_frame, surface_normal)
 from glphong.checks.shadows import shadow_visibility
@@ -37,7 +38,7 @@ from glphong.lights import light_for_key
 from glphong.materials import registered_models
 
 __all__ = [
-    "safe_normalize", "frame_from_tangent", "shading_frame", "surface_normal", "point_irradiance", "range_window", "log_one_minus", "lobe_from_delta",
+    "safe_normalize", "plain_normalize", "log_one_minus_series", "frame_from_tangent", "shading_frame", "surface_normal", "point_irradiance", "range_window", "log_one_minus", "lobe_from_delta",
     "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
     "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "microfacet_geometry", "microfacet_ggx", "incident_light", "material_emission", "material_response", "light_term", "view_direction", "shade_point",
     "shade_inputs", "shade", "input_bounds", "area_angle", "area_clip", "area_polygon_cosine", "area_solid_angle",

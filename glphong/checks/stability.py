@@ -33,10 +33,11 @@ from glphong.materials.phong import Phong
 from glphong.scene.camera import PerspectiveCamera
 from glphong.scene.geometry import MeshData
 from glphong.lights import AmbientLight, LightModel, light_named, registered_lights
+from glphong.scene.numerics import numerics_pieces
 from glphong.scene.scene import Scene
 from glphong.shaders.key import ProgramKey, TermKey
 
-__all__ = ["Case", "CASES", "case_scene", "case_inputs", "generic_cases", "lobe_cases", "cases_for", "VALID_RANGES", "oracle", "StabilityRow", "StabilityReport", "run_stability"]
+__all__ = ["Case", "CASES", "case_scene", "case_inputs", "generic_cases", "lobe_cases", "cases_for", "VALID_RANGES", "oracle", "StabilityRow", "StabilityReport", "run_stability", "case_numerics"]
 
 #: documented ranges inside which the GPU equals the textbook model within the tolerance band
 VALID_RANGES = {
@@ -302,6 +303,7 @@ class StabilityRow:
     inf: int
     in_range: bool
     note: str = ""
+    numerics: tuple = ()
 
 
 @dataclass
@@ -312,6 +314,7 @@ class StabilityReport:
     renderer: str
     formulation: str
     rows: list = field(default_factory=list)
+    numerics: str = "stable"
 
     @property
     def passed_count(self):
@@ -333,19 +336,29 @@ class StabilityReport:
     def format_table(self):
         """A fixed-width text table, one case per line (the channel with the largest expected value)."""
         head = (f"{'case':44s} {'GPU':>12s} {'float64':>12s} {'rel err':>9s} {'band':>9s} {'':4s} NaN Inf  note")
-        lines = [f"glphong stability: {self.formulation} formulation on {self.backend} ({self.renderer})", head,
+        mode = f", numerics={self.numerics}" if self.formulation == "stable" else ""
+        lines = [f"glphong stability: {self.formulation} formulation{mode} on {self.backend} ({self.renderer})", head,
                  "-" * len(head)]
         for r in self.rows:
             c = int(np.argmax(np.abs(r.expected))) if np.any(np.isfinite(r.expected)) else 0
             lines.append(f"{r.case[:44]:44s} {r.gpu[c]:12.5g} {r.expected[c]:12.5g} {r.relative_error:9.2g} "
                          f"{r.band_width:9.2g} {'pass' if r.passed else 'FAIL'} {r.nan:3d} {r.inf:3d}  "
-                         f"{'' if r.in_range else '[outside valid range] '}{r.note}")
+                         f"{'' if r.in_range else '[outside valid range] '}{r.note}"
+                         f"{' [specialised: ' + ', '.join(r.numerics) + ']' if r.numerics else ''}")
         lines.append(f"{self.passed_count}/{len(self.rows)} cases inside the tolerance band; "
                      f"{self.nan_count} NaN and {self.inf_count} Inf channels")
         return "\n".join(lines)
 
 
-def run_stability(backend="auto", formulation="stable", cases=CASES, context=None):
+def case_numerics(case, scene=None):
+    """The pieces ``Renderer(numerics='auto')`` specialises for the case's object (`glphong.scene.numerics`), less
+    'normal': the case's point is shaded with its own normal, which the points program normalises stably (sorted
+    tuple).  The point, the origin, lies in the object's box, over which the pieces were decided."""
+    scene = case_scene(case) if scene is None else scene
+    return tuple(p for p in numerics_pieces(scene, scene.objects[0]) if p != "normal")
+
+
+def run_stability(backend="auto", formulation="stable", cases=CASES, context=None, numerics="stable"):
     """Run the suite on a backend.
 
     Parameters
@@ -356,6 +369,9 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
     cases : sequence of Case
     context : glphong.gpu.contexts.GLContext, optional
         Use this context instead of creating one.
+    numerics : {'stable', 'auto'}
+        With the stable formulation, 'auto' evaluates each case with the pieces ``Renderer(numerics='auto')``
+        would specialise for it (`case_numerics`; each row lists them).
 
     Returns
     -------
@@ -364,12 +380,13 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
 
     gl = context or create_context(backend)
     programs = ProgramCache(gl.mgl)
-    report = StabilityReport(gl.backend, gl.renderer_name, formulation)
+    report = StabilityReport(gl.backend, gl.renderer_name, formulation, numerics=numerics)
     try:
         for case in cases:
             scene = case_scene(case)
             key, uniforms = case_inputs(case, scene)
-            key = replace(key, formulation=formulation)
+            pieces = case_numerics(case, scene) if numerics == "auto" and formulation == "stable" else ()
+            key = replace(key, formulation=formulation, numerics=pieces)
             position = np.zeros((1, 3))
             normal = np.asarray([case.normal], dtype=np.float32)
             tangent = np.asarray([case.tangent], dtype=np.float32)
@@ -400,7 +417,7 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
             report.rows.append(StabilityRow(
                 case.name, case.group, gpu.tolist(), expected.tolist(), twin.tolist(), low.tolist(), high.tolist(),
                 float(np.max(np.nan_to_num(relative_error(gpu, expected), nan=np.inf))), float(np.nanmax(width)), bool(ok), int(np.isnan(gpu).sum()),
-                int(np.isinf(gpu).sum()), case.in_range, case.note))
+                int(np.isinf(gpu).sum()), case.in_range, case.note, pieces))
     finally:
         with gl:
             programs.release()

@@ -5,6 +5,7 @@ import numpy as np
 
 from glphong.shaders.assembly import assemble, effective_source
 from glphong.scene.culling import culling_decision
+from glphong.scene.numerics import numerics_decisions, with_numerics
 from glphong.scene.scene import Scene
 from glphong.shaders.key import model_chunk_label
 
@@ -30,6 +31,9 @@ class ProgramDescription:
         The generated sources, as compiled.
     culling : tuple of str
         Per drawn object, whether its back faces are culled and why (`glphong.scene.culling`).
+    numerics : tuple of str
+        With ``numerics='auto'``: per drawn object and piece of arithmetic, whether it is specialised and why
+        (`glphong.scene.numerics`); empty otherwise.
     """
 
     key: object
@@ -41,6 +45,7 @@ class ProgramDescription:
     vertex_source: str
     fragment_source: str
     culling: tuple = ()
+    numerics: tuple = ()
 
     @property
     def effective_fragment_source(self):
@@ -55,8 +60,8 @@ def describe(scenes, renderer=None, gbuffer=False):
     ----------
     scenes : Scene or sequence of Scene
     renderer : glphong.Renderer, optional
-        Describe the keys this renderer uses (its formulation and specialisation); by
-        default the specialised, stable keys.
+        Describe the keys this renderer uses (its formulation, numerics and specialisation); by
+        default those of a default renderer (specialised, stable formulation, ``numerics='auto'``).
     gbuffer : bool
         Include the G-buffer programs.
 
@@ -69,12 +74,18 @@ def describe(scenes, renderer=None, gbuffer=False):
     scenes = [scenes] if isinstance(scenes, Scene) else list(scenes)
     outputs = ("radiance", "gbuffer") if gbuffer else ("radiance",)
 
-    users, absent, culling = {}, {}, {}
+    users, absent, culling, numerics = {}, {}, {}, {}
     for scene in scenes:
         for obj in scene.objects:
             for output in outputs:
-                key = renderer.program_key(scene, obj, output) if renderer else scene.program_key(obj, output)
+                key = renderer.program_key(scene, obj, output) if renderer else \
+                    with_numerics(scene.program_key(obj, output), scene, obj)
                 users.setdefault(key, []).append(obj.name)
+                if (renderer is None or renderer.numerics == "auto") and key.output in ("radiance", "display") \
+                        and key.formulation == "stable" and not key.uber:
+                    numerics.setdefault(key, []).extend(
+                        f"{obj.name}: {d.piece}: {'specialised' if d.specialised else 'stable'} ({d.reason})"
+                        for d in numerics_decisions(scene, obj))
                 decision = "drawn: culling='off'" if renderer is not None and renderer.culling == "off" else \
                     culling_decision(obj, scene.camera)[1]
                 culling.setdefault(key, []).append(f"{obj.name}: {decision}")
@@ -92,7 +103,7 @@ def describe(scenes, renderer=None, gbuffer=False):
         out.append(ProgramDescription(key, tuple(dict.fromkeys(names)), key.vertex_chunks(), key.fragment_chunks(),
                                       defines, key.left_out(list(absent.get(key, {}).items())),
                                       assemble(key.vertex_chunks(), defines, generated), fragment,
-                                      tuple(culling[key])))
+                                      tuple(culling[key]), tuple(numerics.get(key, ()))))
     return out
 
 
@@ -127,6 +138,10 @@ def format_descriptions(descriptions, source=False):
             lines.append("    back faces:")
             lines += [f"      - {item}" for item in d.culling[:6]]
             lines += [f"      - and {len(d.culling) - 6} more objects" for _ in (1,) if len(d.culling) > 6]
+        if d.numerics:
+            lines.append("    numerics (auto):")
+            lines += [f"      - {item}" for item in d.numerics[:15]]
+            lines += [f"      - and {len(d.numerics) - 15} more" for _ in (1,) if len(d.numerics) > 15]
         if source and d.fragment_source:
             lines.append("    effective fragment source:")
             lines += [f"      | {line}" for line in d.effective_fragment_source.splitlines()]

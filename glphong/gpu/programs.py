@@ -64,6 +64,9 @@ class Program:
         # closed form (docs/design.md section 13)
         self.optional |= {light_for_key(k.name, k.source_hash).uniform_name(p.name) for k in getattr(key, "lights", ())
                           if k.extended for p in light_for_key(k.name, k.source_hash).uniform_params()}
+        # with the textbook view vector (numerics='auto'), a term that declares the view but never reads it leaves the
+        # eye unread: the stable form's validity no longer gates the lights
+        self.optional |= {"u_eye"} if "view" in getattr(key, "numerics", ()) else set()
         #: the bytes last written to each uniform (`write` skips unchanged ones)
         self._written = {}
         #: sampler uniforms in texture-unit order

@@ -19,6 +19,7 @@ from glphong.gpu.frame import Frame, GBuffer
 from glphong.gpu.resources import ORPHANS, ORPHANS_LOCK, MeshBuffers, release_orphans, release_resources, release_targets
 from glphong.gpu.contexts import check_not_forked, create_context
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
+from glphong.scene.numerics import NUMERICS, view_decision, with_numerics
 from glphong.shaders.key import FORMULATIONS, GBUFFER_PLANES, EncodeKey, uber_key
 from glphong.gpu.shadows import ShadowMaps
 from glphong.gpu.programs import ProgramCache
@@ -40,6 +41,7 @@ class _ObjectEntry:
     mirrored: bool
     sphere: tuple = None  # ((x, y, z), radius) in the world where the mesh's back faces may be culled
     checked: object = None
+    camera: object = None  # the camera the key's 'view' piece was decided for (numerics='auto')
 
 
 def _available_memory():
@@ -95,6 +97,11 @@ class Renderer:
     formulation : {'stable', 'naive'}
         'stable' (default): docs/design.md section 3.  'naive': the textbook float32 formulation,
         for measuring what stability costs and buys; not for real use.
+    numerics : {'auto', 'stable'}
+        'auto' (default): per object, the pieces of the stable formulation that the scene's ranges prove
+        unnecessary are compiled in their cheaper form (`glphong.scene.numerics`, docs/design.md section 3,
+        "Stability where a scene needs it"), which keeps every pixel inside the error band; `glphong.describe`
+        shows each decision and its reason.  'stable': the stable formulation everywhere.
     culling : {'auto', 'off'}
         'auto' (default): cull the back faces of an object where they cannot be seen (a closed,
         outward-wound mesh wholly between the near and far planes; `glphong.scene.culling`), which
@@ -125,7 +132,7 @@ class Renderer:
 
     def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
                  formulation="stable", specialise=True, culling="auto", device=None, shadow_map_size=1024,
-                 shadow_filter_radius=0):
+                 shadow_filter_radius=0, numerics="auto"):
         self.shadow_map_size = _validate.positive_int("shadow_map_size", shadow_map_size, 16, 8192)
         self.shadow_filter_radius = _validate.positive_int("shadow_filter_radius", shadow_filter_radius, 0, 8)
         self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
@@ -133,6 +140,7 @@ class Renderer:
         self.supersample = _validate.positive_int("supersample", supersample, 1, 8)
         self._size = self._check_size(width, height)
         self.formulation = _validate.choice("formulation", formulation, FORMULATIONS)
+        self.numerics = _validate.choice("numerics", numerics, NUMERICS)
         self.culling = _validate.choice("culling", culling, ("auto", "off"))
         if not isinstance(specialise, (bool, np.bool_)):
             raise TypeError(f"specialise must be a bool, True or False (got {specialise!r})")
@@ -378,7 +386,7 @@ class Renderer:
                              "vertex has no texture footprint): use Renderer(shading='pixel')")
         if key.formulation != self.formulation or key.shade_per_vertex != per_vertex:
             key = replace(key, formulation=self.formulation, shade_per_vertex=per_vertex)
-        return key
+        return with_numerics(key, scene, obj) if self.numerics == "auto" else key
 
     def _check_scene(self, scene):
         if not isinstance(scene, Scene):
@@ -450,7 +458,8 @@ class Renderer:
         shadow maps, added to the programs that read them."""
         drop = self.formulation == "naive"
         state = (output, scene.light_keys(), scene.ambient_radiance, self.formulation,
-                 self.shading, self.specialise, self.culling)
+                 self.shading, self.specialise, self.culling, self.numerics)
+        camera = scene.camera
         shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
         frame_packs = {}
         entries = self._entries
@@ -459,6 +468,8 @@ class Renderer:
             if per_object is None:
                 per_object = entries[obj] = {}
             entry = per_object.get(output)
+            if entry is not None and entry.camera is not camera and not self._same_view_piece(entry, obj, camera):
+                entry = None
             if shared is not None or entry is None or entry.state != state or entry.index != index:
                 key = shared or self.program_key(scene, obj, output)
                 program = self.programs.get(key)
@@ -467,7 +478,7 @@ class Renderer:
                 vao = self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program)
                 sphere = world_sphere(obj.mesh, obj.pose) if self.culling == "auto" and closed_outward(obj.mesh)[0] else None
                 entry = _ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
-                                     None if sphere is None else (tuple(sphere[0]), sphere[1]))
+                                     None if sphere is None else (tuple(sphere[0]), sphere[1]), camera=camera)
                 if shared is None:
                     per_object[output] = entry
             frame = frame_packs.get(entry.program)
@@ -480,6 +491,16 @@ class Renderer:
                 entry.program.check_complete(frame[0], entry.pack)
                 entry.checked = frame[1]
             yield entry.program, frame[0], entry
+
+    def _same_view_piece(self, entry, obj, camera):
+        """True where ``entry``'s key needs no change for ``camera``: its 'view' piece (the only piece that depends on
+        the camera, `glphong.scene.numerics`) is decided the same way; the entry then remembers ``camera``."""
+        key = entry.key
+        if self.numerics == "auto" and key.output in ("radiance", "display") and key.formulation == "stable" \
+                and not key.uber and view_decision(obj, camera)[0] != ("view" in key.numerics):
+            return False
+        entry.camera = camera
+        return True
 
     @staticmethod
     def _read(fbo, size, components, attachment=0, dtype="f4"):

@@ -12,7 +12,7 @@ import numpy as np
 
 from glphong.twin.functions import perpendiculars
 
-__all__ = ["ShadowSetup", "shadow_setups", "scene_bounds", "CUBE_FACES"]
+__all__ = ["ShadowSetup", "shadow_setups", "scene_bounds", "object_bounds", "CUBE_FACES"]
 
 #: the cube's faces in map order: (major axis, sign, the two other axes)
 CUBE_FACES = tuple((a, s, tuple(b for b in range(3) if b != a)) for a in range(3) for s in (1.0, -1.0))
@@ -107,7 +107,7 @@ class ShadowSetup:
 _BOUNDS = weakref.WeakKeyDictionary()
 
 
-def _object_bounds(mesh, pose):
+def object_bounds(mesh, pose):
     """``(low, high)`` of ``mesh``'s vertices under ``pose``, walked once per mesh and pose: a scene rebuilt every
     frame from the same meshes (pyrender's, `glphong.integrations.pyrender.shadows`) does not walk them again."""
     seen = _BOUNDS.get(mesh)
@@ -127,7 +127,7 @@ def scene_bounds(scene):
     """``(low, high)`` (3,) float64: the world-space bounding box of every object of ``scene``."""
     corners = []
     for obj in scene.objects:
-        corners += list(_object_bounds(obj.mesh, obj.pose))
+        corners += list(object_bounds(obj.mesh, obj.pose))
     if not corners:
         return np.zeros(3), np.zeros(3)
     return np.min(corners, axis=0), np.max(corners, axis=0)

@@ -25,6 +25,13 @@ UBER_MAX_LIGHTS = 8
 OUTPUTS = ("radiance", "gbuffer", "points", "display", "response", "shadow")
 SHADOW_PASSES = (None, "cube", "ortho")
 FORMULATIONS = ("stable", "naive")
+#: the pieces of arithmetic that Renderer(numerics='auto') specialises where the scene's ranges prove it (docs/design.md
+#: section 3, "Stability where a scene needs it"), each with its define: the normal's, the view vector's and the
+#: point-like lights' normalisation and the point light's falloff I / d^2 in their textbook form, and the cosine-power
+#: lobes without the log branch of delta >= 1/2, where every exponent makes the lobe 0 there
+NUMERICS_DEFINES = {"falloff": "NAIVE_FALLOFF", "light": "NAIVE_LIGHT", "lobe_tail": "LOBE_TAIL_ZERO",
+                    "normal": "NAIVE_NORMAL", "view": "NAIVE_VIEW"}
+NUMERICS_PIECES = tuple(NUMERICS_DEFINES)
 #: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed)
 GBUFFER_PLANES = ("tangent", "uv", "color", "lod", "face")
 #: how a surface input is made (``<MODEL>_<PARAM>_INPUT`` is the mode's index plus 1)
@@ -204,6 +211,10 @@ class ProgramKey:
         The stable float32 formulation of docs/design.md section 3, or the textbook one (``normalize``,
         ``d*d``, ``pow(dot(v, r), q)``, through the ``NAIVE`` define every chunk may honour) kept
         only to show why the stable one exists.
+    numerics : tuple of str
+        With formulation 'stable': the pieces of `NUMERICS_PIECES` specialised because the scene's ranges prove
+        the result stays inside the error band (``Renderer(numerics='auto')``, `glphong.scene.numerics`), sorted;
+        each sets its define of `NUMERICS_DEFINES`.
     uber : bool
         The uber-shader: its terms (every built-in one and the scene's own) and `UBER_MAX_LIGHTS`
         lights of each kind compiled in and switched by uniforms.  Kept to measure what
@@ -249,6 +260,7 @@ class ProgramKey:
     has_uv: bool = False
     two_sided: bool = True
     formulation: str = "stable"
+    numerics: tuple = ()
     uber: bool = False
     shade_per_vertex: bool = False
     has_color: bool = False
@@ -265,7 +277,9 @@ class ProgramKey:
     def __post_init__(self):
         if self.output not in OUTPUTS or self.formulation not in FORMULATIONS or \
                 not all(isinstance(t, TermKey) for t in self.terms) or not all(isinstance(k, LightKey) for k in self.lights) \
-                or self.shadow_pass not in SHADOW_PASSES:
+                or self.shadow_pass not in SHADOW_PASSES or \
+                tuple(sorted(set(self.numerics))) != tuple(self.numerics) or \
+                not set(self.numerics) <= set(NUMERICS_PIECES):
             raise ValueError(f"invalid ProgramKey {self}")
 
     @property
@@ -348,6 +362,8 @@ class ProgramKey:
             ("RUNTIME_SWITCHES", b(self.uber)),
             ("SHADE_PER_VERTEX", b(self.shade_per_vertex)),
             ("NAIVE", b(self.formulation == "naive")),
+            *((define, b(piece in self.numerics or (self.formulation == "naive" and define.startswith("NAIVE_"))))
+              for piece, define in NUMERICS_DEFINES.items()),
             # SWITCH(u_flag): a float uniform flag in the uber-shader, the constant true otherwise
             ("SWITCH(flag)", "((flag) > 0.5)" if self.uber else "true"),
         ]
@@ -507,7 +523,7 @@ class ProgramKey:
             if f.name in ("terms", "lights"):
                 if v:
                     parts.append(f"{f.name}=" + "+".join(t.describe() for t in v))
-            elif f.name != "output" and v not in (False, 0, None, "stable"):
+            elif f.name != "output" and v not in (False, 0, None, "stable", ()):
                 parts.append(f.name if v is True else f"{f.name}={v}")
         return " ".join(parts)
 

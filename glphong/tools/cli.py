@@ -175,7 +175,7 @@ def _stability(args):
     cases = list(CASES)
     for definition in _import_models(args.imports):
         cases += list(definition.stability_cases())
-    reports = [run_stability(args.backend, "stable", cases=cases)]
+    reports = [run_stability(args.backend, "stable", cases=cases, numerics=args.numerics)]
     if args.naive:
         reports.append(run_stability(args.backend, "naive", cases=cases))
     if args.json:
@@ -393,6 +393,9 @@ def build_parser():
     render.set_defaults(func=_render)
     stability = sub.add_parser("stability", help="run the extreme-case suite: GPU vs float64 vs tolerance band")
     stability.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
+    stability.add_argument("--numerics", default="stable", choices=("stable", "auto"),
+                           help="'auto': each case with the pieces Renderer(numerics='auto') specialises for its ranges "
+                                "(listed per row); default: the stable formulation everywhere")
     stability.add_argument("--naive", action="store_true",
                            help="also run the cases through the textbook pow(dot(v, r), q) shader")
     stability.add_argument("--json", default=None, type=lambda t: t if t == "-" else _writable(t),

@@ -7,13 +7,17 @@ The family (`speed_scenes`), each at 512x512 and 1024x1024:
 - ``100 spheres``: 100 small spheres;
 - ``1M triangles``: one mesh of 1,310,720 triangles (an icosphere of level 8);
 - ``1000 objects``: 1000 small spheres of 80 triangles, three materials;
-- ``8 lights``: the sphere under 8 point lights.
+- ``8 lights``: the sphere under 8 point lights;
+- ``fine plane``: a Phong (q = 50) plane filling the view, subdivided into 131,072 triangles of about two pixels at
+  512x512, under one point light (per-pixel arithmetic and small triangles).
 
 Every scene is drawn with Phong and Blinn-Phong materials, ambient light and point lights.  Per scene
 and size, in one process and in interleaved rounds (each round renders once with every method), after
 warm-up, the median frame time and its spread (the 25th to 75th percentile, relative) of:
 
-- ``glphong float``: `Renderer.render`, one sample, linear float32 radiance with coverage;
+- ``glphong float``: `Renderer.render`, one sample, linear float32 radiance with coverage (``numerics='auto'``, the
+  default: docs/design.md section 3, "Stability where a scene needs it");
+- ``glphong stable``: the same with ``numerics='stable'`` (the stable formulation everywhere);
 - ``naive floor``: `glphong.analysis.comparisons.HandWrittenRenderer` with the textbook shader (``pow(dot(v, r),
   q)``, ``normalize``): the same meshes and a float target, uniforms packed once, no culling;
 - ``glphong 4x 8-bit``: `Renderer.render_srgb8` with 4x MSAA (the display resolve);
@@ -48,7 +52,7 @@ from glphong.scene.geometry import MeshData
 __all__ = ["SCENES", "speed_scenes", "SpeedReport", "run_speed", "python_per_object", "png_cost", "scaling_fits"]
 
 #: the family, in table order
-SCENES = ("sphere", "plane", "100 spheres", "1M triangles", "1000 objects", "8 lights")
+SCENES = ("sphere", "plane", "100 spheres", "1M triangles", "1000 objects", "8 lights", "fine plane")
 
 _PHONG = Phong(kd=(0.18, 0.12, 0.08), ks=0.5, q=60.0)
 _BLINN = BlinnPhong(kd=(0.08, 0.12, 0.18), ks=0.5, q=200.0)
@@ -107,6 +111,10 @@ def speed_scenes(quick=False):
     s = Scene(camera, _lights(8), ambient)
     s.add(primitives.sphere(5, 0.95), _PHONG)
     scenes["8 lights"] = s
+    s = Scene(PerspectiveCamera.look_at((0.0, 0.0, 1.0), (0.0, 0.0, 0.0), yfov=math.radians(60.0)),
+              [PointLight((0.8, 0.6, 1.5), 60.0)], ambient)
+    s.add(primitives.plane(4.0, 32 if quick else 256), Phong(kd=(0.18, 0.12, 0.08), ks=0.5, q=50.0))
+    scenes["fine plane"] = s
     return scenes
 
 
@@ -123,7 +131,7 @@ class SpeedReport:
 
     def format(self):
         """The tables as text."""
-        head = (f"{'scene':14s} {'size':>5s} {'float ms':>9s} {'floor ms':>9s} {'float/floor':>12s} "
+        head = (f"{'scene':14s} {'size':>5s} {'float ms':>9s} {'floor ms':>9s} {'float/floor':>12s} {'stable/floor':>13s} "
                 f"{'4x8 ms':>8s} {'pyr ms':>8s} {'pyr/4x8':>8s} {'pyr2s ms':>9s} {'pyr2s/4x8':>10s}  spread")
         lines = [f"frame times on {self.renderer}: median of interleaved rounds after warm-up, spread = "
                  "largest (p75 - p25) / median of the row", head]
@@ -133,7 +141,8 @@ class SpeedReport:
                    f"{t['pyrender 2-sided']:9.1f} {t['pyrender 2-sided'] / t['glphong 4x 8-bit']:10.2f}") \
                 if "pyrender" in t else f"{'-':>8s} {'-':>8s} {'-':>9s} {'-':>10s}"
             lines.append(f"{r['scene']:14s} {r['size']:5d} {t['glphong float']:9.1f} {t['naive floor']:9.1f} "
-                         f"{t['glphong float'] / t['naive floor']:12.2f} {t['glphong 4x 8-bit']:8.1f} {pyr}  "
+                         f"{t['glphong float'] / t['naive floor']:12.2f} {t['glphong stable'] / t['naive floor']:13.2f} "
+                         f"{t['glphong 4x 8-bit']:8.1f} {pyr}  "
                          f"{max(r['spread'].values()):.0%}")
         if self.python_per_object:
             p = self.python_per_object
@@ -191,6 +200,7 @@ def run_speed(sizes=(512, 1024), repeats=9, quick=False, pyrender=True, progress
     bar = progress_bar(len(sizes) * len(scenes), progress, unit="scene")
     for size in sizes:
         float_renderer = Renderer(size, size, backend="egl")
+        stable_renderer = Renderer(size, size, backend="egl", numerics="stable")
         msaa = Renderer(size, size, backend="egl", samples=4)
         report.renderer = float_renderer.context.renderer_name + ", EGL"
         peers = []
@@ -198,6 +208,7 @@ def run_speed(sizes=(512, 1024), repeats=9, quick=False, pyrender=True, progress
             for name, scene in scenes.items():
                 floor = HandWrittenRenderer(size, size, backend="egl", shader="textbook").prepare(scene)
                 runs = {"glphong float": lambda s=scene: float_renderer.render(s), "naive floor": floor.render,
+                        "glphong stable": lambda s=scene: stable_renderer.render(s),
                         "glphong 4x 8-bit": lambda s=scene: msaa.render_srgb8(s)}
                 if pyrender_class is not None:
                     default = pyrender_class(size, size, "egl").prepare(scene)
@@ -220,6 +231,7 @@ def run_speed(sizes=(512, 1024), repeats=9, quick=False, pyrender=True, progress
                     bar.update()
         finally:
             float_renderer.release()
+            stable_renderer.release()
             msaa.release()
     if bar:
         bar.close()

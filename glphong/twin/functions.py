@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = [
-    "ShadingFrame", "safe_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "perpendiculars", "log_one_minus",
+    "ShadingFrame", "safe_normalize", "plain_normalize", "frame_from_tangent", "shading_frame", "point_irradiance", "range_window", "perpendiculars", "log_one_minus_series", "log_one_minus",
     "lobe_from_delta", "phong_delta", "phong_lobe", "BLINN_HALF_FLOOR", "blinn_delta", "blinn_lobe", "half_cosine",
     "fresnel_schlick", "fresnel_dielectric", "atan2_first_quadrant", "microfacet_geometry", "microfacet_ggx", "light_term", "FLT_MAX",
     "FRAME_PARALLEL_LIMIT", "surface_normal",
@@ -76,6 +76,17 @@ def _dot(a, b):
 
 
 # --------------------------------------------------------------------------- common.glsl
+def plain_normalize(x):
+    """The textbook normalisation (common.glsl): ``x / |x|`` with ``|x|^2`` formed from the raw coordinates, always
+    valid; the same returns as `safe_normalize` ((..., 3) -> valid (...), x_hat (..., 3), length (...))."""
+    x = np.asarray(x)
+    with np.errstate(invalid="ignore", over="ignore", divide="ignore", under="ignore"):
+        xx = _dot(x, x).astype(x.dtype)
+        x_hat = (x * (1 / np.sqrt(xx))[..., None]).astype(x.dtype)  # x * inversesqrt(x.x), as in GLSL
+        length = np.sqrt(xx).astype(x.dtype)
+    return np.ones(x.shape[:-1], dtype=bool), x_hat, length
+
+
 def safe_normalize(x):
     """Scaled normalisation (common.glsl).
 
@@ -229,36 +240,44 @@ def _series_terms(dtype):
     return k
 
 
-def log_one_minus(delta):
-    """``ln(1 - delta)`` for ``0 <= delta < 1`` (lobe.glsl).
+def log_one_minus_series(delta):
+    """``ln(1 - delta)`` for ``0 <= delta < 1/2`` as ``-2 artanh(delta / (2 - delta))`` by its odd series (lobe.glsl;
+    8 terms in float32 as in the GLSL, as many as float64 needs otherwise); ``(...)`` -> ``(...)``."""
+    delta = np.asarray(delta)
+    dtype = delta.dtype if delta.dtype.kind == "f" else np.float64
+    delta = delta.astype(dtype)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        two_sigma = ((2 * delta) / (2 - delta)).astype(dtype)
+        t = (0.25 * (two_sigma * two_sigma)).astype(dtype)
+        series = np.zeros_like(two_sigma)
+        for k in reversed(range(_series_terms(dtype))):
+            series = (series * t + dtype.type(1.0) / dtype.type(2 * k + 1)).astype(dtype)
+    return (-two_sigma * series).astype(dtype)
 
-    ``-2 artanh(delta / (2 - delta))`` by its odd series for ``delta < 1/2`` (8 terms in
-    float32 as in the GLSL, as many as float64 needs otherwise), ``log(1 - delta)`` above.
-    """
+
+def log_one_minus(delta):
+    """``ln(1 - delta)`` for ``0 <= delta < 1`` (lobe.glsl): `log_one_minus_series` for ``delta < 1/2``,
+    ``log(1 - delta)`` above."""
     delta = np.asarray(delta)
     dtype = delta.dtype if delta.dtype.kind == "f" else np.float64
     delta = delta.astype(dtype)
     small = delta < 0.5
     with np.errstate(divide="ignore", invalid="ignore"):
-        two_sigma = np.where(small, (2 * delta) / (2 - delta), 0).astype(dtype)
-        t = (0.25 * (two_sigma * two_sigma)).astype(dtype)
-        series = np.zeros_like(two_sigma)
-        for k in reversed(range(_series_terms(dtype))):
-            series = (series * t + dtype.type(1.0) / dtype.type(2 * k + 1)).astype(dtype)
         direct = np.log(np.where(small, 0.5, 1 - delta)).astype(dtype)
-    return np.where(small, -two_sigma * series, direct).astype(dtype)
+    return np.where(small, log_one_minus_series(np.where(small, delta, 0)), direct).astype(dtype)
 
 
-def lobe_from_delta(delta, q):
+def lobe_from_delta(delta, q, tail_zero=False):
     """``(1 - delta)^q``, stable for q up to FLT_MAX (lobe.glsl).
 
     Returns 1 for q == 0, 0 for delta >= 1, else ``exp(max(q ln(1 - delta), -104))``; ``q`` a scalar or
-    an array broadcasting with ``delta`` (a per-point exponent).
+    an array broadcasting with ``delta`` (a per-point exponent).  ``tail_zero``: the ``LOBE_TAIL_ZERO`` form, 0
+    from delta = 1/2 on (the same values where every q is at least ``glphong.scene.numerics.LOBE_TAIL_Q``).
     """
     delta = np.asarray(delta)
     dtype = delta.dtype if delta.dtype.kind == "f" else np.float64
     q = np.asarray(q, dtype=dtype)
-    inside = delta < 1
+    inside = delta < (0.5 if tail_zero else 1)
     with np.errstate(over="ignore", invalid="ignore"):
         value = np.exp(np.maximum(q * log_one_minus(np.where(inside, delta, 0)), dtype.type(-104)))
     value = np.where(inside, value, 0)

@@ -10,7 +10,11 @@
 bool point_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)
 {
     float d;
+#if NAIVE_LIGHT
+    bool valid = plain_normalize(u_point_position[j] - x, wi, d);
+#else
     bool valid = safe_normalize(u_point_position[j] - x, wi, d);
+#endif
     irradiance = point_irradiance(u_point_intensity[j], d);
 #if defined(POINT_RANGE)
     irradiance = u_point_range[j] > 0.0 ? irradiance * range_window(d, u_point_range[j]) : irradiance;

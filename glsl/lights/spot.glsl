@@ -19,7 +19,11 @@
 bool spot_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)
 {
     float d;
+#if NAIVE_LIGHT
+    bool valid = plain_normalize(u_spot_position[j] - x, wi, d);
+#else
     bool valid = safe_normalize(u_spot_position[j] - x, wi, d);
+#endif
     vec3 chord = -wi - u_spot_axis[j];
     float delta = 0.5 * dot(chord, chord);
     float g = clamp((u_spot_versin_outer[j] - delta) * u_spot_scale[j], 0.0, 1.0);

@@ -7,7 +7,11 @@
 bool unattenuated_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)
 {
     float d;
+#if NAIVE_LIGHT
+    bool valid = plain_normalize(u_unattenuated_position[j] - x, wi, d);
+#else
     bool valid = safe_normalize(u_unattenuated_position[j] - x, wi, d);
+#endif
     irradiance = u_unattenuated_radiance[j];
     return valid;
 }
