@@ -142,7 +142,7 @@ MUTATIONS = [
       "float series = 1.0 + t * (1.0 / 3.0 +", "float series = 1.0 + t * (1.0 / 3.03 +",
       "log_one_minus: artanh series coefficient 1/3 -> 1/3.03"),
     M("lobe.glsl:q0-rule", "glsl/lobe.glsl",
-      "return q == 0.0 ? 1.0 :", "return q < 0.0 ? 1.0 :",
+      "return q == 0.0 ? 1.0 : (delta < 1.0", "return q < 0.0 ? 1.0 : (delta < 1.0",
       "lobe_from_delta: the q == 0 rule (0^0 := 1) dropped"),
     M("lobe.glsl:clamp-80", "glsl/lobe.glsl",
       "log_one_minus(delta < 1.0 ? delta : 0.0), -104.0));", "log_one_minus(delta < 1.0 ? delta : 0.0), -80.0));",
@@ -443,6 +443,22 @@ MUTATIONS = [
       "an int parameter read as the float of its bits"),
     M("png.py:filter-byte", "glphong/core/png.py", "rows[:, 0] = 1\n", "rows[:, 0] = 0\n",
       "PNG rows filtered Sub but labelled None"),
+    # ---- stability where a scene needs it (issue 29)
+    M("numerics.py:near-plane-ignored", "glphong/scene/numerics.py",
+      "    nearest = max(nearest, camera.znear * (1 - POSITION_RESOLUTION))",
+      "    nearest = max(nearest, camera.znear * (1 - POSITION_RESOLUTION), 1.0)",
+      "the view piece assumes every fragment at least 1 m from the eye"),
+    M("numerics.py:normals-may-cancel", "glphong/scene/numerics.py",
+      "((a, a), (b, b), (c, c), (a, b), (b, c), (a, c))", "((a, a), (b, b), (c, c))",
+      "the normal bound forgets the pairwise dots: opposite normals on a triangle get the textbook normalize"),
+    M("numerics.py:falloff-unbounded", "glphong/scene/numerics.py",
+      "if peak > FALLOFF_LIMIT", "if peak > FALLOFF_LIMIT * 1e6",
+      "the textbook falloff allowed where I / d^2 overflows"),
+    M("numerics.py:tail-q", "glphong/scene/numerics.py", "LOBE_TAIL_Q = 151.0", "LOBE_TAIL_Q = 100.0",
+      "the lobes' log branch left out from q = 100, where the lobe is not 0 at cos = 1/2"),
+    M("lobe.glsl:tail-half", "glsl/lobe.glsl", "    return q == 0.0 ? 1.0 : (delta < 0.5 ? lobe : 0.0);",
+      "    return q == 0.0 ? 1.0 : (delta < 0.4 ? lobe : 0.0);",
+      "LOBE_TAIL_ZERO cuts the lobe at cos = 0.6 instead of 1/2"),
 ]
 del M
 
