@@ -75,7 +75,8 @@ one for each new uniform's wiring on the host (a light kind's ``uniform_value``,
 ``path`` relative to the repository root; ``old`` an exact snippet (whitespace included; add
 surrounding lines to make it unique); ``new`` its mutated text; ``what`` one line saying what
 the bug is.  Run ``--list`` to validate, then ``--only <name>`` to see it caught.  Mutate only
-code the tests can run: the ``NAIVE`` variants of the chunks are compared only with themselves
+code the tests can run: the ``NAIVE`` variants of the chunks are compared only with themselves (those that
+``numerics='auto'`` compiles, ``NAIVE_<PIECE>`` and plain_normalize, are mutated: they are production code)
 and glphong/checks/stability.py is a test tool, so neither is mutated here.
 """
 import argparse
@@ -456,6 +457,10 @@ MUTATIONS = [
       "the textbook falloff allowed where I / d^2 overflows"),
     M("numerics.py:tail-q", "glphong/scene/numerics.py", "LOBE_TAIL_Q = 151.0", "LOBE_TAIL_Q = 100.0",
       "the lobes' log branch left out from q = 100, where the lobe is not 0 at cos = 1/2"),
+    M("lights.glsl:naive-falloff-1.01", "glsl/lights.glsl", "    return intensity / (d * d);",
+      "    return intensity / (1.01 * d * d);", "the textbook falloff numerics='auto' compiles: I / (1.01 d^2)"),
+    M("common.glsl:plain-length", "glsl/common.glsl", "    len = length(x);\n    return true;",
+      "    len = 1.001 * length(x);\n    return true;", "plain_normalize's length 0.1% long"),
     M("lobe.glsl:tail-half", "glsl/lobe.glsl", "    return q == 0.0 ? 1.0 : (delta < 0.5 ? lobe : 0.0);",
       "    return q == 0.0 ? 1.0 : (delta < 0.4 ? lobe : 0.0);",
       "LOBE_TAIL_ZERO cuts the lobe at cos = 0.6 instead of 1/2"),
