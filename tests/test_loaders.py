@@ -140,6 +140,12 @@ def test_cli_render_file(tmp_path, capsys):
     warnings = [line for line in captured.err.splitlines() if "warning" in line]
     assert len(warnings) == 1 and warnings[0].startswith("glphong render: warning: ") and "illum 5" in warnings[0]
     assert Image.open(out).size == (64, 48)
+    # the stable formulation everywhere on request: verified too, and the same picture to the 8-bit step
+    stable = tmp_path / "stable.png"
+    assert main(["render", str(path), "--width", "64", "--height", "48", "--verify", "--numerics", "stable",
+                 "--out", str(stable)]) == 0 and "PASS" in capsys.readouterr().out
+    difference = np.abs(np.asarray(Image.open(out), int) - np.asarray(Image.open(stable), int))
+    assert difference.max() <= 1
     assert main(["render", str(tmp_path / "scene.stl")]) == 2
     assert "glphong reads .obj, .gltf, .glb scene files" in capsys.readouterr().err
     with pytest.raises(SystemExit):

@@ -87,12 +87,13 @@ def _render_file(args):
         keywords = {"light_units": args.light_units, "camera_name": args.camera, "allow_outside": args.allow_outside}
         specs = [(str(Path(args.file).resolve()), 360.0 * k / args.frames, keywords) for k in range(args.frames)]
         paths = render_many(orbit_scene, specs, args.width, args.height, folder, fmt="png", backend=args.backend,
-                            samples=args.samples)
+                            samples=args.samples, numerics=args.numerics)
         print(f"wrote {len(paths)} frames of a turntable of {args.file} to {folder} in "
               f"{time.perf_counter() - start:.1f} s")
         return 0
     out = args.out if args.out is not None else str(Path(args.file).with_suffix(".png").name)
-    with Renderer(args.width, args.height, backend=args.backend, samples=args.samples) as renderer:
+    with Renderer(args.width, args.height, backend=args.backend, samples=args.samples,
+                  numerics=args.numerics) as renderer:
         start = time.perf_counter()
         frame = renderer.render(scene)
         seconds = time.perf_counter() - start
@@ -375,6 +376,9 @@ def build_parser():
     render.add_argument("--width", type=_image_side, default=512, help="with FILE: image width, 1 to 16384 (default 512)")
     render.add_argument("--height", type=_image_side, default=512, help="with FILE: image height, 1 to 16384 (default 512)")
     render.add_argument("--samples", type=int, choices=(1, 2, 4), default=1, help="with FILE: MSAA samples (default 1)")
+    render.add_argument("--numerics", choices=("auto", "stable"), default="auto",
+                        help="with FILE: 'auto' (default) the stable float32 arithmetic only where the scene's ranges "
+                             "need it, 'stable' everywhere (docs/stability.md)")
     render.add_argument("--light-units", choices=("photometric", "radiometric"), default=None,
                         help="with a glTF FILE that has lights: candela and lux (the glTF specification) or W/sr "
                              "and W/m^2")
