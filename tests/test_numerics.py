@@ -1,7 +1,6 @@
 """Stability where a scene needs it (docs/design.md section 3): ``Renderer(numerics='auto')`` specialises a piece of
 arithmetic only where the scene's ranges prove the bound, keeps the stable one elsewhere, and stays in the band."""
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -17,7 +16,6 @@ from glphong.scene.geometry import MeshData
 from glphong.scene.numerics import (FALLOFF_LIMIT, LOBE_TAIL_Q, NORMAL_LENGTHS, numerics_decisions, numerics_pieces,
                                     normal_range)
 from glphong.shaders.key import NUMERICS_DEFINES, NUMERICS_PIECES, ProgramKey
-from glphong.testing import glsl_function
 from glphong.tools.speed import speed_scenes
 
 FLT_MAX = float(np.finfo(np.float32).max)
