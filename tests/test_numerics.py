@@ -8,6 +8,7 @@ import pytest
 import glphong
 from glphong.checks.glsl_source import LIBRARY_DEFINES
 from glphong.checks.stability import CASES, case_numerics, run_stability
+from glphong.checks.tolerances import lobe_band
 from glphong.core.glsl_files import chunk_source
 from glphong.gpu.describe import describe, format_descriptions
 from glphong.materials import registered_models
@@ -265,3 +266,59 @@ def test_plain_normalize_and_the_series_against_their_twins(session_gl):
     # beyond the bound the textbook form fails where the stable one does not: |x| = 2^65 overflows x.x
     beyond = probe.evaluate(session_gl, "plain_normalize", x=np.float32([[2.0 ** 65, 0, 0]]))
     assert beyond["x_hat"][0, 0] != 1.0 and probe.evaluate(session_gl, "safe_normalize", x=np.float32([[2.0 ** 65, 0, 0]]))["x_hat"][0, 0] == 1.0
+
+
+def test_definitions_declare_what_the_decisions_read():
+    """A model names the exponent of its lobes (`MaterialModel.lobe_exponent`), a light kind the uniforms its pieces
+    are bounded by (`LightModel.numerics_bounds`); the decisions read those, not the names, and a definition that
+    names something else is refused."""
+    from glphong.materials import MaterialDefinitionError, MaterialModel, Param
+
+    assert {m.name for m in registered_models() if m.lobe_exponent} == {
+        "phong_lobe", "blinn_lobe", "normalized_phong_lobe", "normalized_blinn_lobe"}
+    assert glphong.PointLight.numerics_bounds == {"light": "position", "falloff": "intensity"}
+    assert glphong.SpotLight.numerics_bounds == {"light": "position"} == glphong.UnattenuatedPointLight.numerics_bounds
+    assert glphong.DirectionalLight.numerics_bounds == {}
+    glsl = ("vec3 {n}_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)\n"
+            "{{ return u_{n}_k * lobe_from_delta(phong_delta(f.n, wi, wo), u_{n}_e); }}")
+
+    def twin(self, f, wi, wo, n_dot_l, p):
+        from glphong import reference as ref
+        return p.k * ref.lobe_from_delta(ref.phong_delta(f.n, wi, wo), p.e)[..., None]
+
+    params = (Param("k", "rgb", low=0.0), Param("e", "scalar", low=0.0, high=1e7, textureable=True))
+    with pytest.raises(MaterialDefinitionError, match="lobe_exponent must be None or the name of a scalar Param"):
+        type("Bad", (MaterialModel,), {"name": "test_numerics_bad", "params": params, "uses": ("lobe",), "needs": ("view",),
+                                       "lobe_exponent": "k", "glsl": glsl.format(n="test_numerics_bad"),
+                                       "response": twin})
+    model = type("Textured", (MaterialModel,), {"name": "test_numerics_lobe", "params": params, "uses": ("lobe",), "needs": ("view",),
+                                                "lobe_exponent": "e", "glsl": glsl.format(n="test_numerics_lobe"),
+                                                "response": twin})
+    light = glphong.PointLight((0.3, 0.2, 1.0), 10.0)
+    assert _decisions(_plane_scene(model(0.5, 200.0), light))["lobe_tail"].specialised
+    assert not _decisions(_plane_scene(model(0.5, 150.0), light))["lobe_tail"].specialised
+    textured = model(0.5, glphong.Texture(np.full((4, 4, 3), 0.9, np.float32), scale=300.0, channel="r"))
+    assert "exponent e varies over the surface" in _decisions(_plane_scene(textured, light))["lobe_tail"].reason
+
+
+def test_textbook_falloff_and_the_tail_against_their_twins(glphong_glsl):
+    """point_irradiance under NAIVE_FALLOFF against the twin's textbook form, lobe_from_delta under LOBE_TAIL_ZERO
+    against the twin's tail_zero form (GLSL and twin alike, function by function)."""
+    from glphong import reference as ref
+
+    def source(define):
+        defines = "\n".join(f"#define {k} {('1' if k == define else v)}" for k, v in LIBRARY_DEFINES)
+        return "\n".join([defines, chunk_source("common"), chunk_source("lights"), chunk_source("lobe")])
+
+    rng = np.random.default_rng(7)
+    intensity = (10.0 ** rng.uniform(-10, 10, size=(300, 3))).astype(np.float32)
+    d = (10.0 ** rng.uniform(-6, 6, size=300)).astype(np.float32)
+    gpu = glphong_glsl(source("NAIVE_FALLOFF"), "point_irradiance")(intensity=intensity, d=d)
+    want = ref.point_irradiance(intensity.astype(np.float64), d.astype(np.float64), textbook=True)
+    np.testing.assert_allclose(gpu, want, rtol=16 * 2.0 ** -24, atol=0)
+    delta = np.linspace(0.0, 1.0, 2001, dtype=np.float32)
+    gpu = glphong_glsl(source("LOBE_TAIL_ZERO"), "lobe_from_delta")(delta=delta, q=200.0)
+    want = ref.lobe_from_delta(delta.astype(np.float64), 200.0, tail_zero=True)
+    assert np.all(gpu[delta >= 0.5] == 0) and np.all(want[delta >= 0.5] == 0)
+    low, high = lobe_band(delta.astype(np.float64), 200.0)
+    assert np.all((gpu >= low) & (gpu <= high))

@@ -35,7 +35,7 @@ from glphong.scene.geometry import MeshData
 from glphong.lights import AmbientLight, LightModel, light_named, registered_lights
 from glphong.scene.numerics import numerics_pieces
 from glphong.scene.scene import Scene
-from glphong.shaders.key import ProgramKey, TermKey
+from glphong.shaders.key import NUMERICS_PIECES, ProgramKey, TermKey
 
 __all__ = ["Case", "CASES", "case_scene", "case_inputs", "generic_cases", "lobe_cases", "cases_for", "VALID_RANGES", "oracle", "StabilityRow", "StabilityReport", "run_stability", "case_numerics"]
 
@@ -355,7 +355,7 @@ def case_numerics(case, scene=None):
     'normal': the case's point is shaded with its own normal, which the points program normalises stably (sorted
     tuple).  The point, the origin, lies in the object's box, over which the pieces were decided."""
     scene = case_scene(case) if scene is None else scene
-    return tuple(p for p in numerics_pieces(scene, scene.objects[0]) if p != "normal")
+    return numerics_pieces(scene, scene.objects[0], tuple(p for p in NUMERICS_PIECES if p != "normal"))
 
 
 def run_stability(backend="auto", formulation="stable", cases=CASES, context=None, numerics="stable"):

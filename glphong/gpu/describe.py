@@ -5,7 +5,7 @@ import numpy as np
 
 from glphong.shaders.assembly import assemble, effective_source
 from glphong.scene.culling import culling_decision
-from glphong.scene.numerics import numerics_decisions, with_numerics
+from glphong.scene.numerics import allowed_pieces, numerics_decisions, with_numerics
 from glphong.scene.scene import Scene
 from glphong.shaders.key import model_chunk_label
 
@@ -78,14 +78,16 @@ def describe(scenes, renderer=None, gbuffer=False):
     for scene in scenes:
         for obj in scene.objects:
             for output in outputs:
-                key = renderer.program_key(scene, obj, output) if renderer else \
-                    with_numerics(scene.program_key(obj, output), scene, obj)
+                key = renderer.program_key(scene, obj, output) if renderer else scene.program_key(obj, output)
+                auto = renderer is None or renderer.numerics == "auto"
+                decisions = numerics_decisions(scene, obj, allowed_pieces(key)) if auto else ()
+                if renderer is None:
+                    key = with_numerics(key, scene, obj, decisions)
                 users.setdefault(key, []).append(obj.name)
-                if (renderer is None or renderer.numerics == "auto") and key.output in ("radiance", "display") \
-                        and key.formulation == "stable" and not key.uber:
+                if key.output in ("radiance", "display"):
                     numerics.setdefault(key, []).extend(
                         f"{obj.name}: {d.piece}: {'specialised' if d.specialised else 'stable'} ({d.reason})"
-                        for d in numerics_decisions(scene, obj))
+                        for d in decisions)
                 decision = "drawn: culling='off'" if renderer is not None and renderer.culling == "off" else \
                     culling_decision(obj, scene.camera)[1]
                 culling.setdefault(key, []).append(f"{obj.name}: {decision}")

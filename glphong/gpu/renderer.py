@@ -19,7 +19,7 @@ from glphong.gpu.frame import Frame, GBuffer
 from glphong.gpu.resources import ORPHANS, ORPHANS_LOCK, MeshBuffers, release_orphans, release_resources, release_targets
 from glphong.gpu.contexts import check_not_forked, create_context
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
-from glphong.scene.numerics import NUMERICS, view_decision, with_numerics
+from glphong.scene.numerics import NUMERICS, allowed_pieces, view_decision, with_numerics
 from glphong.shaders.key import FORMULATIONS, GBUFFER_PLANES, EncodeKey, uber_key
 from glphong.gpu.shadows import ShadowMaps
 from glphong.gpu.programs import ProgramCache
@@ -496,8 +496,8 @@ class Renderer:
         """True where ``entry``'s key needs no change for ``camera``: its 'view' piece (the only piece that depends on
         the camera, `glphong.scene.numerics`) is decided the same way; the entry then remembers ``camera``."""
         key = entry.key
-        if self.numerics == "auto" and key.output in ("radiance", "display") and key.formulation == "stable" \
-                and not key.uber and view_decision(obj, camera)[0] != ("view" in key.numerics):
+        if self.numerics == "auto" and "view" in allowed_pieces(key) \
+                and view_decision(obj, camera)[0] != ("view" in key.numerics):
             return False
         entry.camera = camera
         return True

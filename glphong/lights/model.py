@@ -160,6 +160,11 @@ class LightModel:
         The ``KHR_lights_punctual`` type it reads and writes (`from_gltf`, `to_gltf`).
     pyrender_type : str or None
         The pyrender light class it maps (`from_pyrender`, `to_pyrender`).
+    numerics_bounds : dict
+        The pieces of ``Renderer(numerics='auto')`` the kind's GLSL reads (glphong.scene.numerics), each with the uniform
+        its bound is taken over: ``'light'`` (the direction by ``plain_normalize`` under ``NAIVE_LIGHT``) with the
+        kind's position, ``'falloff'`` (``point_irradiance`` under ``NAIVE_FALLOFF``) with its intensity [W/sr].
+        Default empty: the kind's arithmetic is never specialised.
     shadow_map : {'cube', 'ortho'} or None
         How the kind's shadows are mapped (docs/design.md section 12): 'cube' for a light at a point (its
         ``position``: six faces around it), 'ortho' for a light at infinity (its ``direction``: one orthographic
@@ -193,6 +198,7 @@ class LightModel:
     gltf_type = None
     pyrender_type = None
     shadow_map = None
+    numerics_bounds = {}
     #: 'punctual' (one direction and irradiance per light and point) or 'extended' (`glphong.lights.ExtendedLight`)
     extent = "punctual"
     #: the light is the surroundings (an environment), which a term's occlusion darkens as it does the ambient light
@@ -546,6 +552,14 @@ def _check_definition(cls):
     if cls.shadow_map not in (None, "cube", "ortho"):
         raise err(f"{cls.__qualname__}.shadow_map must be None, 'cube' (a light at its `position`) or 'ortho' (a light "
                   f"at infinity along its `direction`) (got {cls.shadow_map!r})")
+    uniform_kinds = {p.name: p.kind for p in (cls.params if cls.uniforms is None else cls.uniforms)}
+    wanted_kinds = {"light": "vec3", "falloff": "rgb"}
+    bounds = cls.numerics_bounds
+    if not isinstance(bounds, dict) or not all(piece in wanted_kinds and uniform_kinds.get(uniform) == wanted_kinds[piece]
+                                               for piece, uniform in bounds.items()) \
+            or ("falloff" in bounds and "light" not in bounds):
+        raise err(f"{cls.__qualname__}.numerics_bounds must map 'light' to the kind's position uniform (vec3) and, with "
+                  f"it, 'falloff' to its intensity uniform (rgb) (got {bounds!r})")
     needed = {"cube": "position", "ortho": "direction"}.get(cls.shadow_map)
     if needed and needed not in {p.name for p in cls.params}:
         raise err(f"{cls.__qualname__}.shadow_map = {cls.shadow_map!r} needs a parameter named {needed!r}")

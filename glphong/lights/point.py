@@ -75,6 +75,7 @@ class PointLight(WithRange, LightModel):
     glsl = GlslFile("lights/point.glsl")
     shadow_map = "cube"
     uses = ("lights",)
+    numerics_bounds = {"light": "position", "falloff": "intensity"}
     in_uber = True
     gltf_type = "point"
     pyrender_type = "PointLight"

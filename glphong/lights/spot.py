@@ -62,6 +62,7 @@ class SpotLight(WithRange, LightModel):
     glsl = GlslFile("lights/spot.glsl")
     shadow_map = "cube"
     uses = ("lights",)
+    numerics_bounds = {"light": "position"}
     gltf_type = "spot"
     pyrender_type = "SpotLight"
 

@@ -25,6 +25,7 @@ class UnattenuatedPointLight(ExactIrradiance, LightModel):
     params = (POSITION, Param("radiance", "rgb", low=0.0, unit="W/m^2", doc="the lecture's L_i, used as E"))
     glsl = GlslFile("lights/unattenuated.glsl")
     in_uber = True
+    numerics_bounds = {"light": "position"}
 
     def incident(self, x, p):
         valid, wi, _ = safe_normalize(p.position - x)

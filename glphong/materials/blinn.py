@@ -71,6 +71,7 @@ class BlinnLobe(MaterialModel):
     needs = ("view",)
     glsl = GlslFile("materials/blinn_lobe.glsl")
     uses = ("lobe",)
+    lobe_exponent = "q"
     vanishes_with = ("ks",)
     in_uber = True  # the lecture's models: every uber-shader holds them
     fresnel_slot = FresnelSlot(cosine="h.l")

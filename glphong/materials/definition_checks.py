@@ -168,6 +168,11 @@ def check_definition(cls, base):
     if cls.occluded_by is not None and cls.occluded_by not in fractions:
         raise MaterialDefinitionError(f"{cls.__qualname__}.occluded_by must be None or the name of a scalar Param in "
                                       f"[0, 1] ({', '.join(sorted(fractions)) or 'none'}) (got {cls.occluded_by!r})")
+    scalars = {p.name for p in params if p.kind == "scalar"}
+    if cls.lobe_exponent is not None and (cls.lobe_exponent not in scalars or "lobe" not in cls.uses):
+        raise MaterialDefinitionError(f"{cls.__qualname__}.lobe_exponent must be None or the name of a scalar Param "
+                                      f"({', '.join(sorted(scalars)) or 'none'}) of a model that uses 'lobe' "
+                                      f"(got {cls.lobe_exponent!r}, uses {cls.uses!r})")
     if not set(cls.vanishes_with) <= set(names):
         raise MaterialDefinitionError(f"{cls.__qualname__}.vanishes_with names {sorted(set(cls.vanishes_with) - set(names))}, "
                                       "which are not params")

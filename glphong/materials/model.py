@@ -282,6 +282,10 @@ class MaterialModel(Material):
     in_uber : bool
         Compiled into every uber-shader, whether or not a scene has it (the lecture's models only;
         default False: a model joins the uber-shader of the scenes that draw it).
+    lobe_exponent : str or None
+        The parameter that is the exponent ``q`` of every ``lobe_from_delta(delta, q)`` the GLSL evaluates, for a
+        model that calls lobe.glsl: ``Renderer(numerics='auto')`` leaves out the lobes' log branch where it is at
+        least 151 (`glphong.scene.numerics`).  None (default): a model that uses lobe.glsl keeps the branch.
 
     Methods a definition provides
     -----------------------------
@@ -317,6 +321,7 @@ class MaterialModel(Material):
     fresnel_slot = None
     ambient_scale = 1.0
     in_uber = False
+    lobe_exponent = None
 
     def __init_subclass__(cls, **kwargs):
         super().__init_subclass__(**kwargs)

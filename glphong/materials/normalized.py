@@ -169,6 +169,7 @@ class NormalizedPhongLobe(MaterialModel):
     needs = ("view",)
     glsl = GlslFile("materials/normalized_phong_lobe.glsl")
     uses = ("lobe",)
+    lobe_exponent = "q"
     vanishes_with = ("rho_s",)
     fresnel_slot = FresnelSlot(cosine="n.l")
     properties = Properties(reciprocal=True, isotropic=True, energy_conserving=True,
@@ -257,6 +258,7 @@ class NormalizedBlinnLobe(MaterialModel):
     needs = ("view",)
     glsl = GlslFile("materials/normalized_blinn_lobe.glsl")
     uses = ("lobe",)
+    lobe_exponent = "q"
     vanishes_with = ("rho_s",)
     fresnel_slot = FresnelSlot(cosine="h.l")
     properties = Properties(reciprocal=True, isotropic=True, energy_conserving=True,

@@ -66,6 +66,7 @@ class PhongLobe(MaterialModel):
     needs = ("view",)
     glsl = GlslFile("materials/phong_lobe.glsl")
     uses = ("lobe",)
+    lobe_exponent = "q"
     vanishes_with = ("ks",)
     in_uber = True  # the lecture's models: every uber-shader holds them
     fresnel_slot = FresnelSlot(cosine="n.l")

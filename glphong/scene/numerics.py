@@ -34,8 +34,8 @@ from glphong.scene.camera import OrthographicCamera
 from glphong.scene.shadows import object_bounds
 from glphong.shaders.key import NUMERICS_PIECES
 
-__all__ = ["NumericsDecision", "numerics_decisions", "numerics_pieces", "with_numerics", "view_decision", "normal_range", "NUMERICS", "NORMAL_LENGTHS",
-           "POSITION_RESOLUTION", "FALLOFF_LIMIT", "LOBE_TAIL_Q", "LOBE_TAIL_MODELS", "DIRECTION_KINDS"]
+__all__ = ["NumericsDecision", "numerics_decisions", "numerics_pieces", "allowed_pieces", "with_numerics", "view_decision",
+           "normal_range", "NUMERICS", "NORMAL_LENGTHS", "POSITION_RESOLUTION", "FALLOFF_LIMIT", "LOBE_TAIL_Q"]
 
 #: the choices of ``Renderer(numerics=...)``: 'auto' specialises what the scene's ranges prove, 'stable' nothing
 NUMERICS = ("auto", "stable")
@@ -50,12 +50,6 @@ FALLOFF_LIMIT = float(np.finfo(np.float32).max) / 16
 #: the smallest exponent for which the lobe is 0 in float32 wherever delta >= 1/2:
 #: 151 (ln(1/2) + 2^-21) < -104, and exp(-104) ~ 6.8e-46 rounds to 0
 LOBE_TAIL_Q = 151.0
-#: the models whose lobe is lobe_from_delta(delta, q) with their parameter q (lobe.glsl)
-LOBE_TAIL_MODELS = ("phong_lobe", "blinn_lobe", "normalized_phong_lobe", "normalized_blinn_lobe")
-#: the light kinds whose direction the ``light`` piece normalises (glsl/lights/<kind>.glsl read NAIVE_LIGHT)
-DIRECTION_KINDS = ("point", "spot", "unattenuated")
-#: the light kinds whose irradiance the ``falloff`` piece computes (point_irradiance)
-FALLOFF_KINDS = ("point",)
 
 
 @dataclass(frozen=True)
@@ -169,35 +163,37 @@ def _view_decision(camera, low, high):
 
 
 def _light_decisions(lights, low, high):
-    """``(light ok, light reason), (falloff ok, falloff reason)`` over the scene's point-like lights."""
+    """``(light ok, light reason), (falloff ok, falloff reason)`` over the scene's lights whose kind reads the pieces
+    (`glphong.lights.LightModel.numerics_bounds`)."""
     box_scale = float(np.max(np.abs(np.concatenate([low, high]))))
     direction, falloff = [], []
     light_why = falloff_why = None
     for j, light in enumerate(lights):
-        if light.kind not in DIRECTION_KINDS:
+        bounds = type(light).numerics_bounds
+        if "light" not in bounds:
             continue
-        position = np.asarray(light.uniform_value("position"), dtype=np.float32).astype(np.float64)
+        position = np.asarray(light.uniform_value(bounds["light"]), dtype=np.float32).astype(np.float64)
         nearest, farthest = _box_distances(position, low, high)
         why = _length_check(f"the direction to {light.kind} light {j}", nearest, farthest,
                             max(box_scale, float(np.max(np.abs(position)))))
         light_why = light_why or why
         direction.append((nearest, farthest))
-        if light.kind in FALLOFF_KINDS:
-            intensity = float(np.max(np.asarray(light.uniform_value("intensity"), dtype=np.float32)))
+        if "falloff" in bounds:
+            intensity = float(np.max(np.asarray(light.uniform_value(bounds["falloff"]), dtype=np.float32)))
             peak = intensity / nearest ** 2 if nearest > 0 else np.inf
             falloff_why = falloff_why or why or (
                 f"point light {j}'s irradiance may reach {_fmt(peak)} W/m^2, above FLT_MAX / 16" if peak > FALLOFF_LIMIT
                 else None)
             falloff.append(peak)
     if not direction:
-        light_result = (False, "no point, spot or unattenuated light")
+        light_result = (False, "no light whose direction the piece normalises (point, spot, unattenuated)")
     elif light_why:
         light_result = (False, light_why)
     else:
         light_result = (True, f"light distances from {_fmt(min(d[0] for d in direction))} to "
                               f"{_fmt(max(d[1] for d in direction))} m")
     if not falloff:
-        falloff_result = (False, "no point light")
+        falloff_result = (False, "no light with the point falloff")
     elif falloff_why:
         falloff_result = (False, falloff_why)
     else:
@@ -208,12 +204,14 @@ def _light_decisions(lights, low, high):
 def _lobe_tail_decision(material):
     exponents = []
     for term in material.components:
-        uses = getattr(term, "uses", ())
-        if "lobe" not in uses and term.name not in LOBE_TAIL_MODELS:
+        if "lobe" not in term.uses:
             continue
-        if term.name not in LOBE_TAIL_MODELS:
+        if term.lobe_exponent is None:
             return False, f"{term.name} evaluates lobes with exponents of its own"
-        q = float(np.float32(term.q))  # a constant: these models' exponents cannot be textured
+        q = getattr(term, term.lobe_exponent)
+        if not isinstance(q, (int, float, np.integer, np.floating)):
+            return False, f"{term.name}'s exponent {term.lobe_exponent} varies over the surface"
+        q = float(np.float32(q))
         if q < LOBE_TAIL_Q:
             return False, f"{term.name}'s exponent q = {q:g} is below {LOBE_TAIL_Q:g}: its lobe is not 0 at cos <= 1/2"
         exponents.append(q)
@@ -222,33 +220,42 @@ def _lobe_tail_decision(material):
     return True, f"lobe exponents from {min(exponents):g}: the lobe is 0 in float32 wherever cos <= 1/2"
 
 
-def numerics_decisions(scene, obj):
-    """The decision on each piece of `glphong.shaders.key.NUMERICS_PIECES` for one object of a scene.
+def numerics_decisions(scene, obj, pieces=NUMERICS_PIECES):
+    """The decision on each of ``pieces`` (default every piece of `glphong.shaders.key.NUMERICS_PIECES`) for one object
+    of a scene.
 
     Parameters
     ----------
     scene : glphong.Scene
     obj : glphong.scene.scene.SceneObject
         One of the scene's objects.
+    pieces : tuple of str
+        The pieces to decide (only their bounds are evaluated).
 
     Returns
     -------
     tuple of NumericsDecision
         In the order of `NUMERICS_PIECES`.
     """
+    pieces = tuple(p for p in NUMERICS_PIECES if p in pieces)
     low, high = object_bounds(obj.mesh, obj.pose)
     if not (np.all(np.isfinite(low)) and np.all(np.isfinite(high))):
-        return tuple(NumericsDecision(p, False, "the object's bounds are not finite") for p in NUMERICS_PIECES)
-    (light_ok, light_why), (falloff_ok, falloff_why) = _light_decisions(scene.lights, low, high)
-    found = {"normal": _normal_decision(obj), "view": view_decision(obj, scene.camera),
-             "light": (light_ok, light_why), "falloff": (falloff_ok, falloff_why),
-             "lobe_tail": _lobe_tail_decision(obj.material)}
-    return tuple(NumericsDecision(piece, bool(found[piece][0]), found[piece][1]) for piece in NUMERICS_PIECES)
+        return tuple(NumericsDecision(p, False, "the object's bounds are not finite") for p in pieces)
+    found = {}
+    if "light" in pieces or "falloff" in pieces:
+        found["light"], found["falloff"] = _light_decisions(scene.lights, low, high)
+    if "normal" in pieces:
+        found["normal"] = _normal_decision(obj)
+    if "view" in pieces:
+        found["view"] = view_decision(obj, scene.camera)
+    if "lobe_tail" in pieces:
+        found["lobe_tail"] = _lobe_tail_decision(obj.material)
+    return tuple(NumericsDecision(piece, bool(found[piece][0]), found[piece][1]) for piece in pieces)
 
 
-def numerics_pieces(scene, obj):
+def numerics_pieces(scene, obj, pieces=NUMERICS_PIECES):
     """The specialised pieces of `numerics_decisions`, sorted (the `ProgramKey.numerics` of the object)."""
-    return tuple(sorted(d.piece for d in numerics_decisions(scene, obj) if d.specialised))
+    return tuple(sorted(d.piece for d in numerics_decisions(scene, obj, pieces) if d.specialised))
 
 
 #: the pieces a program of each output may specialise: the G-buffer writes the normal exactly as the radiance program
@@ -256,12 +263,19 @@ def numerics_pieces(scene, obj):
 _OUTPUT_PIECES = {"radiance": NUMERICS_PIECES, "display": NUMERICS_PIECES, "gbuffer": ("normal",)}
 
 
-def with_numerics(key, scene, obj):
-    """``key`` (a `glphong.shaders.key.ProgramKey` of ``obj``) with the pieces `numerics_pieces` proves for ``obj``:
-    radiance and display programs of the stable formulation, and the G-buffer's normal (the same bits as the
-    radiance program's); any other key (the uber-shader, the textbook formulation, other outputs) unchanged."""
-    allowed = _OUTPUT_PIECES.get(key.output, ())
-    if not allowed or key.uber or key.formulation != "stable":
+def allowed_pieces(key):
+    """The pieces a program of ``key`` may specialise (tuple): by its output, for the stable formulation's
+    specialised programs; none for the uber-shader, the textbook formulation and the other outputs."""
+    return () if key.uber or key.formulation != "stable" else _OUTPUT_PIECES.get(key.output, ())
+
+
+def with_numerics(key, scene, obj, decisions=None):
+    """``key`` (a `glphong.shaders.key.ProgramKey` of ``obj``) with the pieces proven for ``obj`` among
+    `allowed_pieces` (``decisions``: `numerics_decisions` already made for it, else made here)."""
+    allowed = allowed_pieces(key)
+    if not allowed:
         return key
-    pieces = tuple(p for p in numerics_pieces(scene, obj) if p in allowed)
+    if decisions is None:
+        decisions = numerics_decisions(scene, obj, allowed)
+    pieces = tuple(sorted(d.piece for d in decisions if d.specialised and d.piece in allowed))
     return replace(key, numerics=pieces) if pieces != key.numerics else key

@@ -32,6 +32,9 @@ FORMULATIONS = ("stable", "naive")
 NUMERICS_DEFINES = {"falloff": "NAIVE_FALLOFF", "light": "NAIVE_LIGHT", "lobe_tail": "LOBE_TAIL_ZERO",
                     "normal": "NAIVE_NORMAL", "view": "NAIVE_VIEW"}
 NUMERICS_PIECES = tuple(NUMERICS_DEFINES)
+#: the pieces whose specialised form is the textbook one (set by formulation='naive' too; lobe_tail is not: the naive
+#: lobes are pow())
+_TEXTBOOK_PIECES = ("falloff", "light", "normal", "view")
 #: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed)
 GBUFFER_PLANES = ("tangent", "uv", "color", "lod", "face")
 #: how a surface input is made (``<MODEL>_<PARAM>_INPUT`` is the mode's index plus 1)
@@ -362,7 +365,7 @@ class ProgramKey:
             ("RUNTIME_SWITCHES", b(self.uber)),
             ("SHADE_PER_VERTEX", b(self.shade_per_vertex)),
             ("NAIVE", b(self.formulation == "naive")),
-            *((define, b(piece in self.numerics or (self.formulation == "naive" and define.startswith("NAIVE_"))))
+            *((define, b(piece in self.numerics or (self.formulation == "naive" and piece in _TEXTBOOK_PIECES)))
               for piece, define in NUMERICS_DEFINES.items()),
             # SWITCH(u_flag): a float uniform flag in the uber-shader, the constant true otherwise
             ("SWITCH(flag)", "((flag) > 0.5)" if self.uber else "true"),

@@ -185,8 +185,9 @@ def surface_normal(n, t, b, texel, scale):
 
 
 # --------------------------------------------------------------------------- lights.glsl
-def point_irradiance(intensity, d):
-    """E1 as ``min((I / d) / d, FLT_MAX)`` (lights.glsl).
+def point_irradiance(intensity, d, textbook=False):
+    """E1 as ``min((I / d) / d, FLT_MAX)`` (lights.glsl); ``textbook``: its ``NAIVE_FALLOFF`` form ``I / (d d)``, which
+    ``numerics='auto'`` compiles where the ranges prove it (`glphong.scene.numerics`).
 
     Parameters
     ----------
@@ -201,8 +202,8 @@ def point_irradiance(intensity, d):
         Irradiance [W/m^2].
     """
     d = np.asarray(d)[..., None]
-    with np.errstate(over="ignore", under="ignore"):
-        return np.minimum((intensity / d) / d, FLT_MAX)
+    with np.errstate(over="ignore", under="ignore", divide="ignore"):
+        return intensity / (d * d) if textbook else np.minimum((intensity / d) / d, FLT_MAX)
 
 
 def range_window(d, range_):

@@ -167,6 +167,9 @@ def _define(**attributes):
      "defines safe_normalize, which glphong's library chunks define"),
     ({"uses": ("shadows",)}, "uses must be a tuple of library chunks"),
     ({"uniforms": (Param("n", "scalar", low=0.0),)}, "must define uniform_value"),
+    ({"numerics_bounds": {"falloff": "peak"}}, "numerics_bounds must map 'light' to the kind's position uniform"),
+    ({"numerics_bounds": {"light": "n"}}, "numerics_bounds must map 'light' to the kind's position uniform"),
+    ({"numerics_bounds": {"lobe": "position"}}, "numerics_bounds must map"),
 ])
 def test_definition_errors(attributes, message):
     with pytest.raises(LightDefinitionError, match=message):
