@@ -19,6 +19,7 @@ import glphong
 from glphong import primitives
 from glphong.core.timing import alternating_medians
 from glphong.gpu.shadows import shadow_map_bytes
+from glphong.shaders.binding import binding
 
 POSITIONS = ((0.3, 0.2, 2.0), (-1.0, 0.5, 1.8), (0.8, -1.0, 1.5), (-0.4, -0.9, 2.2))
 
@@ -61,7 +62,7 @@ def main():
                                                        "with": lambda: renderer.render(shadowed)},
                                                       repeats=args.repeats, warmup=1)
                         key = renderer.program_key(shadowed, shadowed.objects[1])
-                        memory = shadow_map_bytes(shadowed.shadow_setups(key.lights, key.shadow_size)) / 2 ** 20
+                        memory = shadow_map_bytes(binding(shadowed).shadow_setups(key.lights, key.shadow_size)) / 2 ** 20
                         extra = (medians["with"] - medians["without"]) / count
                         print(f"| {size} | {kind} | {count} | {map_size} | {1000 * medians['without']:.1f} | "
                               f"{1000 * medians['with']:.1f} | {1000 * extra:.1f} | {memory:.0f} |", flush=True)

@@ -18,6 +18,7 @@ import trimesh
 
 import glphong
 from glphong.core.timing import alternating_medians
+from glphong.shaders.binding import binding
 
 
 def _scene(materials, lights):
@@ -77,7 +78,7 @@ def main():
                    "ratio_uber_over_specialised": med["uber"] / med["specialised"],
                    "compile_ms_specialised": 1000 * compile_s["specialised"], "compile_ms_uber": 1000 * compile_s["uber"],
                    "first_frame_ms_specialised": 1000 * first_s["specialised"], "first_frame_ms_uber": 1000 * first_s["uber"],
-                   "programs_specialised": len({scene.program_key(o) for o in scene.objects})}
+                   "programs_specialised": len({binding(scene).program_key(o) for o in scene.objects})}
             rows.append(row)
             print(f"{name:18s} {args.size}x{args.size} {backend}: specialised {row['specialised_ms']:.1f} ms, "
                   f"uber {row['uber_ms']:.1f} ms, uber/specialised {row['ratio_uber_over_specialised']:.2f}x; "

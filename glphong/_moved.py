@@ -16,7 +16,10 @@ import importlib.util
 import sys
 import warnings
 
-__all__ = ["MOVED", "PUBLIC", "install", "target_of"]
+from glphong.scene.scene import Scene
+from glphong.shaders.binding import binding
+
+__all__ = ["MOVED", "PUBLIC", "MOVED_METHODS", "install", "target_of"]
 
 #: deprecated old path -> new path (removed in the release after next)
 MOVED = {
@@ -49,6 +52,7 @@ MOVED = {
     "glphong.bench": "glphong.tools.bench",
     "glphong.speed": "glphong.tools.speed",
     "glphong.expressions": "glphong.tools.expressions",
+    "glphong.scene.numerics": "glphong.shaders.numerics",
 }
 #: documented old path -> new path, answered without a warning
 PUBLIC = {
@@ -59,6 +63,26 @@ PUBLIC = {
     "glphong.reference": "glphong.checks.reference",
     "glphong.verify": "glphong.checks.verify",
 }
+
+
+#: deprecated ``Scene`` method -> its new place: the scene is data, and the program side reads it
+#: (``scene.program_key(obj)`` is ``glphong.shaders.binding.binding(scene).program_key(obj)``)
+MOVED_METHODS = {name: "glphong.shaders.binding.binding(scene)." + name for name in (
+    "program_key", "gbuffer_needs", "light_keys", "shadow_setups", "light_uniform_values", "uniform_values",
+    "frame_uniform_values", "object_uniform_values")}
+
+
+def _moved_method(name):
+    """A ``Scene`` method that warns once per call site and answers through the scene's binding."""
+
+    def method(self, *args, **kwargs):
+        warnings.warn(f"Scene.{name} moved to {MOVED_METHODS[name]}; the old method goes in the release after next "
+                      "(see the changelog)", DeprecationWarning, stacklevel=2)
+        return getattr(binding(self), name)(*args, **kwargs)
+
+    method.__name__ = method.__qualname__ = name
+    method.__doc__ = f"Deprecated: `{MOVED_METHODS[name]}`."
+    return method
 
 
 def target_of(name):
@@ -101,8 +125,11 @@ def _caller_level():
 
 
 def install():
-    """Register the `PUBLIC` paths and put the finder on ``sys.meta_path``, once (``import glphong`` does
-    this, after importing the modules the public paths name)."""
+    """Register the `PUBLIC` paths, put the finder on ``sys.meta_path`` and give ``Scene`` its `MOVED_METHODS`,
+    once (``import glphong`` does this, after importing the modules the public paths name)."""
+    for name in MOVED_METHODS:
+        if name not in vars(Scene):
+            setattr(Scene, name, _moved_method(name))
     for old, new in PUBLIC.items():
         sys.modules.setdefault(old, importlib.import_module(new))
     if not any(isinstance(finder, _MovedFinder) for finder in sys.meta_path):

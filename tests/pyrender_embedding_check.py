@@ -14,6 +14,7 @@ import trimesh  # noqa: E402
 
 import glphong  # noqa: E402
 from glphong.integrations.pyrender import GlphongMaterial, enable, glphong_lights_of, scene_from_pyrender  # noqa: E402
+from glphong.shaders.binding import binding  # noqa: E402
 
 
 def translation(x, y, z):
@@ -67,7 +68,7 @@ def main(platform):
     with glphong.Renderer(width, height, backend=platform, samples=samples, numerics="stable") as g:
         ours = g.render_srgb8(glphong_scene)
         frame = g.render(glphong_scene)
-        own_chunks = [g.programs.get(glphong_scene.program_key(o)).key.fragment_chunks() for o in glphong_scene.objects]
+        own_chunks = [g.programs.get(binding(glphong_scene).program_key(o)).key.fragment_chunks() for o in glphong_scene.objects]
     interior = frame.coverage == 1.0
     for _ in range(2):  # erode by 2 px: silhouettes are compared apart
         interior[1:-1, 1:-1] &= interior[:-2, 1:-1] & interior[2:, 1:-1] & interior[1:-1, :-2] & interior[1:-1, 2:]

@@ -19,6 +19,7 @@ import trimesh
 import glphong
 from glphong import reference
 from glphong.gpu.contexts import BACKENDS
+from glphong.shaders.binding import binding
 
 SPHERE_SIZE = 128
 SPHERE_LEVELS = (1, 2, 3, 4, 5)
@@ -93,8 +94,8 @@ def sphere_error(renderer, level):
     w = h = SPHERE_SIZE
     scene, obj = sphere_scene(level)
     frame = renderer.render(scene)
-    key = scene.program_key(obj)
-    uniforms = {k: v.astype(np.float64) for k, v in scene.uniform_values(0, key, w / h).items()}
+    key = binding(scene).program_key(obj)
+    uniforms = {k: v.astype(np.float64) for k, v in binding(scene).uniform_values(0, key, w / h).items()}
     hit, position, normal = ray_cast_sphere(scene.camera, w, h)
     exact = np.zeros((h, w, 3))
     exact[hit] = reference.shade_point(position[hit], normal[hit], np.ones(int(hit.sum()), bool),

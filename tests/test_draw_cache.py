@@ -13,6 +13,7 @@ import pytest
 
 import glphong
 from glphong import primitives
+from glphong.shaders.binding import binding
 
 
 def _scene():
@@ -68,7 +69,7 @@ def test_unchanged_uniforms_are_not_written_again(glphong_backend, glphong_make_
     renderer.render(scene)
     assert calls == []  # one object per program here: nothing changed since the last frame
     with renderer.context:
-        values = scene.uniform_values(0, program.key, 1.0)
+        values = binding(scene).uniform_values(0, program.key, 1.0)
         values["u_eye"] = np.zeros(4, np.float32)
         program.bind(values)  # another path writes a uniform: the next frame must restore it
     assert "u_eye" in calls

@@ -57,3 +57,37 @@ def test_every_moved_target_exists():
 
     for new in list(_moved.MOVED.values()) + list(_moved.PUBLIC.values()):
         importlib.import_module(new)
+
+
+def test_scene_binding_methods_answer_through_the_binding_with_a_warning():
+    """The program-binding methods ``Scene`` had (``scene.program_key(obj)``, ``scene.uniform_values(...)``, ...)
+    answer for one release through `glphong.shaders.binding`, each call warning with the new place."""
+    import warnings
+
+    import numpy as np
+
+    import glphong
+    from glphong.shaders.binding import binding
+
+    scene = glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0)),
+                          lights=[glphong.PointLight((2, 2, 2), 100.0)], ambient=glphong.AmbientLight(0.1))
+    scene.add(glphong.primitives.sphere(1), glphong.Phong(0.2, 0.5, 10.0))
+    bound, obj = binding(scene), scene.objects[0]
+    assert binding(scene) is bound and bound.scene is scene
+    key = bound.program_key(obj)
+    calls = {"program_key": (obj,), "gbuffer_needs": (), "light_keys": (), "light_uniform_values": (key,),
+             "uniform_values": (0, key, 1.0), "frame_uniform_values": (key, 1.0), "object_uniform_values": (0, key),
+             "shadow_setups": (key.lights, 64)}
+    assert set(calls) == set(_moved.MOVED_METHODS)
+    for name, args in calls.items():
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            old = getattr(scene, name)(*args)
+        new = getattr(bound, name)(*args)
+        assert [str(w.message).split(";")[0] for w in caught] == \
+            [f"Scene.{name} moved to glphong.shaders.binding.binding(scene).{name}"]
+        assert caught[0].filename == __file__  # the warning points at the caller
+        if isinstance(new, dict):
+            assert new.keys() == old.keys() and all(np.array_equal(new[k], old[k]) for k in new)
+        else:
+            assert new == old

@@ -14,7 +14,7 @@ from glphong.gpu.describe import describe, format_descriptions
 from glphong.materials import registered_models
 from glphong.scene import primitives
 from glphong.scene.geometry import MeshData
-from glphong.scene.numerics import (FALLOFF_LIMIT, LOBE_TAIL_Q, NORMAL_LENGTHS, numerics_decisions, numerics_pieces,
+from glphong.shaders.numerics import (FALLOFF_LIMIT, LOBE_TAIL_Q, NORMAL_LENGTHS, numerics_decisions, numerics_pieces,
                                     normal_range)
 from glphong.shaders.key import NUMERICS_DEFINES, NUMERICS_PIECES, ProgramKey
 from glphong.tools.speed import speed_scenes

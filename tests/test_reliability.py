@@ -8,6 +8,7 @@ import pytest
 import glphong
 from glphong import primitives
 from glphong.testing import assert_render_matches
+from glphong.shaders.binding import binding
 
 FLT_MAX = float(np.finfo(np.float32).max)
 
@@ -58,13 +59,13 @@ def test_subnormal_values_are_flushed_where_uniforms_are_made(glphong_renderer):
     alike, so GPU and twin agree (was: verify failed)."""
     glphong_renderer.resize(32, 32)
     scene = _scene(glphong.Lambert(1e-40), None, ambient=glphong.AmbientLight(3e38))
-    key = scene.program_key(scene.objects[0])
-    assert scene.uniform_values(0, key, 1.0)["u_lambert_kd"].tolist() == [0.0, 0.0, 0.0]
+    key = binding(scene).program_key(scene.objects[0])
+    assert binding(scene).uniform_values(0, key, 1.0)["u_lambert_kd"].tolist() == [0.0, 0.0, 0.0]
     frame = glphong_renderer.render(scene)
     np.testing.assert_array_equal(frame.radiance[frame.mask], 0.0)
     assert_render_matches(scene, glphong_renderer)
     lit = _scene(glphong.Lambert(0.3), glphong.PointLight((0.0, 0.0, 3.0), 4 * np.pi * 1e-39))  # I = 1e-39 W/sr
-    assert lit.uniform_values(0, lit.program_key(lit.objects[0]), 1.0)["u_point_intensity"].tolist() == [[0.0] * 3]
+    assert binding(lit).uniform_values(0, binding(lit).program_key(lit.objects[0]), 1.0)["u_point_intensity"].tolist() == [[0.0] * 3]
     assert_render_matches(lit, glphong_renderer)
 
 
@@ -322,7 +323,7 @@ def test_no_stray_warnings_before_the_errors_or_from_extreme_valid_input():
         warnings.simplefilter("error")  # any warning fails
         with pytest.raises(ValueError, match="positions must be finite"):
             glphong.scene.geometry.MeshData.from_trimesh(inf_vertex)
-        values = scene.uniform_values(0, scene.program_key(scene.objects[0]), 1.0)
+        values = binding(scene).uniform_values(0, binding(scene).program_key(scene.objects[0]), 1.0)
     assert all(v.dtype == np.float32 for v in values.values())
 
 

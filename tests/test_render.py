@@ -10,6 +10,7 @@ import glphong
 from glphong.shaders.key import ProgramKey, program_key, uber_key
 from glphong.gpu.programs import Program, ShaderCompileError, UniformError
 from glphong.shaders.assembly import name_chunks as _name_chunks
+from glphong.shaders.binding import binding
 
 BACKENDS = ("egl", "osmesa")
 
@@ -152,7 +153,7 @@ def test_program_cache_counts_and_no_recompilation(renderer):
         scene.add(sphere, m, pose=translation(x, 0, 0))
     before = len(renderer.programs)
     renderer.render(scene)
-    keys = {scene.program_key(o) for o in scene.objects}
+    keys = {binding(scene).program_key(o) for o in scene.objects}
     assert len(keys) == 3  # the two Phong materials share one program
     assert len(renderer.programs) - before <= 3
     misses = renderer.programs.misses

@@ -12,6 +12,7 @@ from glphong import reference
 from glphong.gpu.describe import describe, format_descriptions
 from glphong.shaders.key import uber_key
 from glphong.materials import registered_models
+from glphong.shaders.binding import binding
 
 
 @pytest.fixture(scope="module", params=("egl", "osmesa"))
@@ -70,7 +71,7 @@ def test_uber_renderer_compiles_one_radiance_program(renderers):
 def test_mixed_scene_compiles_one_program_per_distinct_key(renderers):
     specialised, _ = renderers
     scene = scene_with(*MATERIALS)
-    distinct = {scene.program_key(o) for o in scene.objects}
+    distinct = {binding(scene).program_key(o) for o in scene.objects}
     assert len(distinct) == 6  # Lambert ka/no-ka, Phong two-/one-sided, Blinn, Blinn without kd
     before = set(specialised.programs.keys())
     specialised.render(scene)
@@ -88,7 +89,7 @@ def test_unlit_scene_neither_uploads_nor_binds_normals(renderers):
     scene = scene_with(glphong.Lambert(0.3, ka=0.2), lights=[], ambient=None)
     frame = specialised.render(scene)
     np.testing.assert_array_equal(frame.radiance[frame.mask], np.float32(0.2))
-    key = scene.program_key(scene.objects[0])
+    key = binding(scene).program_key(scene.objects[0])
     assert not key.has_normal and key.attributes() == ("in_position",)
     with specialised.context:
         program = specialised.programs.get(key)
@@ -134,8 +135,8 @@ def test_twin_follows_the_key(monkeypatch):
     monkeypatch.setattr(BlinnLobe, "response", forbidden)
     material = glphong.Phong(0.3, 0.0, 10.0)  # ks = 0: the lobe term vanishes
     scene = scene_with(material)
-    key = scene.program_key(scene.objects[0])
-    u = {k: v.astype(np.float64) for k, v in scene.uniform_values(0, key, 1.0).items()}
+    key = binding(scene).program_key(scene.objects[0])
+    u = {k: v.astype(np.float64) for k, v in binding(scene).uniform_values(0, key, 1.0).items()}
     out = reference.shade_point(np.zeros((1, 3)), np.array([[0.0, 0.0, 1.0]]), np.array([True]), None, key, u, material)
     assert out.shape == (1, 3) and out[0, 0] > 0
 
@@ -144,7 +145,7 @@ def test_uber_limit_is_enforced():
     lights = [glphong.PointLight((0, 0, 3 + i), 1.0) for i in range(9)]
     scene = scene_with(glphong.Lambert(0.3), lights=lights)
     with pytest.raises(ValueError, match="at most 8 lights of each kind"):
-        scene.uniform_values(0, uber_key([glphong.Lambert(0.3)]), 1.0)
+        binding(scene).uniform_values(0, uber_key([glphong.Lambert(0.3)]), 1.0)
 
 
 def test_cli_describe_default_scene():

@@ -32,6 +32,7 @@ from glphong.scene.geometry import MeshData, tangents_from_uvs
 from glphong.materials import MaterialModel, Param, Properties
 from glphong.testing import assert_render_matches, assert_twin_matches, direction_sets
 from glphong.checks.tolerances import EPS
+from glphong.shaders.binding import binding
 
 RNG_SEED = 20261207
 BACKENDS = ("egl", "osmesa")
@@ -422,7 +423,7 @@ def test_aniso_program_key_and_gbuffer_carry_the_tangent(renderer):
     assert "in_tangent" in key.attributes() and "in_uv" not in key.attributes()
     gkey = renderer.program_key(scene, obj, "gbuffer")
     assert gkey.has_tangent and "in_tangent" in gkey.attributes()
-    assert scene.gbuffer_needs() == frozenset({"tangent"})
+    assert binding(scene).gbuffer_needs() == frozenset({"tangent"})
 
 
 def test_builtin_materials_have_no_tangent(renderer):
@@ -432,7 +433,7 @@ def test_builtin_materials_have_no_tangent(renderer):
         assert not key.has_tangent and not key.has_uv
         assert "in_tangent" not in key.attributes() and "in_uv" not in key.attributes()
         assert not renderer.program_key(scene, obj, "gbuffer").has_tangent
-    assert scene.gbuffer_needs() == frozenset()
+    assert binding(scene).gbuffer_needs() == frozenset()
     gbuffer = renderer.gbuffer(scene)
     assert gbuffer.tangent is None and gbuffer.uv is None
     assert gbuffer.mask.sum() > 4000
@@ -546,7 +547,7 @@ def test_tangent_and_uv_terms_in_one_scene(renderer):
     then uv) for every object, and the render matches the twin."""
     scene = oblique_scene(ANISO, plane=False)
     scene.add(primitives.plane(3.0, 2), RAMP, name="plane")
-    assert scene.gbuffer_needs() == frozenset({"tangent", "uv"})
+    assert binding(scene).gbuffer_needs() == frozenset({"tangent", "uv"})
     report = assert_render_matches(scene, renderer)
     assert report.covered_pixels > 4000
     gbuffer = renderer.gbuffer(scene)

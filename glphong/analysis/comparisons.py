@@ -53,8 +53,9 @@ import numpy as np
 from glphong.gpu.contexts import create_context, release_offscreen
 from glphong.shaders.assembly import assemble
 from glphong.scene.camera import IntrinsicsCamera, OrthographicCamera
-from glphong.scene.numerics import with_numerics
+from glphong.shaders.numerics import with_numerics
 from glphong.scene.scene import Scene
+from glphong.shaders.binding import binding
 
 __all__ = ["HandWrittenRenderer", "PyrenderRenderer", "to_pyrender", "pyrender_roughness", "import_pyrender",
            "SHADERS", "PYRENDER_PLATFORMS"]
@@ -111,7 +112,7 @@ class HandWrittenRenderer:
 
     def key(self, scene, obj):
         """The `ProgramKey` this renderer draws ``obj`` with."""
-        key = scene.program_key(obj)
+        key = binding(scene).program_key(obj)
         return replace(key, formulation="naive") if self.shader == "textbook" else with_numerics(key, scene, obj)
 
     def prepare(self, scene):
@@ -149,7 +150,7 @@ class HandWrittenRenderer:
                 vao = mgl.vertex_array(program, content, mesh["indices"], index_element_size=4)
                 self._vaos.append(vao)
                 uniforms = []
-                for name, value in scene.uniform_values(index, key, aspect).items():
+                for name, value in binding(scene).uniform_values(index, key, aspect).items():
                     if program.get(name, None) is None:
                         if key.formulation == "naive":
                             continue  # the compiler removed an input the naive program never reads

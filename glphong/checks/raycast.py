@@ -18,7 +18,7 @@ Conventions
 - Shading: exactly the twin.  A `glphong.Scene` is built from the camera, the lights and
   the ambient light, each object's material is added with a dummy one-triangle mesh, and
   each hit is shaded by ``reference.shade_point(p, n, valid, u['u_eye'], key, u, material)`` with
-  ``u = scene.uniform_values(index, key, width / height)`` cast to float64: the very
+  ``u = binding(scene).uniform_values(index, key, width / height)`` cast to float64: the very
   uniforms the GPU receives, so material and light parameters are the float32-rounded
   inputs (relative rounding <= 2^-24) while positions and normals are exact float64.
   The point ``p = o + t d`` and the outward normal come from the exact surface.
@@ -42,6 +42,7 @@ from glphong.materials import Material
 from glphong.materials.table import uniform_as
 from glphong.checks.reference import safe_normalize, shade_point
 from glphong.scene.scene import Scene
+from glphong.shaders.binding import binding
 
 __all__ = ["Sphere", "Plane", "AnalyticObject", "RayCastImage", "stratified_offsets",
            "render_reference", "compare_to_reference", "T_MIN", "CHUNK_RAYS"]
@@ -317,8 +318,8 @@ def render_reference(camera, objects, lights=(), ambient=None, width=256, height
     shading = []
     for index, obj in enumerate(objects):
         scene_obj = scene.add(dummy, obj.material)
-        key = scene.program_key(scene_obj)
-        u = {k: uniform_as(v, np.float64) for k, v in scene.uniform_values(index, key, width / height).items()}
+        key = binding(scene).program_key(scene_obj)
+        u = {k: uniform_as(v, np.float64) for k, v in binding(scene).uniform_values(index, key, width / height).items()}
         shading.append((key, u))
 
     offsets = stratified_offsets(n)

@@ -36,6 +36,7 @@ from glphong.shaders.generated import closed_form
 from glphong.shaders.key import lod_slots
 from glphong.lights import light_for_key
 from glphong.materials import registered_models
+from glphong.shaders.binding import binding
 
 __all__ = [
     "safe_normalize", "plain_normalize", "log_one_minus_series", "frame_from_tangent", "shading_frame", "surface_normal", "point_irradiance", "range_window", "log_one_minus", "lobe_from_delta",
@@ -406,13 +407,13 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None):
         selection = gbuffer.object_index == index
         if not selection.any():
             continue
-        key = scene.program_key(obj)
+        key = binding(scene).program_key(obj)
         if key.shadow_slots:
             if shadows is None:
                 raise ValueError("the scene has lights with shadows=True: the twin needs the renderer's shadow settings "
                                  "(shadows=renderer.shadow_settings)")
             key = replace(key, shadow_size=shadows[0], shadow_filter=shadows[1])
-        uniforms = {k: uniform_as(v, dtype) for k, v in scene.uniform_values(index, key, width / height).items()}
+        uniforms = {k: uniform_as(v, dtype) for k, v in binding(scene).uniform_values(index, key, width / height).items()}
         position = gbuffer.position[selection].astype(dtype)
         n_valid, n, _ = safe_normalize(gbuffer.normal[selection].astype(dtype))
         tangent = gbuffer.tangent[selection].astype(dtype) if key.has_tangent else None
@@ -437,7 +438,7 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None):
 
 def _visibility(scene, key, position, normal, filter_radius):
     """Per light of ``key`` in loop order: None, or its ray-cast visibility ``(exact, low, high)``."""
-    setups = {(s.kind, s.index): s for s in scene.shadow_setups(key.lights, key.shadow_size)}
+    setups = {(s.kind, s.index): s for s in binding(scene).shadow_setups(key.lights, key.shadow_size)}
     out = []
     for light in key.lights:
         if light.extended:  # no shadows; not in incident_light's list

@@ -33,9 +33,10 @@ from glphong.materials.phong import Phong
 from glphong.scene.camera import PerspectiveCamera
 from glphong.scene.geometry import MeshData
 from glphong.lights import AmbientLight, LightModel, light_named, registered_lights
-from glphong.scene.numerics import numerics_pieces
+from glphong.shaders.numerics import numerics_pieces
 from glphong.scene.scene import Scene
 from glphong.shaders.key import NUMERICS_PIECES, ProgramKey, TermKey
+from glphong.shaders.binding import binding
 
 __all__ = ["Case", "CASES", "case_scene", "case_inputs", "generic_cases", "lobe_cases", "cases_for", "VALID_RANGES", "oracle", "StabilityRow", "StabilityReport", "run_stability", "case_numerics"]
 
@@ -70,8 +71,8 @@ def case_inputs(case, scene=None):
     ``scene`` is `case_scene` of the case when given (to build it once), else built here.
     """
     scene = case_scene(case) if scene is None else scene
-    key = replace(scene.program_key(scene.objects[0]), output="points", two_sided=False)
-    uniforms = scene.uniform_values(0, key, 1.0)
+    key = replace(binding(scene).program_key(scene.objects[0]), output="points", two_sided=False)
+    uniforms = binding(scene).uniform_values(0, key, 1.0)
     for name in ("u_model", "u_view_projection", "u_normal_matrix"):
         uniforms.pop(name, None)
     return key, uniforms
@@ -351,7 +352,7 @@ class StabilityReport:
 
 
 def case_numerics(case, scene=None):
-    """The pieces ``Renderer(numerics='auto')`` specialises for the case's object (`glphong.scene.numerics`), less
+    """The pieces ``Renderer(numerics='auto')`` specialises for the case's object (`glphong.shaders.numerics`), less
     'normal': the case's point is shaded with its own normal, which the points program normalises stably (sorted
     tuple).  The point, the origin, lies in the object's box, over which the pieces were decided."""
     scene = case_scene(case) if scene is None else scene

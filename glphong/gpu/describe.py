@@ -5,9 +5,10 @@ import numpy as np
 
 from glphong.shaders.assembly import assemble, effective_source
 from glphong.scene.culling import culling_decision
-from glphong.scene.numerics import allowed_pieces, numerics_decisions, with_numerics
+from glphong.shaders.numerics import allowed_pieces, numerics_decisions, with_numerics
 from glphong.scene.scene import Scene
 from glphong.shaders.key import model_chunk_label
+from glphong.shaders.binding import binding
 
 __all__ = ["ProgramDescription", "describe", "format_descriptions"]
 
@@ -33,7 +34,7 @@ class ProgramDescription:
         Per drawn object, whether its back faces are culled and why (`glphong.scene.culling`).
     numerics : tuple of str
         With ``numerics='auto'``: per drawn object and piece of arithmetic, whether it is specialised and why
-        (`glphong.scene.numerics`); empty otherwise.
+        (`glphong.shaders.numerics`); empty otherwise.
     """
 
     key: object
@@ -78,7 +79,7 @@ def describe(scenes, renderer=None, gbuffer=False):
     for scene in scenes:
         for obj in scene.objects:
             for output in outputs:
-                key = renderer.program_key(scene, obj, output) if renderer else scene.program_key(obj, output)
+                key = renderer.program_key(scene, obj, output) if renderer else binding(scene).program_key(obj, output)
                 auto = renderer is None or renderer.numerics == "auto"
                 decisions = numerics_decisions(scene, obj, allowed_pieces(key)) if auto else ()
                 if renderer is None:

@@ -1,7 +1,7 @@
 """Offscreen rendering: scene -> program keys -> cached programs -> float32 images.
 
-One render: for each object, the scene gives its `ProgramKey`; the cache gives the
-program; the scene gives the uniforms, bound strictly; only the vertex attributes
+One render: for each object, the scene's binding (`glphong.shaders.binding`) gives its `ProgramKey`; the
+cache gives the program; the binding gives the uniforms, bound strictly; only the vertex attributes
 the program reads are bound; the draw goes to an RGBA32F target that is read back
 as float32 with row 0 at the top.
 """
@@ -19,8 +19,9 @@ from glphong.gpu.frame import Frame, GBuffer
 from glphong.gpu.resources import ORPHANS, ORPHANS_LOCK, MeshBuffers, release_orphans, release_resources, release_targets
 from glphong.gpu.contexts import check_not_forked, create_context
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
-from glphong.scene.numerics import NUMERICS, allowed_pieces, view_decision, with_numerics
+from glphong.shaders.binding import binding
 from glphong.shaders.key import FORMULATIONS, GBUFFER_PLANES, EncodeKey, uber_key
+from glphong.shaders.numerics import NUMERICS, allowed_pieces, view_decision, with_numerics
 from glphong.gpu.shadows import ShadowMaps
 from glphong.gpu.programs import ProgramCache
 from glphong.scene.scene import Scene
@@ -99,7 +100,7 @@ class Renderer:
         for measuring what stability costs and buys; not for real use.
     numerics : {'auto', 'stable'}
         'auto' (default): per object, the pieces of the stable formulation that the scene's ranges prove
-        unnecessary are compiled in their cheaper form (`glphong.scene.numerics`, docs/design.md section 3,
+        unnecessary are compiled in their cheaper form (`glphong.shaders.numerics`, docs/design.md section 3,
         "Stability where a scene needs it"), which keeps every pixel inside the error band; `glphong.describe`
         shows each decision and its reason.  'stable': the stable formulation everywhere.
     culling : {'auto', 'off'}
@@ -344,7 +345,7 @@ class Renderer:
         GBuffer
         """
         self._check_scene(scene)
-        needs = scene.gbuffer_needs()
+        needs = binding(scene).gbuffer_needs()
         extras = [n for n in GBUFFER_PLANES if n in needs]
         with self.context:
             fbo = self._target(("gbuffer", *extras))
@@ -367,11 +368,11 @@ class Renderer:
         """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading)."""
         per_vertex = output == "radiance" and self.shading == "vertex"
         if output == "radiance" and not self.specialise:
-            if any(k.shadowed for k in scene.light_keys()):
+            if any(k.shadowed for k in binding(scene).light_keys()):
                 raise ValueError("the uber-shader holds no shadow maps, and the scene has lights with shadows=True: "
                                  "render it with specialise=True")
             return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex, scene.lights)
-        key = scene.program_key(obj, output)
+        key = binding(scene).program_key(obj, output)
         if key.shadow_slots:
             if per_vertex:
                 raise ValueError("shadows are looked up per pixel: a scene with lights with shadows=True needs "
@@ -411,12 +412,13 @@ class Renderer:
 
     def _shadow_values(self, scene, output):
         """Draw the shadow maps the frame's programs read; their samplers' values (dict, empty without shadows).
-        Every lit program shares the scene's light keys, so the maps are the scene's (`Scene.shadow_setups`)."""
-        lights = scene.light_keys()
+        Every lit program shares the scene's light keys, so the maps are the scene's (`glphong.shaders.binding.SceneBinding.shadow_setups`)."""
+        bound = binding(scene)
+        lights = bound.light_keys()
         if output not in ("radiance", "display") or not any(k.shadowed for k in lights):
             return {}
         casters = [obj for obj in scene.objects if obj.casts_shadow]
-        return self._shadow_maps.draw(scene.shadow_setups(lights, self.shadow_map_size), casters, self.programs,
+        return self._shadow_maps.draw(bound.shadow_setups(lights, self.shadow_map_size), casters, self.programs,
                                       lambda mesh, program: self._mesh_buffers(mesh).vertex_array(self._mgl, program))
 
     def _draw(self, scene, output, fbo, frame_values=None):
@@ -457,7 +459,8 @@ class Renderer:
         call adds to every program's frame pack (the display programs' ``u_exposure``), ``shadow_values`` the
         shadow maps, added to the programs that read them."""
         drop = self.formulation == "naive"
-        state = (output, scene.light_keys(), scene.ambient_radiance, self.formulation,
+        bound = binding(scene)
+        state = (output, bound.light_keys(), scene.ambient_radiance, self.formulation,
                  self.shading, self.specialise, self.culling, self.numerics)
         camera = scene.camera
         shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
@@ -473,8 +476,8 @@ class Renderer:
             if shared is not None or entry is None or entry.state != state or entry.index != index:
                 key = shared or self.program_key(scene, obj, output)
                 program = self.programs.get(key)
-                values = scene.uniform_values(index, key, aspect) if shared is not None else \
-                    scene.object_uniform_values(index, key)
+                values = bound.uniform_values(index, key, aspect) if shared is not None else \
+                    bound.object_uniform_values(index, key)
                 vao = self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program)
                 sphere = world_sphere(obj.mesh, obj.pose) if self.culling == "auto" and closed_outward(obj.mesh)[0] else None
                 entry = _ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
@@ -483,7 +486,7 @@ class Renderer:
                     per_object[output] = entry
             frame = frame_packs.get(entry.program)
             if frame is None:
-                values = {} if shared is not None else scene.frame_uniform_values(entry.key, aspect)
+                values = {} if shared is not None else bound.frame_uniform_values(entry.key, aspect)
                 shadows = (shadow_values or {}) if entry.key.shadow_slots else {}
                 pack = entry.program.pack(values | (frame_values or {}) | shadows, drop)
                 frame = frame_packs[entry.program] = (pack, tuple(name for name, _, _ in pack))
@@ -494,7 +497,7 @@ class Renderer:
 
     def _same_view_piece(self, entry, obj, camera):
         """True where ``entry``'s key needs no change for ``camera``: its 'view' piece (the only piece that depends on
-        the camera, `glphong.scene.numerics`) is decided the same way; the entry then remembers ``camera``."""
+        the camera, `glphong.shaders.numerics`) is decided the same way; the entry then remembers ``camera``."""
         key = entry.key
         if self.numerics == "auto" and "view" in allowed_pieces(key) \
                 and view_decision(obj, camera)[0] != ("view" in key.numerics):

@@ -161,7 +161,7 @@ class LightModel:
     pyrender_type : str or None
         The pyrender light class it maps (`from_pyrender`, `to_pyrender`).
     numerics_bounds : dict
-        The pieces of ``Renderer(numerics='auto')`` the kind's GLSL reads (glphong.scene.numerics), each with the uniform
+        The pieces of ``Renderer(numerics='auto')`` the kind's GLSL reads (glphong.shaders.numerics), each with the uniform
         its bound is taken over: ``'light'`` (the direction by ``plain_normalize`` under ``NAIVE_LIGHT``) with the
         kind's position, ``'falloff'`` (``point_irradiance`` under ``NAIVE_FALLOFF``) with its intensity [W/sr].
         Default empty: the kind's arithmetic is never specialised.

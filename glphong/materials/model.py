@@ -285,7 +285,7 @@ class MaterialModel(Material):
     lobe_exponent : str or None
         The parameter that is the exponent ``q`` of every ``lobe_from_delta(delta, q)`` the GLSL evaluates, for a
         model that calls lobe.glsl: ``Renderer(numerics='auto')`` leaves out the lobes' log branch where it is at
-        least 151 (`glphong.scene.numerics`).  None (default): a model that uses lobe.glsl keeps the branch.
+        least 151 (`glphong.shaders.numerics`).  None (default): a model that uses lobe.glsl keeps the branch.
 
     Methods a definition provides
     -----------------------------

@@ -216,7 +216,7 @@ class ProgramKey:
         only to show why the stable one exists.
     numerics : tuple of str
         With formulation 'stable': the pieces of `NUMERICS_PIECES` specialised because the scene's ranges prove
-        the result stays inside the error band (``Renderer(numerics='auto')``, `glphong.scene.numerics`), sorted;
+        the result stays inside the error band (``Renderer(numerics='auto')``, `glphong.shaders.numerics`), sorted;
         each sets its define of `NUMERICS_DEFINES`.
     uber : bool
         The uber-shader: its terms (every built-in one and the scene's own) and `UBER_MAX_LIGHTS`

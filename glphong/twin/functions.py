@@ -187,7 +187,7 @@ def surface_normal(n, t, b, texel, scale):
 # --------------------------------------------------------------------------- lights.glsl
 def point_irradiance(intensity, d, textbook=False):
     """E1 as ``min((I / d) / d, FLT_MAX)`` (lights.glsl); ``textbook``: its ``NAIVE_FALLOFF`` form ``I / (d d)``, which
-    ``numerics='auto'`` compiles where the ranges prove it (`glphong.scene.numerics`).
+    ``numerics='auto'`` compiles where the ranges prove it (`glphong.shaders.numerics`).
 
     Parameters
     ----------
@@ -273,7 +273,7 @@ def lobe_from_delta(delta, q, tail_zero=False):
 
     Returns 1 for q == 0, 0 for delta >= 1, else ``exp(max(q ln(1 - delta), -104))``; ``q`` a scalar or
     an array broadcasting with ``delta`` (a per-point exponent).  ``tail_zero``: the ``LOBE_TAIL_ZERO`` form, 0
-    from delta = 1/2 on (the same values where every q is at least ``glphong.scene.numerics.LOBE_TAIL_Q``).
+    from delta = 1/2 on (the same values where every q is at least ``glphong.shaders.numerics.LOBE_TAIL_Q``).
     """
     delta = np.asarray(delta)
     dtype = delta.dtype if delta.dtype.kind == "f" else np.float64

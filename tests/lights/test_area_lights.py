@@ -30,6 +30,7 @@ from glphong.shaders.generated import lights_chunk
 from glphong.shaders import assembly
 from glphong.twin.quadrature import disk_integral
 from glphong.shaders.key import uber_key
+from glphong.shaders.binding import binding
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -208,13 +209,13 @@ def test_the_polygon_and_rect_agree():
 def test_left_out_where_no_scene_needs_it():
     point_only = glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0)), [glphong.PointLight((0, 0, 2), 10)])
     point_only.add(primitives.plane(), glphong.Phong(0.2, 0.3, 20.0))
-    key = point_only.program_key(point_only.objects[0])
+    key = binding(point_only).program_key(point_only.objects[0])
     assert "area" not in key.light_library_chunks() and all(t.integral is None for t in key.terms)
     closed = _scene(LIGHTS["rect"]())
-    key = closed.program_key(closed.objects[0])  # Phong, integer q: no sample loop, no sampled response
+    key = binding(closed).program_key(closed.objects[0])  # Phong, integer q: no sample loop, no sampled response
     text = lights_chunk(key)
     assert "rect_irradiance" in text and "rect_lobe" in text and "rect_sample" not in text
-    key = closed.program_key(closed.objects[1])  # Blinn-Phong: Lambert in closed form, the lobe sampled
+    key = binding(closed).program_key(closed.objects[1])  # Blinn-Phong: Lambert in closed form, the lobe sampled
     text = lights_chunk(key)
     assert "rect_irradiance" in text and "rect_sample" in text and "rect_lobe" not in text
 

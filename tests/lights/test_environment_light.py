@@ -29,6 +29,7 @@ from glphong.materials.phong import PhongLobe
 from glphong.shaders.key import program_key
 from glphong.twin import environment as env
 from glphong.twin.environment_quadrature import environment_integral
+from glphong.shaders.binding import binding
 
 
 def _points_gpu(backend, material, light, normals, eye=(0.0, 0.0, 5.0)):
@@ -173,11 +174,11 @@ def test_lambert_only_uploads_the_irradiance_map_alone():
     scene.add(primitives.sphere(1, 0.5), glphong.Lambert(0.5))
     scene.add(primitives.sphere(1, 0.5), glphong.Phong(0.5, 0.2, 10.0))
     scene.add(primitives.sphere(1, 0.5), glphong.BlinnPhong(0.5, 0.2, 10.0))
-    given = [set(scene.light_uniform_values(scene.program_key(obj))) for obj in scene.objects]
+    given = [set(binding(scene).light_uniform_values(binding(scene).program_key(obj))) for obj in scene.objects]
     assert given[0] == {"u_environment_irradiance", "u_environment_resolution"}
     assert given[1] == given[0] | {"u_environment_sh", "u_environment_frame"}
     assert {"u_environment_sample_direction", "u_environment_samples"} <= given[2]
-    assert "ENVIRONMENT_SH" not in dict(scene.program_key(scene.objects[0]).lights[0].defines)
+    assert "ENVIRONMENT_SH" not in dict(binding(scene).program_key(scene.objects[0]).lights[0].defines)
     assert program_key(glphong.Lambert(0.5), [glphong.PointLight((0, 0, 1), 10.0)], None).lights[0].defines == ()
 
 

@@ -21,6 +21,7 @@ from glphong.checks.stability import run_stability
 from glphong.lights import LightDefinitionError, LightModel, light_cases, registered_lights
 from glphong.materials import Param
 from glphong.testing import TwinMismatch, assert_light_matches
+from glphong.shaders.binding import binding
 
 EXAMPLE = Path(__file__).resolve().parent.parent.parent / "examples" / "custom_light.py"
 
@@ -124,17 +125,17 @@ def test_program_key_counts_kinds_generically():
               PhongLuminaire((0, 0, 1), (0, 0, -1), 1.0), glphong.PointLight((1, 0, 1), 1.0)]
     scene = glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0)), lights)
     scene.add(primitives.plane(2.0), glphong.Lambert(0.5))
-    key = scene.program_key(scene.objects[0])
+    key = binding(scene).program_key(scene.objects[0])
     assert [(k.name, k.count) for k in key.lights] == [("point", 2), ("spot", 1), ("luminaire", 1)]
     assert key.num_lights == 4 and key.light_count("point") == 2
     assert "lights=point*2+spot*1+luminaire*1" in key.describe()
     defines = dict(key.defines())
     assert defines["NUM_LUMINAIRE_LIGHTS"] == "1" and defines["NUM_LIGHTS"] == "4"
-    uniforms = scene.light_uniform_values(key)
+    uniforms = binding(scene).light_uniform_values(key)
     assert uniforms["u_point_position"].shape == (2, 3) and uniforms["u_luminaire_n"].shape == (1,)
     dark = glphong.Scene(scene.camera, [])
     dark.add(primitives.plane(2.0), glphong.Lambert(0.5))
-    assert dark.program_key(dark.objects[0]).lights == ()
+    assert binding(dark).program_key(dark.objects[0]).lights == ()
 
 
 def _define(**attributes):

@@ -20,6 +20,7 @@ import trimesh
 import glphong
 from glphong import primitives
 from glphong.checks.shadows import shadow_visibility
+from glphong.shaders.binding import binding
 from glphong.shaders import assembly
 
 SPHERE_CENTRE, SPHERE_RADIUS = np.array([0.0, 0.0, 0.7]), 0.5
@@ -125,7 +126,7 @@ def test_sphere_shadow_is_the_closed_form_cone(glphong_make_renderer):
     half_angle = np.max(np.arcsin(np.linalg.norm(edges[:, 0] - edges[:, 1], axis=1) / (2 * SPHERE_RADIUS)))
     inner = SPHERE_RADIUS * np.cos(half_angle) ** 2  # the polyhedron contains the sphere through its faces' centres
     key = renderer.program_key(scene, scene.objects[1])
-    (setup,) = scene.shadow_setups(key.lights, key.shadow_size)
+    (setup,) = binding(scene).shadow_setups(key.lights, key.shadow_size)
     exact, low, high = shadow_visibility(scene, setup, x, np.tile([0.0, 0.0, 1.0], (len(x), 1)), 0)
     assert np.all(exact[distance > SPHERE_RADIUS * (1 + 1e-9)] == 1.0)
     assert np.all(exact[distance < inner * (1 - 1e-9)] == 0.0)
@@ -176,16 +177,16 @@ def test_the_planted_scenes_pass_unplanted(name, kind, glphong_make_renderer):
 
 def test_what_a_scene_does_not_need_is_left_out(glphong_make_renderer):
     plain = sphere_over_plane("point")
-    key = plain.program_key(plain.objects[1])
+    key = binding(plain).program_key(plain.objects[1])
     assert key.shadow_slots and "shadows" in key.shading_chunks()
     dark = glphong.Scene(plain.camera, [glphong.PointLight((0.3, 0.2, 2.0), 60.0)])
     dark.add(primitives.plane(4.0), glphong.Lambert(0.6))
-    key = dark.program_key(dark.objects[0])
+    key = binding(dark).program_key(dark.objects[0])
     assert not key.shadow_slots and "shadows" not in key.shading_chunks()
     assert any("shadow maps" in line for line in key.left_out())
     nothing_casts = glphong.Scene(plain.camera, [_light("point")])
     nothing_casts.add(primitives.plane(4.0), glphong.Lambert(0.6), casts_shadow=False)
-    assert not nothing_casts.program_key(nothing_casts.objects[0]).shadow_slots
+    assert not binding(nothing_casts).program_key(nothing_casts.objects[0]).shadow_slots
     # a sphere that casts no shadow leaves the floor unshadowed: the same image as without shadows
     renderer = glphong_make_renderer(64, 48, "egl")
     ghost = glphong.Scene(plain.camera, [_light("point")])

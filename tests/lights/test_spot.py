@@ -16,6 +16,7 @@ from glphong.checks import reference
 from glphong.checks.tolerances import radiance_band
 from glphong.lights.spot import spot_falloff
 from glphong.shaders.key import light_keys
+from glphong.shaders.binding import binding
 
 EPS32 = 2.0 ** -24
 
@@ -113,7 +114,7 @@ def test_key_leaves_out_what_the_scene_lacks():
     assert light_keys([plain])[0].defines == ()
     assert light_keys([plain, ranged])[0].defines == (("RANGE", "1"),)
     scene = _plane_scene(plain)
-    key = scene.program_key(scene.objects[0])
+    key = binding(scene).program_key(scene.objects[0])
     assert [k.chunk.split("@")[0] for k in key.lights] == ["light:spot"]
     assert "lights" in key.shading_chunks() and "SPOT_RANGE" not in dict(key.defines())
     left_out = "\n".join(key.left_out())

@@ -11,6 +11,7 @@ import pytest
 import glphong
 from glphong.materials import ShadingFrame
 from glphong.testing import assert_twin_matches, evaluate
+from glphong.shaders.binding import binding
 
 Z = np.array([0.0, 0.0, 1.0])
 
@@ -189,7 +190,7 @@ def test_every_gltf_texture_verifies_with_one_level_of_detail_per_size(glphong_b
                                glphong.Texture(small, 0.9, srgb=False, channel="g"),
                                emissive=glphong.Texture(big[::-1], 0.1), occlusion=glphong.Texture(small[::-1], srgb=False, channel="r"))
     scene = _front_scene(material, [glphong.PointLight((0.5, 0.5, 1.5), 20.0)], ambient=0.5)
-    lights, ambient = scene.light_keys(), scene.ambient_radiance
+    lights, ambient = binding(scene).light_keys(), scene.ambient_radiance
     assert len(program_key(material, lights, ambient).textured_inputs) == 5
     assert program_key(material, lights, ambient, output="gbuffer", gbuffer_needs={"uv", "lod"}).lod_textures == 2
     report = glphong.verify(scene, glphong_make_renderer(96, 72, glphong_backend))

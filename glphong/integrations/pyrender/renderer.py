@@ -30,6 +30,7 @@ from glphong.shaders.key import program_key
 from glphong.integrations.pyrender.materials import DRAWING, GlphongMaterial
 from glphong.integrations.pyrender.scenes import glphong_camera_of, glphong_lights_of
 from glphong.integrations.pyrender.shadows import EmbeddedShadows
+from glphong.shaders.binding import binding
 
 __all__ = ["GlphongRenderer", "enable", "enable_everywhere", "disable_everywhere"]
 
@@ -91,9 +92,9 @@ class _ProgramAdapter:
                 np.append(self._camera["cam_pos"], 1.0)
         values["u_exposure"] = material.exposure
         values.update(material.glphong.uniform_values(key))
-        values.update(scene.light_uniform_values(key))
+        values.update(binding(scene).light_uniform_values(key))
         if key.shadow_slots:
-            for setup in scene.shadow_setups(key.lights, key.shadow_size):
+            for setup in binding(scene).shadow_setups(key.lights, key.shadow_size):
                 values.update(setup.uniform_values())
             values.update(self.shadow_values)
         self.program.bind(values)
@@ -171,7 +172,7 @@ class GlphongRenderer(_PyrenderRenderer):
             raise ValueError("GlphongMaterial primitives cannot be instanced (primitive.poses has "
                              f"{len(primitive.poses)} poses); use one mesh node per instance")
         scene = self._glphong_scene
-        key = program_key(material.glphong, scene.light_keys(), scene.ambient_radiance, output="display")
+        key = program_key(material.glphong, binding(scene).light_keys(), scene.ambient_radiance, output="display")
         if key.shadow_slots:
             key = replace(key, shadow_size=self.shadow_map_size, shadow_filter=self.shadow_filter_radius)
         # pyrender packs the attributes a primitive has in this order, one location each

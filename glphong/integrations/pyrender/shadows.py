@@ -17,6 +17,7 @@ import pyrender
 from glphong.gpu.shadows import ShadowMaps
 from glphong.materials import Lambert
 from glphong.scene.geometry import MeshData
+from glphong.shaders.binding import binding
 
 __all__ = ["EmbeddedShadows"]
 
@@ -87,7 +88,7 @@ class EmbeddedShadows:
         state the pass changes (framebuffer bindings, viewport, write masks, capabilities) is restored for pyrender."""
         from OpenGL import GL
 
-        lights = glphong_scene.light_keys()
+        lights = binding(glphong_scene).light_keys()
         if not any(k.shadowed for k in lights):
             return {}
         # moderngl's framebuffers set their own depth and colour write masks and scissor test: pyrender clears its
@@ -100,7 +101,7 @@ class EmbeddedShadows:
         enabled = {cap: bool(GL.glIsEnabled(cap)) for cap in (GL.GL_SCISSOR_TEST, GL.GL_DEPTH_TEST, GL.GL_CULL_FACE,
                                                                GL.GL_BLEND)}
         try:
-            return self._maps.draw(glphong_scene.shadow_setups(lights, size), glphong_scene.objects, programs,
+            return self._maps.draw(binding(glphong_scene).shadow_setups(lights, size), glphong_scene.objects, programs,
                                    lambda mesh, program: _PrimitiveDraw(self._primitives[id(mesh)], program))
         finally:
             GL.glBindVertexArray(0)
