@@ -48,7 +48,7 @@ from glphong.gpu.programs import ProgramCache
 from glphong.gpu.renderer import Renderer
 from glphong.materials.cases import Case
 from glphong.materials.lambert import Lambert
-from glphong.shaders.key import response_key
+from glphong.shaders.builders import response_key
 
 __all__ = ["evaluate", "direction_sets", "assert_twin_matches", "assert_render_matches", "assert_light_matches",
            "light_points", "TwinMismatch",

@@ -14,7 +14,7 @@ from glphong.gpu.contexts import EGLDisplayTerminatedError, create_context
 from glphong.gpu.programs import ProgramCache
 from glphong.materials.model import Material
 from glphong.materials.table import uniform_as
-from glphong.shaders.key import response_key
+from glphong.shaders.builders import response_key
 
 __all__ = ["evaluate", "direction_sets", "frame_around", "direction", "rotate_toward", "float32_units",
            "cosine_power_interval"]

@@ -18,15 +18,14 @@ from pathlib import Path
 
 from glphong.checks.glsl_types import TYPE_NAMES, glsl_type
 from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
-from glphong.core.glsl_files import chunk_source
-from glphong.materials.params import LIBRARY_CHUNKS
-from glphong.shaders.key import NUMERICS_DEFINES
+from glphong.core.glsl_files import chunk_source, library_chunks
+from glphong.shaders.options import NUMERICS_DEFINES
 
 __all__ = ["GlslSourceError", "Expanded", "expand", "Parameter", "Signature", "functions", "uniforms",
            "strip_comments", "read_source_file", "map_log", "log_locations", "check_signature", "LIBRARY", "LIBRARY_DEFINES", "MAX_SOURCE_BYTES"]
 
 #: glphong's library chunks in include order (``#include <glphong/NAME>``)
-LIBRARY = ("common", "lights") + LIBRARY_CHUNKS + ("area", "normal_map")
+LIBRARY = library_chunks()
 #: what ``#include <glphong/NAME>`` may name: the library, and the sRGB curve of display outputs
 INCLUDABLE = LIBRARY + ("srgb",)
 #: the expanded source's limit [bytes]

@@ -33,7 +33,7 @@ from glphong.checks.shadows import shadow_visibility
 from glphong.twin.area import (area_angle, area_clip, area_clipped_cosine, area_clipped_lobe, area_edge_powers,  # noqa: F401
                                area_polygon_cosine, area_polygon_lobe, area_solid_angle, area_triangle_sample)
 from glphong.shaders.generated import closed_form
-from glphong.shaders.key import lod_slots
+from glphong.shaders.builders import lod_slots
 from glphong.lights import light_for_key
 from glphong.materials import registered_models
 from glphong.shaders.binding import binding

@@ -35,7 +35,8 @@ from glphong.scene.geometry import MeshData
 from glphong.lights import AmbientLight, LightModel, light_named, registered_lights
 from glphong.shaders.numerics import numerics_pieces
 from glphong.scene.scene import Scene
-from glphong.shaders.key import NUMERICS_PIECES, ProgramKey, TermKey
+from glphong.shaders.keys import ProgramKey, TermKey
+from glphong.shaders.options import NUMERICS_PIECES
 from glphong.shaders.binding import binding
 
 __all__ = ["Case", "CASES", "case_scene", "case_inputs", "generic_cases", "lobe_cases", "cases_for", "VALID_RANGES", "oracle", "StabilityRow", "StabilityReport", "run_stability", "case_numerics"]

@@ -7,7 +7,7 @@ from glphong.shaders.assembly import assemble, effective_source
 from glphong.scene.culling import culling_decision
 from glphong.shaders.numerics import allowed_pieces, numerics_decisions, with_numerics
 from glphong.scene.scene import Scene
-from glphong.shaders.key import model_chunk_label
+from glphong.shaders.generated import model_chunk_label
 from glphong.shaders.binding import binding
 
 __all__ = ["ProgramDescription", "describe", "format_descriptions"]

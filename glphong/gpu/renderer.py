@@ -20,7 +20,9 @@ from glphong.gpu.resources import ORPHANS, ORPHANS_LOCK, MeshBuffers, release_or
 from glphong.gpu.contexts import check_not_forked, create_context
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
-from glphong.shaders.key import FORMULATIONS, GBUFFER_PLANES, EncodeKey, uber_key
+from glphong.shaders.builders import uber_key
+from glphong.shaders.keys import EncodeKey
+from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES
 from glphong.shaders.numerics import NUMERICS, allowed_pieces, view_decision, with_numerics
 from glphong.gpu.shadows import ShadowMaps
 from glphong.gpu.programs import ProgramCache

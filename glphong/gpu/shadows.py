@@ -10,7 +10,7 @@ from frame to frame; the maps are redrawn every frame.
 import moderngl
 
 from glphong.core.validate import FLT_MAX
-from glphong.shaders.key import shadow_key
+from glphong.shaders.builders import shadow_key
 
 __all__ = ["ShadowMap", "ShadowMaps", "shadow_map_bytes"]
 

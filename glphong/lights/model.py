@@ -28,10 +28,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from glphong.core import validate as _validate
+from glphong.core.glsl_files import library_chunks
 from glphong.materials.cases import Case
 from glphong.materials.model import bind_arguments
 from glphong.materials.phong import Phong
-from glphong.materials.params import (_GLSL_KEYWORDS, _IDENT, LIBRARY_CHUNKS, RESERVED_NAMES, DefinitionError, GlslFile,  # noqa: F401
+from glphong.materials.params import (_GLSL_KEYWORDS, _IDENT, RESERVED_NAMES, DefinitionError, GlslFile,  # noqa: F401
                                       Param, ParamValues)
 from glphong.materials.registry import (_library_names, _strip_comments, _top_level_names, hashed_source,
                                         registered_models)
@@ -44,7 +45,7 @@ __all__ = ["LightModel", "LightDefinitionError", "registered_lights", "light_nam
 
 #: library chunks a light kind may use: ``lights`` (``point_irradiance``, ``range_window``), ``area`` (a polygon seen
 #: from a point, after ``angle``) and the materials' ones
-LIGHT_LIBRARY_CHUNKS = ("lights", "area") + LIBRARY_CHUNKS
+LIGHT_LIBRARY_CHUNKS = library_chunks("light")
 
 
 @dataclass(frozen=True)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from glphong.core import validate as _validate
+from glphong.core.glsl_files import library_chunks
 from glphong.twin.functions import ShadingFrame
 from glphong.materials.surface import SurfaceInput
 
@@ -22,8 +23,9 @@ __all__ = ["Param", "Choice", "Properties", "ParamValues", "ShadingFrame", "Glsl
 KINDS = {"scalar": "float", "rgb": "vec3", "vec3": "vec3", "direction": "vec3"}
 #: what a model may ask for beyond the normal and the light direction
 NEEDS = ("view", "tangent", "uv")
-#: library chunks (glsl/<name>.glsl) a model may use besides common.glsl, which is always there
-LIBRARY_CHUNKS = ("lobe", "fresnel", "angle", "microfacet")
+#: library chunks (glsl/<name>.glsl) a model may use besides common.glsl, which is always there (in the order of
+#: `glphong.core.glsl_files.LIBRARY`)
+LIBRARY_CHUNKS = library_chunks("model")
 #: names a model may not take: GLSL prefixes and uniforms of the shading loop and the library
 RESERVED_NAMES = frozenset({
     "material", "shade", "common", "lights", "light", "point", "unattenuated", "directional", "ambient",

@@ -11,8 +11,8 @@ import re
 import sys
 from pathlib import Path
 
-from glphong.core.glsl_files import chunk_source, glsl_root
-from glphong.materials.params import LIBRARY_CHUNKS, GlslFile
+from glphong.core.glsl_files import chunk_source, glsl_root, library_chunks
+from glphong.materials.params import GlslFile
 from glphong.materials.params import MaterialDefinitionError as _MaterialDefinitionError
 
 __all__ = ["registered_models", "model_named", "model_source", "model_for_key", "register"]
@@ -164,7 +164,7 @@ def _generated_names(cls):
 def _library_names():
     """What the library chunks define at file scope (read once: the shader folder is fixed at import)."""
     names = {"material_emission", "material_response", "shade_point"}
-    for chunk in ("common", "lights", "area") + LIBRARY_CHUNKS + ("shade", "srgb"):
+    for chunk in library_chunks() + ("shade", "srgb"):
         names |= _top_level_names(_strip_comments(chunk_source(chunk)))
     return frozenset(names)
 

@@ -18,7 +18,8 @@ from glphong.materials import model_named
 from glphong.materials.surface import TextureImage
 from glphong.materials.table import TableData
 from glphong.scene.shadows import shadow_setups
-from glphong.shaders.key import GBUFFER_PLANES, UBER_MAX_LIGHTS, light_keys, lod_slots, program_key
+from glphong.shaders.builders import light_keys, lod_slots, program_key
+from glphong.shaders.options import GBUFFER_PLANES, UBER_MAX_LIGHTS
 
 __all__ = ["SceneBinding", "binding"]
 

@@ -32,7 +32,7 @@ import numpy as np
 
 from glphong.scene.camera import OrthographicCamera
 from glphong.scene.shadows import object_bounds
-from glphong.shaders.key import NUMERICS_PIECES
+from glphong.shaders.options import NUMERICS_PIECES
 
 __all__ = ["NumericsDecision", "numerics_decisions", "numerics_pieces", "allowed_pieces", "with_numerics", "view_decision",
            "normal_range", "NUMERICS", "NORMAL_LENGTHS", "POSITION_RESOLUTION", "FALLOFF_LIMIT", "LOBE_TAIL_Q"]

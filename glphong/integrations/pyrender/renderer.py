@@ -25,7 +25,7 @@ from glphong.gpu.contexts import attach_current
 from glphong.gpu.programs import ProgramCache
 from glphong.lights import AmbientLight
 from glphong.scene.scene import Scene
-from glphong.shaders.key import program_key
+from glphong.shaders.builders import program_key
 
 from glphong.integrations.pyrender.materials import DRAWING, GlphongMaterial
 from glphong.integrations.pyrender.scenes import glphong_camera_of, glphong_lights_of
