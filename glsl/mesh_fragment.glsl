@@ -18,9 +18,12 @@
 //   that draws the object's surface (radiance, G-buffer, per-vertex), so the G-buffer covers what the radiance does.
 // NORMAL_MAP: n = surface_normal(shading_frame(n, tangent, uv), texture(u_normal_map_texture, uv).rgb, scale)
 //   (normal_map.glsl) where n is valid, before the G-buffer is written and before shading: both see the mapped normal.
-// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, NUM_LOD_TEXTURES,
+// HAS_FACE: the triangle's own normal, from the derivatives of the interpolated position (the slope of the shadow
+//   bias, shadows.glsl): a G-buffer plane, and shadow_face_normal when shading.
+// NAIVE_NORMAL: n by plain_normalize where the key proves it safe, common.glsl.
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, HAS_FACE, NUM_LOD_TEXTURES,
 // GBUFFER_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
-// RUNTIME_SWITCHES, SWITCH(flag).
+// NAIVE_NORMAL, RUNTIME_SWITCHES, SWITCH(flag).
 
 invariant in vec3 v_position;
 #if ALPHA_MASK

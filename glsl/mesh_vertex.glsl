@@ -14,7 +14,7 @@
 // 2, 3 and 5 in glphong's own draws, pyrender's packed order inside pyrender (the key says which).
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, *_LOCATION, SHADE_PER_VERTEX, ALPHA_MASK,
-// TWO_SIDED, NEEDS_VIEW, SWITCH(flag).
+// TWO_SIDED, NEEDS_VIEW, RUNTIME_SWITCHES, SWITCH(flag).
 
 const float GOURAUD_MAX = 1.2676506002282294e30;  // 2^100: per-vertex radiance saturates here
 layout(location = 0) in vec3 in_position;

@@ -23,7 +23,7 @@
 // The view vector v is computed only where a term reads it (NEEDS_VIEW).
 // The uber-shader reads its light counts from uniforms (<KIND>_LIGHT_COUNT).
 //
-// Key defines read here: NEEDS_VIEW, NUM_LIGHTS (the total over the kinds).
+// Key defines read here: NEEDS_VIEW, NAIVE_VIEW (v by plain_normalize where the key proves it safe, common.glsl), NUM_LIGHTS (the total over the kinds).
 
 #if NUM_LIGHTS > 0
 // the loops over the program's light kinds, generated from the key (generated:lights, after this chunk)

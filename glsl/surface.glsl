@@ -8,6 +8,8 @@
 //   GL_ARB_texture_query_lod), written to the G-buffer so the twin blends the same two levels.  It has no
 //   numpy twin on purpose: it reports the GPU's own choice, which the twin reads instead of recomputing.
 // Called only from main(), in uniform control flow: the implicit derivatives are defined.
+// Key defines read here: OUTPUT_GBUFFER, NUM_LOD_TEXTURES (surface_texture_lod exists only in a G-buffer program
+//   that writes levels of detail).
 
 vec3 surface_texture(sampler2D s, vec2 uv)
 {

@@ -10,18 +10,25 @@ Several contexts, of either backend, may live in one process.  Make a context
 current with ``with ctx:`` before issuing GL calls on it; ``with`` blocks nest,
 and leaving an inner block makes the enclosing block's context current again.
 
-One module of about 600 lines on purpose: the two backends share one context pool (recycling), one
-fork guard and one notion of "current", whose invariants hold only if a single module owns them.
+The two backends share one context pool (recycling), one fork guard and one notion of "current",
+whose invariants hold only if a single module owns them: this one.  The drivers' C libraries
+(:mod:`ctypes` bindings of libEGL and libOSMesa) are `glphong.gpu.drivers`'s, and contexts another
+library made (`attach_current`, `release_offscreen`) are `glphong.gpu.foreign`'s; their names stay
+importable from here.
 """
 
 import atexit
 import ctypes
-import ctypes.util
-import functools
 import os
 import threading
 
 import moderngl
+
+from glphong.gpu.drivers import (  # noqa: F401 - the drivers' names stay importable from here
+    _GL_UNSIGNED_BYTE, _OSMESA_CONTEXT_MAJOR_VERSION, _OSMESA_CONTEXT_MINOR_VERSION, _OSMESA_CORE_PROFILE,
+    _OSMESA_DEPTH_BITS, _OSMESA_FORMAT, _OSMESA_PROFILE, _OSMESA_RGBA, _OSMESA_VERSIONS, _egl_current_context,
+    _osmesa_library, _OSMesaLoader, egl_device_count)
+from glphong.gpu.foreign import _CurrentContextLoader, attach_current, release_offscreen  # noqa: F401 - as above
 
 __all__ = [
     "BACKENDS",
@@ -46,17 +53,6 @@ SYSTEM_PACKAGES = {
 
 _ENV_BACKEND = "GLPHONG_BACKEND"
 
-# OSMesa constants, from GL/osmesa.h and GL/gl.h.
-_OSMESA_FORMAT = 0x22
-_OSMESA_RGBA = 0x1908
-_OSMESA_DEPTH_BITS = 0x30
-_OSMESA_PROFILE = 0x33
-_OSMESA_CORE_PROFILE = 0x34
-_OSMESA_CONTEXT_MAJOR_VERSION = 0x36
-_OSMESA_CONTEXT_MINOR_VERSION = 0x37
-_GL_UNSIGNED_BYTE = 0x1401
-_OSMESA_VERSIONS = ((4, 5), (3, 3))
-
 _entered = threading.local()
 
 
@@ -79,21 +75,7 @@ _EGL_TERMINATED = (
     "taking the contexts of every other library in the process with it; glphong's drew nothing from "
     "then on (moderngl says 'cannot create texture' or returns garbage). Make a new glphong.Renderer "
     "(a fresh context re-initialises the display), keep pyrender's renderer alive while glphong's are "
-    "in use, or release it with glphong.analysis.comparisons.PyrenderRenderer.release, which does not terminate it")
-
-
-@functools.lru_cache(maxsize=1)
-def _egl_current_context():
-    """libEGL's ``eglGetCurrentContext`` (ctypes), or None where libEGL cannot be loaded."""
-    name = ctypes.util.find_library("EGL")
-    if name is None:
-        return None
-    try:
-        function = ctypes.CDLL(name).eglGetCurrentContext
-    except (OSError, AttributeError):
-        return None
-    function.restype = ctypes.c_void_p
-    return function
+    "in use, or release it with glphong.integrations.pyrender.release(renderer), which does not terminate it")
 
 
 #: the process that first tried to make a context (llvmpipe starts its rasterizer threads then)
@@ -325,91 +307,10 @@ class GLContext:
         )
 
 
-class _OSMesaLoader:
-    """moderngl loader and make-current hooks for one OSMesa context."""
-
-    def __init__(self, lib, handle):
-        self._lib = lib
-        self._handle = handle
-        # OSMesa needs a colour buffer to make a context current; all
-        # rendering goes to framebuffer objects, so one pixel suffices.
-        self._buffer = (ctypes.c_ubyte * 4)()
-
-    def make_current(self):
-        """Make the context current; return whether OSMesa accepted it."""
-        return bool(
-            self._lib.OSMesaMakeCurrent(self._handle, self._buffer, _GL_UNSIGNED_BYTE, 1, 1)
-        )
-
-    def load_opengl_function(self, name):
-        """Return the address of GL function ``name``, 0 if it is missing."""
-        return self._lib.OSMesaGetProcAddress(name.encode()) or 0
-
-    def destroy(self):
-        """Destroy the OSMesa context."""
-        self._lib.OSMesaDestroyContext(self._handle)
-
-    def __enter__(self):
-        self.make_current()
-
-    def __exit__(self, *exc_info):
-        pass
-
-    def release(self):
-        pass
-
-
-@functools.cache
-def _osmesa_library():
-    """Load libOSMesa and declare the signatures used here."""
-    errors = []
-    for name in (ctypes.util.find_library("OSMesa"), "libOSMesa.so.8", "libOSMesa.so"):
-        if name is None:
-            continue
-        try:
-            lib = ctypes.CDLL(name)
-            break
-        except OSError as exc:
-            errors.append(str(exc))
-    else:
-        raise OSError("libOSMesa not found: " + "; ".join(errors))
-    lib.OSMesaCreateContextAttribs.restype = ctypes.c_void_p
-    lib.OSMesaCreateContextAttribs.argtypes = [ctypes.POINTER(ctypes.c_int), ctypes.c_void_p]
-    lib.OSMesaMakeCurrent.restype = ctypes.c_ubyte
-    lib.OSMesaMakeCurrent.argtypes = [
-        ctypes.c_void_p, ctypes.c_void_p, ctypes.c_uint, ctypes.c_int, ctypes.c_int
-    ]
-    lib.OSMesaGetProcAddress.restype = ctypes.c_void_p
-    lib.OSMesaGetProcAddress.argtypes = [ctypes.c_char_p]
-    lib.OSMesaDestroyContext.restype = None
-    lib.OSMesaDestroyContext.argtypes = [ctypes.c_void_p]
-    return lib
-
-
 def _create_egl(require, device=0):
     # moderngl itself rejects a context older than ``require``.
     mgl = moderngl.create_context(standalone=True, backend="egl", require=require, device_index=device)
     return GLContext("egl", mgl, device=device)
-
-
-def egl_device_count():
-    """The number of EGL devices (``eglQueryDevicesEXT``), or None where libEGL or the extension is missing."""
-    name = ctypes.util.find_library("EGL")
-    if name is None:
-        return None
-    try:
-        egl = ctypes.CDLL(name)
-        egl.eglGetProcAddress.restype = ctypes.c_void_p
-        egl.eglGetProcAddress.argtypes = [ctypes.c_char_p]
-        address = egl.eglGetProcAddress(b"eglQueryDevicesEXT")
-    except (OSError, AttributeError):
-        return None
-    if not address:
-        return None
-    query = ctypes.CFUNCTYPE(ctypes.c_uint, ctypes.c_int, ctypes.POINTER(ctypes.c_void_p),
-                             ctypes.POINTER(ctypes.c_int))(address)
-    count = ctypes.c_int(0)
-    return count.value if query(0, None, ctypes.byref(count)) else None
 
 
 def _create_osmesa(require):
@@ -571,83 +472,3 @@ def available_backends():
         if ctx is not None:
             ctx.release()
     return report
-
-
-class _CurrentContextLoader:
-    """moderngl loader for a context some other library created and made current.
-
-    Entering and leaving do nothing: the owner keeps the context current.
-    """
-
-    def __init__(self, get_proc_address):
-        self._get_proc_address = get_proc_address
-
-    def load_opengl_function(self, name):
-        return self._get_proc_address(name.encode()) or 0
-
-    def __enter__(self):
-        pass
-
-    def __exit__(self, *exc_info):
-        pass
-
-    def release(self):
-        pass
-
-
-def attach_current(platform):
-    """Wrap the OpenGL context another library made current (e.g. pyrender's), without owning it.
-
-    Parameters
-    ----------
-    platform : {'egl', 'osmesa'}
-        How the current context was created; GL functions are loaded with
-        ``eglGetProcAddress`` or ``OSMesaGetProcAddress``.
-
-    Returns
-    -------
-    moderngl.Context
-        Valid while the owner keeps that context current; releasing it is the owner's job.
-    """
-    if platform == "egl":
-        name = ctypes.util.find_library("EGL") or "libEGL.so.1"
-        get_proc_address = ctypes.CDLL(name).eglGetProcAddress
-        get_proc_address.restype = ctypes.c_void_p
-        get_proc_address.argtypes = [ctypes.c_char_p]
-    elif platform == "osmesa":
-        get_proc_address = _osmesa_library().OSMesaGetProcAddress
-    else:
-        raise ValueError(f"platform must be 'egl' or 'osmesa' (got {platform!r})")
-    moderngl.init_context(_CurrentContextLoader(get_proc_address))
-    return moderngl.get_context()
-
-
-def release_offscreen(offscreen):
-    """Delete a ``pyrender.OffscreenRenderer``'s GL objects and its context without ending the EGL display the
-    process shares; idempotent.
-
-    pyrender's own ``OffscreenRenderer.delete()`` (also when the garbage collector drops one) calls
-    ``eglTerminate`` on the device's display, which Mesa shares with every other EGL context on that device in the
-    process (glphong's, moderngl's, other pyrender renderers'), and so ends them all.  Here, on EGL, pyrender's
-    scene renderer deletes its GL objects and only its own context is destroyed (this reaches into pyrender
-    0.1.45's private attributes, the same in its forks ``pyrender2`` and ``pyrender-maintained``); on OSMesa
-    ``delete()`` is called, which ends nothing else.
-
-    Parameters
-    ----------
-    offscreen : pyrender.OffscreenRenderer
-    """
-    platform = getattr(offscreen, "_platform", None)
-    if platform is None:
-        return
-    if not hasattr(platform, "_egl_display"):
-        offscreen.delete()
-        return
-    from OpenGL.EGL import EGL_NO_CONTEXT, EGL_NO_SURFACE, eglDestroyContext, eglMakeCurrent
-
-    platform.make_current()
-    offscreen._renderer.delete()
-    eglMakeCurrent(platform._egl_display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT)
-    eglDestroyContext(platform._egl_display, platform._egl_context)
-    platform._egl_context = platform._egl_display = None
-    offscreen._renderer = offscreen._platform = None

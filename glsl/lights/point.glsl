@@ -5,7 +5,7 @@
 //   E  = I_j / d^2  by point_irradiance (I_j = Phi_j / (4 pi) [W/sr], d = |p_j - x| [m])
 //   times range_window(d, range_j) where POINT_RANGE (some point light of the scene has a range; a
 //   light without one has range_j = 0 and keeps E: a select, no branch).
-// Key defines read here: POINT_RANGE.
+// Key defines read here: POINT_RANGE, NAIVE_LIGHT (wi by plain_normalize where the key proves it safe, common.glsl).
 
 bool point_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)
 {

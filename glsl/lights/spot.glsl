@@ -14,7 +14,7 @@
 //     (= f I / d^2; g / d never overflows or flushes where E is representable, as (I / d) / d for points)
 //   times range_window(d, range_j) where SPOT_RANGE (some spot light of the scene has a range).
 //   Units: I_j [W/sr] along the axis; d, range [m]; a_j unit, the direction the light points in.
-// Key defines read here: SPOT_RANGE.
+// Key defines read here: SPOT_RANGE, NAIVE_LIGHT (wi by plain_normalize where the key proves it safe, common.glsl).
 
 bool spot_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)
 {

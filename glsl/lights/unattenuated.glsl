@@ -3,6 +3,7 @@
 //
 // unattenuated_incident(x, j, out wi, out E) -> valid
 //   wi = (p_j - x) / |p_j - x|  by safe_normalize;  E = L_i,j [W/m^2], no falloff.
+// Key defines read here: NAIVE_LIGHT (wi by plain_normalize where the key proves it safe, common.glsl).
 
 bool unattenuated_incident(vec3 x, int j, out vec3 wi, out vec3 irradiance)
 {
