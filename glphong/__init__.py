@@ -28,7 +28,7 @@ from glphong.materials import AlphaMask, Material, MaterialModel, MaterialSum, N
 from glphong.materials.ashikhmin_shirley import AshikhminShirley
 from glphong.materials.blinn import BlinnPhong
 from glphong.materials.cook_torrance import CookTorrance
-from glphong.materials.fresnel import DielectricFresnel, SchlickFresnel
+from glphong.definitions.fresnel import DielectricFresnel, SchlickFresnel
 from glphong.materials.diffuse import Diffuse
 from glphong.materials.gltf_pbr import GltfPBR
 from glphong.materials.lafortune import Lafortune

@@ -14,7 +14,7 @@ from PIL import Image
 
 import glphong
 from glphong import primitives
-from glphong.materials.surface import alpha_masked
+from glphong.definitions.surface import alpha_masked
 from glphong.scene.geometry import MeshData
 
 HALF = np.array([[255, 0]], np.uint8)  # one row: opaque, clear

@@ -80,7 +80,7 @@ from glphong.materials import (AshikhminShirley, BlinnLobe, CookTorrance, CookTo
                                GltfPBR, Lafortune, LafortuneLobes, Lambert, MaterialModel, MaterialSum, MeasuredBRDF, MtlPhong,
                                NormalizedBlinnLobe, NormalizedBlinnPhong, NormalizedPhong, NormalizedPhongLobe,
                                OrenNayar, PhongLobe, SchlickFresnel, WardLobe, registered_models)
-from glphong.materials.model import MATERIAL_KEYWORDS, NEEDS
+from glphong.definitions.params import MATERIAL_KEYWORDS, NEEDS
 from glphong.gpu.programs import assemble
 from glphong.checks.stability import cases_for, run_stability
 from glphong.testing import assert_twin_matches, direction_sets, evaluate

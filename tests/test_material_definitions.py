@@ -95,7 +95,7 @@ def test_a_valid_definition_registers_under_its_name():
      r"never reads u_test_def_k"),
     ({"glsl": "uniform vec3 u_test_def_k;\nvec3 test_def_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l) "
               "{ return u_test_def_k; }"}, r"declares its own u_test_def_\* uniforms"),
-    ({"name": "lambert"}, r"the name 'lambert' is taken by the built-in glphong\.materials\.lambert\.Lambert"),
+    ({"name": "lambert"}, r"the material name 'lambert' is taken by the built-in glphong\.materials\.lambert\.Lambert"),
     ({"name": "material"}, r"name 'material' is reserved"),
     ({"name": "Minnaert"}, r"name must be a lowercase GLSL identifier"),
     ({"needs": ("normal",)}, r"needs must be a tuple of 'view', 'tangent', 'uv'"),
@@ -176,7 +176,7 @@ def test_redefining_the_same_class_replaces_it_and_another_class_cannot_take_the
     first = _definition(name="test_redefined")
     again = _definition(name="test_redefined")  # the same module and qualname: a re-run notebook cell
     assert model_named("test_redefined") is again is not first
-    with pytest.raises(MaterialDefinitionError, match="the name 'test_rim' is taken by"):
+    with pytest.raises(MaterialDefinitionError, match="the material name 'test_rim' is taken by"):
         type("Other", (MaterialModel,), {"name": "test_rim", "params": Rim.params, "glsl": Rim.glsl,
                                          "needs": ("view",), "response": Rim.response})
 
@@ -531,7 +531,7 @@ class Sheen(MaterialModel):
 
     def response(self, f, wi, wo, n_dot_l, p):
         from glphong.materials.blinn import half_cosine
-        from glphong.materials.fresnel import fresnel_factor
+        from glphong.definitions.fresnel import fresnel_factor
 
         n_dot_v = np.maximum(np.sum(f.n * wo, axis=-1), 0.0)
         if p.power == "two":

@@ -30,7 +30,11 @@ def _import(old, new):
     return int(count), message
 
 
-@pytest.mark.parametrize("old", ["glphong.stability", "glphong.key", "glphong.loaders", "glphong.cli"])
+@pytest.mark.parametrize("old", ["glphong.stability", "glphong.key", "glphong.loaders", "glphong.cli",
+                                 "glphong.checks.glsl_function", "glphong.checks.evaluate", "glphong.checks.probe",
+                                 "glphong.tools.bench", "glphong.tools.speed", "glphong.analysis.comparisons",
+                                 "glphong.materials.model", "glphong.materials.params", "glphong.lights.model",
+                                 "glphong.scene.numerics"])
 def test_an_old_path_is_the_new_module_with_a_warning(old):
     count, message = _import(old, _moved.MOVED[old])
     assert count == 1 and f"{old} moved to {_moved.MOVED[old]}" in message
@@ -50,6 +54,47 @@ def test_from_import_of_an_old_path_and_private_names():
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.splitlines()[0].startswith("warned glphong.stability moved to glphong.checks.stability")
     assert out.stdout.splitlines()[-1] == f"True {2.0 ** -24}"
+
+
+def test_the_toolkit_and_the_benchmarks_keep_their_old_names():
+    """``glphong.bench``, 0.1.0's work-precision module, is now the benchmarks' package: its old names answer there
+    without a warning; the toolkit's and the comparisons' old module paths still give their names (warning once)."""
+    code = ("import warnings\n"
+            "warnings.simplefilter('error', DeprecationWarning)\n"
+            "from glphong.bench import (BenchCase, BenchReport, Method, methods, quick_cases, run_bench, standard_cases,\n"
+            "                           scaling_table, speed_targets, SPHERES, PLANE_Y, PLANE_SIZE)\n"
+            "import glphong.testing\n"
+            "warnings.simplefilter('ignore', DeprecationWarning)\n"
+            "from glphong.checks.probe import evaluate, shade_points, signatures\n"
+            "from glphong.checks.evaluate import direction_sets, evaluate, float32_units\n"
+            "from glphong.checks.glsl_inputs import edge_inputs, glsl_inputs\n"
+            "from glphong.analysis.comparisons import HandWrittenRenderer, PyrenderRenderer, import_pyrender, to_pyrender\n"
+            "from glphong.tools.bench_continuous import sky_map\n"
+            "import sys\n"
+            "print(glphong.testing.evaluate is evaluate, sorted(m for m in sys.modules if m.split('.')[0] == 'pytest'))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip() == "True []"
+
+
+def test_a_user_definition_through_the_old_paths():
+    """A model and a light kind written against 0.1.0's mechanism modules still define, register and render."""
+    code = ("import warnings; warnings.simplefilter('ignore', DeprecationWarning)\n"
+            "from glphong.materials.model import MaterialModel, Param, Properties\n"
+            "from glphong.lights.model import LightModel\n"
+            "import glphong\n"
+            "class Flat(MaterialModel):\n"
+            "    name = 'old_path_flat'\n"
+            "    params = (Param('k', 'rgb', low=0.0, high=1.0, default=0.5),)\n"
+            "    glsl = 'vec3 old_path_flat_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l) "
+            "{ return u_old_path_flat_k * n_dot_l; }'\n"
+            "    def response(self, f, wi, wo, n_dot_l, p):\n"
+            "        return p.k * n_dot_l[..., None]\n"
+            "assert glphong.materials.model_named('old_path_flat') is Flat\n"
+            "assert issubclass(glphong.PointLight, LightModel)\n"
+            "print('ok')")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr[-2000:]
 
 
 def test_every_moved_target_exists():

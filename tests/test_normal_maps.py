@@ -14,8 +14,8 @@ import pytest
 
 import glphong
 from glphong import primitives, reference
-from glphong.checks import probe
-from glphong.materials.surface import TextureImage, surface_texture
+from glphong.testing import probe
+from glphong.definitions.surface import TextureImage, surface_texture
 from glphong.scene.geometry import MeshData
 
 RNG = np.random.default_rng(26)

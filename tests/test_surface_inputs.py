@@ -1,4 +1,4 @@
-"""Textures and vertex colours as inputs of textureable parameters (glphong/materials/surface.py).
+"""Textures and vertex colours as inputs of textureable parameters (glphong/definitions/surface.py).
 
 Independent checks, not the code under test:
 - texel decoding against the sRGB formula written here, the pyramid's sizes and means from the
@@ -18,8 +18,8 @@ import pytest
 import glphong
 from glphong import primitives
 from glphong.scene.geometry import MeshData
-from glphong.materials import surface as surface_module
-from glphong.materials.surface import TextureImage, surface_texture
+from glphong.definitions import surface as surface_module
+from glphong.definitions.surface import TextureImage, surface_texture
 from glphong.checks.tolerances import BAND, BandConstants
 
 

@@ -21,8 +21,8 @@ from PIL import Image
 import glphong
 from glphong import primitives
 from glphong.scene.geometry import MeshData
-from glphong.materials.as_json import material_from_json, material_to_json
-from glphong.materials.surface import TextureImage
+from glphong.definitions.as_json import material_from_json, material_to_json
+from glphong.definitions.surface import TextureImage
 
 RNG = np.random.default_rng(11)
 NOISE = RNG.integers(0, 256, (16, 24, 3), dtype=np.uint8)

@@ -15,10 +15,10 @@ Tables (`MeasuredBRDF`) are not stored: a file would hold megabytes of JSON.  On
 found among the defined materials by module and name (a user's module must have been imported).
 """
 
-from glphong.materials.fresnel import Fresnel
-from glphong.materials.model import Choice, Material, Param
-from glphong.materials.surface import AlphaMask, NormalMap, SurfaceInput
-from glphong.materials.table import Table
+from glphong.definitions.fresnel import Fresnel
+from glphong.definitions.material import Choice, Material, Param
+from glphong.definitions.surface import AlphaMask, NormalMap, SurfaceInput
+from glphong.definitions.table import Table
 __all__ = ["material_to_json", "material_from_json"]
 
 #: the version of the layout above

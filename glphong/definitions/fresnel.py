@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from glphong.materials.params import Param
+from glphong.definitions.params import Param
 from glphong.twin.band import EPS
 from glphong.twin.functions import fresnel_dielectric, fresnel_schlick
 

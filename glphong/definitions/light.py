@@ -21,7 +21,6 @@ structural defines in ``p.defines``).  Like the GLSL, the twin reads nothing but
 The built-in kinds (`glphong.lights.PointLight`, `UnattenuatedPointLight`, `DirectionalLight`,
 `SpotLight`) are defined exactly this way.  A definition is checked when its class is created.
 """
-import inspect
 import re
 from dataclasses import dataclass
 
@@ -29,13 +28,12 @@ import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.core.glsl_files import library_chunks
-from glphong.materials.cases import Case
-from glphong.materials.model import bind_arguments
-from glphong.materials.phong import Phong
-from glphong.materials.params import (_GLSL_KEYWORDS, _IDENT, RESERVED_NAMES, DefinitionError, GlslFile,  # noqa: F401
-                                      Param, ParamValues)
-from glphong.materials.registry import (_library_names, _strip_comments, _top_level_names, hashed_source,
-                                        registered_models)
+from glphong.definitions.cases import Case
+from glphong.definitions.definition import Definition
+from glphong.definitions.light_checks import check_light_definition
+from glphong.definitions.material import MaterialSum, bind_arguments
+from glphong.definitions.params import DefinitionError, GlslFile, Param, ParamValues  # noqa: F401 - a kind's vocabulary
+from glphong.definitions.registry import LIGHTS, MATERIALS, light_for_key, light_named, light_source, registered_lights
 from glphong.twin.band import EPS
 from glphong.twin.functions import perpendiculars
 
@@ -88,55 +86,9 @@ class LightDefinitionError(DefinitionError):
     """A `LightModel` definition is incomplete or inconsistent."""
 
 
-_REGISTRY = {}
-_SOURCES = {}
-_BY_HASH = {}
-
-
-def registered_lights():
-    """Every defined light kind, built-in and user, in the order the shader loops over them (tuple):
-    the built-ins (point, unattenuated, directional, spot), then user kinds in definition order."""
-    return tuple(_REGISTRY.values())
-
-
-def light_named(name):
-    """The `LightModel` subclass registered as ``name`` (KeyError naming the defined kinds)."""
-    try:
-        return _REGISTRY[name]
-    except KeyError:
-        raise KeyError(f"no light kind is named {name!r} (defined: {', '.join(_REGISTRY)})") from None
-
-
-def light_for_key(name, source_hash):
-    """The light kind a program key's entry was made from (by name and source hash)."""
-    cls = _BY_HASH.get((name, source_hash))
-    if cls is None:
-        cls = light_named(name)
-        if cls.source_hash() != source_hash:
-            raise KeyError(f"no definition of the light kind {name!r} has source hash {source_hash}")
-    return cls
-
-
-def light_source(cls):
-    """``(text, label, first_line, source_hash)`` of a light kind's GLSL (cached per class)."""
-    return hashed_source(cls, _SOURCES, _BY_HASH)
-
-
-def light_cases(light):
-    """Generic stability geometry for one light (a `glphong.materials.cases.Case` each): the light over a
-    Lambert+Phong point at normal, oblique and grazing incidence of the point's normal."""
-    name = type(light).name
-    material = Phong(0.3, 0.4, 20.0)
-    out = []
-    for label, normal in (("normal", (0.0, 0.0, 1.0)), ("oblique 60 deg", (0.0, np.sin(np.pi / 3), np.cos(np.pi / 3))),
-                          ("grazing 89.9 deg", (0.0, np.sin(np.radians(89.9)), np.cos(np.radians(89.9))))):
-        out.append(Case(f"{name} light, {label}", f"light {name}", material, normal=tuple(float(c) for c in normal),
-                        eye=(0.3, 0.2, 2.0), lights=(light,)))
-    return tuple(out)
-
-
-class LightModel:
-    """One kind of light, defined the way the built-ins are.
+class LightModel(Definition):
+    """One kind of light, defined the way the built-ins are (the definition mechanism of
+    `glphong.definitions.definition.Definition`, which material models share).
 
     Class attributes a definition sets
     ----------------------------------
@@ -222,23 +174,24 @@ class LightModel:
     #: uniform name -> the structural define it exists under (declared inside ``#if defined(<KIND>_<NAME>)``)
     conditional_uniforms = {}
 
-    def __init_subclass__(cls, **kwargs):
-        super().__init_subclass__(**kwargs)
-        if "name" not in cls.__dict__:
-            if "glsl" in cls.__dict__ or "incident" in cls.__dict__:
-                raise LightDefinitionError(f"{cls.__qualname__} defines a light but no name: add name = '...' "
-                                           "(a lowercase GLSL prefix)" if cls.name is None else
-                                           f"{cls.__qualname__} redefines glsl or incident but keeps the name "
-                                           f"{cls.name!r}: give it a name of its own")
-            return
-        existing = _REGISTRY.get(cls.name) if isinstance(cls.name, str) else None
-        if existing is not None and existing is not cls:
-            same = (existing.__module__, existing.__qualname__) == (cls.__module__, cls.__qualname__)
-            if existing.__module__.startswith("glphong.") or not same:
-                raise LightDefinitionError(f"{cls.__qualname__}: the light name {cls.name!r} is taken by "
-                                           f"{existing.__module__}.{existing.__qualname__}; choose another name")
-        _check_definition(cls)
-        _REGISTRY[cls.name] = cls  # a re-run of the same definition (a notebook cell) replaces it
+    registry = LIGHTS
+    #: where the kind comes in the shader's loop over kinds (the built-ins' order; None: after them, in definition
+    #: order)
+    loop_order = None
+
+    @classmethod
+    def check_unnamed(cls):
+        """A subclass without a name of its own may not define GLSL or a twin (it would render as its parent)."""
+        if "glsl" in cls.__dict__ or "incident" in cls.__dict__:
+            raise LightDefinitionError(f"{cls.__qualname__} defines a light but no name: add name = '...' "
+                                       "(a lowercase GLSL prefix)" if cls.name is None else
+                                       f"{cls.__qualname__} redefines glsl or incident but keeps the name "
+                                       f"{cls.name!r}: give it a name of its own")
+
+    @classmethod
+    def check_definition(cls):
+        """The checks of `glphong.definitions.light_checks` (raising `LightDefinitionError`)."""
+        check_light_definition(cls, LightModel)
 
     def __init__(self, *args, shadows=False, **kwargs):
         if type(self).name is None:
@@ -268,8 +221,10 @@ class LightModel:
         return type(self).name
 
     def parameter_values(self):
-        """Every parameter's validated value by name (dict), and ``shadows``."""
-        return {p.name: getattr(self, p.name) for p in self.params} | {"shadows": self.shadows}
+        """Every parameter's validated value by name (dict), and ``shadows`` for a kind that casts shadows: the
+        constructor's arguments, so ``type(light)(**light.parameter_values()) == light``."""
+        values = {p.name: getattr(self, p.name) for p in self.params}
+        return values | {"shadows": self.shadows} if self.shadow_map is not None else values
 
     def __setattr__(self, name, value):
         raise AttributeError(f"{type(self).__name__} is immutable: make a new light instead of setting {name!r}")
@@ -292,11 +247,6 @@ class LightModel:
     def uniform_params(cls):
         """The uniforms the GLSL reads, as `Param` (`uniforms`, or `params`)."""
         return cls.params if cls.uniforms is None else cls.uniforms
-
-    @classmethod
-    def uniform_name(cls, uniform):
-        """``u_<name>_<uniform>``."""
-        return f"u_{cls.name}_{uniform}"
 
     def uniform_value(self, name):
         """The value of uniform ``name`` for this light (default: the parameter of that name)."""
@@ -328,21 +278,6 @@ class LightModel:
         given = {name for name, _ in defines}
         return tuple(p for p in cls.uniform_params()
                      if cls.conditional_uniforms.get(p.name) is None or cls.conditional_uniforms[p.name] in given)
-
-    @classmethod
-    def source(cls):
-        """The kind's GLSL text."""
-        return light_source(cls)[0]
-
-    @classmethod
-    def source_hash(cls):
-        """First 12 hex digits of the SHA-256 of the declarations, uses and GLSL text (part of the program key)."""
-        return light_source(cls)[3]
-
-    @classmethod
-    def source_label(cls):
-        """Where the GLSL comes from (a file, or the class), for compile errors."""
-        return light_source(cls)[1]
 
     @classmethod
     def structural_defines(cls, lights):
@@ -515,112 +450,30 @@ def sensitivity_band(evaluate, x, p, params, constants, directions=()):
 
 
 # --------------------------------------------------------------------------- definition-time checks
-def _check_definition(cls):
-    """The definition-time checks of a `LightModel` subclass; raises LightDefinitionError."""
-    err = LightDefinitionError
-    name = cls.name
-    if not isinstance(name, str) or not _IDENT.match(name) or "__" in name or name.endswith("_"):
-        raise err(f"{cls.__qualname__}.name must be a lowercase GLSL identifier such as 'luminaire' (got {name!r})")
-    builtin = cls.__module__.startswith("glphong.")
-    if not builtin and (name in RESERVED_NAMES or name in _GLSL_KEYWORDS or name.startswith("gl_")):
-        raise err(f"{cls.__qualname__}.name {name!r} is reserved by glphong's shading code or GLSL; choose another")
-    clash = [m for m in registered_models() if m.name == name]
-    if clash:
-        raise err(f"{cls.__qualname__}.name {name!r} is the name of the material model "
-                  f"{clash[0].__module__}.{clash[0].__qualname__} (their uniforms u_{name}_* would clash); choose another")
-    for attr in ("params", "uniforms"):
-        value = getattr(cls, attr)
-        if attr == "uniforms" and value is None:
-            continue
-        if not isinstance(value, tuple) or not all(isinstance(p, Param) for p in value):
-            raise err(f"{cls.__qualname__}.{attr} must be a tuple of glphong.materials.Param")
-        names = [p.name for p in value]
-        if len(set(names)) != len(names):
-            raise err(f"{cls.__qualname__}.{attr} repeats a name ({names})")
-        if any(p.textureable for p in value):
-            raise err(f"{cls.__qualname__}.{attr}: a light's parameters are constants (textureable is for materials)")
-    shadowing = sorted({p.name for p in cls.params} & set(dir(LightModel)))
-    if shadowing:
-        raise err(f"{cls.__qualname__}.params: {', '.join(shadowing)} would shadow a LightModel attribute; "
-                  "choose other parameter names")
-    if not isinstance(cls.uses, tuple) or not set(cls.uses) <= set(LIGHT_LIBRARY_CHUNKS):
-        raise err(f"{cls.__qualname__}.uses must be a tuple of library chunks "
-                  f"{', '.join(map(repr, LIGHT_LIBRARY_CHUNKS))} (got {cls.uses!r})")
-    if cls.uniforms is not None and "uniform_value" not in {k for c in cls.__mro__[:-1] if c is not LightModel
-                                                            for k in c.__dict__}:
-        raise err(f"{cls.__qualname__} declares uniforms different from its params, so it must define "
-                  "uniform_value(self, name) giving each uniform's value")
-    if cls.shadow_map not in (None, "cube", "ortho"):
-        raise err(f"{cls.__qualname__}.shadow_map must be None, 'cube' (a light at its `position`) or 'ortho' (a light "
-                  f"at infinity along its `direction`) (got {cls.shadow_map!r})")
-    uniform_kinds = {p.name: p.kind for p in (cls.params if cls.uniforms is None else cls.uniforms)}
-    wanted_kinds = {"light": "vec3", "falloff": "rgb"}
-    bounds = cls.numerics_bounds
-    if not isinstance(bounds, dict) or not all(piece in wanted_kinds and uniform_kinds.get(uniform) == wanted_kinds[piece]
-                                               for piece, uniform in bounds.items()) \
-            or ("falloff" in bounds and "light" not in bounds):
-        raise err(f"{cls.__qualname__}.numerics_bounds must map 'light' to the kind's position uniform (vec3) and, with "
-                  f"it, 'falloff' to its intensity uniform (rgb) (got {bounds!r})")
-    needed = {"cube": "position", "ortho": "direction"}.get(cls.shadow_map)
-    if needed and needed not in {p.name for p in cls.params}:
-        raise err(f"{cls.__qualname__}.shadow_map = {cls.shadow_map!r} needs a parameter named {needed!r}")
-    contract = cls.contract()
-    wanted = " and ".join(f"`{f.glsl(name)}`" for f in contract)
-    if cls.glsl is None:
-        raise err(f"{cls.__qualname__} has no glsl: set glsl to the GLSL source of {wanted} or to a .glsl path")
-    for function in contract:
-        method = cls.__dict__.get(function.suffix)
-        inherited = [c.__dict__.get(function.suffix) for c in cls.__mro__[1:-1] if c.__module__ != __name__
-                     and not c.__dict__.get("abstract_contract", False)]
-        if method is None and all(m is None for m in inherited):
-            raise err(f"{cls.__qualname__} defines no numpy twin: add `def {function.suffix}(self, "
-                      f"{', '.join(function.twin)})` returning {function.returns}, the same formulation as its GLSL")
-        if method is not None:
-            try:
-                args = [a for a in list(inspect.signature(method).parameters.values())[1:]
-                        if a.kind in (a.POSITIONAL_ONLY, a.POSITIONAL_OR_KEYWORD)]
-            except (TypeError, ValueError):
-                args = None
-            if args is not None and len(args) != len(function.twin):
-                raise err(f"{cls.__qualname__}.{function.suffix} must take (self, {', '.join(function.twin)}) "
-                          f"(got ({', '.join(['self'] + [a.name for a in args])}))")
-    _SOURCES.pop(cls, None)
-    _check_glsl(cls, _strip_comments(light_source(cls)[0]))
-    for method in getattr(cls, "required_methods", ()):
-        if all(c.__dict__.get(method) is None for c in cls.__mro__[:-1] if c.__module__ != __name__
-               and not c.__dict__.get("abstract_contract", False)):
-            raise err(f"{cls.__qualname__} defines no `{method}`: an extended kind gives its float64 exact integral, "
-                      f"`def exact(self, x, n, p, integrand, clip=())` (glphong.twin.quadrature has polygons, spheres "
-                      "and disks)")
+_CASE_MATERIAL = {}
 
 
-def _check_glsl(cls, code):
-    err, name = LightDefinitionError, cls.name
-    for function in cls.contract():
-        if not re.search(function.pattern(name), code):
-            found = re.search(rf"\b\w+\s+{name}_{function.suffix}\s*\([^)]*\)", code)
-            raise err(f"{cls.__qualname__}.glsl must define `{function.glsl(name)}` (name = {name!r} gives the prefix); "
-                      + (f"found `{found.group(0)}`" if found else f"found no {name}_{function.suffix}"))
-    read = set(re.findall(rf"\bu_{name}_([A-Za-z_]\w*)", code))
-    declared = {p.name for p in cls.uniform_params()}
-    if read - declared:
-        raise err(f"{cls.__qualname__}.glsl reads {', '.join(f'u_{name}_{x}' for x in sorted(read - declared))}, "
-                  f"which no uniform declares (uniforms: {', '.join(sorted(declared)) or 'none'})")
-    if declared - read:
-        raise err(f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(declared - read))}: "
-                  "every uniform is an array the light function must use (or remove it)")
-    if re.search(rf"\buniform\s+\w+\s+u_{name}_", code):
-        raise err(f"{cls.__qualname__}.glsl declares its own u_{name}_* uniforms: glphong declares them (arrays "
-                  f"of NUM_{name.upper()}_LIGHTS) from its uniforms; remove the declarations")
-    own = _top_level_names(code)
-    clash = own & _library_names()
-    if clash:
-        raise err(f"{cls.__qualname__}.glsl defines {', '.join(sorted(clash))}, which glphong's library chunks "
-                  f"define; prefix your functions with {name}_")
-    unprefixed = sorted(n for n in own if not n.startswith(f"{name}_") and not n.upper().startswith(f"{name.upper()}_"))
-    if unprefixed:
-        raise err(f"{cls.__qualname__}.glsl defines {', '.join(unprefixed)} without the prefix {name}_ (lights and "
-                  "materials share one program): prefix them")
+def _lecture_phong():
+    """The lecture's Phong, ``Lambert + PhongLobe``, as a `MaterialSum` of the registered models 'lambert' and
+    'phong_lobe' (the same terms as `glphong.Phong`; made once)."""
+    found = _CASE_MATERIAL.get("phong")
+    if found is None:
+        terms = (MATERIALS.named("lambert"), MATERIALS.named("phong_lobe"))
+        found = _CASE_MATERIAL["phong"] = type("Phong", (MaterialSum,), {"terms": terms, "__module__": __name__})
+    return found
+
+
+def light_cases(light):
+    """Generic stability geometry for one light (a `glphong.definitions.cases.Case` each): the light over a
+    Lambert+Phong point at normal, oblique and grazing incidence of the point's normal."""
+    name = type(light).name
+    material = _lecture_phong()(0.3, 0.4, 20.0)
+    out = []
+    for label, normal in (("normal", (0.0, 0.0, 1.0)), ("oblique 60 deg", (0.0, np.sin(np.pi / 3), np.cos(np.pi / 3))),
+                          ("grazing 89.9 deg", (0.0, np.sin(np.radians(89.9)), np.cos(np.radians(89.9))))):
+        out.append(Case(f"{name} light, {label}", f"light {name}", material, normal=tuple(float(c) for c in normal),
+                        eye=(0.3, 0.2, 2.0), lights=(light,)))
+    return tuple(out)
 
 
 class ExactIrradiance:

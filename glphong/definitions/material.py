@@ -24,191 +24,21 @@ from dataclasses import dataclass
 import numpy as np
 
 from glphong.core import validate as _validate
-from glphong.materials.definition_checks import check_definition
-from glphong.materials.params import (MATERIAL_KEYWORDS, NEEDS, Choice, GlslFile, MaterialDefinitionError, Param, ParamValues,
-                                      Properties, ShadingFrame)
-from glphong.materials.registry import _REGISTRY, _is_builtin, model_named, model_source, register, registered_models
-from glphong.materials.table import Table, TableData
-from glphong.materials.cases import generic_cases
-from glphong.materials.fresnel import FRESNEL_PARAMS, fresnel_uniform_values
-from glphong.materials.surface import AlphaMask, NormalMap, SurfaceInput
+from glphong.definitions.material_base import Material, bind_arguments, constant_part, surface_define  # noqa: F401
+from glphong.definitions.material_checks import check_definition
+from glphong.definitions.params import (Choice, GlslFile, MaterialDefinitionError, Param, ParamValues, Properties,
+                                        ShadingFrame)
+from glphong.definitions.definition import Definition
+from glphong.definitions.registry import MATERIALS, model_named, registered_models
+from glphong.definitions.table import Table, TableData
+from glphong.definitions.cases import generic_cases
+from glphong.definitions.fresnel import FRESNEL_PARAMS, fresnel_uniform_values
+from glphong.definitions.surface import SurfaceInput
 from glphong.twin.band import EPS
 from glphong.twin.functions import perpendiculars
 
-__all__ = ["Integral", "Param", "Choice", "Table", "TableData", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
+__all__ = ["Integral", "bind_arguments", "surface_define", "constant_part", "Param", "Choice", "Table", "TableData", "Properties", "ParamValues", "ShadingFrame", "Material", "MaterialModel", "MaterialSum",
            "MaterialDefinitionError", "GlslFile", "registered_models", "model_named"]
-
-
-# --------------------------------------------------------------------------- materials
-class Material:
-    """Base of everything `glphong.Scene.add` accepts: a sum of terms, a constant ``k_a``, sidedness.
-
-    Subclass `MaterialModel` (one term) or `MaterialSum` (several), never this class directly.
-
-    Attributes
-    ----------
-    ka : tuple of 3 float
-        Constant radiance ``k_a`` [W/(m^2 sr)] (the lecture's ambient term), >= 0.
-    two_sided : bool
-        Shade back faces with the normal flipped toward the viewer.
-    normal_map : glphong.NormalMap or None
-        A tangent-space normal map: every term shades with the mapped normal.
-    alpha_mask : glphong.AlphaMask or None
-        Alpha testing: fragments whose alpha is below the cutoff are not drawn.
-    """
-
-    #: display name; a model's name is also its GLSL prefix
-    name = None
-    #: declared BRDF properties (for a sum: derived from its terms unless declared)
-    properties = Properties()
-
-    def _set_common(self, ka, two_sided, normal_map=None, alpha_mask=None):
-        object.__setattr__(self, "ka", _validate.rgb("ka", ka))
-        if not isinstance(two_sided, (bool, np.bool_)):
-            raise TypeError(f"two_sided must be a bool, True or False (got {two_sided!r})")
-        object.__setattr__(self, "two_sided", bool(two_sided))
-        if normal_map is not None and not isinstance(normal_map, NormalMap):
-            raise TypeError(f"normal_map must be a glphong.NormalMap or None (got {type(normal_map).__name__})")
-        object.__setattr__(self, "normal_map", normal_map)
-        if alpha_mask is not None and not isinstance(alpha_mask, AlphaMask):
-            raise TypeError(f"alpha_mask must be a glphong.AlphaMask or None (got {type(alpha_mask).__name__})")
-        object.__setattr__(self, "alpha_mask", alpha_mask)
-
-    @property
-    def components(self):
-        """The material's terms, as `MaterialModel` instances (tuple)."""
-        raise NotImplementedError
-
-    def parameter_values(self):
-        """Every parameter's validated value by name (dict), ``ka`` and ``two_sided`` included."""
-        out = {}
-        for term in self.components:
-            out.update({a.name: getattr(term, a.name) for a in term.arguments()})
-        out.update(ka=self.ka, two_sided=self.two_sided, normal_map=self.normal_map, alpha_mask=self.alpha_mask)
-        return out
-
-    def uniform_values(self, key):
-        """The material's uniforms for a program ``key``, as float32 arrays.
-
-        Parameters
-        ----------
-        key : glphong.shaders.key.ProgramKey
-
-        Returns
-        -------
-        dict of str to numpy.ndarray
-            ``u_ka`` where the key has it, and ``u_<model>_<param>`` of the key's terms: every
-            parameter of a term in the light loop (its tables as `TableData`), the ambient
-            parameter of a term that only answers ``L_a``.
-        """
-        values = {}
-        if key.has_ka:
-            values["u_ka"] = _validate.float32_uniform(self.ka)
-        values.update(self.surface_uniform_values(key))
-        by_name = {term.name: term for term in self.components}
-        for term_key in key.terms:
-            term = by_name.get(term_key.name)
-            if term is None:
-                continue  # the uber-shader's terms this material does not have: the caller fills zeros
-            unlit = {term_key.ambient_param if term_key.ambient else None, term_key.emission, term_key.occlusion}
-            generated = {term.emission, term.occluded_by} - unlit  # read by material_emission only, where the key has them
-            params = [p for p in term.active_params() if p.name not in generated] if term_key.lit else \
-                [p for p in term.params if p.name in unlit]
-            surface = term.surface_inputs()
-            for p in params:
-                if p.name in surface:  # scale * texture * vertex colour, per fragment (material_inputs)
-                    values[term.uniform_name(f"{p.name}_scale")] = _validate.float32_uniform(surface[p.name].scale)
-                    if surface[p.name].texture is not None:
-                        values[term.uniform_name(f"{p.name}_texture")] = surface[p.name].texture
-                else:
-                    values[term.uniform_name(p.name)] = _validate.float32_uniform(term.uniform_value(p.name))
-            if term_key.lit:  # tables as `TableData`: the renderer binds their textures, the twin reads them
-                values.update({term.uniform_name(t.name): getattr(term, t.name) for t in term.tables})
-        return values
-
-    def surface_uniform_values(self, key):
-        """The uniforms of the material's normal map and alpha mask that program ``key`` reads (radiance and
-        G-buffer programs alike): ``u_normal_map_texture``, ``u_normal_map_scale``, ``u_alpha_mask_cutoff``,
-        ``u_alpha_mask_scale`` and ``u_alpha_mask_texture``."""
-        values = {}
-        if key.normal_map:
-            values["u_normal_map_texture"] = self.normal_map.texture
-            values["u_normal_map_scale"] = _validate.float32_uniform(self.normal_map.scale)
-        if key.alpha_mask:
-            mask = self.alpha_mask
-            values["u_alpha_mask_cutoff"] = _validate.float32_uniform(mask.cutoff)
-            values["u_alpha_mask_scale"] = _validate.float32_uniform(mask.alpha.scale if mask.textured else mask.alpha)
-            if mask.textured:
-                values["u_alpha_mask_texture"] = mask.alpha.texture
-        return values
-
-    def __setattr__(self, name, value):
-        raise AttributeError(f"{type(self).__name__} is immutable: make a new material instead of setting {name!r}")
-
-    def __eq__(self, other):
-        return type(other) is type(self) and other.parameter_values() == self.parameter_values()
-
-    def __hash__(self):
-        return hash((type(self), tuple(self.parameter_values().items())))
-
-    def __repr__(self):
-        values = self.parameter_values()
-        arguments = type(self).arguments() if hasattr(type(self), "arguments") else ()
-        hidden = {a.name for a in arguments if not isinstance(a, Param) and values.get(a.name) == a.default}
-        shown = [f"{k}={_short(v)}" for k, v in values.items() if k not in MATERIAL_KEYWORDS and k not in hidden]
-        if any(values["ka"]):
-            shown.append(f"ka={_short(values['ka'])}")
-        if not values["two_sided"]:
-            shown.append("two_sided=False")
-        shown += [f"{k}={values[k]!r}" for k in ("normal_map", "alpha_mask") if values[k] is not None]
-        return f"{type(self).__name__}({', '.join(shown)})"
-
-
-def _constant_part(value):
-    """A parameter's value, or a surface input's constant ``scale``."""
-    return getattr(value, "scale", value)
-
-
-def surface_define(model, param):
-    """``<MODEL>_<PARAM>_INPUT``: defined where a program sets the parameter per fragment."""
-    return f"{model.upper()}_{param.upper()}_INPUT"
-
-
-def _short(value):
-    if value is None or isinstance(value, str) or not isinstance(value, (tuple, float, int)):
-        return repr(value)
-    if isinstance(value, tuple) and len(set(value)) == 1:
-        return f"{value[0]:g}"
-    return f"({', '.join(f'{c:g}' for c in value)})" if isinstance(value, tuple) else f"{value:g}"
-
-
-def bind_arguments(cls, params, args, kwargs):
-    """Map positional and keyword arguments onto ``params`` (validated values by name).
-
-    ``params`` are the constructor's arguments in positional order: `Table`, `Param`, `Choice` and a
-    `FresnelSlot` (whose default may be None, a valid value)."""
-    if len(args) > len(params):
-        raise TypeError(f"{cls.__name__}() takes at most {len(params)} positional arguments "
-                        f"({', '.join(p.name for p in params)}) (got {len(args)})")
-    names = [p.name for p in params]
-    given = dict(zip(names, args))
-    for name, value in kwargs.items():
-        if name not in names:
-            raise TypeError(f"{cls.__name__}() got an unexpected parameter {name!r} "
-                            f"(parameters: {', '.join(names + list(getattr(cls, 'keywords', MATERIAL_KEYWORDS)))})")
-        if name in given:
-            raise TypeError(f"{cls.__name__}() got parameter {name!r} twice")
-        given[name] = value
-    out = {}
-    for p in params:
-        if p.name in given:
-            out[p.name] = p.validate(given[p.name])
-        elif p.default is not None or getattr(p, "optional", False) or not isinstance(p, (Param, Table)):
-            out[p.name] = p.default
-        else:
-            raise TypeError(f"{cls.__name__}() missing parameter {p.name!r} ({p.kind} in {p.interval}"
-                            f"{', ' + p.unit if p.unit else ''})")
-    return out
 
 
 @dataclass(frozen=True)
@@ -236,8 +66,9 @@ class Integral:
     exponent: str = None
 
 
-class MaterialModel(Material):
-    """One reflectance model (a term of a material), defined the way the built-ins are.
+class MaterialModel(Material, Definition):
+    """One reflectance model (a term of a material), defined the way the built-ins are (the definition mechanism of
+    `glphong.definitions.definition.Definition`, which light kinds share).
 
     Class attributes a definition sets
     ----------------------------------
@@ -323,30 +154,29 @@ class MaterialModel(Material):
     in_uber = False
     lobe_exponent = None
 
-    def __init_subclass__(cls, **kwargs):
-        super().__init_subclass__(**kwargs)
+    registry = MATERIALS
+    definition_error = MaterialDefinitionError
+    definition_kind = "material"
+
+    @classmethod
+    def check_unnamed(cls):
+        """A subclass without a name of its own is abstract or pure Python: it may not redefine the GLSL, twin or
+        parameters, which would render as its parent."""
         own = cls.__dict__
-        if "name" not in own:
-            redefined = [a for a in ("glsl", "response", "params", "tables", "needs", "uses") if a in own]
-            if redefined and cls.name is not None:
-                raise MaterialDefinitionError(
-                    f"{cls.__qualname__} redefines {', '.join(redefined)} but keeps the name {cls.name!r} of "
-                    f"{cls.__mro__[1].__qualname__}: give it a name of its own (name = '...'), or it would "
-                    "render as its parent")
-            if cls.name is None and ("glsl" in own or "response" in own):
-                raise MaterialDefinitionError(f"{cls.__qualname__} defines a model but no name: add name = '...' "
-                                              "(a lowercase GLSL prefix)")
-            return  # an abstract intermediate, or a pure-Python subclass of a model
-        existing = _REGISTRY.get(cls.name) if isinstance(cls.name, str) else None
-        if existing is not None and existing is not cls:
-            same = (existing.__module__, existing.__qualname__) == (cls.__module__, cls.__qualname__)
-            if _is_builtin(existing) or not same:
-                raise MaterialDefinitionError(
-                    f"{cls.__qualname__}: the name {cls.name!r} is taken by "
-                    f"{'the built-in ' if _is_builtin(existing) else ''}{existing.__module__}.{existing.__qualname__}; "
-                    "choose another name")
+        redefined = [a for a in ("glsl", "response", "params", "tables", "needs", "uses") if a in own]
+        if redefined and cls.name is not None:
+            raise MaterialDefinitionError(
+                f"{cls.__qualname__} redefines {', '.join(redefined)} but keeps the name {cls.name!r} of "
+                f"{cls.__mro__[1].__qualname__}: give it a name of its own (name = '...'), or it would "
+                "render as its parent")
+        if cls.name is None and ("glsl" in own or "response" in own):
+            raise MaterialDefinitionError(f"{cls.__qualname__} defines a model but no name: add name = '...' "
+                                          "(a lowercase GLSL prefix)")
+
+    @classmethod
+    def check_definition(cls):
+        """The checks of `glphong.definitions.material_checks` (raising `MaterialDefinitionError`)."""
         check_definition(cls, MaterialModel)
-        register(cls)  # a re-run of the same definition (a notebook cell) replaces it
 
     def integral_form(self):
         """How this term reflects an extended light in closed form (`Integral`), or None: sampled (default)."""
@@ -408,22 +238,7 @@ class MaterialModel(Material):
     def components(self):
         return (self,)
 
-    # ---- what the program key and the uniforms are made of
-    @classmethod
-    def uniform_name(cls, param):
-        """``u_<model>_<param>``."""
-        return f"u_{cls.name}_{param}"
-
-    @classmethod
-    def source(cls):
-        """The model's GLSL text."""
-        return model_source(cls)[0]
-
-    @classmethod
-    def source_hash(cls):
-        """First 12 hex digits of the SHA-256 of the GLSL text (part of the program key)."""
-        return model_source(cls)[3]
-
+    # ---- what the program key and the uniforms are made of (uniform_name, source, source_hash: `Definition`)
     @classmethod
     def uniform_declarations(cls):
         """The GLSL declarations of the model's uniforms, generated from `params` and `tables`; where the
@@ -440,7 +255,7 @@ class MaterialModel(Material):
                   f"{' [' + t.unit + ']' if t.unit else ''}" for t in cls.tables]
         if cls.fresnel_slot is not None:
             upper, name = cls.name.upper(), cls.name
-            lines += [f"// the Fresnel factor F(c) of fresnel= (glphong/materials/fresnel.py), c = {cls.fresnel_slot.cosine}",
+            lines += [f"// the Fresnel factor F(c) of fresnel= (glphong/definitions/fresnel.py), c = {cls.fresnel_slot.cosine}",
                       f"vec3 {name}_fresnel(float c)", "{",
                       f"#if defined({upper}_FRESNEL_SCHLICK)",
                       f"    return fresnel_schlick(u_{name}_fresnel_f0, c);",
@@ -466,15 +281,15 @@ class MaterialModel(Material):
     def vanishes(self):
         """True where a `vanishes_with` parameter is zero in every channel (a surface input: its scale):
         the term is left out."""
-        return any(not np.any(_constant_part(getattr(self, name))) for name in self.vanishes_with)
+        return any(not np.any(constant_part(getattr(self, name))) for name in self.vanishes_with)
 
     def answers_ambient(self):
         """True where the model answers ``L_a`` with a non-zero ``k``."""
-        return self.ambient is not None and bool(np.any(_constant_part(getattr(self, self.ambient))))
+        return self.ambient is not None and bool(np.any(constant_part(getattr(self, self.ambient))))
 
     def emits(self):
         """True where the model declares an `emission` parameter and it is not zero in every channel."""
-        return self.emission is not None and bool(np.any(_constant_part(getattr(self, self.emission))))
+        return self.emission is not None and bool(np.any(constant_part(getattr(self, self.emission))))
 
     def gltf_fields(self, texture_index):
         """glTF's own material fields for this term, where the model is a glTF material (`GltfPBR`); None otherwise,

@@ -5,23 +5,44 @@ parameters and tables, ``needs`` and ``uses``, the ambient parameter, the Fresne
 signature, and the GLSL (the response function and its signature, the uniforms it reads, what it
 reads without declaring it in ``needs``, names that clash with the library or another model).
 """
-import inspect
 import re
 
 import numpy as np
 
-from glphong.materials.fresnel import FresnelSlot
-from glphong.materials.params import (_GLSL_KEYWORDS, _IDENT, LIBRARY_CHUNKS, NEEDS, RESERVED_NAMES, Choice,
-                                      MaterialDefinitionError, Param, Properties)
-from glphong.materials.registry import (_SOURCES, _generated_names, _library_names, _model_names, _strip_comments,
-                                        _top_level_names, model_source, registered_models)
-from glphong.materials.table import Table
+from glphong.definitions.checks import (check_library_clash, check_name, check_not_shadowing, check_params,
+                                        check_uniform_reads, check_uses, twin_arguments)
+from glphong.definitions.fresnel import FresnelSlot
+from glphong.definitions.params import LIBRARY_CHUNKS, NEEDS, Choice, MaterialDefinitionError, Properties
+from glphong.definitions.registry import model_source, registered_models
+from glphong.definitions.source import strip_comments, top_level_names
+from glphong.definitions.table import Table
 
 __all__ = ["check_definition"]
 
+
+def _generated_names(cls):
+    """The uniform and switch names glphong generates for a model."""
+    names = {cls.uniform_name(p.name) for p in cls.uniform_params() + cls.tables}
+    names |= {cls.uniform_name(f"{p.name}_{suffix}") for p in cls.params if p.textureable for suffix in ("scale", "texture")}
+    names |= {f"u_use_{cls.name}", f"u_use_{cls.name}_ambient"}
+    return names | ({f"{cls.name}_fresnel"} if cls.fresnel_slot is not None else set())
+
+
+
+_MODEL_NAMES = {}
+
+
+def _model_names(cls):
+    """What a registered model's GLSL defines at file scope, once per definition (name and source hash)."""
+    key = (cls.name, cls.source_hash())
+    names = _MODEL_NAMES.get(key)
+    if names is None:
+        names = _MODEL_NAMES[key] = frozenset(top_level_names(strip_comments(cls.source())))
+    return names
+
 def _check_glsl(cls, text):
     """The definition-time checks of a model's GLSL text."""
-    code = _strip_comments(text)
+    code = strip_comments(text)
     name = cls.name
     wanted = f"vec3 {name}_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)"
     pattern = rf"\bvec3\s+{name}_response\s*\(\s*ShadingFrame\s+\w+\s*,\s*vec3\s+\w+\s*,\s*vec3\s+\w+\s*,\s*float\s+\w+\s*\)"
@@ -32,22 +53,11 @@ def _check_glsl(cls, text):
             f"{cls.__qualname__}.glsl must define `{wanted}` (name = {name!r} gives the prefix); "
             + (f"found `{found.group(0)}`" if found else
                f"found no {name}_response (functions defined: {', '.join(functions) or 'none'})"))
-    read = set(re.findall(rf"\bu_{name}_([A-Za-z_]\w*)", code))
     declared = {p.name for p in cls.uniform_params()} | {t.name for t in cls.tables}
-    if read - declared:
-        raise MaterialDefinitionError(
-            f"{cls.__qualname__}.glsl reads {', '.join(f'u_{name}_{x}' for x in sorted(read - declared))}, "
-            f"which no Param or Table declares (params and tables: {', '.join(sorted(declared)) or 'none'})")
     # the Fresnel slot's uniforms and the ambient parameter are read by generated code
-    unread = declared - read - {p.name for p in cls.uniform_params()[len(cls.params):]} \
-        - {cls.ambient, cls.emission, cls.occluded_by}
-    if unread:
-        raise MaterialDefinitionError(
-            f"{cls.__qualname__}.glsl never reads {', '.join(f'u_{name}_{x}' for x in sorted(unread))}: "
-            "every Param and Table is a uniform the response must use (or remove it)")
-    if re.search(rf"\buniform\s+\w+\s+u_{name}_", code):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl declares its own u_{name}_* uniforms: glphong "
-                                      "declares them from params; remove the declarations")
+    check_uniform_reads(cls, code, declared, {p.name for p in cls.uniform_params()[len(cls.params):]}
+                        | {cls.ambient, cls.emission, cls.occluded_by}, what="Param or Table",
+                        listing="params and tables", every="every Param and Table is a uniform the response must use")
     calls = re.search(rf"\b{name}_fresnel\s*\(", code)
     if cls.fresnel_slot is not None and not calls:
         raise MaterialDefinitionError(f"{cls.__qualname__} has a fresnel_slot, so its GLSL must call "
@@ -87,11 +97,7 @@ def _check_needs(cls, code):
 
 def _check_namespace(cls, code):
     """What a model defines must not collide with the library or another model (they share a program)."""
-    own = _top_level_names(code)
-    clash = own & _library_names()
-    if clash:
-        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl defines {', '.join(sorted(clash))}, which glphong's "
-                                      f"library chunks define; prefix your functions with {cls.name}_")
+    own = check_library_clash(cls, code)
     for other in registered_models():
         if other.name == cls.name:
             continue
@@ -117,15 +123,11 @@ def _check_twin(cls, base):
         raise MaterialDefinitionError(
             f"{cls.__qualname__} defines no numpy twin: add `def response(self, f, wi, wo, n_dot_l, p)` "
             "returning f_r (n.wi) [1/sr] as an (N, 3) array, the same formulation as its GLSL")
-    try:
-        params = list(inspect.signature(response).parameters.values())[1:]
-    except (TypeError, ValueError):
-        return
-    positional = [p for p in params if p.kind in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD)]
-    if len(positional) != len(_TWIN_ARGS) and not any(p.kind == p.VAR_POSITIONAL for p in params):
+    positional = twin_arguments(response)
+    if positional is not None and len(positional) != len(_TWIN_ARGS):
         raise MaterialDefinitionError(
             f"{cls.__qualname__}.response must take (self, {', '.join(_TWIN_ARGS)}) "
-            f"(got ({', '.join(['self'] + [p.name for p in params])}))")
+            f"(got ({', '.join(['self'] + [p.name for p in positional])}))")
 
 
 def check_definition(cls, base):
@@ -133,30 +135,16 @@ def check_definition(cls, base):
     attributes a parameter must not shadow and whose placeholder twin a model must replace); raises
     MaterialDefinitionError."""
     name = cls.name
-    if not isinstance(name, str) or not _IDENT.match(name) or "__" in name or name.endswith("_"):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.name must be a lowercase GLSL identifier such as "
-                                      f"'minnaert' (got {name!r})")
-    if name in RESERVED_NAMES or name in _GLSL_KEYWORDS or name.startswith("gl_"):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.name {name!r} is reserved by glphong's shading code "
-                                      "or GLSL; choose another")
+    check_name(cls, "minnaert")
     params = cls.params
-    if not isinstance(params, tuple) or not all(isinstance(p, Param) for p in params):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.params must be a tuple of glphong.materials.Param")
+    names = check_params(cls, "params")
     if not isinstance(cls.tables, tuple) or not all(isinstance(t, Table) for t in cls.tables):
         raise MaterialDefinitionError(f"{cls.__qualname__}.tables must be a tuple of glphong.materials.Table")
-    names = [p.name for p in params]
-    if len(set(names)) != len(names):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.params repeats a name ({names})")
-    shadowing = sorted(set(names + [t.name for t in cls.tables]) & set(dir(base)))
-    if shadowing:
-        raise MaterialDefinitionError(f"{cls.__qualname__}.params: {', '.join(shadowing)} would shadow a "
-                                      "MaterialModel attribute; choose other parameter names")
+    check_not_shadowing(cls, names + [t.name for t in cls.tables], base)
     if not isinstance(cls.needs, tuple) or not set(cls.needs) <= set(NEEDS):
         raise MaterialDefinitionError(f"{cls.__qualname__}.needs must be a tuple of {', '.join(map(repr, NEEDS))} "
                                       f"(got {cls.needs!r})")
-    if not isinstance(cls.uses, tuple) or not set(cls.uses) <= set(LIBRARY_CHUNKS):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.uses must be a tuple of library chunks "
-                                      f"{', '.join(map(repr, LIBRARY_CHUNKS))} (got {cls.uses!r})")
+    check_uses(cls, LIBRARY_CHUNKS)
     rgb = {p.name for p in params if p.kind == "rgb"}
     if cls.ambient is not None and cls.ambient not in rgb:
         raise MaterialDefinitionError(f"{cls.__qualname__}.ambient must be None or the name of an rgb Param "
@@ -196,7 +184,6 @@ def check_definition(cls, base):
                                       f"`vec3 {name}_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)` "
                                       "or to the path of a .glsl file")
     _check_twin(cls, base)
-    _SOURCES.pop(cls, None)
     _check_glsl(cls, model_source(cls)[0])
 
 

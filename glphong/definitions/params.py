@@ -13,7 +13,7 @@ import numpy as np
 from glphong.core import validate as _validate
 from glphong.core.glsl_files import library_chunks
 from glphong.twin.functions import ShadingFrame
-from glphong.materials.surface import SurfaceInput
+from glphong.definitions.surface import SurfaceInput
 
 __all__ = ["Param", "Choice", "Properties", "ParamValues", "ShadingFrame", "GlslFile", "DefinitionError", "MaterialDefinitionError",
            "KINDS", "NEEDS", "LIBRARY_CHUNKS", "RESERVED_NAMES", "MATERIAL_KEYWORDS"]
@@ -83,7 +83,7 @@ class Param:
     low_inclusive, high_inclusive : bool
         Whether the ends of the range are allowed values.
     textureable : bool
-        The parameter also takes a `glphong.materials.surface.SurfaceInput` (a texture, vertex
+        The parameter also takes a `glphong.definitions.surface.SurfaceInput` (a texture, vertex
         colours or both, `glphong.Texture`, `glphong.VertexColors`): its value then varies over the
         surface, and the model's GLSL reads ``u_<model>_<name>`` unchanged (glphong sets it per fragment
         before the response is called).  rgb and scalar parameters; a scalar's input reads one channel

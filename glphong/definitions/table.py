@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from glphong.materials.params import MaterialDefinitionError, _check_argument_name
+from glphong.definitions.params import MaterialDefinitionError, _check_argument_name
 
 __all__ = ["Table", "TableData", "uniform_as"]
 

@@ -10,7 +10,7 @@ What is written:
   factors, a metallic-roughness texture that both read (blue, green), its emissive with
   ``KHR_materials_emissive_strength``; any material's normal map as ``normalTexture`` and alpha mask as
   ``alphaMode`` MASK) and, exactly, in the material's
-  ``extras: {"glphong": ...}`` (`glphong.materials.as_json`), which `load_scene` prefers;
+  ``extras: {"glphong": ...}`` (`glphong.definitions.as_json`), which `load_scene` prefers;
 - textures as PNG images (8-bit sources, re-encoded losslessly) with their samplers;
 - the camera (perspective: ``yfov``, ``znear``, ``zfar``; orthographic: ``ymag``; an `IntrinsicsCamera`'s
   principal point is not representable: written as its perspective frustum, with a warning);
@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 from glphong.materials import SurfaceInput
-from glphong.materials.as_json import material_to_json
+from glphong.definitions.as_json import material_to_json
 from glphong.scene.camera import IntrinsicsCamera, OrthographicCamera
 from glphong.scene.scene import Scene
 

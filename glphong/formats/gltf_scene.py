@@ -12,9 +12,9 @@ from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, 
 from glphong.materials import AlphaMask, NormalMap, Texture, TextureImage, VertexColors
 from glphong.materials.cook_torrance import CookTorrance
 from glphong.materials.gltf_pbr import GltfPBR
-from glphong.materials.fresnel import SchlickFresnel
+from glphong.definitions.fresnel import SchlickFresnel
 from glphong.formats.overrides import chosen_material
-from glphong.materials.as_json import material_from_json
+from glphong.definitions.as_json import material_from_json
 from glphong.scene.geometry import MeshData
 from glphong.scene.camera import OrthographicCamera, PerspectiveCamera
 from glphong.scene.from_trimesh import _trimesh_material, default_view, empty_scene, with_default_view
@@ -47,7 +47,7 @@ def _glphong_extras(document):
 
 def material_from_extras(entry, gltf, where=""):
     """The glphong material stored in a glTF material's ``extras: {"glphong": ...}``
-    (`glphong.materials.as_json`), or None where there is none.
+    (`glphong.definitions.as_json`), or None where there is none.
 
     Parameters
     ----------
@@ -183,7 +183,7 @@ BLEND_REFUSED = ("alphaMode BLEND: glphong draws opaque and alpha-masked surface
 
 def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1.0):
     """A glTF metallic-roughness material (JSON ``materials`` entry) as `glphong.GltfPBR`, the specification's
-    Appendix B, with its textures (docs/formats.md):
+    Appendix B, with its textures (docs/scenes_from_files.md):
 
     - ``base_color = baseColorFactor.rgb * baseColorTexture (sRGB) * COLOR_0``;
     - ``metallic = metallicFactor * metallicRoughnessTexture.b``, ``roughness = roughnessFactor *

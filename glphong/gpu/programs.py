@@ -14,9 +14,9 @@ from glphong.shaders.assembly import assemble, name_chunks
 from glphong.gpu.shadows import ShadowMap
 from glphong.gpu.textures import TextureStore
 from glphong.lights import light_for_key
-from glphong.materials.registry import model_for_key
-from glphong.materials.surface import TextureImage
-from glphong.materials.table import TableData
+from glphong.definitions.registry import model_for_key
+from glphong.definitions.surface import TextureImage
+from glphong.definitions.table import TableData
 
 __all__ = ["ProgramCache", "Program", "ShaderCompileError", "UniformError"]
 

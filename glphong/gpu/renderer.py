@@ -9,14 +9,15 @@ import functools
 import threading
 import warnings
 import weakref
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import moderngl
 import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.gpu.frame import Frame, GBuffer
-from glphong.gpu.resources import ORPHANS, ORPHANS_LOCK, MeshBuffers, release_orphans, release_resources, release_targets
+from glphong.gpu.resources import (ORPHANS, ORPHANS_LOCK, MeshBuffers, ObjectEntry, available_memory, release_orphans,
+                                   release_resources, release_targets)
 from glphong.gpu.contexts import check_not_forked, create_context
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
@@ -29,34 +30,6 @@ from glphong.gpu.programs import ProgramCache
 from glphong.scene.scene import Scene
 
 __all__ = ["Renderer", "Frame", "GBuffer"]
-
-
-@dataclass(eq=False)
-class _ObjectEntry:
-    """What a renderer draws one scene object with (see `Renderer._draw_list`)."""
-
-    state: tuple
-    index: int
-    key: object
-    program: object
-    pack: tuple
-    vertex_array: object
-    mirrored: bool
-    sphere: tuple = None  # ((x, y, z), radius) in the world where the mesh's back faces may be culled
-    checked: object = None
-    camera: object = None  # the camera the key's 'view' piece was decided for (numerics='auto')
-
-
-def _available_memory():
-    """``MemAvailable`` of /proc/meminfo [bytes] (llvmpipe's render targets live in host memory), or None."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        return None
-    return None
 
 
 def _one_call_at_a_time(method):
@@ -177,7 +150,7 @@ class Renderer:
         self._meshes = {}
         self._targets = {}
         self._shadow_maps = ShadowMaps(self._mgl, self._targets)
-        self._entries = weakref.WeakKeyDictionary()  # SceneObject -> {output: _ObjectEntry}
+        self._entries = weakref.WeakKeyDictionary()  # SceneObject -> {output: ObjectEntry}
 
     def render_target_bytes(self, size=None):
         """Memory the render targets and one float32 readback need at ``size`` (default the current one) [bytes].
@@ -201,7 +174,7 @@ class Renderer:
             raise ValueError(f"width and height times supersample must be at most this context's largest "
                              f"render target, {self._max_size} pixels ({renderer_name}) (got {internal[0]}x{internal[1]})")
         needed = self.render_target_bytes(size)
-        available = _available_memory()
+        available = available_memory()
         if available is not None and needed > 0.8 * available:
             raise ValueError(f"a {size[0]}x{size[1]} renderer (supersample {self.supersample}, samples {self.samples}) "
                              f"needs about {needed / 2**30:.1f} GiB for its render targets and readback; this machine "
@@ -455,7 +428,7 @@ class Renderer:
 
         Per frame, the uniforms every object shares (camera, lights) are packed once per program key;
         per object, its key, program, vertex array and packed uniforms (pose, normal matrix, material)
-        are made once and kept (`_ObjectEntry`) while the scene's lights, ambient light and the object's
+        are made once and kept (`ObjectEntry`) while the scene's lights, ambient light and the object's
         index are what they were: objects, materials and poses are immutable.  The uber-shader's key is
         the scene's, the same for every object (made once per frame).  ``frame_values`` are uniforms the
         call adds to every program's frame pack (the display programs' ``u_exposure``), ``shadow_values`` the
@@ -482,7 +455,7 @@ class Renderer:
                     bound.object_uniform_values(index, key)
                 vao = self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program)
                 sphere = world_sphere(obj.mesh, obj.pose) if self.culling == "auto" and closed_outward(obj.mesh)[0] else None
-                entry = _ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
+                entry = ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
                                      None if sphere is None else (tuple(sphere[0]), sphere[1]), camera=camera)
                 if shared is None:
                     per_object[output] = entry

@@ -1,5 +1,6 @@
 """The GL objects a renderer owns, and their release: a mesh's buffers and vertex arrays
-(`MeshBuffers`, uploaded per attribute on first use), and the release of everything a renderer made,
+(`MeshBuffers`, uploaded per attribute on first use), what a renderer keeps per drawn object (`ObjectEntry`), the
+host memory its targets may take (`available_memory`), and the release of everything a renderer made,
 also for renderers the garbage collector found unreleased (`ORPHANS`, released at the next glphong call
 or at exit: the collector may run anywhere, inside pyrender's draw or on another thread, where GL work
 is unsafe).
@@ -7,12 +8,42 @@ is unsafe).
 import atexit
 import threading
 import weakref
+from dataclasses import dataclass
 
 import numpy as np
 
 from glphong.gpu.contexts import EGLDisplayTerminatedError
 
-__all__ = ["MeshBuffers", "release_resources", "release_targets", "release_orphans", "ORPHANS", "ORPHANS_LOCK"]
+__all__ = ["MeshBuffers", "ObjectEntry", "available_memory", "release_resources", "release_targets", "release_orphans",
+           "ORPHANS", "ORPHANS_LOCK"]
+
+
+@dataclass(eq=False)
+class ObjectEntry:
+    """What a renderer draws one scene object with (see `Renderer._draw_list`)."""
+
+    state: tuple
+    index: int
+    key: object
+    program: object
+    pack: tuple
+    vertex_array: object
+    mirrored: bool
+    sphere: tuple = None  # ((x, y, z), radius) in the world where the mesh's back faces may be culled
+    checked: object = None
+    camera: object = None  # the camera the key's 'view' piece was decided for (numerics='auto')
+
+
+def available_memory():
+    """``MemAvailable`` of /proc/meminfo [bytes] (llvmpipe's render targets live in host memory), or None."""
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        return None
+    return None
 
 
 class MeshBuffers:

@@ -34,7 +34,7 @@ class TextureStore:
     def texture(self, table):
         """The texture holding ``table`` (uploaded on first use).  A `TableData`: texel ``(k, j, i)`` is
         ``array[i, j, k]``, nearest filtering, no mipmaps (the GLSL reads it with ``texelFetch``).  A
-        `glphong.materials.surface.TextureImage`: its levels as float16 or float32 rgb, its filter and wrap."""
+        `glphong.definitions.surface.TextureImage`: its levels as float16 or float32 rgb, its filter and wrap."""
         entry = self._entries.get(table.digest)
         if entry is not None and entry[0]() is not None:
             return entry[1]

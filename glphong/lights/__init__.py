@@ -1,22 +1,26 @@
-"""Lights as open definitions (docs/design.md section 11): `LightModel` and the built-in kinds, defined with it.
+"""Lights as open definitions (docs/design.md section 11): the built-in kinds, defined with `LightModel`.
 
-A kind is one module and one GLSL chunk (``glsl/lights/<name>.glsl``); the program key counts the lights of
-each kind generically, and the shader's loop over each present kind is generated (`glphong.shaders.generated`).
+A kind is one module here and one GLSL chunk (``glsl/lights/<name>.glsl``), defined with the mechanism a user's
+kind uses (`glphong.definitions.light.LightModel`); the program key counts the lights of each kind generically, and
+the shader's loop over each present kind is generated (`glphong.shaders.generated`), in the kinds' `loop_order`.
+Every module of this package is discovered and imported, so a new kind is one file here (with its GLSL and its
+tests: the conformance harness tests/lights/test_light_conformance.py holds every registered kind).
 """
-from glphong.lights.model import (LightDefinitionError, LightModel, light_cases, light_for_key, light_named,
-                                  pose_pointing, registered_lights)
-from glphong.lights.point import PointLight
-from glphong.lights.unattenuated import UnattenuatedPointLight
-from glphong.lights.directional import DirectionalLight
-from glphong.lights.spot import SpotLight
-from glphong.lights.ambient import AmbientLight
-from glphong.lights.extended import ExtendedLight
-from glphong.lights.area import PolygonLight, RectLight
-from glphong.lights.sphere import SphereLight
-from glphong.lights.disk import DiskLight
-from glphong.lights.environment import EnvironmentLight
+import importlib as _importlib
+import pkgutil as _pkgutil
+
+from glphong.definitions.light import (LightDefinitionError, LightModel, light_cases, light_for_key, light_named,
+                                       pose_pointing, registered_lights)
 
 __all__ = ["LightModel", "LightDefinitionError", "registered_lights", "light_named", "light_for_key", "light_cases",
-           "pose_pointing", "PointLight", "UnattenuatedPointLight", "DirectionalLight", "SpotLight", "AmbientLight",
-           "ExtendedLight", "RectLight", "PolygonLight", "SphereLight", "DiskLight",
-           "EnvironmentLight"]
+           "pose_pointing"]
+
+# every module of this package defines kinds (or a family's base, `ExtendedLight`, or the ambient light): importing
+# it registers its kinds, and the light classes it exports are this package's
+for _info in sorted(_pkgutil.iter_modules(__path__), key=lambda info: info.name):
+    _module = _importlib.import_module(f"{__name__}.{_info.name}")
+    for _name in _module.__all__:
+        if isinstance(getattr(_module, _name), type):
+            globals()[_name] = getattr(_module, _name)
+            __all__.append(_name)
+del _info, _module, _name

@@ -18,7 +18,7 @@ import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.lights.extended import CENTER, RADIANCE, SAMPLES, ExtendedLight, extended_cases
-from glphong.lights.model import GlslFile, Param
+from glphong.definitions.light import GlslFile, Param
 from glphong.materials.lambert import Lambert
 from glphong.twin.area import (area_clip, area_clip_rounding, area_clipped_cosine, area_clipped_lobe,
                                area_cosine_rounding, area_lobe_rounding, area_triangle_sample, polygon_arrays)
@@ -71,6 +71,11 @@ class _Polygonal:
 class RectLight(_Polygonal, ExtendedLight):
     """A one-sided uniform parallelogram light: corners ``center +- u/2 +- v/2``, emitting along ``u x v``.
 
+    At a point ``x`` with normal ``n``: ``E(n) = L integral (n.w)^+ dw`` over the polygon as seen from ``x``, exactly
+    (Lambert's edge formula, clipped to the horizon); the lecture's Phong lobe ``integral max(r.w, 0)^q L [n.w > 0]
+    dw`` exactly for integer ``q`` (Arvo's edge recurrences); every other term by the midpoint rule, ``E_k = L cos_l
+    A_k / d_k^2`` toward each of its cells.  Its power is ``pi L A``.
+
     Parameters
     ----------
     center : (3,) array_like
@@ -84,6 +89,7 @@ class RectLight(_Polygonal, ExtendedLight):
     """
 
     name = "rect"
+    loop_order = 4
     params = (CENTER,
               Param("u", "vec3", low=-np.inf, unit="m", doc="first edge vector"),
               Param("v", "vec3", low=-np.inf, unit="m", doc="second edge vector; emits along u x v"),
@@ -96,6 +102,12 @@ class RectLight(_Polygonal, ExtendedLight):
         super().check()
         if not np.linalg.norm(np.cross(self.u, self.v)) > 0.0:
             raise ValueError(f"RectLight: u and v must span a parallelogram (got u={self.u}, v={self.v}, parallel or zero)")
+
+    @classmethod
+    def example(cls, **overrides):
+        """A 0.6 m square 1 m above the origin, emitting down (toward -z)."""
+        return cls(**({"center": (0.0, 0.0, 1.0), "u": (0.0, 0.6, 0.0), "v": (0.6, 0.0, 0.0), "radiance": 0.5}
+                      | overrides))
 
     def area(self):
         """``|u x v|`` [m^2]."""
@@ -163,6 +175,11 @@ class PolygonLight(_Polygonal, ExtendedLight):
     """A one-sided uniform planar convex polygon light, emitting toward the side from which its vertices run
     counter-clockwise.
 
+    At a point ``x`` with normal ``n``: ``E(n) = L integral (n.w)^+ dw`` over the polygon as seen from ``x``, exactly
+    (Lambert's edge formula, clipped to the horizon); the lecture's Phong lobe ``integral max(r.w, 0)^q L [n.w > 0]
+    dw`` exactly for integer ``q`` (Arvo's edge recurrences); every other term by the midpoint rule, ``E_k = L cos_l
+    A_k / d_k^2`` toward each of its cells.  Its power is ``pi L A``.
+
     Parameters
     ----------
     vertices : (V, 3) array_like
@@ -174,6 +191,7 @@ class PolygonLight(_Polygonal, ExtendedLight):
     """
 
     name = "polygon"
+    loop_order = 5
     params = (RADIANCE, SAMPLES)
     uniforms = (Param("vertex", "vec3", low=-np.inf, unit="m", doc="the vertices, padded to 8"),
                 Param("edge", "vec3", low=-np.inf, unit="m", doc="v_{i+1} - v_i, in float64, padded to 8"),
@@ -189,6 +207,13 @@ class PolygonLight(_Polygonal, ExtendedLight):
     def __init__(self, vertices, radiance, samples=4.0, method="auto"):
         object.__setattr__(self, "vertices", _convex_polygon(vertices))
         super().__init__(radiance, samples, method=method)
+
+    @classmethod
+    def example(cls, **overrides):
+        """A regular pentagon of radius 0.4 m, 1 m above the origin, emitting down (clockwise seen from above)."""
+        angles = -2.0 * np.pi * np.arange(5) / 5
+        vertices = [(0.4 * np.cos(a), 0.4 * np.sin(a), 1.0) for a in angles]
+        return cls(**({"vertices": vertices, "radiance": 0.5} | overrides))
 
     def parameter_values(self):
         return {"vertices": tuple(map(tuple, self.vertices))} | super().parameter_values()

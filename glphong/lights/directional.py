@@ -2,7 +2,7 @@
 GLSL: ``glsl/lights/directional.glsl``).  glTF's and pyrender's directional lights."""
 import numpy as np
 
-from glphong.lights.model import ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp, mp32, mp_dot, pose_pointing
+from glphong.definitions.light import ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp, mp32, mp_dot, pose_pointing
 
 __all__ = ["DirectionalLight"]
 
@@ -11,7 +11,7 @@ _IRRADIANCE = Param("irradiance", "rgb", low=0.0, unit="W/m^2", doc="E on a surf
 
 
 class DirectionalLight(ExactIrradiance, LightModel):
-    """A light at infinity: constant direction and irradiance.
+    """A light at infinity: constant direction and irradiance, ``E = irradiance`` at every point.
 
     Parameters
     ----------
@@ -25,6 +25,7 @@ class DirectionalLight(ExactIrradiance, LightModel):
     """
 
     name = "directional"
+    loop_order = 2
     params = (_DIRECTION, _IRRADIANCE)
     uniforms = (Param("towards", "direction", low=-1.0, high=1.0, doc="unit vector toward the light"), _IRRADIANCE)
     glsl = GlslFile("lights/directional.glsl")

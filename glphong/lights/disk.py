@@ -7,7 +7,7 @@ docstring of disk.glsl); every other term is summed over ``samples^2`` cells of 
 import numpy as np
 
 from glphong.lights.extended import CENTER, RADIANCE, RADIUS, SAMPLES, ExtendedLight, extended_cases
-from glphong.lights.model import GlslFile, Param
+from glphong.definitions.light import GlslFile, Param
 from glphong.twin.area import area_angle
 from glphong.twin.band import EPS
 from glphong.twin.functions import perpendiculars, safe_normalize
@@ -40,6 +40,10 @@ def disk_angle_over(y, x):
 class DiskLight(ExtendedLight):
     """A one-sided uniform disk light, emitting toward the side its ``normal`` points to.
 
+    ``E(n) = L integral (n.w)^+ dw`` over the disk as seen from ``x``, exactly (its rim's contour integral, the
+    horizon included); every other term summed over ``samples^2`` cells of equal area.  Its power is
+    ``pi L pi R^2``; far away it is a point of intensity ``L pi R^2 cos(theta_l)``.
+
     Parameters
     ----------
     center : (3,) array_like
@@ -55,6 +59,7 @@ class DiskLight(ExtendedLight):
     """
 
     name = "disk"
+    loop_order = 7
     params = (CENTER, Param("normal", "direction", low=-np.inf, doc="the side it emits to"), RADIUS, RADIANCE, SAMPLES)
     glsl = GlslFile("lights/disk.glsl")
     uses = ("angle", "area")

@@ -28,7 +28,7 @@ import numpy as np
 from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
 from glphong.core.rgbe import read_hdr
 from glphong.lights.extended import ExtendedLight, extended_cases
-from glphong.lights.model import GlslFile, Param
+from glphong.definitions.light import GlslFile, Param
 from glphong.materials.lambert import Lambert
 from glphong.twin import environment as env
 from glphong.twin.band import EPS
@@ -118,6 +118,11 @@ def _rotation(value):
 class EnvironmentLight(ExtendedLight):
     """Radiance from an equirectangular map, each texel constant over its exact solid angle (module docstring).
 
+    ``L_r(wo) = integral f_r(wi, wo) L_i(wi) (n.wi)^+ dwi`` over the sphere: Lambert by the irradiance
+    ``E(n) = integral L_i(w) (n.w)^+ dw`` (an irradiance cube map of exact per-texel integrals, or the spherical
+    harmonics convolved with the clamped cosine); the lecture's Phong lobe by the spherical harmonics convolved with
+    the lobe; every other term over the map averaged onto ``samples x 2 samples`` texels.
+
     Parameters
     ----------
     image : (H, W) or (H, W, 3) array_like, or path-like
@@ -139,6 +144,7 @@ class EnvironmentLight(ExtendedLight):
     """
 
     name = "environment"
+    loop_order = 8
     params = (RESOLUTION, ORDER, ENV_SAMPLES)
     uniforms = _UNIFORMS
     glsl = GlslFile("lights/environment.glsl")

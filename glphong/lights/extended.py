@@ -5,7 +5,7 @@ The reflected radiance of an extended light is ``L_r(wo) = integral f_r(wi, wo) 
 kind is an `ExtendedLight` subclass and gives it three ways, each a GLSL function and its numpy twin:
 
 - ``vec3 <kind>_irradiance(vec3 x, vec3 n, int j)`` (twin ``irradiance(self, x, n, p)``): the irradiance ``E(n) =
-  integral L_i(w) (n.w)^+ dw`` [W/m^2], which a term of `glphong.materials.model.Integral` form 'irradiance'
+  integral L_i(w) (n.w)^+ dw`` [W/m^2], which a term of `glphong.definitions.material.Integral` form 'irradiance'
   (Lambert) reflects as ``k E``;
 - ``vec3 <kind>_lobe(vec3 x, vec3 n, vec3 r, float q, int j)`` (twin ``lobe(self, x, n, r, q, p)``), where the kind
   lists 'lobe' in `integrals`: ``integral max(r.w, 0)^q L_i(w) [n.w > 0] dw`` [W/(m^2 sr) sr] for an integer ``q``,
@@ -18,8 +18,8 @@ A kind also gives its float64 exact integral (`exact`: an adaptive quadrature co
 `glphong.twin.quadrature`), which `glphong.verify` compares the method with (the method error map), apart from the
 float32 band of the GPU against the twin.
 """
-from glphong.lights.model import ContractFunction, LightModel, Param, sensitivity_band
-from glphong.materials.cases import Case
+from glphong.definitions.light import ContractFunction, LightModel, Param, sensitivity_band
+from glphong.definitions.cases import Case
 from glphong.materials.lambert import Lambert
 from glphong.materials.phong import Phong, PhongLobe
 

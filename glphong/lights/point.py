@@ -8,7 +8,7 @@ import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.core.radiometry import point_intensity, power_from_intensity
-from glphong.lights.model import (ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp, mp32, mp_range_window,
+from glphong.definitions.light import (ExactIrradiance, GlslFile, LightModel, Param, gltf_entry, mp, mp32, mp_range_window,
                                   mp_toward)
 from glphong.twin.functions import point_irradiance, range_window, safe_normalize
 
@@ -53,7 +53,9 @@ class WithRange:
 
 
 class PointLight(WithRange, LightModel):
-    """Isotropic point source given by its power (docs/design.md E1).
+    """Isotropic point source given by its power (docs/design.md E1): ``E = Phi / (4 pi d^2)`` at distance ``d``.
+
+    Times KHR_lights_punctual's window ``clamp(1 - (d/range)^4, 0, 1)`` where a ``range`` is given.
 
     Parameters
     ----------
@@ -70,6 +72,7 @@ class PointLight(WithRange, LightModel):
     """
 
     name = "point"
+    loop_order = 0  # the shader loops over the kinds in this order (point, unattenuated, directional, spot, ...)
     params = (POSITION, Param("power", "rgb", low=0.0, high=_MAX_POWER, unit="W", doc="radiant flux Phi"), RANGE)
     uniforms = (POSITION, Param("intensity", "rgb", low=0.0, unit="W/sr", doc="Phi / (4 pi)"), RANGE)
     glsl = GlslFile("lights/point.glsl")

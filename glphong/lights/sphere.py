@@ -9,7 +9,7 @@ tends to a `PointLight` of that power as ``R -> 0`` (tested).
 import numpy as np
 
 from glphong.lights.extended import CENTER, RADIANCE, RADIUS, SAMPLES, ExtendedLight, extended_cases
-from glphong.lights.model import GlslFile
+from glphong.definitions.light import GlslFile
 from glphong.twin.area import area_angle
 from glphong.twin.band import EPS
 from glphong.twin.functions import atan2_first_quadrant, perpendiculars, safe_normalize
@@ -25,6 +25,11 @@ def _dot(a, b):
 class SphereLight(ExtendedLight):
     """A uniform spherical light.
 
+    Seen from ``x`` at distance ``d > R`` it is a cone of directions of half-angle ``sigma``, ``sin(sigma) = R/d``,
+    of radiance ``L``: ``E(n) = L integral (n.w)^+ dw`` over the cone, exactly (the horizon included); every other
+    term summed over ``samples^2`` cells of equal solid angle.  Its intensity is ``pi R^2 L`` in every direction,
+    its power ``4 pi^2 R^2 L``.
+
     Parameters
     ----------
     center : (3,) array_like
@@ -38,6 +43,7 @@ class SphereLight(ExtendedLight):
     """
 
     name = "sphere"
+    loop_order = 6
     params = (CENTER, RADIUS, RADIANCE, SAMPLES)
     glsl = GlslFile("lights/sphere.glsl")
     uses = ("angle", "area")

@@ -8,9 +8,9 @@ pyrender's ``SpotLight`` has the same falloff and ignores range.
 import numpy as np
 
 from glphong.core.radiometry import point_intensity
-from glphong.lights.model import GlslFile, LightModel, Param, gltf_entry, mp, mp32, mp_dot, mp_range_window, mp_toward, pose_pointing
+from glphong.definitions.light import GlslFile, LightModel, Param, gltf_entry, mp, mp32, mp_dot, mp_range_window, mp_toward, pose_pointing
 from glphong.lights.point import POSITION, RANGE, WithRange, with_range
-from glphong.materials.cases import Case
+from glphong.definitions.cases import Case
 from glphong.materials.phong import Phong
 from glphong.twin.band import EPS
 from glphong.twin.functions import FLT_MAX, safe_normalize
@@ -35,6 +35,10 @@ def spot_falloff(cos_theta, inner_cone_angle, outer_cone_angle):
 class SpotLight(WithRange, LightModel):
     """A spot light: a point source whose light is confined to a cone (KHR_lights_punctual).
 
+    ``E = f I / d^2`` at distance ``d``, ``theta`` the angle from the axis, with the specification's falloff
+    ``f = clamp(cos(theta) s + o, 0, 1)^2``, ``s = 1 / max(0.001, cos(inner) - cos(outer))``, ``o = -cos(outer) s``;
+    times the window ``clamp(1 - (d/range)^4, 0, 1)`` where a ``range`` is given.
+
     Parameters
     ----------
     position : (3,) array_like
@@ -54,6 +58,7 @@ class SpotLight(WithRange, LightModel):
     """
 
     name = "spot"
+    loop_order = 3
     params = (POSITION, _AXIS, _INTENSITY, _INNER, _OUTER, RANGE)
     uniforms = (POSITION, Param("axis", "direction", low=-1.0, high=1.0, doc="unit axis"), _INTENSITY,
                 Param("versin_outer", "scalar", low=0.0, high=1.0, doc="1 - cos(outer) = 2 sin^2(outer/2)"),

@@ -3,7 +3,7 @@ irradiance at every distance (docs/design.md E2, section 11; GLSL: ``glsl/lights
 No glTF or pyrender light has it (both always fall off as ``1/d^2``)."""
 import numpy as np
 
-from glphong.lights.model import ExactIrradiance, GlslFile, LightModel, Param, mp32, mp_toward
+from glphong.definitions.light import ExactIrradiance, GlslFile, LightModel, Param, mp32, mp_toward
 from glphong.lights.point import POSITION
 from glphong.twin.functions import safe_normalize
 
@@ -11,7 +11,8 @@ __all__ = ["UnattenuatedPointLight"]
 
 
 class UnattenuatedPointLight(ExactIrradiance, LightModel):
-    """A positional light of value ``L_i`` with no distance falloff (docs/design.md E2).
+    """A positional light of value ``L_i`` with no distance falloff (docs/design.md E2): ``E = L_i`` at every
+    distance.
 
     Parameters
     ----------
@@ -22,6 +23,7 @@ class UnattenuatedPointLight(ExactIrradiance, LightModel):
     """
 
     name = "unattenuated"
+    loop_order = 1
     params = (POSITION, Param("radiance", "rgb", low=0.0, unit="W/m^2", doc="the lecture's L_i, used as E"))
     glsl = GlslFile("lights/unattenuated.glsl")
     in_uber = True

@@ -32,22 +32,25 @@ and `FresnelSlot` (see README, "Write your own material").
 import importlib as _importlib
 import pkgutil as _pkgutil
 
-from glphong.materials.model import Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues, Properties, ShadingFrame, model_named, registered_models
-from glphong.materials.surface import AlphaMask, NormalMap, SurfaceInput, Texture, TextureImage, VertexColors
-from glphong.materials.table import Table, TableData
+from glphong.definitions.material import Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues, Properties, ShadingFrame, model_named, registered_models
+from glphong.definitions.surface import AlphaMask, NormalMap, SurfaceInput, Texture, TextureImage, VertexColors
+from glphong.definitions.table import Table, TableData
+from glphong.definitions.cases import Case
+from glphong.definitions.fresnel import DielectricFresnel, Fresnel, FresnelSlot, SchlickFresnel
+from glphong.definitions.params import DefinitionError
 
 __all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "Table", "TableData", "ParamValues",
            "Properties", "ShadingFrame", "MaterialDefinitionError", "GlslFile", "registered_models", "model_named",
-           "SurfaceInput", "Texture", "TextureImage", "VertexColors", "NormalMap", "AlphaMask"]
+           "SurfaceInput", "Texture", "TextureImage", "VertexColors", "NormalMap", "AlphaMask", "Fresnel",
+           "SchlickFresnel", "DielectricFresnel", "FresnelSlot", "Case", "DefinitionError"]
 
-# every module of this package but the mechanism is one model: importing it registers the model, and
-# the material classes it exports are this package's, so a new model is one file here (with its GLSL
+# every module of this package is one model (the mechanism is glphong.definitions): importing it registers the
+# model, and the material classes it exports are this package's, so a new model is one file here (with its GLSL
 # and its tests); its twin functions stay in its module (and are found by glphong.reference)
 for _info in sorted(_pkgutil.iter_modules(__path__), key=lambda info: info.name):
-    if _info.name not in ("model", "table", "surface", "as_json"):  # the mechanism
-        _module = _importlib.import_module(f"{__name__}.{_info.name}")
-        for _name in _module.__all__:
-            if isinstance(getattr(_module, _name), type):
-                globals()[_name] = getattr(_module, _name)
-                __all__.append(_name)
+    _module = _importlib.import_module(f"{__name__}.{_info.name}")
+    for _name in _module.__all__:
+        if isinstance(getattr(_module, _name), type):
+            globals()[_name] = getattr(_module, _name)
+            __all__.append(_name)
 del _info, _module, _name

@@ -78,9 +78,9 @@ Where the paper and common implementations differ (glphong follows the paper):
 """
 import numpy as np
 
-from glphong.materials.model import GlslFile, MaterialModel, Param, Properties
+from glphong.definitions.material import GlslFile, MaterialModel, Param, Properties
 from glphong.materials.phong import _dot, lobe_oracle
-from glphong.materials.cases import Case, generic_cases
+from glphong.definitions.cases import Case, generic_cases
 from glphong.twin.band import EPS, FLT_MIN
 from glphong.twin.functions import fresnel_schlick, lobe_from_delta, safe_normalize
 
@@ -184,7 +184,14 @@ def ashikhmin_shirley_specular(f, wi, wo, n_dot_l, n_dot_v, rho_s, nu, nv):
 
 class AshikhminShirley(MaterialModel):
     """The anisotropic Phong BRDF of Ashikhmin and Shirley 2000: a glossy Schlick-Fresnel layer over a
-    diffuse substrate, ``f_r = f_s + f_d`` (see the module for the formulas).
+    diffuse substrate, ``f_r = f_s + f_d`` [1/sr], 0 where ``n.v <= 0``.
+
+    In the frame ``(t, b, n)`` with ``h = (l + v)/|l + v|`` (the module docstring has the stable evaluation)::
+
+        f_s  = sqrt((nu + 1)(nv + 1)) / (8 pi) (n.h)^e F(v.h) / ((v.h) max(n.l, n.v))
+        e    = (nu (h.t)^2 + nv (h.b)^2) / (1 - (n.h)^2)
+        F(u) = rho_s + (1 - rho_s)(1 - u)^5
+        f_d  = 28 rho_d / (23 pi) (1 - rho_s) (1 - (1 - n.l/2)^5) (1 - (1 - n.v/2)^5)
 
     Parameters
     ----------

@@ -17,12 +17,12 @@ q          scalar  >= 0        1       exponent (q = 0: lobe 1 where h is define
 import numpy as np
 
 from glphong.twin.functions import BLINN_HALF_FLOOR, blinn_delta, blinn_lobe, half_cosine
-from glphong.materials.fresnel import FresnelSlot, fresnel_band, fresnel_factor
+from glphong.definitions.fresnel import FresnelSlot, fresnel_band, fresnel_factor
 from glphong.materials.lambert import Lambert
-from glphong.materials.model import GlslFile, MaterialModel, MaterialSum, Properties
+from glphong.definitions.material import GlslFile, MaterialModel, MaterialSum, Properties
 from glphong.materials.phong import _KS, _Q, _dot, lobe_oracle
-from glphong.materials.cases import generic_cases, lobe_cases
-from glphong.materials.fresnel import fresnel_oracle
+from glphong.definitions.cases import generic_cases, lobe_cases
+from glphong.definitions.fresnel import fresnel_oracle
 from glphong.twin.band import EPS, lobe_band
 from glphong.twin.functions import safe_normalize
 

@@ -88,10 +88,10 @@ m = 1), so `CookTorrance` conserves energy when ``rho_d + max F <= 1``; the 1982
 import numpy as np
 
 from glphong.materials.diffuse import Diffuse
-from glphong.materials.fresnel import DielectricFresnel, FresnelSlot, SchlickFresnel, fresnel_factor
-from glphong.materials.model import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
-from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
-from glphong.materials.fresnel import fresnel_oracle
+from glphong.definitions.fresnel import DielectricFresnel, FresnelSlot, SchlickFresnel, fresnel_factor
+from glphong.definitions.material import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.definitions.cases import Case, _mirror_eye, _unit, generic_cases
+from glphong.definitions.fresnel import fresnel_oracle
 from glphong.twin.functions import microfacet_geometry, microfacet_ggx
 
 __all__ = ["CookTorranceLobe", "CookTorrance", "cook_torrance_geometry", "cook_torrance_beckmann",
@@ -180,6 +180,13 @@ def oracle_half_vector(f, wi, wo, n_dot_l):
 class CookTorranceLobe(MaterialModel):
     """The Cook-Torrance specular term alone: ``f_r = F(h.l) D G / (4 (n.l)(n.v))`` (form="microfacet")
     or the paper's ``F(h.l) D' G / (pi (n.l)(n.v))`` (form="1982", exactly 4 times as large).
+
+    With ``h = (l + v)/|l + v|`` and ``cos(theta_h) = n.h``::
+
+        D  = exp(-tan^2(theta_h) / m^2) / (pi m^2 cos^4(theta_h))     Beckmann (distribution="beckmann"), D' = pi D
+        G  = min(1, 2 (n.h)(n.v) / (v.h), 2 (n.h)(n.l) / (v.h))      Torrance-Sparrow masking
+
+    [1/sr]; ``distribution="ggx"`` puts GGX's ``D`` with ``alpha = m`` in place of Beckmann's.
 
     Parameters
     ----------

@@ -14,8 +14,8 @@ rho_d      rgb     [0, 1]      1       diffuse albedo (kd = rho_d / pi)
 """
 import numpy as np
 
-from glphong.materials.model import GlslFile, Integral, MaterialModel, Param, Properties
-from glphong.materials.cases import generic_cases
+from glphong.definitions.material import GlslFile, Integral, MaterialModel, Param, Properties
+from glphong.definitions.cases import generic_cases
 from glphong.twin.band import EPS
 
 __all__ = ["Diffuse", "diffuse", "RHO_D"]

@@ -43,11 +43,11 @@ by the albedo the specular part takes); the metal loses it as roughness grows (s
 """
 import numpy as np
 
-from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
+from glphong.definitions.cases import Case, _mirror_eye, _unit, generic_cases
 from glphong.materials.cook_torrance import oracle_half_vector
-from glphong.materials.model import MaterialModel, Param, Properties, _constant_part
-from glphong.materials.params import GlslFile
-from glphong.materials.surface import SurfaceInput
+from glphong.definitions.material import MaterialModel, Param, Properties, constant_part
+from glphong.definitions.params import GlslFile
+from glphong.definitions.surface import SurfaceInput
 from glphong.twin.band import EPS
 from glphong.twin.functions import microfacet_geometry, microfacet_ggx
 
@@ -89,11 +89,23 @@ def gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2):
 
 
 class GltfPBR(MaterialModel):
-    """glTF 2.0's metallic-roughness material, as the specification's Appendix B writes it (module docstring).
+    """glTF 2.0's metallic-roughness material, as the specification's Appendix B writes it:
+    ``f_r = mix(dielectric, metal, metallic)`` [1/sr].
+
+    With ``alpha = roughness^2``, ``x = (1 - |v.h|)^5`` and ``c`` the base colour (the module docstring has the
+    numerics)::
+
+        D = alpha^2 / (pi ((n.h)^2 (alpha^2 - 1) + 1)^2)                                   GGX
+        V = 1 / (2 (|n.v| sqrt(alpha^2 + (1 - alpha^2)(n.l)^2) + |n.l| sqrt(alpha^2 + (1 - alpha^2)(n.v)^2)))
+        metal = (c + (1 - c) x) V D
+        dielectric = mix(c / pi, V D, f0 + (1 - f0) x),  f0 = ((ior - 1)/(ior + 1))^2
+
+    ``emissive`` is radiance added whatever the lights; ``occlusion`` multiplies the answers to the ambient and the
+    environment light only.
 
     Parameters
     ----------
-    base_color : float or (3,) array_like or glphong.materials.surface.SurfaceInput
+    base_color : float or (3,) array_like or glphong.definitions.surface.SurfaceInput
         ``baseColorFactor`` (linear RGB) in [0, 1]; times the base-colour texture and ``COLOR_0`` where given
         (`glphong.Texture`, sRGB).
     metallic : float or SurfaceInput
@@ -131,8 +143,8 @@ class GltfPBR(MaterialModel):
         """glTF's fields as the file writes them: the factors as they are, the metallic-roughness texture where
         metallic and roughness read one image's blue and green, the emissive factor (its strength above 1 as
         ``KHR_materials_emissive_strength``) and texture (`MaterialModel.gltf_fields`)."""
-        pbr = {"baseColorFactor": [float(c) for c in np.broadcast_to(_constant_part(self.base_color), 3)] + [1.0],
-               "metallicFactor": float(_constant_part(self.metallic)), "roughnessFactor": float(_constant_part(self.roughness))}
+        pbr = {"baseColorFactor": [float(c) for c in np.broadcast_to(constant_part(self.base_color), 3)] + [1.0],
+               "metallicFactor": float(constant_part(self.metallic)), "roughnessFactor": float(constant_part(self.roughness))}
         if isinstance(self.base_color, SurfaceInput) and self.base_color.texture is not None:
             pbr["baseColorTexture"] = {"index": texture_index(self.base_color.texture)}
         m, r = self.metallic, self.roughness
@@ -140,7 +152,7 @@ class GltfPBR(MaterialModel):
                 m.texture is not None and (m.channel, r.channel) == ("b", "g"):
             pbr["metallicRoughnessTexture"] = {"index": texture_index(m.texture)}
         out = {}
-        emissive = np.broadcast_to(np.asarray(_constant_part(self.emissive), np.float64), 3)
+        emissive = np.broadcast_to(np.asarray(constant_part(self.emissive), np.float64), 3)
         if emissive.max() > 0:
             out["emissiveFactor"] = [float(c) for c in emissive / max(emissive.max(), 1.0)]
             if emissive.max() > 1.0:

@@ -94,8 +94,8 @@ the lobe's scale made explicit as the issue specifies):
 import numpy as np
 
 from glphong.materials.diffuse import Diffuse
-from glphong.materials.model import GlslFile, MaterialModel, MaterialSum, Param, Properties
-from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
+from glphong.definitions.material import GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.definitions.cases import Case, _mirror_eye, _unit, generic_cases
 from glphong.twin.band import EPS, FLT_MAX, lobe_band
 from glphong.twin.functions import log_one_minus, safe_normalize
 

@@ -12,8 +12,8 @@ kd         rgb     >= 0        1/sr    diffuse BRDF value k_d
 """
 import numpy as np
 
-from glphong.materials.model import GlslFile, Integral, MaterialModel, Param, Properties
-from glphong.materials.cases import generic_cases
+from glphong.definitions.material import GlslFile, Integral, MaterialModel, Param, Properties
+from glphong.definitions.cases import generic_cases
 from glphong.twin.band import EPS
 
 __all__ = ["Lambert", "lambert"]

@@ -50,9 +50,9 @@ import numpy as np
 
 from glphong.core import merl
 from glphong.twin.functions import atan2_first_quadrant, frame_from_tangent, safe_normalize
-from glphong.materials.model import Choice, GlslFile, MaterialModel, Properties
-from glphong.materials.table import Table, TableData
-from glphong.materials.cases import Case, _mirror_eye, _unit, generic_cases
+from glphong.definitions.material import Choice, GlslFile, MaterialModel, Properties
+from glphong.definitions.table import Table, TableData
+from glphong.definitions.cases import Case, _mirror_eye, _unit, generic_cases
 from glphong.twin.band import EPS
 
 __all__ = ["MeasuredBRDF", "measured_brdf_coordinates", "measured_brdf_fetch", "measured_brdf_nearest",
@@ -161,7 +161,13 @@ def register_tabulator(function):
 
 
 class MeasuredBRDF(MaterialModel):
-    """A measured isotropic BRDF in the MERL layout (see the module docstring).
+    """A measured isotropic BRDF in the MERL layout: ``f_r(wi, wo) = T[i_h, i_d, i_p]`` [1/sr], per channel.
+
+    The bin of the half and difference angles (Rusinkiewicz 1998) ``theta_h = angle(n, h)``, ``theta_d = angle(h,
+    l)`` and ``phi_d`` (the azimuth of l about h, folded into [0, pi]), at ``x_h = 90 sqrt(theta_h / (pi/2))``,
+    ``x_d = 90 theta_d / (pi/2)``, ``x_p = 180 phi_d / pi``: the bin ``floor(x)``, clamped, as the reference reader
+    indexes it (``lookup='nearest'``), or trilinear between the samples at ``x_h = i``, ``x_d = j + 1/2``,
+    ``x_p = k + 1/2`` (``lookup='trilinear'``).  The module docstring has the details.
 
     Parameters
     ----------

@@ -21,7 +21,7 @@ kamb       rgb     >= 0                ambient coefficient ``Ka``: the answer ``
 Not reciprocal, not energy-conserving, isotropic (the lecture's Phong; `glphong.analysis` measures it).
 """
 from glphong.twin.functions import phong_lobe
-from glphong.materials.model import GlslFile, MaterialModel, Param, Properties
+from glphong.definitions.material import GlslFile, MaterialModel, Param, Properties
 
 __all__ = ["MtlPhong"]
 

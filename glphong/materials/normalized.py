@@ -85,11 +85,11 @@ import numpy as np
 from glphong.twin.functions import blinn_lobe, half_cosine, phong_delta, phong_lobe
 from glphong.materials.blinn import blinn_lobe_band
 from glphong.materials.diffuse import Diffuse
-from glphong.materials.fresnel import FresnelSlot, fresnel_band, fresnel_factor
-from glphong.materials.model import GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.definitions.fresnel import FresnelSlot, fresnel_band, fresnel_factor
+from glphong.definitions.material import GlslFile, MaterialModel, MaterialSum, Param, Properties
 from glphong.materials.phong import lobe_oracle
-from glphong.materials.cases import Case, generic_cases, lobe_cases
-from glphong.materials.fresnel import DielectricFresnel, SchlickFresnel, fresnel_oracle
+from glphong.definitions.cases import Case, generic_cases, lobe_cases
+from glphong.definitions.fresnel import DielectricFresnel, SchlickFresnel, fresnel_oracle
 from glphong.twin.band import EPS, FLT_MIN, lobe_band
 
 __all__ = ["NormalizedPhongLobe", "NormalizedPhong", "NormalizedBlinnLobe", "NormalizedBlinnPhong",

@@ -84,8 +84,8 @@ Where common implementations differ from the paper (glphong follows the paper, d
 import numpy as np
 
 from glphong.twin.functions import atan2_first_quadrant
-from glphong.materials.model import Choice, GlslFile, MaterialModel, Param, Properties
-from glphong.materials.cases import Case, generic_cases
+from glphong.definitions.material import Choice, GlslFile, MaterialModel, Param, Properties
+from glphong.definitions.cases import Case, generic_cases
 from glphong.twin.band import EPS
 from glphong.twin.functions import safe_normalize
 
@@ -182,6 +182,16 @@ def oren_nayar_qualitative(cos_i, sin_i, cos_o, sin_o, c, s2):
 class OrenNayar(MaterialModel):
     """Oren and Nayar's rough diffuse reflector (SIGGRAPH 94): Lambertian V-cavity facets of slope
     deviation ``sigma``.
+
+    With ``s2 = sigma^2``, ``alpha = max(theta_i, theta_o)``, ``beta = min(theta_i, theta_o)`` and
+    ``c = cos(phi_o - phi_i)``, in 1/sr::
+
+        full:        rho/pi (C1 + c C2 tan(beta) + (1 - |c|) C3 tan((alpha + beta)/2))
+                     + 0.17 rho^2/pi s2/(s2 + 0.13) (1 - c (2 beta/pi)^2)
+        qualitative: rho/pi (A + B max(0, c) sin(alpha) tan(beta))
+
+        C1 = A = 1 - 0.5 s2/(s2 + 0.33),  B = 0.45 s2/(s2 + 0.09),  C3 = 0.125 s2/(s2 + 0.09) (4 alpha beta/pi^2)^2
+        C2 = B sin(alpha) where c >= 0,  B (sin(alpha) - (2 beta/pi)^3) where c < 0
 
     Parameters
     ----------

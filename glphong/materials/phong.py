@@ -18,11 +18,11 @@ q          scalar  >= 0        1       exponent (q = 0: lobe 1, the 0^0 := 1 con
 import numpy as np
 
 from glphong.twin.functions import phong_delta, phong_lobe
-from glphong.materials.fresnel import FresnelSlot, fresnel_band, fresnel_factor
+from glphong.definitions.fresnel import FresnelSlot, fresnel_band, fresnel_factor
 from glphong.materials.lambert import Lambert
-from glphong.materials.model import GlslFile, Integral, MaterialModel, MaterialSum, Param, Properties
-from glphong.materials.cases import generic_cases, lobe_cases
-from glphong.materials.fresnel import fresnel_oracle
+from glphong.definitions.material import GlslFile, Integral, MaterialModel, MaterialSum, Param, Properties
+from glphong.definitions.cases import generic_cases, lobe_cases
+from glphong.definitions.fresnel import fresnel_oracle
 from glphong.twin.band import EPS, lobe_band
 
 __all__ = ["PhongLobe", "Phong", "phong_delta", "phong_lobe"]

@@ -76,8 +76,8 @@ Where the papers and common implementations differ (glphong follows the papers, 
 import numpy as np
 
 from glphong.materials.diffuse import Diffuse
-from glphong.materials.model import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
-from glphong.materials.cases import Case, generic_cases
+from glphong.definitions.material import Choice, GlslFile, MaterialModel, MaterialSum, Param, Properties
+from glphong.definitions.cases import Case, generic_cases
 from glphong.twin.band import EPS
 from glphong.twin.functions import safe_normalize
 
@@ -175,7 +175,18 @@ def _duff_basis(n):
 
 
 class WardLobe(MaterialModel):
-    """The anisotropic Ward lobe alone (module docstring for the formulas).
+    """The anisotropic Ward lobe alone: ``f_r = rho_s exp(-e) / (4 pi ax ay sqrt((n.l)(n.v)))`` (Walter's form).
+
+    With ``ax = alpha_x``, ``ay = alpha_y`` along the tangent ``t`` and the bitangent ``b``, ``h = (l + v)/|l + v|``
+    and ``H = l + v`` (unnormalised)::
+
+        e = ((h.t / ax)^2 + (h.b / ay)^2) / (h.n)^2
+        walter:  f_r = rho_s exp(-e) / (4 pi ax ay sqrt((n.l)(n.v)))
+        duer:    f_r = rho_s exp(-e) / (4 pi ax ay (n.l)(n.v))
+        bounded: f_r = rho_s (H.H) exp(-e) / (pi ax ay (H.n)^4)
+
+    [1/sr], 0 where ``n.v <= 0``; no Fresnel factor (the module docstring has the papers and the stable
+    evaluation).
 
     Parameters
     ----------

@@ -11,8 +11,8 @@ import re
 from dataclasses import dataclass
 
 from glphong.core.glsl_files import GLSL_VERSION, chunk_source
-from glphong.lights.model import light_for_key, light_source
-from glphong.materials.registry import model_for_key, model_source
+from glphong.definitions.light import light_for_key, light_source
+from glphong.definitions.registry import model_for_key, model_source
 
 __all__ = ["Chunk", "resolve_chunk", "assemble", "effective_source", "name_chunks", "LINE_BLOCK", "PRELUDE_LINE"]
 

@@ -15,8 +15,8 @@ import numpy as np
 from glphong.core import validate as _validate
 from glphong.lights import light_named
 from glphong.materials import model_named
-from glphong.materials.surface import TextureImage
-from glphong.materials.table import TableData
+from glphong.definitions.surface import TextureImage
+from glphong.definitions.table import TableData
 from glphong.scene.shadows import shadow_setups
 from glphong.shaders.builders import light_keys, lod_slots, program_key
 from glphong.shaders.options import GBUFFER_PLANES, UBER_MAX_LIGHTS

@@ -3,8 +3,8 @@
 sections 5 and 8)."""
 from dataclasses import replace
 
-from glphong.lights.model import light_for_key, registered_lights
-from glphong.materials.model import registered_models
+from glphong.definitions.light import light_for_key, registered_lights
+from glphong.definitions.material import registered_models
 from glphong.shaders.keys import LightKey, ProgramKey, TermKey
 from glphong.shaders.options import MAX_TEXTURED_INPUTS, UBER_MAX_LIGHTS
 

@@ -1,7 +1,7 @@
 """The ``#define`` lines of a program, generated from its `glphong.shaders.keys.ProgramKey` (docs/design.md
 section 5): the outputs, the attributes read, the formulation and numerics pieces, the light kinds' array sizes and
 structural defines, the terms' structural defines and surface-input modes."""
-from glphong.materials.model import surface_define
+from glphong.definitions.material import surface_define
 from glphong.shaders.options import INPUT_MODES, NUMERICS_DEFINES, TEXTBOOK_PIECES
 
 __all__ = ["program_defines"]

@@ -6,7 +6,7 @@ shipped chunk files.
 """
 import numpy as np
 
-from glphong.materials.registry import model_named, model_source
+from glphong.definitions.registry import model_named, model_source
 
 __all__ = ["MATERIAL_CHUNK", "LIGHTS_CHUNK", "LOD_CHUNK", "material_chunk", "lights_chunk", "lod_chunk",
            "model_chunk_label"]

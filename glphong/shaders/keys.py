@@ -48,7 +48,7 @@ class TermKey:
         The parameters the program sets per fragment (surface inputs, glsl/surface.glsl) and how:
         ``(param, mode)`` with mode ``'texture'``, ``'vertex'`` or ``'texture*vertex'``, followed by ``':r'``,
         ``':g'`` or ``':b'`` where a scalar parameter reads one channel.
-    integral : glphong.materials.model.Integral or None
+    integral : glphong.definitions.material.Integral or None
         How the term reflects an extended light in closed form, where the program has one (else sampled).
     emission : str or None
         The rgb parameter the term emits (`glphong.materials.MaterialModel.emission`), where it is not zero.

@@ -3,7 +3,7 @@ it leaves out (docs/design.md section 5)."""
 from dataclasses import fields
 
 from glphong.core.glsl_files import library_chunks
-from glphong.lights.model import registered_lights
+from glphong.definitions.light import registered_lights
 from glphong.shaders.generated import model_chunk_label
 from glphong.shaders.options import GBUFFER_PLANES, UBER_MAX_LIGHTS
 

@@ -10,7 +10,7 @@ import math
 
 from glphong import materials
 from glphong.materials import Material
-from glphong.materials.fresnel import Fresnel
+from glphong.definitions.fresnel import Fresnel
 
 __all__ = ["ExpressionError", "parse_material", "material_classes", "MAX_TEXT_LENGTH", "MAX_DEPTH", "MAX_ITEMS", "MAX_STRING_LENGTH",
            "MAX_NODES", "MAX_INT_DIGITS"]
@@ -58,7 +58,7 @@ def material_classes():
     Returns
     -------
     dict of str to type
-        The `glphong.materials.Material` subclasses and `glphong.materials.fresnel.Fresnel` subclasses
+        The `glphong.materials.Material` subclasses and `glphong.definitions.fresnel.Fresnel` subclasses
         that ``glphong.materials.__all__`` exports, less the bases `Material`, `MaterialModel`,
         `MaterialSum` and `Fresnel` themselves.
     """
@@ -240,7 +240,7 @@ def parse_material(text):
     - string literals of at most `MAX_STRING_LENGTH` characters (``form='1982'``);
     - tuples and lists of accepted values, of at most `MAX_ITEMS` items;
     - calls of Fresnel factors (``SchlickFresnel(f0)``, ``DielectricFresnel(ior)``, any exported
-      `glphong.materials.fresnel.Fresnel` subclass) and of material classes, with such arguments.
+      `glphong.definitions.fresnel.Fresnel` subclass) and of material classes, with such arguments.
 
     Nothing else: no other names, attributes, subscripts, operators other than a sign, comprehensions,
     lambdas, assignment expressions, f-strings, ``*args`` or ``**kwargs``.  The text is at most

@@ -35,7 +35,7 @@ class BandConstants:
         Absolute error of ``n.l`` and ``n.v``.
     T : float
         Error of a filtered texture value as a fraction of the spread of the texels it weights
-        (`glphong.materials.surface.surface_texture_band`).  GL does not bound filter-weight precision;
+        (`glphong.definitions.surface.surface_texture_band`).  GL does not bound filter-weight precision;
         2^-7 covers 8-bit weights (Direct3D's minimum).  llvmpipe measured 5.6e-5 (256x256 renders of
         64- and 1024-texel textures, float16 and float32 texels, trilinear, lod 0 to 8); the test
         (tests/test_surface_inputs.py) holds it below 2^-12 beyond 16 ulps of the texels' magnitude.

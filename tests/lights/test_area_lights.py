@@ -19,12 +19,12 @@ import pytest
 
 import glphong
 from glphong import primitives
-from glphong.checks.probe import shade_points
+from glphong.checks.points import shade_points
 from glphong.checks.stability import case_inputs
 from glphong.gpu.contexts import create_context
 from glphong.gpu.programs import ProgramCache
 from glphong.lights import LightDefinitionError
-from glphong.materials.cases import Case
+from glphong.definitions.cases import Case
 from glphong.materials.phong import PhongLobe
 from glphong.shaders.generated import lights_chunk
 from glphong.shaders import assembly

@@ -17,14 +17,14 @@ import pytest
 
 import glphong
 from glphong import primitives
-from glphong.checks.probe import shade_points
+from glphong.checks.points import shade_points
 from glphong.checks.stability import case_inputs
 from glphong.core.filesafety import SceneFileError
 from glphong.core.rgbe import write_hdr
 from glphong.gpu.contexts import create_context
 from glphong.gpu.programs import ProgramCache
 from glphong.lights.environment import Y_UP
-from glphong.materials.cases import Case
+from glphong.definitions.cases import Case
 from glphong.materials.phong import PhongLobe
 from glphong.shaders.key import program_key
 from glphong.twin import environment as env

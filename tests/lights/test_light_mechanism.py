@@ -148,7 +148,7 @@ def _define(**attributes):
 @pytest.mark.parametrize("attributes, message", [
     ({"name": "Probe"}, "must be a lowercase GLSL identifier"),
     ({"name": "shade"}, "is reserved by glphong's shading code"),
-    ({"name": "spot"}, "the light name 'spot' is taken by glphong.lights.spot.SpotLight"),
+    ({"name": "spot"}, "the light name 'spot' is taken by the built-in glphong.lights.spot.SpotLight"),
     ({"name": "lambert"}, "is the name of the material model"),
     ({"params": [Param("n", "scalar", low=0.0)]}, "params must be a tuple of glphong.materials.Param"),
     ({"incident": None}, r"defines no numpy twin: add `def incident\(self, x, p\)`"),
