@@ -7,23 +7,21 @@ One process, interleaved rounds, medians:
 - the render of a 640x480 frame (a Phong sphere on a Lambert floor, one point light; ``Renderer.render``);
 - ``Frame.save_png`` of it (the exact sRGB encode in row blocks on threads, then glphong's PNG writer), and its two
   parts;
-- the same image through Pillow at the same zlib level (1), for the PNG writer's comparison;
+- the same image through Pillow at the same zlib level (1), for the PNG writer's comparison
+  (these four: `glphong.bench.png_cost`, which ``glphong bench --speed`` reports too);
 - a turntable of ``--frames`` frames through `glphong.batch.render_many` (worker processes, each rendering the next frame
   while its writer thread encodes and writes the last) as PNG and as ``.npy`` (a raw copy: the render's own cost).
 """
 import argparse
-import io
 import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
-from PIL import Image
 
 import glphong
-from glphong.core.imaging import encode_srgb8
 from glphong.batch import render_many
-from glphong.core.png import encode_png
+from glphong.bench import png_cost
 
 
 def scene(angle=0.0):
@@ -36,10 +34,6 @@ def scene(angle=0.0):
     return out
 
 
-def median_ms(times):
-    return 1e3 * float(np.median(times))
-
-
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--size", default="640x480")
@@ -48,35 +42,14 @@ def main():
     parser.add_argument("--backend", default="egl")
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
-    times = {k: [] for k in ("render", "save_png", "encode_srgb8", "encode_png", "pillow_png")}
-    with tempfile.TemporaryDirectory() as folder, glphong.Renderer(width, height, backend=args.backend) as renderer:
-        s = scene()
-        frame = renderer.render(s)
-        path = Path(folder) / "frame.png"
-        for _ in range(args.repeats):
-            start = time.perf_counter()
-            frame = renderer.render(s)
-            times["render"].append(time.perf_counter() - start)
-            start = time.perf_counter()
-            frame.save_png(path)
-            times["save_png"].append(time.perf_counter() - start)
-            start = time.perf_counter()
-            image = encode_srgb8(frame.radiance)
-            times["encode_srgb8"].append(time.perf_counter() - start)
-            start = time.perf_counter()
-            ours = encode_png(image, 1)
-            times["encode_png"].append(time.perf_counter() - start)
-            start = time.perf_counter()
-            pillow = io.BytesIO()
-            Image.fromarray(image).save(pillow, format="PNG", compress_level=1)
-            times["pillow_png"].append(time.perf_counter() - start)
-    render = median_ms(times["render"])
-    print(f"{width}x{height}, {args.backend}, {args.repeats} interleaved rounds (median)")
+    cost = png_cost(width, height, args.repeats, scene=scene(), backend=args.backend)
+    print(f"{width}x{height}, {args.backend}, {args.repeats} interleaved rounds after warm-up (median)")
     print("| step | ms | / render |")
     print("|---|---|---|")
-    for name, t in times.items():
-        print(f"| {name} | {median_ms(t):.2f} | {median_ms(t) / render:.2f} |")
-    print(f"PNG size: glphong {len(ours)} bytes, Pillow {len(pillow.getvalue())} bytes (zlib level 1 both)")
+    for name, key in (("render", "render_ms"), ("save_png", "save_ms"), ("encode_srgb8", "encode_ms"),
+                      ("encode_png", "write_ms"), ("pillow_png", "deflate_ms")):
+        print(f"| {name} | {cost[key]:.2f} | {cost[key] / cost['render_ms']:.2f} |")
+    print(f"PNG size: glphong {cost['png_bytes']} bytes, Pillow {cost['pillow_bytes']} bytes (zlib level 1 both)")
 
     # one process, one renderer: frames per second rendering alone, saving each PNG after its render, and saving on a
     # writer thread while the next frame renders (what render_many's workers do)

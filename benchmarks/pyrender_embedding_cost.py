@@ -9,19 +9,20 @@ the median of the rounds and the ratio of medians.  The scene is tests/pyrender_
 pyrender's examples/example.py (its models are not installed with pyrender), lights from the side.
 """
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
 
+import numpy as np
+
+from glphong.bench import import_pyrender
+
 PLATFORM = sys.argv[1] if len(sys.argv) > 1 and sys.argv[1] in ("egl", "osmesa") else "egl"
-os.environ["PYOPENGL_PLATFORM"] = PLATFORM
+pyrender = import_pyrender(PLATFORM)  # PYOPENGL_PLATFORM set before pyrender (and PyOpenGL) first load
 OPTIONS = [a for a in sys.argv[1:] if a not in ("egl", "osmesa")]
 sys.argv[1:] = [PLATFORM]  # what the imported check module reads
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
 
-import numpy as np  # noqa: E402
-import pyrender  # noqa: E402
 from pyrender.renderer import Renderer as PyrenderRenderer  # noqa: E402
 
 import pyrender_flags_check as example  # noqa: E402

@@ -5,8 +5,9 @@ one step in every channel.
 Both sides draw the very same geometry and material: the file goes through trimesh into a ``pyrender.Scene``, and
 glphong's scene is `glphong.integrations.pyrender.scene_from_pyrender(scene, convert=True)` of it (each
 ``MetallicRoughnessMaterial`` as `glphong.GltfPBR`, `gltf_pbr_of`).  glphong's radiance is encoded as pyrender encodes
-its colour (``x^(1/2.2)``, clamped, rounded to 8 bits), so the figures compare shading only; ``--srgb`` compares
-glphong's own sRGB output instead.  pyrender runs on OSMesa (single-sampled: no multisampled edges) by default.
+its colour (``x^(1/2.2)``, clamped, rounded to 8 bits: `glphong.bench.pyrender_encode`), so the figures compare
+shading only; ``--srgb`` compares glphong's own sRGB output instead.  pyrender runs on OSMesa (single-sampled: no
+multisampled edges) by default.
 
 Usage::
 
@@ -24,7 +25,7 @@ import numpy as np
 import trimesh
 from PIL import Image
 
-from glphong.analysis.comparisons import import_pyrender
+from glphong.bench import import_pyrender, pyrender_encode
 
 
 def synthetic_models(folder):
@@ -145,16 +146,11 @@ def _view(pyrender, tm_scene, width, height):
     return scene
 
 
-def _gamma8(radiance):
-    """pyrender's encoding: clamp, x^(1/2.2), round to 8 bits."""
-    return np.rint(np.clip(radiance, 0.0, 1.0) ** (1 / 2.2) * 255.0).astype(np.uint8)
-
-
 def measure(path, size, platform, srgb=False):
     """``dict`` of the figures for one file."""
     pyrender = import_pyrender(platform)
     import glphong  # noqa: PLC0415 - after pyrender chose its platform
-    from glphong.integrations.pyrender import scene_from_pyrender  # noqa: PLC0415
+    from glphong.integrations.pyrender import release, scene_from_pyrender  # noqa: PLC0415
 
     width, height = size, size
     scene = _view(pyrender, trimesh.load(str(path), force="scene"), width, height)
@@ -162,8 +158,7 @@ def measure(path, size, platform, srgb=False):
     try:
         theirs, _ = offscreen.render(scene)
     finally:
-        if platform != "egl":
-            offscreen.delete()
+        release(offscreen)  # on EGL without eglTerminate, which would end glphong's contexts too
     ours_scene = scene_from_pyrender(scene, convert=True)
     renderer = glphong.Renderer(width, height)
     out = {"file": Path(path).name, "materials": sorted({type(o.material).__name__ for o in ours_scene.objects})}
@@ -178,7 +173,7 @@ def measure(path, size, platform, srgb=False):
     facing = np.sum(gbuffer.normal * to_light, axis=-1) > 0  # n.l > 0: glphong's gate (pyrender lights n.l <= 0 too)
     for name, variant in variants.items():
         frame = renderer.render(variant)
-        ours = renderer.render_srgb8(variant) if srgb else _gamma8(frame.radiance)
+        ours = renderer.render_srgb8(variant) if srgb else pyrender_encode(frame.radiance)
         covered = frame.mask & (theirs.max(axis=-1) > 0) | frame.mask & (ours.max(axis=-1) > 0)
         inner = covered.copy()
         for axis in (0, 1):

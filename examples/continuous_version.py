@@ -27,7 +27,7 @@ import numpy as np
 import glphong
 from glphong import primitives
 from glphong.lights.environment import Y_UP
-from glphong.tools.bench_continuous import sky_map
+from glphong.bench import sky_map
 
 L = 6.0  # the panel's radiance [W/(m^2 sr)]
 CENTER, U, V = np.array([0.0, 1.6, 0.6]), np.array([1.6, 0.0, 0.0]), np.array([0.0, -0.25, 0.9])  # emits along U x V: down

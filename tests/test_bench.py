@@ -7,8 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from glphong.tools.bench import BenchCase, Method, methods, quick_cases, run_bench
-from glphong.tools.bench_continuous import continuous_methods
+from glphong.bench import BenchCase, Method, continuous_methods, methods, quick_cases, run_bench
 
 
 @pytest.fixture(scope="module")
@@ -81,7 +80,7 @@ def test_speed_report_in_process(tmp_path):
     platform): a row per scene with positive times and spreads, Python overhead, PNG cost and fits."""
     import json
 
-    from glphong.tools.speed import SCENES, run_speed
+    from glphong.bench import SCENES, run_speed
 
     report = run_speed(sizes=(32,), repeats=3, quick=True, pyrender=False, progress=False)
     assert [r["scene"] for r in report.rows] == list(SCENES)

@@ -1,4 +1,4 @@
-"""Benchmark adapters (glphong.analysis.comparisons): the hand-written moderngl floor and the pyrender conversion.
+"""Benchmark peers (glphong.bench): the hand-written moderngl floor and the pyrender conversion.
 
 pyrender is optional: its tests skip when it is not installed.  PyOpenGL reads
 PYOPENGL_PLATFORM once per process, so pyrender runs on EGL in this process and on
@@ -16,8 +16,7 @@ import pytest
 import trimesh
 
 import glphong
-from glphong.analysis.comparisons import (HandWrittenRenderer, PyrenderRenderer, import_pyrender, pyrender_roughness,
-                                 to_pyrender)
+from glphong.bench import HandWrittenRenderer, PyrenderRenderer, import_pyrender, pyrender_roughness, to_pyrender
 from glphong.scene.geometry import MeshData
 
 BACKENDS = ("egl", "osmesa")
@@ -48,7 +47,7 @@ def sphere_scene(material, directional=False, power_scale=1.0):
 
 
 def test_import_glphong_never_imports_pyrender():
-    code = ("import sys, glphong, glphong.analysis.comparisons; "
+    code = ("import sys, glphong, glphong.bench; "
             "print(sorted(m for m in ('pyrender', 'OpenGL') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True)
     assert out.stdout.strip() == "[]"
@@ -203,7 +202,7 @@ def test_pyrender_renderer_refuses_second_platform(pyrender_egl):
 _OSMESA_SCRIPT = textwrap.dedent("""
     import json, sys
     import numpy as np, trimesh, glphong
-    from glphong.analysis.comparisons import PyrenderRenderer
+    from glphong.bench import PyrenderRenderer
     material = glphong.Phong(kd=(0.2, 0.1, 0.05), ks=0.5, q=60.0)
     scene = glphong.Scene(glphong.PerspectiveCamera.look_at((0.3, 0.8, 3.2), (0, 0, 0), yfov=0.9),
                           lights=[glphong.PointLight((2.0, 2.5, 3.0), 80.0)], ambient=glphong.AmbientLight(0.05))

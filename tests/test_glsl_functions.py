@@ -7,7 +7,7 @@ the two are compared under the tolerance model of `glphong.checks.tolerances`.
 import numpy as np
 import pytest
 
-from glphong.checks import probe
+from glphong.testing import probe
 from glphong import reference as ref
 from glphong.checks.tolerances import BAND, EPS, FLT_MIN, lobe_band
 

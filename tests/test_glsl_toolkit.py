@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 
-from glphong.checks.glsl_function import VERTEX_CHUNK
-from glphong.checks.glsl_types import TYPE_NAMES, glsl_type
+from glphong.testing.glsl_runner import VERTEX_CHUNK
+from glphong.testing.glsl_types import TYPE_NAMES, glsl_type
 from glphong.testing import (GlslMismatch, GlslSourceError, GlslUndefinedWarning, assert_glsl_matches, edge_inputs,
                              edge_values, glsl, glsl_inputs, glsl_values, ulp32, ulps_between, unit_float32)
 
@@ -92,7 +92,7 @@ def test_chunks_give_the_same_rows(glphong_glsl, monkeypatch):
     fn = glphong_glsl("float f(float x, uint k) { return x * 2.0 + float(k); }", "f")
     x, k = np.linspace(-1, 1, 2500), np.arange(2500, dtype=np.uint32)
     whole = fn(x, k)
-    monkeypatch.setattr("glphong.checks.glsl_function.VERTEX_CHUNK", 1000)
+    monkeypatch.setattr("glphong.testing.glsl_runner.VERTEX_CHUNK", 1000)
     np.testing.assert_array_equal(fn(x, k), whole)
     assert VERTEX_CHUNK == 1 << 20
     # the fragment stage's grid is at most 4096 pixels high: a one-pixel-wide grid of 5000 rows takes two draws
@@ -312,7 +312,7 @@ def test_edge_values_and_inputs():
     assert np.iinfo(np.int32).min in edge_values("int") and 2 ** 32 - 1 in edge_values("uint")
 
     class Fake:  # edge_inputs reads the signature only
-        from glphong.checks.glsl_source import functions
+        from glphong.testing.glsl_source import functions
         signature = functions("float f(vec3 n, vec3 l, float q) { return 0.0; }")["f"][0]
 
     rows = edge_inputs(Fake, unit={"n", "l"})
@@ -370,11 +370,11 @@ def test_a_missing_backend_skips_with_its_reason(tmp_path):
     """The plugin's glphong_glsl fixture on a backend that is not there: the test skips and says why."""
     (tmp_path / "conftest.py").write_text(
         'pytest_plugins = ["glphong.testing"]\n'
-        "import glphong.testing\n"
+        "import glphong.testing.backends\n"
         "from glphong.gpu.contexts import BackendUnavailableError\n"
         "def fail(name, *a, **k):\n"
         "    raise BackendUnavailableError(f'{name}: libEGL is not installed (test double)')\n"
-        "glphong.testing.create_context = fail\n")
+        "glphong.testing.backends.create_context = fail\n")
     (tmp_path / "test_f.py").write_text("def test_f(glphong_glsl):\n    glphong_glsl('float f(float x) { return x; }', 'f')\n")
     env = {k: v for k, v in os.environ.items() if k not in ("PYTEST_ADDOPTS", "GLPHONG_REQUIRE_BACKENDS")}
     out = subprocess.run([sys.executable, "-m", "pytest", "-q", "-rs", "-p", "no:cacheprovider", str(tmp_path)],

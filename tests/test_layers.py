@@ -1,9 +1,9 @@
 """The house in layers (docs/design.md section 6): every import points downward, and no two modules import
 each other, directly or through others.
 
-- ``import-linter`` checks the layers contract of ``.importlinter`` (core < twin < materials < shaders < scene
-  < gpu < checks < testing < analysis < formats < batch, integrations < tools), counting imports at module
-  level and inside functions alike;
+- ``import-linter`` checks the layers contract of ``.importlinter`` (core < twin < definitions < materials < lights
+  < scene < shaders < gpu < checks < evaluation < testing < analysis < formats < batch, integrations < bench
+  < tools), counting imports at module level and inside functions alike;
 - an independent walk over every module's syntax tree counts import cycles among glphong's modules (zero),
   and imports inside functions (none but the optional dependencies' and the moved-path finder's).
 """

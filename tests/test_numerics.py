@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import glphong
-from glphong.checks.glsl_source import LIBRARY_DEFINES
+from glphong.testing.glsl_source import LIBRARY_DEFINES
 from glphong.checks.stability import CASES, case_numerics, run_stability
 from glphong.checks.tolerances import lobe_band
 from glphong.core.glsl_files import chunk_source
@@ -17,7 +17,7 @@ from glphong.scene.geometry import MeshData
 from glphong.shaders.numerics import (FALLOFF_LIMIT, LOBE_TAIL_Q, NORMAL_LENGTHS, numerics_decisions, numerics_pieces,
                                     normal_range)
 from glphong.shaders.key import NUMERICS_DEFINES, NUMERICS_PIECES, ProgramKey
-from glphong.tools.speed import speed_scenes
+from glphong.bench import speed_scenes
 
 FLT_MAX = float(np.finfo(np.float32).max)
 
@@ -242,7 +242,7 @@ def test_pieces_are_documented():
 def test_plain_normalize_and_the_series_against_their_twins(session_gl):
     """The new chunk functions against their numpy twins: plain_normalize on lengths across [2^-50, 2^63] (within
     4 eps of safe_normalize's twin there), log_one_minus_series on delta from 1e-30 to 1/2 (a few ulp)."""
-    from glphong.checks import probe
+    from glphong.testing import probe
     from glphong import reference as ref
 
     rng = np.random.default_rng(2029)

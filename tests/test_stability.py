@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 import glphong
 from glphong import reference as ref
 from glphong.shaders.key import program_key
-from glphong.checks.probe import shade_points
+from glphong.checks.points import shade_points
 from glphong.gpu.programs import ProgramCache
 from glphong.checks.stability import CASES, case_inputs, case_scene, oracle, run_stability
 from glphong.checks.tolerances import FLT_MAX, FLT_MIN, point_band

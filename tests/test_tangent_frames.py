@@ -7,7 +7,7 @@ What is tested:
   with the analytic dp/dphi away from the poles and the u seam (measured tolerance below), the
   handedness is the one the UV map has, and it matches `glphong.primitives.sphere`'s analytic
   tangents; t is orthogonal to the normal; degenerate UV triangles give t = 0 and no NaN.
-- common.glsl ``frame_from_tangent`` on the GPU (`glphong.checks.probe`) against its numpy twin on seeded
+- common.glsl ``frame_from_tangent`` on the GPU (`glphong.testing.probe`) against its numpy twin on seeded
   random normals and tangents and on the edge cases: tangent parallel to n (Duff et al.'s fallback
   basis), zero tangent, negative and zero handedness; (t, b, n) orthonormal.
 - A user material that needs ``'tangent'`` (``test_aniso``) defined through `MaterialModel`: its
@@ -26,7 +26,7 @@ import trimesh
 
 import glphong
 from glphong import primitives
-from glphong.checks import probe
+from glphong.testing import probe
 from glphong import reference as ref
 from glphong.scene.geometry import MeshData, tangents_from_uvs
 from glphong.materials import MaterialModel, Param, Properties

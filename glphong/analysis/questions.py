@@ -51,7 +51,8 @@ import math
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from glphong.checks.evaluate import direction_sets, evaluate, float32_units
+
+from glphong.evaluation import direction_sets, evaluate, float32_units
 
 __all__ = ["f_r", "albedo", "properties", "format_properties", "BrdfProperties", "hemisphere_directions",
            "DEFAULT_THETA_I"]

@@ -13,7 +13,7 @@ cast is of the discrete one), over the covered pixels, and timed (median frame t
   (``method='sampled'``, knob ``samples``).  The sky's exact integral costs about 35 ms a pixel, so its errors are
   measured on a 64 x 48 rendering of the same scene (24 x 18 quick) and its frame times at the bench's size.
 
-Points have the keys of the ray-cast points (`glphong.tools.bench`), the case naming the light and the material.
+Points have the keys of the ray-cast points (`glphong.bench.work_precision`), the case naming the light and the material.
 """
 from contextlib import ExitStack
 
@@ -89,7 +89,7 @@ def continuous_points(bench_scene, width, height, repeats=5, quick=False, backen
     Parameters
     ----------
     bench_scene : callable
-        ``bench_scene(material, lights)`` -> the bench's scene (`glphong.tools.bench.BenchCase.scene` geometry).
+        ``bench_scene(material, lights)`` -> the bench's scene (`glphong.bench.work_precision.family_scene`).
     width, height, repeats : int
     quick : bool
         Fewer cases and knob values.

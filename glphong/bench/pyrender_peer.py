@@ -1,18 +1,9 @@
-"""Benchmark adapters: a hand-written moderngl floor and a pyrender conversion.
-
-`HandWrittenRenderer`
-    The minimal moderngl program that draws a glphong scene with glphong's own generated
-    GLSL: every one-time step (compilation, uploads, uniform packing) happens in
-    `HandWrittenRenderer.prepare`, and `HandWrittenRenderer.render` only binds, writes
-    precomputed uniform bytes, draws and reads back.  Its frame time is the floor that
-    glphong's per-frame overhead (key computation, strict uniform binding, validation) is
-    measured against: the keys of a default `glphong.Renderer` (``numerics='auto'``).  ``shader='textbook'`` draws
-    with the naive formulation instead.
-
-`to_pyrender`, `PyrenderRenderer`
-    A glphong `Scene` as a ``pyrender.Scene``, for speed and quality comparisons with a
-    widely used rasteriser.  pyrender is optional: it is imported only inside these
-    functions, and ``import glphong`` never imports it (nor PyOpenGL).
+"""pyrender as the peer glphong is measured against: a glphong `Scene` as a ``pyrender.Scene`` (`to_pyrender`),
+drawn by pyrender's ``OffscreenRenderer`` (`PyrenderRenderer`), for speed and quality comparisons with a widely used
+rasteriser.  pyrender is optional: it is imported only inside these functions (`import_pyrender`, which sets
+``PYOPENGL_PLATFORM`` first), and ``import glphong`` never imports it (nor PyOpenGL).  A renderer is released by
+`glphong.integrations.pyrender.release` (`glphong.gpu.contexts.release_offscreen`), which does not end the EGL display
+the process shares.  The other way, pyrender's scenes drawn by glphong, is `glphong.integrations.pyrender`.
 
 The pyrender conversion is approximate where the models differ (pyrender shades a
 metallic-roughness microfacet BRDF, not Phong or Blinn):
@@ -43,25 +34,19 @@ sample count is hard-coded); on OSMesa it draws into the context's single-sample
 framebuffer, so there is no antialiasing.
 """
 import importlib
+import importlib.util
 import os
 import sys
-from dataclasses import replace
 
-import moderngl
 import numpy as np
 
-from glphong.gpu.contexts import create_context, release_offscreen
-from glphong.shaders.assembly import assemble
+from glphong.gpu.contexts import release_offscreen
 from glphong.scene.camera import IntrinsicsCamera, OrthographicCamera
-from glphong.shaders.numerics import with_numerics
 from glphong.scene.scene import Scene
-from glphong.shaders.binding import binding
 
-__all__ = ["HandWrittenRenderer", "PyrenderRenderer", "to_pyrender", "pyrender_roughness", "import_pyrender",
-           "SHADERS", "PYRENDER_PLATFORMS"]
-
-#: shader variants of `HandWrittenRenderer`
-SHADERS = ("glphong", "textbook")
+__all__ = ["PyrenderRenderer", "to_pyrender", "pyrender_roughness", "pyrender_base_color", "import_pyrender",
+           "pyrender_unavailable", "pyrender_encode", "pyrender_decode", "PYRENDER_PLATFORMS", "PYRENDER_SAMPLES",
+           "PYRENDER_GAMMA"]
 
 #: pyrender platforms `PyrenderRenderer` supports (values of ``PYOPENGL_PLATFORM``)
 PYRENDER_PLATFORMS = ("egl", "osmesa")
@@ -69,149 +54,8 @@ PYRENDER_PLATFORMS = ("egl", "osmesa")
 #: MSAA sample count pyrender 0.1.45 hard-codes for its framebuffer-object path (EGL)
 PYRENDER_SAMPLES = 4
 
-
-class HandWrittenRenderer:
-    """The fastest honest moderngl rendering of a glphong scene: the floor of glphong's overhead.
-
-    Parameters
-    ----------
-    width, height : int
-        Image size in pixels.
-    backend : {'egl', 'osmesa', 'auto'}
-        Passed to `glphong.gpu.contexts.create_context`; the renderer owns the context.
-    shader : {'glphong', 'textbook'}
-        'glphong': the stable programs glphong draws with.  'textbook': the same keys with
-        ``formulation='naive'`` (the textbook GLSL), the floor of a naive implementation.
-
-    Notes
-    -----
-    `prepare` does every one-time step; `render` only makes the context current, binds and
-    clears the target, enables the depth test, then per object writes the precomputed
-    uniform bytes and draws, and reads the float32 target back.  The scene is captured at
-    `prepare`: later changes to it are not seen until `prepare` is called again.
-    """
-
-    def __init__(self, width, height, backend="egl", shader="glphong"):
-        if shader not in SHADERS:
-            raise ValueError(f"shader must be one of {', '.join(map(repr, SHADERS))} (got {shader!r})")
-        self.width = int(width)
-        self.height = int(height)
-        self.shader = shader
-        self.context = create_context(backend)
-        self._mgl = self.context.mgl
-        self._programs = {}
-        self._buffers = []
-        self._vaos = []
-        self._draws = ()
-        self._fbo = None
-
-    @property
-    def backend(self):
-        """Name of the OpenGL backend in use ('egl' or 'osmesa')."""
-        return self.context.backend
-
-    def key(self, scene, obj):
-        """The `ProgramKey` this renderer draws ``obj`` with."""
-        key = binding(scene).program_key(obj)
-        return replace(key, formulation="naive") if self.shader == "textbook" else with_numerics(key, scene, obj)
-
-    def prepare(self, scene):
-        """Compile, upload and pack everything ``scene`` needs; replaces a previous scene."""
-        if self.context is None:
-            raise RuntimeError("this HandWrittenRenderer has been released")
-        aspect = self.width / self.height
-        with self.context:
-            self._release_scene()
-            mgl = self._mgl
-            colour = mgl.renderbuffer((self.width, self.height), 4, dtype="f4")
-            self._fbo = mgl.framebuffer([colour], mgl.depth_renderbuffer((self.width, self.height)))
-            mgl.disable(moderngl.CULL_FACE)
-            meshes, draws = {}, []
-            for index, obj in enumerate(scene.objects):
-                key = self.key(scene, obj)
-                program = self._programs.get(key)
-                if program is None:
-                    defines, generated = key.defines(), key.generated_chunks()
-                    program = self._programs[key] = mgl.program(
-                        vertex_shader=assemble(key.vertex_chunks(), defines, generated),
-                        fragment_shader=assemble(key.fragment_chunks(), defines, generated))
-                mesh = meshes.get(id(obj.mesh))
-                if mesh is None:
-                    mesh = meshes[id(obj.mesh)] = {"indices": mgl.buffer(obj.mesh.indices.tobytes())}
-                    self._buffers.append(mesh["indices"])
-                content = []
-                for name, source, fmt in (("in_position", "positions", "3f"), ("in_normal", "normals", "3f"),
-                                          ("in_tangent", "tangents", "4f"), ("in_uv", "uvs", "2f")):
-                    if name in key.attributes() and name in program:
-                        if source not in mesh:
-                            mesh[source] = mgl.buffer(getattr(obj.mesh, source).tobytes())
-                            self._buffers.append(mesh[source])
-                        content.append((mesh[source], fmt, name))
-                vao = mgl.vertex_array(program, content, mesh["indices"], index_element_size=4)
-                self._vaos.append(vao)
-                uniforms = []
-                for name, value in binding(scene).uniform_values(index, key, aspect).items():
-                    if program.get(name, None) is None:
-                        if key.formulation == "naive":
-                            continue  # the compiler removed an input the naive program never reads
-                        raise KeyError(f"program {key.describe()!r} has no uniform {name!r}")
-                    uniform = program[name]
-                    data = np.asarray(value, dtype=np.float32)
-                    if data.ndim == 2 and data.shape[0] == data.shape[1] and uniform.dimension == data.size:
-                        data = data.T  # row-major matrix -> GL column-major
-                    uniforms.append((uniform, np.ascontiguousarray(data).tobytes()))
-                draws.append((tuple(uniforms), vao))
-            self._draws = tuple(draws)
-        return self
-
-    def render(self):
-        """Draw the prepared scene; return its radiance, (H, W, 3) float32, row 0 at the top."""
-        fbo = self._fbo
-        if fbo is None:
-            raise RuntimeError("call prepare(scene) first (or this HandWrittenRenderer has been released)")
-        with self.context:
-            fbo.use()
-            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            self._mgl.enable(moderngl.DEPTH_TEST)
-            for uniforms, vao in self._draws:
-                for uniform, data in uniforms:
-                    uniform.write(data)
-                vao.render()
-            rgba = np.frombuffer(fbo.read(components=4, dtype="f4"), dtype=np.float32)
-        return np.ascontiguousarray(rgba.reshape(self.height, self.width, 4)[::-1, :, :3])
-
-    def _release_scene(self):
-        for vao in self._vaos:
-            vao.release()
-        for buffer in self._buffers:
-            buffer.release()
-        for program in self._programs.values():
-            program.release()
-        if self._fbo is not None:
-            self.context.release_framebuffer(self._fbo)
-        self._programs, self._buffers, self._vaos, self._draws, self._fbo = {}, [], [], (), None
-
-    def release(self):
-        """Release every GL object and the context; idempotent."""
-        if self.context is None:
-            return
-        with self.context:
-            self._release_scene()
-        self.context.release()
-        self.context = None
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        self.release()
-
-    def __repr__(self):
-        state = "released" if self.context is None else self.backend
-        return f"HandWrittenRenderer({self.width}x{self.height}, shader={self.shader!r}, {state})"
-
-
-# --------------------------------------------------------------------------- pyrender
+#: the exponent of pyrender's output encoding: it writes ``clip(x, 0, 1) ** (1 / PYRENDER_GAMMA)`` in 8 bits
+PYRENDER_GAMMA = 2.2
 
 
 def _loaded_pyopengl_platform():
@@ -225,6 +69,65 @@ def _loaded_pyopengl_platform():
         if name.startswith(known):
             return known
     return name.removesuffix("platform")
+
+
+def _platform_conflict(platform):
+    """Why pyrender cannot run on ``platform`` in this process because PyOpenGL is loaded on another one, or None."""
+    loaded = _loaded_pyopengl_platform()
+    if loaded is not None and loaded != platform:
+        return (f"PyOpenGL (and pyrender) already use the {loaded!r} platform in this process; PYOPENGL_PLATFORM "
+                f"is read once, at the first import, so pyrender on {platform!r} needs a new process")
+    return None
+
+
+def pyrender_unavailable(platform="egl"):
+    """Why `PyrenderRenderer` cannot run on ``platform`` in this process, or None; imports nothing (importing
+    pyrender would fix PyOpenGL's platform).
+
+    Parameters
+    ----------
+    platform : {'egl', 'osmesa'}
+
+    Returns
+    -------
+    str or None
+        The reason: pyrender is not installed (or is blocked in ``sys.modules``), or PyOpenGL already runs on
+        another platform here.
+    """
+    if platform not in PYRENDER_PLATFORMS:
+        return f"pyrender runs on {', '.join(map(repr, PYRENDER_PLATFORMS))} here, not {platform!r}"
+    if "pyrender" in sys.modules and sys.modules["pyrender"] is None or importlib.util.find_spec("pyrender") is None:
+        return "pyrender is not installed; pip install 'glphong[pyrender]'"
+    return _platform_conflict(platform)
+
+
+def pyrender_encode(radiance):
+    """Radiance as pyrender writes its colour: clamped to [0, 1], ``x ** (1 / 2.2)``, rounded to 8 bits.
+
+    Parameters
+    ----------
+    radiance : (..., 3) array_like
+
+    Returns
+    -------
+    (..., 3) uint8 ndarray
+    """
+    encoded = np.clip(np.asarray(radiance, dtype=np.float64), 0.0, 1.0) ** (1.0 / PYRENDER_GAMMA)
+    return np.rint(encoded * 255.0).astype(np.uint8)
+
+
+def pyrender_decode(rgb8):
+    """pyrender's 8-bit colour back to radiance, ``(c / 255) ** 2.2`` (exposure 1; what it clamped stays clamped).
+
+    Parameters
+    ----------
+    rgb8 : (..., 3) uint8 array_like
+
+    Returns
+    -------
+    (..., 3) float64 ndarray
+    """
+    return (np.asarray(rgb8, dtype=np.float64) / 255.0) ** PYRENDER_GAMMA
 
 
 def import_pyrender(platform):
@@ -245,11 +148,9 @@ def import_pyrender(platform):
     """
     if platform not in PYRENDER_PLATFORMS:
         raise ValueError(f"platform must be one of {', '.join(map(repr, PYRENDER_PLATFORMS))} (got {platform!r})")
-    loaded = _loaded_pyopengl_platform()
-    if loaded is not None and loaded != platform:
-        raise RuntimeError(
-            f"PyOpenGL (and pyrender) already use the {loaded!r} platform in this process; PYOPENGL_PLATFORM "
-            f"is read once, at the first import, so pyrender on {platform!r} needs a new process")
+    conflict = _platform_conflict(platform)
+    if conflict is not None:
+        raise RuntimeError(conflict)
     os.environ["PYOPENGL_PLATFORM"] = platform
     return importlib.import_module("pyrender")
 
@@ -405,21 +306,17 @@ class PyrenderRenderer:
         return self
 
     def render(self):
-        """Render the prepared scene: (H, W, 3) uint8, gamma 1/2.2 encoded, row 0 at the top."""
+        """Render the prepared scene: (H, W, 3) uint8, gamma 1/2.2 encoded (`pyrender_decode` undoes it), row 0 at
+        the top."""
         if self._renderer is None:
             raise RuntimeError("this PyrenderRenderer has been released")
         colour, _depth = self._renderer.render(self.scene)
         return colour
 
     def release(self):
-        """Delete pyrender's renderer and its context; idempotent.
-
-        On EGL this does not call ``OffscreenRenderer.delete``: pyrender's EGL platform then
-        calls ``eglTerminate`` on the device's display, which Mesa shares with every other
-        EGL context on that device in the process (glphong's and moderngl's included) and so
-        destroys them all.  Here pyrender's GL objects are deleted and only its own EGL
-        context is destroyed (this reaches into pyrender 0.1.45's private attributes).
-        """
+        """Delete pyrender's renderer and its context, as `glphong.integrations.pyrender.release` does (on EGL
+        without ``OffscreenRenderer.delete``, whose ``eglTerminate`` would end every EGL context of the process);
+        idempotent."""
         offscreen, self._renderer = self._renderer, None
         if offscreen is not None:
             release_offscreen(offscreen)

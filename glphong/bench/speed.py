@@ -18,7 +18,7 @@ warm-up, the median frame time and its spread (the 25th to 75th percentile, rela
 - ``glphong float``: `Renderer.render`, one sample, linear float32 radiance with coverage (``numerics='auto'``, the
   default: docs/design.md section 3, "Stability where a scene needs it");
 - ``glphong stable``: the same with ``numerics='stable'`` (the stable formulation everywhere);
-- ``naive floor``: `glphong.analysis.comparisons.HandWrittenRenderer` with the textbook shader (``pow(dot(v, r),
+- ``naive floor``: `glphong.bench.floor.HandWrittenRenderer` with the textbook shader (``pow(dot(v, r),
   q)``, ``normalize``): the same meshes and a float target, uniforms packed once, no culling;
 - ``glphong 4x 8-bit``: `Renderer.render_srgb8` with 4x MSAA (the display resolve);
 - ``pyrender`` and ``pyrender 2-sided``: pyrender's ``OffscreenRenderer`` at its defaults (4x MSAA on
@@ -44,8 +44,10 @@ from glphong.materials.lambert import Lambert
 from glphong.materials.phong import Phong
 from glphong.scene.scene import Scene
 from glphong.core.timing import alternating_times, median_seconds, progress_bar
-from glphong.analysis.comparisons import HandWrittenRenderer, PyrenderRenderer, import_pyrender
+from glphong.bench.floor import HandWrittenRenderer
+from glphong.bench.pyrender_peer import PyrenderRenderer, import_pyrender
 from glphong.core.imaging import encode_srgb8
+from glphong.core.png import encode_png
 from glphong.gpu.renderer import Renderer
 from glphong.scene.geometry import MeshData
 
@@ -151,8 +153,8 @@ class SpeedReport:
         if self.png:
             p = self.png
             lines.append(f"save_png {p['size']}: {p['save_ms']:.1f} ms = {p['ratio']:.2f} x the render "
-                         f"({p['render_ms']:.1f} ms; encode {p['encode_ms']:.1f} ms, PNG compress_level 1 "
-                         f"{p['deflate_ms']:.1f} ms)")
+                         f"({p['render_ms']:.1f} ms; sRGB encode {p['encode_ms']:.1f} ms, glphong's PNG writer "
+                         f"{p['write_ms']:.1f} ms; Pillow at compress_level 1 {p['deflate_ms']:.1f} ms)")
         if self.fits:
             lines.append("\nfitted costs (least squares, glphong float):")
             lines += [f"  {name}: {f['value']:.3g} {f['unit']} (from {f['points']})" for name, f in self.fits.items()]
@@ -263,33 +265,53 @@ def python_per_object(scene, size=64, repeats=9):
             "glphong_ms": 1e3 * g, "floor_ms": 1e3 * f}
 
 
-def png_cost(width=640, height=480, repeats=9):
-    """`Frame.save_png` (to a temporary file) against the render of the ``sphere`` scene at ``width`` x ``height``.
+def png_cost(width=640, height=480, repeats=9, scene=None, backend="egl"):
+    """`Frame.save_png` (to a temporary file) and its parts against the render of ``scene`` at ``width`` x
+    ``height``, in interleaved rounds after warm-up (``glphong bench --speed``; benchmarks/frame_saving.py).
+
+    Parameters
+    ----------
+    width, height, repeats : int
+    scene : glphong.Scene, optional
+        Default: the family's ``sphere`` (`speed_scenes`).
+    backend : str
 
     Returns
     -------
     dict
-        ``render_ms``, ``save_ms``, ``encode_ms``, ``deflate_ms``, ``ratio``, ``size``.
+        Median milliseconds: ``render_ms``, ``save_ms`` (`Frame.save_png`), its two parts ``encode_ms`` (the exact
+        sRGB encode, `glphong.core.imaging.encode_srgb8`) and ``write_ms`` (glphong's PNG writer,
+        `glphong.core.png.encode_png`, zlib level 1), and ``deflate_ms`` (Pillow's PNG writer at the same level, for
+        comparison); ``ratio`` (save / render), ``size`` (``'WxH'``) and the file sizes ``png_bytes`` (glphong's)
+        and ``pillow_bytes``.
     """
     from PIL import Image
 
     import os
     import tempfile
 
-    scene = speed_scenes(quick=True)["sphere"]
-    with Renderer(width, height, backend="egl") as renderer, tempfile.TemporaryDirectory() as folder:
+    scene = speed_scenes(quick=True)["sphere"] if scene is None else scene
+    with Renderer(width, height, backend=backend) as renderer, tempfile.TemporaryDirectory() as folder:
         frame = renderer.render(scene)
         codes = encode_srgb8(frame.radiance)
         path = os.path.join(folder, "frame.png")
+
+        def pillow():
+            out = io.BytesIO()
+            Image.fromarray(codes).save(out, format="PNG", compress_level=1)
+            return out
+
         times = alternating_times({
             "render": lambda: renderer.render(scene),
             "save": lambda: frame.save_png(path),
             "encode": lambda: encode_srgb8(frame.radiance),
-            "deflate": lambda: Image.fromarray(codes).save(io.BytesIO(), format="PNG", compress_level=1)},
+            "write": lambda: encode_png(codes, 1),
+            "deflate": pillow},
             repeats, warmup=2)
+        sizes = {"png_bytes": len(encode_png(codes, 1)), "pillow_bytes": len(pillow().getvalue())}
     ms = {k: 1e3 * statistics.median(t) for k, t in times.items()}
-    return {"render_ms": ms["render"], "save_ms": ms["save"], "encode_ms": ms["encode"], "deflate_ms": ms["deflate"],
-            "ratio": ms["save"] / ms["render"], "size": f"{width}x{height}"}
+    return {"render_ms": ms["render"], "save_ms": ms["save"], "encode_ms": ms["encode"], "write_ms": ms["write"],
+            "deflate_ms": ms["deflate"], "ratio": ms["save"] / ms["render"], "size": f"{width}x{height}", **sizes}
 
 
 def scaling_fits(quick=False, repeats=5):

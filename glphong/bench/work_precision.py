@@ -22,16 +22,17 @@ from glphong.lights import AmbientLight, PointLight
 from glphong.materials.blinn import BlinnPhong
 from glphong.materials.phong import Phong
 from glphong.scene.scene import Scene
-from glphong.core.timing import median_seconds, progress_bar
-from glphong.analysis.comparisons import HandWrittenRenderer, PyrenderRenderer
+from glphong.core.timing import alternating_medians, median_seconds, progress_bar
+from glphong.bench.continuous import continuous_points
+from glphong.bench.floor import HandWrittenRenderer
+from glphong.bench.pyrender_peer import PyrenderRenderer, pyrender_decode, pyrender_unavailable
 from glphong.checks import reference as ref
 from glphong.checks.raycast import AnalyticObject, Plane, Sphere, compare_to_reference, render_reference
-from glphong.core.timing import alternating_medians
 from glphong.gpu.contexts import available_backends
 from glphong.gpu.renderer import Renderer
-from glphong.tools.bench_continuous import continuous_points
 
-__all__ = ["BenchCase", "standard_cases", "quick_cases", "Method", "methods", "run_bench", "BenchReport"]
+__all__ = ["BenchCase", "standard_cases", "quick_cases", "Method", "methods", "run_bench", "BenchReport",
+           "scaling_table", "speed_targets", "family_camera", "family_scene", "SPHERES", "PLANE_Y", "PLANE_SIZE"]
 
 SPHERES = (((-0.75, 0.0, 0.0), 0.65), ((0.8, -0.15, 0.3), 0.5))
 PLANE_Y = -0.65
@@ -284,8 +285,7 @@ def _measure(method, case, value, width, height, reference, repeats):
             renderer.prepare(case.scene(value))
             rgb8 = renderer.render()
             seconds = median_seconds(renderer.render, repeats)
-            # pyrender clamps and encodes x^(1/2.2) at exposure 1 (not the sRGB curve): undo that
-            image = (rgb8.astype(np.float64) / 255.0) ** 2.2
+            image = pyrender_decode(rgb8)  # pyrender clamps and encodes x^(1/2.2), not the sRGB curve: undo that
             mask = np.any(rgb8 != 0, axis=-1)
         finally:
             renderer.release()
@@ -299,12 +299,9 @@ def _available(method):
     """None if the method can run here, else the reason."""
 
     if method.kind == "pyrender":
-        import importlib.util
-        import sys
-
-        # find_spec, not import: importing pyrender before PYOPENGL_PLATFORM is set fixes PyOpenGL to GLX
-        if "pyrender" in sys.modules and sys.modules["pyrender"] is None or importlib.util.find_spec("pyrender") is None:
-            return f"{method.name}: pyrender is not installed; pip install 'glphong[pyrender]'"
+        reason = pyrender_unavailable(method.options["platform"])  # imports nothing: that would fix PyOpenGL's platform
+        if reason is not None:
+            return f"{method.name}: {reason}"
     backend = method.options.get("backend", "egl")
     reason = available_backends().get(backend)
     return None if reason is None else f"{method.name}: backend {backend} unavailable: {reason}"
@@ -329,7 +326,7 @@ def run_bench(width=256, height=192, cases=None, method_list=None, repeats=5, re
     scaling, targets : bool
         Also measure the scaling table and the speed ratios.
     continuous : bool
-        Also the area lights' methods against their exact integrals (`glphong.tools.bench_continuous`).
+        Also the area lights' methods against their exact integrals (`glphong.bench.continuous`).
     progress : bool
         Show a tqdm progress bar (when tqdm is installed).
 

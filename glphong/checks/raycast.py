@@ -39,7 +39,7 @@ from glphong.scene.camera import Camera
 from glphong.scene.geometry import MeshData
 from glphong.lights import AmbientLight
 from glphong.materials import Material
-from glphong.materials.table import uniform_as
+from glphong.definitions.table import uniform_as
 from glphong.checks.reference import safe_normalize, shade_point
 from glphong.scene.scene import Scene
 from glphong.shaders.binding import binding

@@ -20,8 +20,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from glphong.materials.surface import surface_texture, surface_texture_band
-from glphong.materials.table import uniform_as
+from glphong.definitions.surface import surface_texture, surface_texture_band
+from glphong.definitions.table import uniform_as
 from glphong.twin.band import BAND, EPS
 from glphong.twin.functions import (BLINN_HALF_FLOOR, FLT_MAX, FRAME_PARALLEL_LIMIT, ShadingFrame, _dot,  # noqa: F401
                                     atan2_first_quadrant, blinn_delta, blinn_lobe, frame_from_tangent, fresnel_dielectric,
@@ -174,7 +174,7 @@ def input_bounds(uv, color, lod, key, u, band=BAND):
     """The surface inputs ``scale * T(uv) * C`` (`glphong.reference.material_inputs`) and the intervals the
     GPU's values lie in, from one sampling of each texture.
 
-    The texture value's interval is `glphong.materials.surface.surface_texture_band`; scale and
+    The texture value's interval is `glphong.definitions.surface.surface_texture_band`; scale and
     colour are exact float32 inputs (>= 0), so the products carry the interval's ends, and the two
     float32 products add ``2 eps`` relative.
 

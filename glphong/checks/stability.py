@@ -22,9 +22,9 @@ import numpy as np
 
 from glphong.checks.tolerances import FLT_MAX, FLT_MIN, point_band
 from glphong.checks.verify import relative_error
-from glphong.materials.cases import Case, _mirror_eye, _unit, _with_ka, cases_for, generic_cases, lobe_cases  # noqa: F401
+from glphong.definitions.cases import Case, _mirror_eye, _unit, _with_ka, cases_for, generic_cases, lobe_cases  # noqa: F401
 from glphong.checks import reference as ref
-from glphong.checks.probe import shade_points
+from glphong.checks.points import shade_points
 from glphong.gpu.contexts import create_context
 from glphong.gpu.programs import ProgramCache
 from glphong.materials import ParamValues, ShadingFrame, registered_models

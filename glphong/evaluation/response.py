@@ -1,58 +1,19 @@
-"""Evaluating a material's response on direction pairs, on the GPU or by its twin, without a scene
-(`evaluate`: a vertex program captured by transform feedback), and the direction sets, frames and float32
-unit vectors the checks use.  `glphong.testing` re-exports all of it for tests; `glphong.analysis`
-evaluates BRDFs through it.
+"""A material's response on direction pairs, on the GPU or by its twin, without a scene (`evaluate`: a vertex
+program captured by transform feedback), and its parts for the tolerance check (`response_inputs`, `twin_response`,
+`gpu_response`).  `glphong.testing` re-exports `evaluate`; `glphong.analysis` evaluates BRDFs through it.
 """
-import atexit
 import threading
 
 import numpy as np
 
 from glphong.checks import reference as ref
-from glphong.checks.tolerances import EPS
-from glphong.gpu.contexts import EGLDisplayTerminatedError, create_context
+from glphong.definitions.material import Material
+from glphong.definitions.table import uniform_as
 from glphong.gpu.programs import ProgramCache
-from glphong.materials.model import Material
-from glphong.materials.table import uniform_as
 from glphong.shaders.builders import response_key
+from glphong.evaluation.pool import pooled
 
-__all__ = ["evaluate", "direction_sets", "frame_around", "direction", "rotate_toward", "float32_units",
-           "cosine_power_interval"]
-
-
-_POOL = {}
-_POOL_LOCK = threading.Lock()
-
-
-def _pooled(backend):
-    """A context and its program cache per backend, created on first use and kept until exit."""
-
-    with _POOL_LOCK:
-        entry = _POOL.get(backend)
-        if entry is not None:
-            try:
-                with entry[2], entry[0]:
-                    pass
-            except EGLDisplayTerminatedError:  # its display was terminated (pyrender on EGL): start anew
-                entry[0]._released = True
-                entry = None
-        if entry is None or entry[0].mgl is None:
-            gl = create_context(backend)
-            gl.detach()  # entered per call, from any thread
-            entry = _POOL[backend] = (gl, ProgramCache(gl.mgl), threading.RLock())
-        return entry
-
-
-@atexit.register
-def _release_pool():
-    for gl, programs, _ in _POOL.values():
-        try:
-            with gl:
-                programs.release()
-            gl.release()
-        except Exception:  # noqa: BLE001 - interpreter shutdown
-            pass
-    _POOL.clear()
+__all__ = ["evaluate", "response_inputs", "twin_response", "gpu_response"]
 
 
 def _rows(name, value, count, width):
@@ -72,8 +33,22 @@ def _unit_rows(name, value, count):
     return a / length
 
 
-def _inputs(material, wi, wo, normal, tangent, uv):
-    """The float32 inputs both sides evaluate: unit directions (normalised in float64, rounded)."""
+def response_inputs(material, wi, wo, normal=(0.0, 0.0, 1.0), tangent=(1.0, 0.0, 0.0), uv=None):
+    """The float32 inputs both sides evaluate: unit directions (normalised in float64, then rounded).
+
+    Parameters
+    ----------
+    material : glphong.materials.Material
+    wi, wo, normal, tangent, uv
+        As in `evaluate`.
+
+    Returns
+    -------
+    wi, wo, normal : (N, 3) float32 ndarray
+    tangent : (N, 4) float32 ndarray
+        Handedness in the fourth component.
+    uv : (N, 2) float32 ndarray
+    """
     if not isinstance(material, Material):
         raise TypeError(f"material must be a glphong material (got {type(material).__name__})")
     wi = np.asarray(wi, dtype=np.float64)
@@ -90,7 +65,31 @@ def _inputs(material, wi, wo, normal, tangent, uv):
             f32(tangent), f32(_rows("uv", (0.0, 0.0) if uv is None else uv, count, 2)))
 
 
-def _twin(material, key, uniforms, wi, wo, normal, tangent, uv):
+def twin_response(material, key, uniforms, wi, wo, normal, tangent, uv):
+    """The numpy twin's response in float64 on the float32 inputs of `response_inputs`, and what the tolerance
+    band of `glphong.checks.tolerances.response_band` is computed from.
+
+    Parameters
+    ----------
+    material : glphong.materials.Material
+    key : glphong.shaders.keys.ProgramKey
+        ``glphong.shaders.builders.response_key(material)``.
+    uniforms : dict of str to array_like
+        ``material.uniform_values(key)``.
+    wi, wo, normal, tangent, uv : ndarray
+        From `response_inputs`.
+
+    Returns
+    -------
+    response : (N, 3) float64 ndarray
+        0 where ``n.wi <= 0``.
+    frame : glphong.materials.ShadingFrame
+        The twin's shading frame at every row.
+    wi, wo : (N, 3) float64 ndarray
+    n_dot_l : (N,) float64 ndarray
+    uniforms : dict of str to ndarray
+        ``uniforms`` in float64.
+    """
     u = {k: uniform_as(v, np.float64) for k, v in uniforms.items()}
     f = ref.shading_frame(normal.astype(np.float64), tangent.astype(np.float64), uv.astype(np.float64), key)
     wi64, wo64 = wi.astype(np.float64), wo.astype(np.float64)
@@ -136,22 +135,39 @@ def evaluate(material, wi, wo, normal=(0.0, 0.0, 1.0), tangent=(1.0, 0.0, 0.0), 
     (N, 3) ndarray
         float32 from the GPU, float64 from the twin.
     """
-    wi, wo, normal, tangent, uv = _inputs(material, wi, wo, normal, tangent, uv)
+    wi, wo, normal, tangent, uv = response_inputs(material, wi, wo, normal, tangent, uv)
     key = response_key(material)
     uniforms = material.uniform_values(key)
     if twin:
-        return _twin(material, key, uniforms, wi, wo, normal, tangent, uv)[0]
-    return _gpu(material, key, uniforms, wi, wo, normal, tangent, uv, backend, context)
+        return twin_response(material, key, uniforms, wi, wo, normal, tangent, uv)[0]
+    return gpu_response(material, key, uniforms, wi, wo, normal, tangent, uv, backend, context)
 
 
-def _gpu(material, key, uniforms, wi, wo, normal, tangent, uv, backend, context):
+def gpu_response(material, key, uniforms, wi, wo, normal, tangent, uv, backend="auto", context=None):
+    """The GLSL ``material_response()`` on the GPU at the float32 inputs of `response_inputs` (see `evaluate`).
+
+    Parameters
+    ----------
+    material : glphong.materials.Material
+        Named in a GL error's message.
+    key, uniforms
+        As in `twin_response`.
+    wi, wo, normal, tangent, uv : ndarray
+        From `response_inputs`.
+    backend, context
+        As in `evaluate`: the backend's pooled context (`glphong.evaluation.pool.pooled`) unless ``context`` is given.
+
+    Returns
+    -------
+    (N, 3) float32 ndarray
+    """
     import moderngl
 
     count = len(wi)
     if count == 0 or not key.terms:
         return np.zeros((count, 3), np.float32)
     if context is None:
-        gl, programs, lock = _pooled(backend)
+        gl, programs, lock = pooled(backend)
     else:
         gl, programs, lock = context, ProgramCache(context.mgl), threading.RLock()
     columns = {"in_wi": (wi, "3f"), "in_wo": (wo, "3f"), "in_normal": (normal, "3f")}
@@ -178,124 +194,3 @@ def _gpu(material, key, uniforms, wi, wo, normal, tangent, uv, backend, context)
             if context is not None:
                 programs.release()
     return data
-
-
-def _rotate_toward(v, axis, angle):
-    """Rotate unit rows ``v`` by ``angle`` [rad] toward the unit rows ``axis`` (perpendicular to v)."""
-    return np.cos(angle)[..., None] * v + np.sin(angle)[..., None] * axis
-
-
-def direction_sets(n=2000, seed=0):
-    """Direction pairs that exercise a BRDF: seeded random, and the edges where shaders break.
-
-    With the normal +z: random ``wi``, ``wo`` over the upper hemisphere (and some ``wo`` below it),
-    and the edge sets: grazing light (``n.l`` from 1e-2 down to 1e-7, and 0), grazing view, the mirror
-    direction (the peak of Phong and Blinn lobes) and small offsets from it, ``l = v`` (the
-    retro-reflection peak), ``l = -v`` mirrored at grazing, ``n.l`` just above 0, and light and view
-    both so grazing (cosines 1e-30 to 1e-19) that ``(n.l)(n.v)`` is below FLT_MIN.
-
-    Parameters
-    ----------
-    n : int
-        Number of random pairs (the edge sets come on top, about 40 % more).
-    seed : int
-
-    Returns
-    -------
-    wi, wo : (M, 3) float64 ndarray
-        Unit vectors.
-    labels : (M,) ndarray of str
-        Which set each pair belongs to.
-    """
-    rng = np.random.default_rng(seed)
-
-    def hemisphere(count, lower=False):
-        v = rng.normal(size=(count, 3))
-        v[:, 2] = np.abs(v[:, 2]) * (-1.0 if lower else 1.0)
-        return v / np.linalg.norm(v, axis=1, keepdims=True)
-
-    def at(cos_theta, count):
-        phi = rng.uniform(0, 2 * np.pi, count)
-        s = np.sqrt(np.maximum(1.0 - cos_theta ** 2, 0.0))
-        return np.stack([s * np.cos(phi), s * np.sin(phi), np.broadcast_to(cos_theta, (count,))], axis=1)
-
-    def mirror(wi):
-        return wi * np.array([-1.0, -1.0, 1.0])
-
-    sets = []
-    k = max(n // 20, 8)
-    sets.append(("random", hemisphere(n), hemisphere(n)))
-    sets.append(("view below the surface", hemisphere(k), hemisphere(k, lower=True)))
-    for cosine in (1e-2, 1e-4, 1e-6, 1e-7, 0.0):
-        sets.append((f"grazing light n.l={cosine:g}", at(np.full(k, cosine), k), hemisphere(k)))
-    for cosine in (1e-2, 1e-4, 1e-6):
-        sets.append((f"grazing view n.v={cosine:g}", hemisphere(k), at(np.full(k, cosine), k)))
-    wi = hemisphere(4 * k)
-    sets.append(("mirror direction (lobe peak)", wi, mirror(wi)))
-    for offset in (1e-6, 1e-4, 1e-3, 1e-2, 1e-1):
-        wi = hemisphere(k)
-        peak = mirror(wi)
-        axis = np.cross(peak, rng.normal(size=(k, 3)))
-        axis /= np.linalg.norm(axis, axis=1, keepdims=True)
-        sets.append((f"near the mirror direction, {offset:g} rad", wi, _rotate_toward(peak, axis, np.full(k, offset))))
-    wi = hemisphere(2 * k)
-    sets.append(("l = v (retro-reflection)", wi, wi.copy()))
-    wi = at(np.full(k, 3e-6), k)
-    sets.append(("l, v grazing and mirrored", wi, -wi * np.array([1.0, 1.0, -1.0])))
-    wi = at(10.0 ** rng.uniform(-7, -3, k), k)
-    sets.append(("n.l just above 0", wi, mirror(wi)))
-    wi, wo = at(10.0 ** rng.uniform(-30, -19, k), k), at(10.0 ** rng.uniform(-30, -19, k), k)
-    sets.append(("l and v grazing, (n.l)(n.v) below FLT_MIN", wi, wo))
-    labels = np.concatenate([[label] * len(a) for label, a, _ in sets])
-    return np.concatenate([a for _, a, _ in sets]), np.concatenate([b for _, _, b in sets]), labels
-
-
-# --------------------------------------------------------------------------- closed-form helpers
-def frame_around(n):
-    """An orthonormal ``(t, b)`` completing the unit normal ``n`` (3,): ``(t, b, n)`` right-handed."""
-    n = np.asarray(n, dtype=np.float64)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    t = np.cross(n, helper)
-    t /= np.linalg.norm(t)
-    return t, np.cross(n, t)
-
-
-def direction(n, theta, phi):
-    """The unit vector at polar angle ``theta`` [rad] from the unit ``n`` and azimuth ``phi`` [rad] about it
-    (measured from `frame_around`'s ``t``)."""
-    t, b = frame_around(n)
-    return np.sin(theta) * (np.cos(phi) * t + np.sin(phi) * b) + np.cos(theta) * np.asarray(n, dtype=np.float64)
-
-
-def rotate_toward(a, target, angle):
-    """Unit ``a`` (3,) rotated by ``angle`` [rad] toward ``target``, in their plane."""
-    axis = target - np.dot(target, a) * a
-    axis /= np.linalg.norm(axis)
-    return np.cos(angle) * a + np.sin(angle) * axis
-
-
-def float32_units(v):
-    """Rows of ``v`` normalised in float64 and rounded to float32 (returned as float64): exactly the unit
-    vectors `evaluate` hands to the GPU and to the twin."""
-    v = np.asarray(v, dtype=np.float64)
-    return np.asarray(v / np.linalg.norm(v, axis=-1, keepdims=True), dtype=np.float32).astype(np.float64)
-
-
-def cosine_power_interval(cos_alpha, q, spread):
-    """The interval of float32 values consistent with ``cos(alpha)^q``, for closed-form tests of lobes.
-
-    ``alpha`` is the angle from the lobe's peak; float32 inputs and arithmetic leave it uncertain by
-    ``+- spread`` [rad] (a few eps: the caller states it for its lobe); ``exp`` is good to
-    ``(3 + 2|x|)`` ulp (GLSL 4.50, 4.7.1) and ``ln(1 - delta)`` to a few ulp relative, so the value is
-    widened by ``eps (8 + 12 lambda)`` relative, ``lambda = -ln(value)``.  The caller accepts 0 below
-    FLT_MIN (flush to zero).
-
-    Returns
-    -------
-    low, high : ndarray
-    """
-    alpha = np.arccos(np.clip(cos_alpha, -1.0, 1.0))
-    low = np.cos(np.minimum(alpha + spread, np.pi / 2)) ** q
-    high = np.cos(np.maximum(alpha - spread, 0.0)) ** q
-    lam = -np.log(np.maximum(low, 1e-300))
-    return low * (1 - EPS * (8 + 12 * lam)), high * (1 + EPS * (8 + 12 * lam))

@@ -13,7 +13,7 @@ function, so that a property test is a few lines::
 """
 import numpy as np
 
-from glphong.checks.glsl_types import glsl_type
+from glphong.testing.glsl_types import glsl_type
 
 __all__ = ["edge_values", "edge_inputs", "glsl_values", "glsl_inputs", "FLOAT_EDGES", "unit_float32"]
 
@@ -47,7 +47,7 @@ def edge_values(type_name, nonfinite=False, unit=False):
     Parameters
     ----------
     type_name : str
-        A GLSL type (`glphong.checks.glsl_types.TYPE_NAMES`).
+        A GLSL type (`glphong.testing.glsl_types.TYPE_NAMES`).
     nonfinite : bool
         Add inf, -inf and NaN (floats).
     unit : bool
@@ -96,7 +96,7 @@ def edge_inputs(fn, nonfinite=False, unit=(), limit=20000, seed=0):
 
     Parameters
     ----------
-    fn : glphong.checks.glsl_function.GlslFunction
+    fn : glphong.testing.GlslFunction
     nonfinite : bool
         Include inf, -inf and NaN among the floats.
     unit : collection of str
@@ -190,7 +190,7 @@ def glsl_inputs(fn, rows=32, unit=(), **options):
 
     Parameters
     ----------
-    fn : glphong.checks.glsl_function.GlslFunction
+    fn : glphong.testing.GlslFunction
     rows : int
     unit : collection of str
         Inputs drawn as unit vectors.

@@ -1,6 +1,6 @@
 """A GLSL function against its numpy twin, with tolerances a numerical person trusts (docs/design.md section 14).
 
-`assert_glsl_matches` runs a `glphong.checks.glsl_function.GlslFunction` and its twin on the same inputs (the
+`assert_glsl_matches` runs a `glphong.testing.GlslFunction` and its twin on the same inputs (the
 float32 values the GPU receives, given to the twin exactly, as float64) and compares every result:
 
 - floats within ``ulps`` units in the last place of float32 at the twin's value, ``atol``, ``rtol``, or the band
@@ -10,7 +10,7 @@ float32 values the GPU receives, given to the twin exactly, as float64) and comp
 - GLSL lets an implementation flush subnormals to zero, in its inputs and results: a result that matches the twin
   evaluated on the inputs with their subnormals flushed, or is zero where the twin's value is subnormal, passes
   and is counted as ``flushed``;
-- rows where the twin met a built-in's undefined domain (`glphong.checks.glsl_builtins.record_undefined`) are
+- rows where the twin met a built-in's undefined domain (`glphong.testing.glsl_builtins.record_undefined`) are
   left out and reported by built-in (``undefined='fail'`` makes them a failure).
 
 A failure raises `GlslMismatch`, naming the worst rows with their inputs, the GPU's value, the twin's and the
@@ -20,8 +20,8 @@ import warnings
 
 import numpy as np
 
-from glphong.checks.glsl_builtins import UNDEFINED, record_undefined
-from glphong.checks.glsl_types import decode, glsl_type
+from glphong.testing.glsl_builtins import UNDEFINED, record_undefined
+from glphong.testing.glsl_types import decode, glsl_type
 
 __all__ = ["GlslMismatch", "GlslUndefinedWarning", "assert_glsl_matches", "ulp32", "ulps_between", "FLT_MIN"]
 
@@ -104,7 +104,7 @@ def assert_glsl_matches(fn, twin, inputs, ulps=None, atol=None, rtol=None, band=
 
     Parameters
     ----------
-    fn : glphong.checks.glsl_function.GlslFunction
+    fn : glphong.testing.GlslFunction
     twin : callable
         ``twin(**inputs)`` on float64 (floats), int64 or bool arrays, one row per invocation: the result as an
         array, or, where ``fn`` has ``out``/``inout`` parameters, a dict by name (``'return'`` for the result) or a

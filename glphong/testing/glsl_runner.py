@@ -1,9 +1,9 @@
 """Any GLSL function as a numpy function: the shader unit tests' runner (docs/design.md section 14).
 
 `glsl_function` compiles a user's GLSL source (a string or a ``.glsl`` file, with ``#include`` s of glphong's
-chunks or the user's own files, `glphong.checks.glsl_source`) around a generated harness that calls the function
+chunks or the user's own files, `glphong.testing.glsl_source`) around a generated harness that calls the function
 ``name`` once per row and returns its result and its ``out`` and ``inout`` parameters, every value as its 32-bit
-patterns (`glphong.checks.glsl_types`).
+patterns (`glphong.testing.glsl_types`).
 
 - ``stage='vertex'`` (default): one row per vertex of a point draw, the results captured by transform feedback,
   up to `VERTEX_CHUNK` rows per draw (larger calls are split; memory grows with the rows: about
@@ -25,10 +25,10 @@ from pathlib import Path
 import moderngl
 import numpy as np
 
-from glphong.checks.evaluate import _pooled
-from glphong.checks.glsl_source import (GlslSourceError, check_signature, expand, functions, log_locations, map_log,
-                                        read_source_file, uniforms as parse_uniforms)
-from glphong.checks.glsl_types import decode, encode, glsl_type
+from glphong.testing.glsl_source import (GlslSourceError, check_signature, expand, functions, log_locations, map_log,
+                                         read_source_file, uniforms as parse_uniforms)
+from glphong.testing.glsl_types import decode, encode, glsl_type
+from glphong.evaluation.pool import pooled
 
 __all__ = ["GlslFunction", "glsl_function", "subnormal_flushing", "VERTEX_CHUNK", "STAGES"]
 
@@ -66,7 +66,7 @@ class GlslFunction:
 
     Attributes
     ----------
-    signature : glphong.checks.glsl_source.Signature
+    signature : glphong.testing.glsl_source.Signature
     stage : {'vertex', 'fragment'}
     uniforms : dict of str to str
         The uniforms the source declares, by name: their GLSL type.
@@ -98,7 +98,7 @@ class GlslFunction:
             if "\n" in str(value):
                 raise ValueError(f"defines: the value of {key} spans lines")
         if context is None:
-            self._gl, _, self._lock = _pooled(backend)
+            self._gl, _, self._lock = pooled(backend)
         else:
             self._gl, self._lock = context, threading.RLock()
         self.backend = getattr(self._gl, "backend", backend)
@@ -452,7 +452,7 @@ def glsl_function(source, name, overload=None, stage="vertex", version=330, defi
 
     Raises
     ------
-    glphong.checks.glsl_source.GlslSourceError
+    glphong.testing.glsl_source.GlslSourceError
         A function that does not exist, an unsupported parameter type, an include that cannot be read, a source
         that does not compile (the compiler's log mapped to the user's files and lines, and the harness).
 

@@ -16,7 +16,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from glphong.checks.glsl_types import TYPE_NAMES, glsl_type
+from glphong.testing.glsl_types import TYPE_NAMES, glsl_type
 from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
 from glphong.core.glsl_files import chunk_source, library_chunks
 from glphong.shaders.options import NUMERICS_DEFINES

@@ -2,7 +2,9 @@
 
 This is how each GLSL chunk function is tested against its numpy twin of the same
 name (docs/design.md section 7, layer 1): the function is called from a generated vertex
-shader on float32 inputs and its return value and ``out`` parameters are captured.
+shader on float32 inputs and its return value and ``out`` parameters are captured, through the public
+`glphong.testing.glsl_function`.  (A 'points' program's ``shade_point()`` at given points is the render check's
+`glphong.checks.points.shade_points`.)
 
 Example
 -------
@@ -14,16 +16,14 @@ import importlib
 import re
 from dataclasses import dataclass
 
-import moderngl
-import numpy as np
-
-from glphong.checks.glsl_function import glsl_function
-from glphong.checks.glsl_source import LIBRARY, LIBRARY_DEFINES, functions
+from glphong.checks.points import shade_points  # noqa: F401 - the old path glphong.checks.probe's, one release
 from glphong.core.glsl_files import chunk_source
-from glphong.shaders.assembly import resolve_chunk
 from glphong.materials import registered_models
+from glphong.shaders.assembly import resolve_chunk
+from glphong.testing.glsl_runner import glsl_function
+from glphong.testing.glsl_source import LIBRARY, LIBRARY_DEFINES, functions
 
-__all__ = ["Signature", "signatures", "twin_of", "evaluate", "shade_points"]
+__all__ = ["Signature", "signatures", "twin_of", "library_source", "evaluate"]
 
 _WIDTH = {"float": 1, "vec2": 2, "vec3": 3, "vec4": 4, "bool": 1}
 
@@ -55,7 +55,7 @@ class Signature:
 
 def _parse(text, chunks, twin_module, uniforms=None):
     """Pure functions of a chunk's text (those of float/vec/bool parameters that read no uniform), as
-    `glphong.checks.glsl_source.functions` finds them."""
+    `glphong.testing.glsl_source.functions` finds them."""
     out = {}
     for name, found in functions(text).items():
         for sig in found:
@@ -133,65 +133,3 @@ def evaluate(gl, name, **inputs):
     with glsl_function(library_source(signature), name, context=gl) as fn:
         out = fn(**inputs)
     return out if isinstance(out, dict) else {"return": out}
-
-
-def shade_points(gl, programs, key, uniforms, positions, normals, drop_unused=False, tangents=None, uvs=None):
-    """Evaluate the GLSL ``shade_point()`` of a 'points' program at arbitrary points.
-
-    Parameters
-    ----------
-    gl : glphong.gpu.contexts.GLContext
-    programs : glphong.gpu.programs.ProgramCache
-        Cache of ``gl``'s programs.
-    key : glphong.shaders.key.ProgramKey
-        With ``output='points'``.
-    uniforms : dict of str to array_like
-        Exactly the program's active uniforms (strict binding).
-    positions, normals : (N, 3) array_like
-        World-space points [m] and raw (unnormalised) normals; cast to float32.
-    drop_unused : bool
-        Drop given uniforms the compiler removed instead of raising (for the naive
-        formulation, whose ``safe_normalize`` never fails, so that e.g. a Lambert program
-        never reads ``u_eye``); missing uniforms are still an error.
-    tangents : (N, 4) array_like, optional
-        Raw tangents with handedness in w, where the key reads them (default (1, 0, 0, 1)).
-    uvs : (N, 2) array_like, optional
-        Texture coordinates, where the key reads them (default 0).
-
-    Returns
-    -------
-    (N, 3) float32 ndarray
-        Radiance [W/(m^2 sr)].
-    """
-    if key.output != "points":
-        raise ValueError(f"key.output must be 'points' (got {key.output!r})")
-    positions = np.ascontiguousarray(positions, dtype=np.float32).reshape(-1, 3)
-    normals = np.ascontiguousarray(normals, dtype=np.float32).reshape(-1, 3)
-    if positions.shape != normals.shape:
-        raise ValueError(f"positions and normals must have the same shape (got {positions.shape} and {normals.shape})")
-    count = len(positions)
-    columns = {"in_position": (positions, "3f"), "in_normal": (normals, "3f")}
-    if key.has_tangent:
-        tangents = np.broadcast_to((1.0, 0.0, 0.0, 1.0) if tangents is None else tangents, (count, 4))
-        columns["in_tangent"] = (np.ascontiguousarray(tangents, dtype=np.float32), "4f")
-    if key.has_uv:
-        uvs = np.broadcast_to(0.0 if uvs is None else uvs, (count, 2))
-        columns["in_uv"] = (np.ascontiguousarray(uvs, dtype=np.float32), "2f")
-    mgl = gl.mgl
-    with gl:
-        program = programs.get(key)
-        program.bind(uniforms, drop_unused=drop_unused)
-        buffers = {name: mgl.buffer(data.tobytes()) for name, (data, _) in columns.items()}
-        result = mgl.buffer(reserve=max(count, 1) * 12)
-        content = [(buffers[name], fmt, name) for name, (_, fmt) in columns.items()
-                   if name in program.gl_program]  # the normal is compiled out of unlit programs
-        vao = mgl.vertex_array(program.gl_program, content)
-        try:
-            gl.bind_idle_framebuffer()
-            vao.transform(result, mode=moderngl.POINTS, vertices=count)
-            data = np.frombuffer(result.read(), dtype=np.float32)[:count * 3].reshape(count, 3).copy()
-            gl.check_error(f"shade_points of {key.describe()}")
-        finally:
-            for obj in (vao, result, *buffers.values()):
-                obj.release()
-    return data

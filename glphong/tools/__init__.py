@@ -1,3 +1,3 @@
-"""The command line (`cli`, `expressions`) and the benchmarks (`bench`, `speed`): glphong's users, not
-its core.
+"""The command line (`cli`, `expressions`): glphong's users, not its core.  What ``glphong bench`` runs is
+`glphong.bench`.
 """

@@ -13,6 +13,7 @@ from glphong.analysis.figures import LIGHT_ANGLES, Q_VALUES, phong_examples, pho
 from glphong.analysis.gallery import render_gallery
 from glphong.analysis.questions import format_properties, properties
 from glphong.batch import BatchError, orbit_scene, render_many
+from glphong.bench import methods, quick_cases, run_bench, run_speed, standard_cases
 from glphong.checks.stability import CASES, run_stability
 from glphong.checks.verify import verify
 from glphong.core.imaging import save_npy
@@ -25,9 +26,7 @@ from glphong.lights import registered_lights
 from glphong.materials import registered_models
 from glphong.materials.blinn import BlinnPhong
 from glphong.materials.phong import Phong
-from glphong.tools.bench import methods, quick_cases, run_bench, standard_cases
 from glphong.tools.expressions import ExpressionError, parse_material
-from glphong.tools.speed import run_speed
 
 __all__ = ["main", "print_error", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED"]
 
@@ -428,7 +427,7 @@ def build_parser():
     bench.add_argument("--quick", action="store_true", help="a tiny configuration (2 scenes, 2 knob values; with "
                        "--speed: small sizes and stand-in meshes)")
     bench.add_argument("--speed", action="store_true", help="frame times on the scene family against the naive "
-                       "floor and pyrender (glphong.tools.speed), instead of the work-precision report")
+                       "floor and pyrender (glphong.bench.speed), instead of the work-precision report")
     bench.add_argument("--out", default="glphong_bench", type=_writable,
                        help="output prefix: PREFIX.csv, PREFIX.json, PREFIX.png")
     bench.add_argument("--no-progress", action="store_true", help="no progress bar")

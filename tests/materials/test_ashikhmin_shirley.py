@@ -26,7 +26,7 @@ identical through EGL and OSMesa:
   where n.l <= 0;
 - the exact limits in the twin: e = (nu + nv)/2 at h = n, no underflow of (h.t)^2 for h.t ~ 1e-200,
   ``(n.h)^e = 1`` at the peak, the peak response ``C F(v.h)/(n.l)``, and F = rho_s at l = v; the GLSL
-  helpers on the GPU (`glphong.checks.probe`): the exponent (4 eps, also with h.t = 1e-20, whose square
+  helpers on the GPU (`glphong.testing.probe`): the exponent (4 eps, also with h.t = 1e-20, whose square
   underflows float32, and at h.t = h.b = 0), ``1 - (1 - c/2)^5`` (4 eps down to c = 1e-37, 0 for
   c <= 0, 31/32 for a cosine above 1) and the normalisation (4 eps);
 - reciprocity (the model claims it): ``f_r(l, v) = f_r(v, l)`` over about 1000 pairs (random and near
@@ -233,11 +233,11 @@ def test_peak_exponent_and_fresnel_limits():
 
 
 def test_glsl_helpers_against_closed_forms(glphong_context):
-    """The chunk's pure helpers on the GPU (`glphong.checks.probe`): the exponent is the weighted mean of nu and
+    """The chunk's pure helpers on the GPU (`glphong.testing.probe`): the exponent is the weighted mean of nu and
     nv to 4 eps, also where (h.t)^2 would underflow and at h.t = h.b = 0 ((nu + nv)/2); the diffuse factor
     ``1 - (1 - c/2)^5`` is good to 4 eps relative down to c = 1e-37 (no cancellation), 0 for c <= 0 and
     ``31/32`` for a cosine that rounds above 1; the normalisation to 4 eps for exponents up to 1e6."""
-    from glphong.checks import probe
+    from glphong.testing import probe
 
     # (1e-20)^2 underflows float32: the helper scales by max(|h.t|, |h.b|) first
     h_t = np.float32([0.0, 0.0, 1e-30, 1e-20, 3e-20, 0.1, 0.6, 1e-3, -0.2])

@@ -3,7 +3,7 @@
 
 What is tested, on both backends where a GPU is involved (fixture ``glphong_backend``):
 
-- ``fresnel_schlick`` and ``fresnel_dielectric`` on the GPU (`glphong.checks.probe`) and in the twin against
+- ``fresnel_schlick`` and ``fresnel_dielectric`` on the GPU (`glphong.testing.probe`) and in the twin against
   independent float64 formulas written here: Schlick's polynomial, and for the dielectric the
   polarised Fresnel equations through Snell's law, ``F = (R_s + R_p) / 2``, ``R_s = ((cos i - n cos t) /
   (cos i + n cos t))^2``, ``R_p = ((n cos i - cos t) / (n cos i + cos t))^2`` (not the g-form the GLSL uses),
@@ -31,7 +31,7 @@ import pytest
 
 import glphong
 from glphong import reference
-from glphong.checks import probe
+from glphong.testing import probe
 from glphong.shaders.key import program_key, uber_key
 from glphong.materials import BlinnLobe, DielectricFresnel, PhongLobe, SchlickFresnel
 from glphong.shaders.assembly import assemble

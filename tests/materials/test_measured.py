@@ -111,12 +111,14 @@ def test_the_band_catches_a_wrong_bin(glphong_backend, tabulated):
 
 def _assert_in_band(material, wi, wo, gpu):
     """`assert_twin_matches`' judgement on given GPU values (the tool's check, at these pairs)."""
-    from glphong.testing import _inputs, _twin, response_key
+    from glphong.shaders.builders import response_key
+    from glphong.evaluation.response import response_inputs, twin_response
     from glphong.checks.tolerances import BAND, EPS
 
-    wi, wo, normal, tangent, uv = _inputs(material, wi, wo, (0.0, 0.0, 1.0), (1.0, 0.0, 0.0), None)
+    wi, wo, normal, tangent, uv = response_inputs(material, wi, wo)
     key = response_key(material)
-    twin, f, wi64, wo64, n_dot_l, u = _twin(material, key, material.uniform_values(key), wi, wo, normal, tangent, uv)
+    twin, f, wi64, wo64, n_dot_l, u = twin_response(material, key, material.uniform_values(key), wi, wo, normal, tangent,
+                                                    uv)
     low, high = material.band(f, wi64, wo64, n_dot_l, material.values(), BAND)
     bad = np.any((gpu < low) | (gpu > high), axis=1) & (n_dot_l > BAND.D * EPS)
     if bad.any():

@@ -49,7 +49,7 @@ import pytest
 
 import glphong
 import glphong.primitives
-from glphong.checks import probe
+from glphong.testing import probe
 from glphong.materials import (DielectricFresnel, Diffuse, NormalizedBlinnLobe, NormalizedBlinnPhong,
                                NormalizedPhong, NormalizedPhongLobe, SchlickFresnel, ShadingFrame)
 from glphong.materials.normalized import normalized_blinn_lobe_norm

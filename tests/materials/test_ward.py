@@ -36,7 +36,7 @@ stability cases are in tests/test_conformance.py), with the toolkit of `glphong.
   t as along b (second moments of the bright pixels' world positions from the G-buffer; asserted > 2),
   the inverse (0.20) with the alphas swapped, the same with the tangent turned to +y (the stretch
   follows t, not the image), and 1.000 for equal alphas;
-- the GLSL helpers ``ward_half`` and ``ward_exponent`` (`glphong.checks.probe`) against their twins on seeded
+- the GLSL helpers ``ward_half`` and ``ward_exponent`` (`glphong.testing.probe`) against their twins on seeded
   and edge inputs (l = -v, |l + v| either side of 2^-20, h.n = 0, 1e-20, 1e-10, < 0): the exponent to
   1e-6 (measured 2.1e-7), capped at WARD_EXPONENT_MAX, never Inf;
 - renders through ``glphong_renderer`` passing `assert_render_matches`: the built-in sphere
@@ -55,7 +55,7 @@ import trimesh
 
 import glphong
 import glphong.primitives
-from glphong.checks import probe
+from glphong.testing import probe
 from glphong.scene.geometry import MeshData
 from glphong.materials import Diffuse, Properties, ShadingFrame, Ward, WardLobe, ward
 from glphong.checks.stability import cases_for, run_stability
@@ -192,7 +192,7 @@ def test_gates_give_exactly_zero(glphong_backend):
 
 
 def test_glsl_helpers_against_their_twins(glphong_context):
-    """ward_half and ward_exponent (glphong.checks.probe) against the twin functions of the same names on
+    """ward_half and ward_exponent (glphong.testing.probe) against the twin functions of the same names on
     seeded inputs and the edges: l = -v, |l + v| at the floor, h.n = 0, 1e-20, 1e-10, negative (rounding)."""
     rng = np.random.default_rng(11)
     wi, wo, _ = direction_sets(300, 4)
