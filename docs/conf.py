@@ -6,8 +6,11 @@ Build (warnings are errors, as in ``tests/test_docs.py``)::
     sphinx-build -W --keep-going -b html docs docs/_build/html
 
 The pages are Markdown (MyST) beside this file; the API reference is generated from the package's
-numpydoc docstrings (``api/``); the gallery is sphinx-gallery over ``examples/`` (``auto_examples/``).
+numpydoc docstrings (``api/``); one page per reflectance model and light kind is written from its definition
+(``_definitions.py``, into ``definitions/``); the gallery is sphinx-gallery over ``examples/`` (``auto_examples/``).
 """
+import importlib.util
+import inspect
 import re
 import sys
 from pathlib import Path
@@ -16,6 +19,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))  # _gallery: the gallery's helpers, named by string (picklable configuration)
 
 import glphong  # noqa: E402  (the installed package: pip install -e . or pip install .)
+import _definitions  # noqa: E402  (the pages written from the definitions, definitions/)
 
 project = "glphong"
 author = "glphong authors"
@@ -79,15 +83,20 @@ myst_heading_anchors = 3
 myst_enable_extensions = ["colon_fence"]
 
 # --- the gallery -----------------------------------------------------------------------------------------------
-# Executed in the build (measured on 2 cores, llvmpipe): phong_examples.py 5.5 s, tutorial.py 3.5 s,
-# textured_scene.py 1.3 s, fresnel_grazing.py 0.1 s (the whole build from clean: 40 s).  Shown un-run:
-# batch_turntable.py (spawns worker processes), pyrender_scene.py and custom_material.py (import pyrender,
-# which fixes PyOpenGL's platform for the whole build), model_scene.py (ends with sys.exit, which would end
-# the build).  _gallery.py gives the executed scripts their output paths and embeds the PNG files they write.
+# Every example runs in the build and shows what it makes (measured on 2 cores, llvmpipe: the gallery 79 s, of which
+# continuous_version.py 65 s, batch_turntable.py 4.3 s, phong_examples.py 4.3 s, pyrender_scene.py 1.4 s, the rest
+# under 1 s each).  An example whose optional dependency is not installed (pyrender: pyrender_scene.py and
+# custom_material.py; hypothesis: test_my_shader.py) is shown un-run, with its reason in the build log.
+# _gallery.py gives the executed scripts their output paths, sets __file__, drops the API pages' stand-in modules
+# before each one, and embeds the PNG files (and .npy frames) they write.
+_NEEDS = {"pyrender": ("pyrender_scene", "custom_material"), "hypothesis": ("test_my_shader",)}
+_UNRUN = sorted(name for module, names in _NEEDS.items() if importlib.util.find_spec(module) is None for name in names)
+for _module in sorted(m for m, names in _NEEDS.items() if set(names) & set(_UNRUN)):
+    print(f"docs/conf.py: {_module} is not installed: {', '.join(_NEEDS[_module])} shown un-run")
 sphinx_gallery_conf = {
     "examples_dirs": [str(HERE.parent / "examples")],
     "gallery_dirs": ["auto_examples"],
-    "filename_pattern": r"[\\/](tutorial|phong_examples|textured_scene|fresnel_grazing|custom_light)\.py$",
+    "filename_pattern": (r"[\\/](?!(" + "|".join(_UNRUN) + r")\.py$)[^\\/]+\.py$") if _UNRUN else r"[\\/][^\\/]+\.py$",
     "ignore_pattern": r"__init__\.py",
     "within_subsection_order": "_gallery.order",
     "image_scrapers": ("matplotlib", "_gallery.png_scraper"),
@@ -177,6 +186,16 @@ def _keep_unknown_sections(app, what, name, obj, options, lines):
     lines[:] = out
 
 
+def _no_type_docstring(app, what, name, obj, options, lines):
+    """A value (``glphong.__version__``, ``glphong.radiometry.PLANCK``) has no docstring of its own and no ``#:``
+    comment where it is defined: autodoc would show its type's (``str``'s, ``float``'s) as if it were its own."""
+    own = inspect.getdoc(type(obj))
+    if what in ("data", "attribute") and own and "\n".join(lines).strip() == own.strip():
+        lines[:] = []
+
+
 def setup(app):
+    app.connect("builder-inited", _definitions.builder_inited)
     app.connect("source-read", _title_examples)
     app.connect("autodoc-process-docstring", _keep_unknown_sections, priority=400)  # before numpydoc (500)
+    app.connect("autodoc-process-docstring", _no_type_docstring, priority=400)

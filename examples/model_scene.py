@@ -68,4 +68,5 @@ def main(model_path=HERE / "data" / "torus.obj", out="model_scene.png"):
 
 
 if __name__ == "__main__":
-    sys.exit(0 if main(*sys.argv[1:]) else 1)
+    if not main(*sys.argv[1:]):
+        sys.exit(1)  # the cross-check failed
