@@ -40,8 +40,8 @@ def _ids(kind):
 
 def test_every_built_in_kind_is_held():
     """The harness sees the kinds by being defined, in the shader's loop order."""
-    assert [k.name for k in KINDS] == BUILT_IN_ORDER
-    assert [k.name for k in registered_lights()][:len(KINDS)] == BUILT_IN_ORDER
+    assert [k.name for k in KINDS][:len(BUILT_IN_ORDER)] == BUILT_IN_ORDER
+    assert [k.name for k in registered_lights()][:len(BUILT_IN_ORDER)] == BUILT_IN_ORDER
 
 
 @pytest.mark.parametrize("kind", KINDS, ids=_ids)
