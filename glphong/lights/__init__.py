@@ -6,9 +6,7 @@ the shader's loop over each present kind is generated (`glphong.shaders.generate
 Every module of this package is discovered and imported, so a new kind is one file here (with its GLSL and its
 tests: the conformance harness tests/lights/test_light_conformance.py holds every registered kind).
 """
-import importlib as _importlib
-import pkgutil as _pkgutil
-
+from glphong.definitions.discovery import import_definitions
 from glphong.definitions.light import (LightDefinitionError, LightModel, light_cases, light_for_key, light_named,
                                        pose_pointing, registered_lights)
 
@@ -17,10 +15,4 @@ __all__ = ["LightModel", "LightDefinitionError", "registered_lights", "light_nam
 
 # every module of this package defines kinds (or a family's base, `ExtendedLight`, or the ambient light): importing
 # it registers its kinds, and the light classes it exports are this package's
-for _info in sorted(_pkgutil.iter_modules(__path__), key=lambda info: info.name):
-    _module = _importlib.import_module(f"{__name__}.{_info.name}")
-    for _name in _module.__all__:
-        if isinstance(getattr(_module, _name), type):
-            globals()[_name] = getattr(_module, _name)
-            __all__.append(_name)
-del _info, _module, _name
+import_definitions(__name__, __path__, globals(), __all__)

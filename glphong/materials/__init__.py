@@ -29,9 +29,7 @@ models (`Phong`, `BlinnPhong`, the normalised ones, `CookTorrance`); each model 
 ``ka`` is a constant radiance [W/(m^2 sr)].  Define your own with `MaterialModel`, `Param`, `Table`, `Choice`
 and `FresnelSlot` (see README, "Write your own material").
 """
-import importlib as _importlib
-import pkgutil as _pkgutil
-
+from glphong.definitions.discovery import import_definitions
 from glphong.definitions.material import Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues, Properties, ShadingFrame, model_named, registered_models
 from glphong.definitions.surface import AlphaMask, NormalMap, SurfaceInput, Texture, TextureImage, VertexColors
 from glphong.definitions.table import Table, TableData
@@ -47,10 +45,4 @@ __all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "Table
 # every module of this package is one model (the mechanism is glphong.definitions): importing it registers the
 # model, and the material classes it exports are this package's, so a new model is one file here (with its GLSL
 # and its tests); its twin functions stay in its module (and are found by glphong.reference)
-for _info in sorted(_pkgutil.iter_modules(__path__), key=lambda info: info.name):
-    _module = _importlib.import_module(f"{__name__}.{_info.name}")
-    for _name in _module.__all__:
-        if isinstance(getattr(_module, _name), type):
-            globals()[_name] = getattr(_module, _name)
-            __all__.append(_name)
-del _info, _module, _name
+import_definitions(__name__, __path__, globals(), __all__)
