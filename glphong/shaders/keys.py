@@ -11,6 +11,7 @@ of the source.  Nothing here knows any model by name; the numpy twin reads the s
 """
 from dataclasses import dataclass
 
+from glphong.core.glsl_files import library_chunks
 from glphong.shaders.defines import program_defines
 from glphong.shaders.generated import LIGHTS_CHUNK, LOD_CHUNK, MATERIAL_CHUNK, lights_chunk, lod_chunk, material_chunk
 from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, NUMERICS_PIECES, OUTPUTS, SHADOW_PASSES
@@ -308,6 +309,12 @@ class ProgramKey:
     def light_library_chunks(self):
         """Library chunks the light kinds use and the terms do not, in first-use order."""
         return tuple(c for c in dict.fromkeys(c for k in self.lights for c in k.uses) if c not in self.library_chunks())
+
+    def included_library(self):
+        """Every library chunk the terms and light kinds use, in the library's one include order
+        (`glphong.core.glsl_files.LIBRARY`: a chunk after those it calls, whichever term or kind asked first)."""
+        used = set(self.library_chunks() + self.light_library_chunks())
+        return tuple(c for c in library_chunks() if c in used)
 
     def shading_chunks(self):
         """Chunks that define ``shade_point()`` and what it calls: only those the key needs

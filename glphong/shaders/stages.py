@@ -60,16 +60,15 @@ def _textured_alpha(key):
     return key.alpha_mask == 2
 
 
-LIGHT_LIBRARY = Slot("library chunks the light kinds call (and the terms do not)", lambda key: key.light_library_chunks())
-TERM_LIBRARY = Slot("library chunks the terms call", lambda key: key.library_chunks())
+LIBRARY = Slot("library chunks the terms and light kinds call, in the library's include order",
+               lambda key: key.included_library())
 TERMS = Slot("each term's model GLSL", lambda key: [t.chunk for t in key.terms])
 LIGHT_KINDS = Slot("each light kind's GLSL", lambda key: [k.chunk for k in key.lights])
 
 #: the chunks that define shade_point() and what it calls
 SHADING = (
     "common",
-    LIGHT_LIBRARY,
-    TERM_LIBRARY,
+    LIBRARY,
     ("surface", _reads_surface),
     ("normal_map", _normal_map),
     TERMS,
@@ -89,7 +88,7 @@ STAGES = {
                 "fragment": ("common", ("surface", _gbuffer_reads_surface), ("normal_map", _normal_map),
                              (LOD_CHUNK, _writes_lod), "mesh_fragment")},
     "points": {"vertex": SHADING + ("shade_points",), "fragment": ()},
-    "response": {"vertex": ("common", TERM_LIBRARY, TERMS, MATERIAL_CHUNK, "response_points"), "fragment": ()},
+    "response": {"vertex": ("common", LIBRARY, TERMS, MATERIAL_CHUNK, "response_points"), "fragment": ()},
     "shadow": {"vertex": ("mesh_vertex",), "fragment": ("common", "shadow_fragment")},
 }
 
