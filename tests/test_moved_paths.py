@@ -5,10 +5,14 @@ import happens once per process.
 """
 import subprocess
 import sys
+import warnings
 
+import numpy as np
 import pytest
 
+import glphong
 from glphong import _moved
+from glphong.shaders.binding import binding
 
 CHECK = r"""
 import importlib, sys, warnings
@@ -107,13 +111,6 @@ def test_every_moved_target_exists():
 def test_scene_binding_methods_answer_through_the_binding_with_a_warning():
     """The program-binding methods ``Scene`` had (``scene.program_key(obj)``, ``scene.uniform_values(...)``, ...)
     answer for one release through `glphong.shaders.binding`, each call warning with the new place."""
-    import warnings
-
-    import numpy as np
-
-    import glphong
-    from glphong.shaders.binding import binding
-
     scene = glphong.Scene(glphong.PerspectiveCamera.look_at((0, 0, 3), (0, 0, 0)),
                           lights=[glphong.PointLight((2, 2, 2), 100.0)], ambient=glphong.AmbientLight(0.1))
     scene.add(glphong.primitives.sphere(1), glphong.Phong(0.2, 0.5, 10.0))

@@ -31,10 +31,13 @@ against the render, `scaling_fits` fitted costs per object, per pixel and light,
 """
 import io
 import math
+import os
 import statistics
+import tempfile
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
+from PIL import Image
 
 from glphong.scene import primitives
 from glphong.scene.camera import PerspectiveCamera
@@ -285,11 +288,6 @@ def png_cost(width=640, height=480, repeats=9, scene=None, backend="egl"):
         comparison); ``ratio`` (save / render), ``size`` (``'WxH'``) and the file sizes ``png_bytes`` (glphong's)
         and ``pillow_bytes``.
     """
-    from PIL import Image
-
-    import os
-    import tempfile
-
     scene = speed_scenes(quick=True)["sphere"] if scene is None else scene
     with Renderer(width, height, backend=backend) as renderer, tempfile.TemporaryDirectory() as folder:
         frame = renderer.render(scene)

@@ -59,7 +59,6 @@ class Definition:
                 f"{cls.__qualname__}: the {cls.definition_kind} name {cls.name!r} is taken by "
                 f"{'the built-in ' if is_builtin(taken) else ''}{taken.__module__}.{taken.__qualname__}; "
                 "choose another name")
-        cls.registry.forget_source(cls)
         cls.check_definition()
         cls.registry.add(cls)  # a re-run of the same definition (a notebook cell) replaces it
 

@@ -21,6 +21,7 @@ structural defines in ``p.defines``).  Like the GLSL, the twin reads nothing but
 The built-in kinds (`glphong.lights.PointLight`, `UnattenuatedPointLight`, `DirectionalLight`,
 `SpotLight`) are defined exactly this way.  A definition is checked when its class is created.
 """
+import functools
 import re
 from dataclasses import dataclass
 
@@ -450,17 +451,12 @@ def sensitivity_band(evaluate, x, p, params, constants, directions=()):
 
 
 # --------------------------------------------------------------------------- definition-time checks
-_CASE_MATERIAL = {}
-
-
+@functools.cache
 def _lecture_phong():
     """The lecture's Phong, ``Lambert + PhongLobe``, as a `MaterialSum` of the registered models 'lambert' and
-    'phong_lobe' (the same terms as `glphong.Phong`; made once)."""
-    found = _CASE_MATERIAL.get("phong")
-    if found is None:
-        terms = (MATERIALS.named("lambert"), MATERIALS.named("phong_lobe"))
-        found = _CASE_MATERIAL["phong"] = type("Phong", (MaterialSum,), {"terms": terms, "__module__": __name__})
-    return found
+    'phong_lobe' (the same terms as `glphong.Phong`, which lives in a layer above this one; made once)."""
+    terms = (MATERIALS.named("lambert"), MATERIALS.named("phong_lobe"))
+    return type("Phong", (MaterialSum,), {"terms": terms, "__module__": __name__})
 
 
 def light_cases(light):

@@ -85,10 +85,6 @@ class Registry:
             self._by_hash[(cls.name, digest)] = cls
         return cached
 
-    def forget_source(self, cls):
-        """Drop ``cls``'s cached source (read again when the class is checked)."""
-        self._sources.pop(cls, None)
-
     def for_key(self, name, source_hash):
         """The definition a program key's entry was made from (by name and source hash): a class redefined since
         (a re-run notebook cell) still builds its own programs."""

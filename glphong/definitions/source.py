@@ -27,14 +27,14 @@ def resolve_source(cls):
     """``(text, label, first_line)`` of a definition's GLSL (a material model's, a light kind's): label names
     the file or the class, and ``first_line`` is the line of the text's first line in that file (1 for .glsl
     files).  Errors are the definition's own class (``cls.definition_error``)."""
-    MaterialDefinitionError = getattr(cls, "definition_error", DefinitionError)  # noqa: N806
+    error = getattr(cls, "definition_error", DefinitionError)
     glsl = cls.__dict__.get("glsl", cls.glsl)
     if isinstance(glsl, GlslFile):
         path = glsl_root().joinpath(*glsl.path.split("/"))  # a Traversable: one part at a time
         try:
             return path.read_text(encoding="utf-8"), glsl.path, 1
         except OSError as exc:
-            raise MaterialDefinitionError(
+            raise error(
                 f"{cls.__qualname__}: cannot read its GLSL {glsl.path!r} from the shader folder {glsl_root()} "
                 f"({exc.strerror}); GLPHONG_GLSL_DIR, when set, must name a full copy of glphong's glsl/ folder, "
                 "and be set before glphong is imported") from None
@@ -45,10 +45,10 @@ def resolve_source(cls):
             base = Path(getattr(module, "__file__", None) or ".").resolve().parent
             path = base / path
         if not path.is_file():
-            raise MaterialDefinitionError(f"{cls.__qualname__}.glsl names the file {str(path)!r}, which does not exist")
+            raise error(f"{cls.__qualname__}.glsl names the file {str(path)!r}, which does not exist")
         return path.read_text(encoding="utf-8"), str(path), 1
     if not isinstance(glsl, str):
-        raise MaterialDefinitionError(f"{cls.__qualname__}.glsl must be GLSL source text or the path of a .glsl file "
+        raise error(f"{cls.__qualname__}.glsl must be GLSL source text or the path of a .glsl file "
                                       f"(got {type(glsl).__name__})")
     label, first = f"{cls.__qualname__}.glsl ({getattr(cls, 'definition_kind', 'material')} {cls.__dict__.get('name', cls.name)!r})", 1
     try:  # where the inline string starts in the Python file, so compile errors name that file and line

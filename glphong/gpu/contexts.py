@@ -24,11 +24,11 @@ import threading
 
 import moderngl
 
-from glphong.gpu.drivers import (  # noqa: F401 - the drivers' names stay importable from here
-    _GL_UNSIGNED_BYTE, _OSMESA_CONTEXT_MAJOR_VERSION, _OSMESA_CONTEXT_MINOR_VERSION, _OSMESA_CORE_PROFILE,
+from glphong.gpu.drivers import (  # noqa: F401 - egl_device_count stays importable from here
+    _OSMESA_CONTEXT_MAJOR_VERSION, _OSMESA_CONTEXT_MINOR_VERSION, _OSMESA_CORE_PROFILE,
     _OSMESA_DEPTH_BITS, _OSMESA_FORMAT, _OSMESA_PROFILE, _OSMESA_RGBA, _OSMESA_VERSIONS, _egl_current_context,
     _osmesa_library, _OSMesaLoader, egl_device_count)
-from glphong.gpu.foreign import _CurrentContextLoader, attach_current, release_offscreen  # noqa: F401 - as above
+from glphong.gpu.foreign import attach_current, release_offscreen  # noqa: F401 - public names of this module
 
 __all__ = [
     "BACKENDS",

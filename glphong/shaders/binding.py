@@ -186,9 +186,10 @@ class SceneBinding:
         scene = self.scene
         obj = scene.objects[index]
         spec = self.program_key(obj, key.output)
-        if max(scene.light_counts().values(), default=0) > UBER_MAX_LIGHTS:
+        counts = {k.name: k.count for k in self.light_keys()}  # cached per state, not recounted per object
+        if max(counts.values(), default=0) > UBER_MAX_LIGHTS:
             raise ValueError(f"the uber-shader takes at most {UBER_MAX_LIGHTS} lights of each kind "
-                             f"(scene has {scene.light_counts()})")
+                             f"(scene has {counts})")
         values = self.uniform_values(index, spec, aspect)
         values["u_normal_matrix"] = np.asarray(obj.normal_matrix, dtype=np.float32)
         if key.needs_view:

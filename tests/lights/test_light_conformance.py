@@ -27,6 +27,9 @@ import glphong
 import glphong.lights
 from glphong import primitives
 from glphong.checks.stability import run_stability
+from glphong.core.glsl_files import library_chunks
+from glphong.materials import registered_models
+from glphong.shaders.builders import program_key
 from glphong.lights import light_cases, registered_lights
 from glphong.testing import assert_light_matches
 
@@ -111,10 +114,6 @@ def test_every_model_under_every_kind_includes_the_library_in_its_order():
     """A program's library chunks follow `glphong.core.glsl_files.LIBRARY` whichever term or kind asked first (a
     term that calls angle.glsl under a kind that calls area.glsl, which calls angle.glsl, failed to compile when the
     kind's chunks came first)."""
-    from glphong.core.glsl_files import library_chunks
-    from glphong.materials import registered_models
-    from glphong.shaders.builders import program_key
-
     order = library_chunks()
     checked = 0
     for model in registered_models():
