@@ -354,6 +354,9 @@ def _try_create(backend, require, device=0):
     The context current before the call stays current if it was entered.
     """
     check_not_forked()
+    stack = _entered_stack()
+    if stack:  # the entered context's queued work completes before another context takes the GL dispatch, which
+        stack[-1].mgl.finish()  # EGL and OSMesa share through libglapi (a clear was once lost: test_contexts)
     reused = _reuse(backend, require, device)
     while reused is not None:
         try:
