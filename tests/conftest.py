@@ -76,6 +76,15 @@ def session_gl(request):
     ctx.release()
 
 
+@pytest.fixture(scope="session")
+def stability_expectations():
+    """One `glphong.checks.stability.CaseExpectations` per test process: the suite's twins, bands and oracles,
+    computed once for every run that passes it (both backends, the stable, naive and auto formulations)."""
+    from glphong.checks.stability import CaseExpectations
+
+    return CaseExpectations()
+
+
 def _isolated_runner(code, timeout=120, memory_bytes=3 << 30, cwd=None, args=()):
     """Run Python ``code`` in a fresh interpreter with an address-space limit and a timeout (see
     `run_isolated`); returns the ``subprocess.CompletedProcess`` (``returncode`` -9 after the timeout)."""

@@ -192,9 +192,9 @@ def test_normal_range_bound_is_a_lower_bound():
     assert 0 < low <= shortest ** 2 and high == pytest.approx(np.max(np.linalg.norm(normals, axis=1)))
 
 
-def test_stability_suite_in_auto_mode(session_gl):
+def test_stability_suite_in_auto_mode(session_gl, stability_expectations):
     """Every case passes with the pieces auto specialises for it; the cases beyond a bound take the stable path."""
-    report = run_stability(context=session_gl, numerics="auto")
+    report = run_stability(context=session_gl, numerics="auto", expectations=stability_expectations)
     failed = [r.case for r in report.rows if not r.passed]
     assert failed == [] and report.nan_count == 0 and report.inf_count == 0, report.format_table()
     assert len(report.rows) == len(CASES) and any(r.numerics for r in report.rows)

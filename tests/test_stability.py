@@ -64,13 +64,8 @@ def test_float64_twin_agrees_with_the_mpmath_oracle():
     assert checked > 80
 
 
-@pytest.fixture(scope="module")
-def stable_reports(session_gl):
-    return run_stability(context=session_gl)
-
-
-def test_stable_formulation_passes_every_case(session_gl):
-    report = run_stability(context=session_gl)
+def test_stable_formulation_passes_every_case(session_gl, stability_expectations):
+    report = run_stability(context=session_gl, expectations=stability_expectations)
     failed = [r.case for r in report.rows if not r.passed]
     assert failed == [], report.format_table()
     assert report.nan_count == 0 and report.inf_count == 0
@@ -87,12 +82,16 @@ WIRED = {"ks": ("u_phong_lobe_ks", "u_blinn_lobe_ks"), "q": ("u_phong_lobe_q", "
 
 
 @pytest.mark.parametrize("uniform", list(WIRED))
-def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, uniform):
+def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, uniform, stability_expectations):
     """Pass/fail is judged against the oracle, which reads the constructors: a uniform uploaded 1% off
-    (the twin and the band, reading the same uniforms, would follow it) fails its cases."""
+    (the twin and the band, reading the same uniforms, would follow it) fails its cases, also where the
+    expectations of the rightly wired cases are already kept (`CaseExpectations` digests the uniforms)."""
     from glphong.checks import stability
 
     original = stability.case_inputs
+    cases = [c for c in CASES if c.name in ("phong q=1000 near", "blinn q=1 peak", "phong q=1 peak",
+                                            "lambert grazing light n.l=0.01", "blinn q=1000 near")]
+    assert run_stability(context=session_gl, cases=cases, expectations=stability_expectations).passed_count == 5
 
     def miswired(case, scene=None):
         key, uniforms = original(case, scene)
@@ -102,9 +101,7 @@ def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, unif
         return key, uniforms
 
     monkeypatch.setattr(stability, "case_inputs", miswired)
-    cases = [c for c in CASES if c.name in ("phong q=1000 near", "blinn q=1 peak", "phong q=1 peak",
-                                            "lambert grazing light n.l=0.01", "blinn q=1000 near")]
-    report = run_stability(context=session_gl, cases=cases)
+    report = run_stability(context=session_gl, cases=cases, expectations=stability_expectations)
     rows = {r.case: r for r in report.rows}
     assert len(rows) == 5
     affected = {"ks": ["phong q=1000 near", "blinn q=1000 near", "phong q=1 peak", "blinn q=1 peak"],
@@ -114,8 +111,22 @@ def test_stability_catches_a_wrongly_wired_uniform(session_gl, monkeypatch, unif
     assert affected and all(not rows[name].passed for name in affected), report.format_table()
 
 
-def test_naive_formulation_fails_where_the_design_says(session_gl):
-    report = run_stability(context=session_gl, formulation="naive")
+def test_kept_expectations_give_the_rows_of_a_fresh_run(session_gl):
+    """A run served from `CaseExpectations` filled by another formulation's run has the rows of a run that computes
+    its own, and the kept entries are the cases' (one per case)."""
+    from glphong.checks.stability import CaseExpectations
+
+    cases = [c for c in CASES if c.group in ("lobe", "light rect")][:12]
+    kept = CaseExpectations()
+    run_stability(context=session_gl, cases=cases, formulation="naive", expectations=kept)
+    assert len(kept) == len(cases)
+    served = run_stability(context=session_gl, cases=cases, expectations=kept)
+    assert len(kept) == len(cases)
+    assert served.rows == run_stability(context=session_gl, cases=cases).rows
+
+
+def test_naive_formulation_fails_where_the_design_says(session_gl, stability_expectations):
+    report = run_stability(context=session_gl, formulation="naive", expectations=stability_expectations)
     rows = {r.case: r for r in report.rows}
     assert not rows["phong q=1e+07 near"].passed  # pow(dot(v, r), q) overshoots
     assert not rows["blinn q=1e+06 peak"].passed

@@ -15,6 +15,7 @@ Valid ranges (`VALID_RANGES`): inside them the GPU result equals the textbook va
 the band.  Outside them it is still never NaN from finite input: results below FLT_MIN flush
 to 0, irradiance beyond FLT_MAX saturates at FLT_MAX, and sums beyond FLT_MAX become +Inf.
 """
+import hashlib
 import json
 from dataclasses import asdict, dataclass, field, replace
 
@@ -39,7 +40,8 @@ from glphong.shaders.keys import ProgramKey, TermKey
 from glphong.shaders.options import NUMERICS_PIECES
 from glphong.shaders.binding import binding
 
-__all__ = ["Case", "CASES", "case_scene", "case_inputs", "generic_cases", "lobe_cases", "cases_for", "VALID_RANGES", "oracle", "StabilityRow", "StabilityReport", "run_stability", "case_numerics"]
+__all__ = ["Case", "CASES", "case_scene", "case_inputs", "generic_cases", "lobe_cases", "cases_for", "VALID_RANGES", "oracle", "StabilityRow", "StabilityReport", "run_stability", "case_numerics",
+           "CaseExpectations", "case_expectation"]
 
 #: documented ranges inside which the GPU equals the textbook model within the tolerance band
 VALID_RANGES = {
@@ -360,7 +362,66 @@ def case_numerics(case, scene=None):
     return numerics_pieces(scene, scene.objects[0], tuple(p for p in NUMERICS_PIECES if p != "normal"))
 
 
-def run_stability(backend="auto", formulation="stable", cases=CASES, context=None, numerics="stable"):
+class CaseExpectations:
+    """The CPU side of the suite, kept for several runs: each case's float64 twin, tolerance band and oracle.
+
+    They read the case and the uniforms its program is given, never the backend, the formulation or the
+    numerics pieces, so runs on two backends, or of the stable, naive and auto formulations, may share one
+    instance (pass it as ``run_stability(..., expectations=...)``) and compute them once: that is nine tenths of
+    a run's time.  An entry is found by a digest of the case's name and validity, its program key (the model's and
+    kinds' source hashes included) and its uniforms (names, dtypes, shapes and bytes): a uniform wired or a model
+    written differently is computed afresh, never served from an earlier run.
+    """
+
+    def __init__(self):
+        self._memo = {}
+
+    def __len__(self):
+        return len(self._memo)
+
+    def of(self, case, scene, key, uniforms):
+        """``(twin, low, high, expected)`` of ``case``, each (3,) float64: `case_expectation`, once per case and
+        uniforms."""
+        digest = hashlib.sha256(f"{case.name}|{case.in_range}|{key!r}".encode())
+        for name in sorted(uniforms):
+            value = np.ascontiguousarray(uniforms[name])
+            digest.update(f"{name}{value.dtype}{value.shape}".encode())
+            digest.update(value.tobytes())
+        entry = digest.hexdigest()
+        if entry not in self._memo:
+            self._memo[entry] = case_expectation(case, scene, key, uniforms)
+        return self._memo[entry]
+
+
+def case_expectation(case, scene, key, uniforms):
+    """The CPU side of one case: ``(twin, low, high, expected)``, each (3,) float64.
+
+    ``twin`` is the float64 mirror of the GLSL at the case's point, ``low`` and ``high`` the band the GPU must lie in,
+    ``expected`` the oracle's value.  Inside the valid range the band's widths are moved onto the oracle: the twin and
+    the band read the uniforms, the oracle the constructors, so a wrongly wired input shows (a band reaching 0 stays
+    at 0, or follows the oracle below it where the model may be negative).  Outside it, the documented float32
+    behaviour (flush, saturation), which the twin mirrors, within the band around it.
+    """
+    position = np.zeros((1, 3))
+    normal = np.asarray([case.normal], dtype=np.float32).astype(np.float64)
+    tangent = np.asarray([case.tangent], dtype=np.float32).astype(np.float64)
+    uv = np.asarray([case.uv], dtype=np.float32).astype(np.float64)
+    u64 = {k: v.astype(np.float64) for k, v in uniforms.items()}
+    n_valid, n, _ = ref.safe_normalize(normal)
+    frame = ref.shading_frame(n, tangent, uv, key)
+    twin = ref.shade_point(position, frame, n_valid, u64.get("u_eye"), key, u64, case.material)[0]
+    low, high = point_band(key, u64, position, frame, n_valid, case.material)
+    low, high = low[0], high[0]
+    expected = oracle(scene, case.normal, tangent=case.tangent, uv=case.uv)
+    if case.in_range:
+        shifted = expected - (twin - low)
+        low = np.where(low > 0, shifted, np.where(low < 0, np.minimum(0.0, shifted), 0.0))
+        high = expected + (high - twin)
+    return twin, low, high, expected
+
+
+def run_stability(backend="auto", formulation="stable", cases=CASES, context=None, numerics="stable",
+                  expectations=None):
     """Run the suite on a backend.
 
     Parameters
@@ -374,6 +435,8 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
     numerics : {'stable', 'auto'}
         With the stable formulation, 'auto' evaluates each case with the pieces ``Renderer(numerics='auto')``
         would specialise for it (`case_numerics`; each row lists them).
+    expectations : CaseExpectations, optional
+        The twins, bands and oracles of earlier runs, to share with this one (default: computed for this run).
 
     Returns
     -------
@@ -382,35 +445,19 @@ def run_stability(backend="auto", formulation="stable", cases=CASES, context=Non
 
     gl = context or create_context(backend)
     programs = ProgramCache(gl.mgl)
+    expectations = CaseExpectations() if expectations is None else expectations
     report = StabilityReport(gl.backend, gl.renderer_name, formulation, numerics=numerics)
     try:
         for case in cases:
             scene = case_scene(case)
             key, uniforms = case_inputs(case, scene)
+            twin, low, high, expected = expectations.of(case, scene, key, uniforms)
             pieces = case_numerics(case, scene) if numerics == "auto" and formulation == "stable" else ()
-            key = replace(key, formulation=formulation, numerics=pieces)
-            position = np.zeros((1, 3))
-            normal = np.asarray([case.normal], dtype=np.float32)
-            tangent = np.asarray([case.tangent], dtype=np.float32)
-            uv = np.asarray([case.uv], dtype=np.float32)
-            gpu = shade_points(gl, programs, key, uniforms, position, normal, tangents=tangent, uvs=uv,
+            gpu = shade_points(gl, programs, replace(key, formulation=formulation, numerics=pieces), uniforms,
+                               np.zeros((1, 3)), np.asarray([case.normal], dtype=np.float32),
+                               tangents=np.asarray([case.tangent], dtype=np.float32),
+                               uvs=np.asarray([case.uv], dtype=np.float32),
                                drop_unused=formulation == "naive")[0].astype(np.float64)
-            u64 = {k: v.astype(np.float64) for k, v in uniforms.items()}
-            n_valid, n, _ = ref.safe_normalize(normal.astype(np.float64))
-            frame = ref.shading_frame(n, tangent.astype(np.float64), uv.astype(np.float64), key)
-            twin = ref.shade_point(position, frame, n_valid, u64.get("u_eye"), key, u64, case.material)[0]
-            low, high = point_band(key, u64, position, frame, n_valid, case.material)
-            low, high = low[0], high[0]
-            expected = oracle(scene, case.normal, tangent=case.tangent, uv=case.uv)
-            if case.in_range:
-                # judged against the oracle, with the band's widths as the tolerance: the twin and the
-                # band read the uniforms, the oracle the constructors, so a wrongly wired input shows
-                # (a band reaching 0 stays at 0, or follows the oracle below it where the model may be negative)
-                shifted = expected - (twin - low)
-                low = np.where(low > 0, shifted, np.where(low < 0, np.minimum(0.0, shifted), 0.0))
-                high = expected + (high - twin)
-            # outside the valid range: the documented float32 behaviour (flush, saturation), which the
-            # twin mirrors, within the band around it
             finite_band = np.isfinite(high)
             ok = np.all((gpu >= low) & (gpu <= high)) and not np.any(np.isnan(gpu)) and \
                 np.all(np.isfinite(gpu[finite_band]))

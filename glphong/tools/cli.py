@@ -14,7 +14,7 @@ from glphong.analysis.gallery import render_gallery
 from glphong.analysis.questions import format_properties, properties
 from glphong.batch import BatchError, orbit_scene, render_many
 from glphong.bench import methods, quick_cases, run_bench, run_speed, standard_cases
-from glphong.checks.stability import CASES, run_stability
+from glphong.checks.stability import CASES, CaseExpectations, run_stability
 from glphong.checks.verify import verify
 from glphong.core.imaging import save_npy
 from glphong.core.version import __version__
@@ -175,9 +175,10 @@ def _stability(args):
     cases = list(CASES)
     for definition in _import_models(args.imports):
         cases += list(definition.stability_cases())
-    reports = [run_stability(args.backend, "stable", cases=cases, numerics=args.numerics)]
+    expectations = CaseExpectations()  # the twins, bands and oracles, once for both formulations
+    reports = [run_stability(args.backend, "stable", cases=cases, numerics=args.numerics, expectations=expectations)]
     if args.naive:
-        reports.append(run_stability(args.backend, "naive", cases=cases))
+        reports.append(run_stability(args.backend, "naive", cases=cases, expectations=expectations))
     if args.json:
         text = "[" + ",\n".join(r.to_json() for r in reports) + "]"
         if args.json == "-":
