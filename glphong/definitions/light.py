@@ -402,35 +402,53 @@ class LightModel(Definition):
         return None
 
 
-def sensitivity_band(evaluate, x, p, params, constants, directions=()):
+def sensitivity_band(evaluate, x, p, params, constants, directions=(), rows=1 << 16):
     """The generic band: ``evaluate(x, p, *directions)`` (N, 3) and its first-order sensitivity to its inputs, each
     perturbed by a few ulps as float32 arithmetic perturbs them, added worst-case (`LightModel.band`).
 
     ``x`` (N, 3) and every 'vec3' uniform of ``params`` are scaled componentwise by ``1 +- D eps`` (each entry of a
     uniform with several per light), every 'direction' uniform and each of ``directions`` ((N, 3) unit vectors: a
     normal, a reflected view) rotated by ``D eps`` about two axes, every scalar and rgb uniform scaled by
-    ``1 +- A eps``.  Returns ``(low, high)``, each (N, 3).
+    ``1 +- A eps``.  The moves of ``x`` and of the directions are stacked along the rows, up to ``rows`` rows to a
+    call of ``evaluate`` (a twin is row by row, so the values are the same as one call per move, and a light with
+    a normal and a reflected view costs one call for those 14 moves); the uniforms' moves, which the rows share, take
+    a call each.  Returns ``(low, high)``, each (N, 3).
     """
     base = np.asarray(evaluate(x, p, *directions), dtype=np.float64)
     up, down = np.zeros_like(base), np.zeros_like(base)
 
-    def add(x_, p_, dirs):
+    def spread(values):
         with np.errstate(all="ignore"):
-            delta = np.nan_to_num(np.asarray(evaluate(x_, p_, *dirs), dtype=np.float64) - base, nan=0.0)
+            delta = np.nan_to_num(values - base, nan=0.0)
         np.maximum(up, delta, out=up)
         np.minimum(down, delta, out=down)
 
+    def add(x_, p_, dirs):
+        with np.errstate(all="ignore"):
+            spread(np.asarray(evaluate(x_, p_, *dirs), dtype=np.float64))
+
     d = constants.D * EPS
+    moves = []  # (x, directions) of each move of the rows' own inputs
     for axis in range(3):
         for sign in (1.0, -1.0):
             moved = np.array(x, dtype=np.float64)
             moved[:, axis] *= 1.0 + sign * d
-            add(moved, p, directions)
+            moves.append((moved, directions))
     for i, v in enumerate(directions):
         for axis in perpendiculars(v):
             for s in (1, -1):
                 turned = v + s * d * axis
-                add(x, p, directions[:i] + (turned / np.linalg.norm(turned, axis=-1, keepdims=True),) + directions[i + 1:])
+                moves.append((x, directions[:i] + (turned / np.linalg.norm(turned, axis=-1, keepdims=True),) +
+                              directions[i + 1:]))
+    group = max(1, rows // max(len(base), 1))
+    for start in range(0, len(moves), group):
+        chunk = moves[start:start + group]
+        stacked = [np.concatenate([np.asarray(m[0], dtype=np.float64) for m in chunk])] + \
+            [np.concatenate([m[1][j] for m in chunk]) for j in range(len(directions))]
+        with np.errstate(all="ignore"):
+            values = np.asarray(evaluate(stacked[0], p, *stacked[1:]), dtype=np.float64)
+        for value in values.reshape((len(chunk),) + base.shape):
+            spread(value)
     for param in params:
         value = np.asarray(getattr(p, param.name), dtype=np.float64)
         variants = []
