@@ -13,7 +13,8 @@ The continuous version integrates over the incident light,
    sends straight down (the panel's midpoint rule).
 
 Each render is checked by ``glphong.verify``, whose second error map compares the shader's method with the exact
-integral (a float64 quadrature over the light): the panel's is at the quadrature's tolerance.  The sky's exact
+integral (a float64 quadrature over the light, or the closed forms in float64 where they are exact): the panel's
+is 0, its closed forms being exact.  The sky's exact
 integral costs about 40 ms a pixel, so its render is verified at ``verify_size`` (20 x 15 by default).  The soft shadow-less
 highlight of the panel against the sixteen sharp highlights of the point lights is the difference the lecture
 draws between the two versions.

@@ -200,3 +200,18 @@ def test_atan2_first_quadrant(session_gl):
     assert not np.isnan(gpu).any() and gpu[-6] == 0.0
     err = np.abs(gpu - want)
     assert np.all(err <= 4 * EPS * np.maximum(want, 2 ** -20)), float(np.max(err / np.maximum(want, 2 ** -20)) / EPS)
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_the_twins_dot_is_numpys_sum_to_the_bit(dtype):
+    """`glphong.twin.functions.dot` replaced ``np.sum(a * b, axis=-1)`` in every twin for speed: the same values to the
+    bit (the sum's order ``(a_0 b_0 + a_1 b_1) + a_2 b_2``), broadcasting and other lengths included."""
+    from glphong.twin.functions import dot
+
+    rng = np.random.default_rng(7)
+    a = (rng.normal(size=(5000, 4, 3)) * 10.0 ** rng.integers(-12, 12, size=(5000, 4, 3))).astype(dtype)
+    b = (rng.normal(size=(5000, 1, 3)) * 10.0 ** rng.integers(-12, 12, size=(5000, 1, 3))).astype(dtype)
+    for x, y in ((a, b), (a[:, 0], b[:, 0]), (a[0, 0], b[:, 0]), (a[..., :2], b[..., :2])):
+        got, want = dot(x, y), np.sum(x * y, axis=-1)
+        assert got.dtype == want.dtype and got.shape == want.shape
+        assert np.array_equal(got.view(np.uint8), want.view(np.uint8))

@@ -300,18 +300,8 @@ def extended_reflection(position, f, wo, lit, key, uniforms, material):
     terms = _terms(material)
     out = np.zeros_like(position)
     for light_key, twin, p, closed, sampled in extended_lights(key, uniforms, position.dtype):
-        reflected = np.zeros_like(position)
         with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-            if any(t.integral.form == "irradiance" for t in closed):
-                e = twin.irradiance(position, f.n, p)
-            for t in closed:
-                values = terms[t.name].values_from_uniforms(uniforms, dtype=position.dtype, inputs=f.inputs)
-                k = getattr(values, t.integral.scale) * occlusion_factor(t, values, light_key.occludable)
-                if t.integral.form == "irradiance":
-                    reflected = reflected + k * (np.float32(t.integral.factor).astype(position.dtype) * e)
-                else:
-                    q = float(getattr(values, t.integral.exponent))
-                    reflected = reflected + k * twin.lobe(position, f.n, view_reflected(f.n, wo), q, p)
+            reflected = closed_reflection(position, f, wo, closed, twin, p, light_key, uniforms, terms)
             for k in range(int(p.defines["MAX_SAMPLES"]) if sampled else 0):
                 valid, wi, irradiance = twin.sample(position, f.n, k, p)
                 n_dot_l = _dot(f.n, wi)
@@ -326,32 +316,66 @@ def extended_reflection(position, f, wo, lit, key, uniforms, material):
     return out
 
 
-def exact_reflection(position, f, wo, lit, key, uniforms, material, lights=None):
+def closed_reflection(position, f, wo, closed, twin, p, light_key, uniforms, terms, factor_dtype=np.float32):
+    """What the ``closed`` terms (`TermKey`) reflect of one extended light by its closed forms, (N, 3): each term's
+    ``k factor E(n)`` (its irradiance form) or ``k`` times the lobe integral about ``r_v`` (its lobe form), the factor
+    rounded to ``factor_dtype`` (float32, as the GLSL's constant; float64 for the exact integral)."""
+    reflected = np.zeros_like(position)
+    if any(t.integral.form == "irradiance" for t in closed):
+        e = twin.irradiance(position, f.n, p)
+    for t in closed:
+        values = terms[t.name].values_from_uniforms(uniforms, dtype=position.dtype, inputs=f.inputs)
+        k = getattr(values, t.integral.scale) * occlusion_factor(t, values, light_key.occludable)
+        if t.integral.form == "irradiance":
+            reflected = reflected + k * (np.asarray(t.integral.factor, factor_dtype).astype(position.dtype) * e)
+        else:
+            reflected = reflected + k * twin.lobe(position, f.n, view_reflected(f.n, wo), _exponent(t, values), p)
+    return reflected
+
+
+def _exponent(term_key, values):
+    """The lobe exponent ``q`` of a term's lobe form, a number."""
+    return float(getattr(values, term_key.integral.exponent))
+
+
+def exact_reflection(position, f, wo, lit, key, uniforms, material, lights=None, closed_forms=True):
     """The exact integral of every lit term's response over each extended light, ``integral f_r L (n.w)^+ dw``
-    [W/(m^2 sr)], by the kind's float64 quadrature (``exact``; docs/design.md section 13), gated by ``lit``;
+    [W/(m^2 sr)] (docs/design.md section 13), gated by ``lit``: by the kind's closed forms where they are the exact
+    integrals of every lit term (`ExtendedLight.exact_integrals`: a polygon's irradiance and whole-q lobe, a sphere's
+    and a disk's irradiance), in float64 with the terms' factors in float64, else by the kind's float64 quadrature of
+    their sum (``exact``, whose tolerance is relative to the sum);
     ``lights``: the scene's lights (needed by a kind whose exact integral reads more than its uniforms: an
-    environment light's map).
+    environment light's map); ``closed_forms=False``: the quadrature for every light (what the tests compare the
+    closed forms with).
 
     Returns
     -------
     value : (N, 3) float64 ndarray
     error : (N,) float64 ndarray
         The quadrature's absolute error estimate, summed over the lights (where it did not converge to its
-        tolerance, this says by how much).
+        tolerance, this says by how much); a closed form adds none (its float64 rounding, ``eps_64 / sqrt(Omega)``
+        relative for a light of solid angle ``Omega``, is below it).
     """
     terms = _terms(material)
     out = np.zeros(position.shape)
     error = np.zeros(len(position))
-    for light_key, twin, p, _, _ in extended_lights(key, uniforms, np.float64, lights):
-        def integrand(index, w):
-            g = f.select(index)
-            with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                return terms_response(g, w, wo[index], _dot(g.n, w), key.lit_terms, uniforms, terms,
-                                      light_key.occludable)
+    for light_key, twin, p, closed, _ in extended_lights(key, uniforms, np.float64, lights):
+        exact = [t for t in closed if twin.closed_form_is_exact(
+            t.integral.form, _exponent(t, terms[t.name].values_from_uniforms(uniforms, dtype=np.float64))
+            if t.integral.form != "irradiance" else None)]
+        if closed_forms and len(exact) == len(key.lit_terms):  # all in closed form (else all by quadrature: its rtol is of the sum)
+            with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+                value = closed_reflection(position, f, wo, exact, twin, p, light_key, uniforms, terms, np.float64)
+        else:
+            def integrand(index, w):
+                g = f.select(index)
+                with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+                    return terms_response(g, w, wo[index], _dot(g.n, w), key.lit_terms, uniforms, terms,
+                                          light_key.occludable)
 
-        value, err, _ = twin.exact(position, f.n, p, integrand)
+            value, err, _ = twin.exact(position, f.n, p, integrand)
+            error = error + np.where(lit, err, 0.0)
         out = out + np.where(lit[:, None], value, 0.0)
-        error = error + np.where(lit, err, 0.0)
     return out, error
 
 

@@ -215,14 +215,16 @@ def verify(scene, renderer, band=BAND, exact=None):
                         shadow_band=shadow_band, exact=exact_radiance, exact_error=exact_error)
 
 
-def exact_image(scene, gbuffer, shadows=None):
-    """The radiance of a G-buffer with every extended light's exact integral (float64 quadrature) in place of the
-    shader's method (docs/design.md section 13): ``(radiance (H, W, 3), error estimate (H, W))``."""
+def exact_image(scene, gbuffer, shadows=None, closed_forms=True):
+    """The radiance of a G-buffer with every extended light's exact integral (float64 quadrature, or the closed forms
+    where they are exact, `glphong.checks.reference.exact_reflection`) in place of the shader's method (docs/design.md
+    section 13): ``(radiance (H, W, 3), error estimate (H, W))``; ``closed_forms=False``: the quadrature throughout."""
     out = np.zeros(gbuffer.position.shape)
     error = np.zeros(gbuffer.mask.shape)
     for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, shadows=shadows):
         def exact(*arguments):  # the exact integrals in place of the shader's methods, keeping the error estimate
-            value, error[selection] = reference.exact_reflection(*arguments, lights=scene.lights)
+            value, error[selection] = reference.exact_reflection(*arguments, lights=scene.lights,
+                                                                 closed_forms=closed_forms)
             return value
 
         out[selection] = reference.shade_point(position, f, n_valid, u.get("u_eye"), key, u, obj.material, exact)

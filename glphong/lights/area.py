@@ -22,7 +22,7 @@ from glphong.definitions.light import GlslFile, Param
 from glphong.materials.lambert import Lambert
 from glphong.twin.area import (area_clip, area_clip_rounding, area_clipped_cosine, area_clipped_lobe,
                                area_cosine_rounding, area_lobe_rounding, area_triangle_sample, polygon_arrays)
-from glphong.twin.functions import safe_normalize
+from glphong.twin.functions import dot as _dot, safe_normalize
 from glphong.twin.quadrature import polygon_integral
 
 __all__ = ["RectLight", "PolygonLight", "MAX_POLYGON_VERTICES"]
@@ -30,10 +30,6 @@ __all__ = ["RectLight", "PolygonLight", "MAX_POLYGON_VERTICES"]
 #: vertices a PolygonLight may have
 MAX_POLYGON_VERTICES = 8
 
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
 
 
 class _Polygonal:
@@ -97,6 +93,7 @@ class RectLight(_Polygonal, ExtendedLight):
     glsl = GlslFile("lights/rect.glsl")
     uses = ("angle", "area")
     integrals = ("irradiance", "lobe")
+    exact_integrals = ("irradiance", "lobe")
 
     def check(self):
         super().check()
@@ -203,6 +200,7 @@ class PolygonLight(_Polygonal, ExtendedLight):
     glsl = GlslFile("lights/polygon.glsl")
     uses = ("angle", "area")
     integrals = ("irradiance", "lobe")
+    exact_integrals = ("irradiance", "lobe")
 
     def __init__(self, vertices, radiance, samples=4.0, method="auto"):
         object.__setattr__(self, "vertices", _convex_polygon(vertices))

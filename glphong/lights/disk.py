@@ -10,14 +10,10 @@ from glphong.lights.extended import CENTER, RADIANCE, RADIUS, SAMPLES, ExtendedL
 from glphong.definitions.light import GlslFile, Param
 from glphong.twin.area import area_angle
 from glphong.twin.band import EPS
-from glphong.twin.functions import perpendiculars, safe_normalize
+from glphong.twin.functions import dot as _dot, perpendiculars, safe_normalize
 from glphong.twin.quadrature import disk_integral
 
 __all__ = ["DiskLight"]
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
 
 
 def disk_atan2(y, x):
@@ -64,6 +60,7 @@ class DiskLight(ExtendedLight):
     glsl = GlslFile("lights/disk.glsl")
     uses = ("angle", "area")
     integrals = ("irradiance",)
+    exact_integrals = ("irradiance",)
 
     def power(self):
         """``pi L pi R^2`` [W] (3,)."""

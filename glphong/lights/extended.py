@@ -70,6 +70,9 @@ class ExtendedLight(LightModel):
 
     extent = "extended"
     integrals = ("irradiance",)
+    #: the closed forms among `integrals` that are the exact integral when evaluated in float64 (a 'lobe' for whole
+    #: exponents q only): `glphong.verify`'s exact image takes them in place of the quadrature (`closed_form_is_exact`)
+    exact_integrals = ()
     exact_uniforms = ("samples",)
     abstract_contract = True
 
@@ -90,6 +93,11 @@ class ExtendedLight(LightModel):
     #: methods a definition must give besides its contract's twins (checked when the class is made): its exact
     #: integral, which `glphong.verify` and the stability suite compare the methods with
     required_methods = ("exact",)
+
+    def closed_form_is_exact(self, form, q=None):
+        """Whether the closed form ``form`` ('irradiance', or 'lobe' of exponent ``q``) is the exact integral
+        (`exact_integrals`; a lobe only for whole ``q``)."""
+        return form in self.exact_integrals and (form != "lobe" or float(q).is_integer())
 
     @classmethod
     def key_integrals(cls, lights=()):

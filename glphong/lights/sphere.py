@@ -12,14 +12,10 @@ from glphong.lights.extended import CENTER, RADIANCE, RADIUS, SAMPLES, ExtendedL
 from glphong.definitions.light import GlslFile
 from glphong.twin.area import area_angle
 from glphong.twin.band import EPS
-from glphong.twin.functions import atan2_first_quadrant, perpendiculars, safe_normalize
+from glphong.twin.functions import atan2_first_quadrant, dot as _dot, perpendiculars, safe_normalize
 from glphong.twin.quadrature import sphere_integral
 
 __all__ = ["SphereLight"]
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
 
 
 class SphereLight(ExtendedLight):
@@ -48,6 +44,7 @@ class SphereLight(ExtendedLight):
     glsl = GlslFile("lights/sphere.glsl")
     uses = ("angle", "area")
     integrals = ("irradiance",)
+    exact_integrals = ("irradiance",)
 
     @classmethod
     def from_power(cls, center, radius, power, samples=4):

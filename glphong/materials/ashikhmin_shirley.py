@@ -79,7 +79,8 @@ Where the paper and common implementations differ (glphong follows the paper):
 import numpy as np
 
 from glphong.definitions.material import GlslFile, MaterialModel, Param, Properties
-from glphong.materials.phong import _dot, lobe_oracle
+from glphong.materials.phong import lobe_oracle
+from glphong.twin.functions import dot as _dot
 from glphong.definitions.cases import Case, generic_cases
 from glphong.twin.band import EPS, FLT_MIN
 from glphong.twin.functions import fresnel_schlick, lobe_from_delta, safe_normalize

@@ -20,7 +20,8 @@ from glphong.twin.functions import BLINN_HALF_FLOOR, blinn_delta, blinn_lobe, ha
 from glphong.definitions.fresnel import FresnelSlot, fresnel_band, fresnel_factor
 from glphong.materials.lambert import Lambert
 from glphong.definitions.material import GlslFile, MaterialModel, MaterialSum, Properties
-from glphong.materials.phong import _KS, _Q, _dot, lobe_oracle
+from glphong.materials.phong import _KS, _Q, lobe_oracle
+from glphong.twin.functions import dot as _dot
 from glphong.definitions.cases import generic_cases, lobe_cases
 from glphong.definitions.fresnel import fresnel_oracle
 from glphong.twin.band import EPS, lobe_band

@@ -119,10 +119,6 @@ _FORM = Choice("form", ("microfacet", "1982"), default="microfacet",
                    "D' = pi D, exactly 4 times the microfacet form")
 
 
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
-
-
 def cook_torrance_beckmann(tan2, m):
     """The paper's un-normalised Beckmann distribution ``D' = pi D = exp(-tan2/m^2) / (m^2 cos^4)``
     (cook_torrance_lobe.glsl), evaluated as ``(exp(-x/2) (1 + t)^2 / m^2) exp(-x/2)``, ``t = min(tan2,

@@ -68,10 +68,6 @@ _IOR = Param("ior", "scalar", low=1.0, high=1e4, default=1.5, unit="",
              doc="KHR_materials_ior: the dielectric's f0 = ((ior - 1)/(ior + 1))^2 (1.5: 0.04, the core's)")
 
 
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
-
-
 #: GGX D, the library chunk microfacet.glsl's (`glphong.twin.functions.microfacet_ggx`); this name is kept
 gltf_pbr_ggx = microfacet_ggx
 

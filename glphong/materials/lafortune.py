@@ -97,7 +97,7 @@ from glphong.materials.diffuse import Diffuse
 from glphong.definitions.material import GlslFile, MaterialModel, MaterialSum, Param, Properties
 from glphong.definitions.cases import Case, _mirror_eye, _unit, generic_cases
 from glphong.twin.band import EPS, FLT_MAX, lobe_band
-from glphong.twin.functions import log_one_minus, safe_normalize
+from glphong.twin.functions import dot as _dot, log_one_minus, safe_normalize
 
 __all__ = ["LafortuneLobes", "Lafortune", "lafortune_local", "lafortune_log", "lafortune_lobe",
            "LAFORTUNE_MAX_LOBES"]
@@ -180,10 +180,6 @@ def _resolve_lobes(owner, lobes, per_lobe):
             part = {"rho": "rho", "c": "Cx, Cy, Cz", "n": "n"}[p.name.split("_", 1)[1]]
             raise type(exc)(f"{where[p.name]} ({part}): {exc}") from None
     return count, values
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
 
 
 def lafortune_local(f, d):

@@ -49,7 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from glphong.core import merl
-from glphong.twin.functions import atan2_first_quadrant, frame_from_tangent, safe_normalize
+from glphong.twin.functions import atan2_first_quadrant, dot as _dot, frame_from_tangent, safe_normalize
 from glphong.definitions.material import Choice, GlslFile, MaterialModel, Properties
 from glphong.definitions.table import Table, TableData
 from glphong.definitions.cases import Case, _mirror_eye, _unit, generic_cases
@@ -61,10 +61,6 @@ __all__ = ["MeasuredBRDF", "measured_brdf_coordinates", "measured_brdf_fetch", "
 #: the last bin of each axis (measured_brdf.glsl MEASURED_BRDF_LAST)
 LAST = np.array(merl.SHAPE) - 1
 _DEG = 180.0 / np.pi
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
 
 
 def measured_brdf_coordinates(n, wi, wo):

@@ -87,7 +87,7 @@ from glphong.twin.functions import atan2_first_quadrant
 from glphong.definitions.material import Choice, GlslFile, MaterialModel, Param, Properties
 from glphong.definitions.cases import Case, generic_cases
 from glphong.twin.band import EPS
-from glphong.twin.functions import safe_normalize
+from glphong.twin.functions import dot as _dot, safe_normalize
 
 __all__ = ["OrenNayar", "oren_nayar_tangential", "oren_nayar_cos_phi", "oren_nayar_tan_beta",
            "oren_nayar_full", "oren_nayar_qualitative", "RHO", "SIGMA"]
@@ -102,10 +102,6 @@ FORM = Choice("form", ("full", "qualitative"), default="full",
               doc="'full': the paper's model with inter-reflection; 'qualitative': its simpler model")
 
 _TWO_OVER_PI = 2.0 / np.pi
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
 
 
 def oren_nayar_tangential(n, w):

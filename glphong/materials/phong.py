@@ -15,7 +15,6 @@ ks         rgb     >= 0        1/sr    specular coefficient k_s
 q          scalar  >= 0        1       exponent (q = 0: lobe 1, the 0^0 := 1 convention)
 =========  ======  ==========  ======  =============================================
 """
-import numpy as np
 
 from glphong.twin.functions import phong_delta, phong_lobe
 from glphong.definitions.fresnel import FresnelSlot, fresnel_band, fresnel_factor
@@ -35,10 +34,6 @@ LOBE_MAX_Q = 10000
 
 _KS = Param("ks", "rgb", low=0.0, unit="1/sr", textureable=True, doc="specular coefficient")
 _Q = Param("q", "scalar", low=0.0, doc="specular exponent; q = 0 gives a constant lobe of 1")
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
 
 
 def lobe_oracle(cosine, q):

@@ -14,17 +14,13 @@ GLSL's 3-ulp polynomial (`glphong.twin.functions.atan2_first_quadrant`).
 import numpy as np
 
 from glphong.twin.band import EPS
-from glphong.twin.functions import atan2_first_quadrant
+from glphong.twin.functions import atan2_first_quadrant, dot as _dot
 
 __all__ = ["AREA_MAX_VERTICES", "area_angle", "area_clip", "area_polygon_cosine", "area_solid_angle",
            "area_edge_powers", "area_polygon_lobe", "area_clipped_cosine", "area_clipped_lobe", "area_cosine_rounding", "area_lobe_rounding", "area_clip_rounding", "area_triangle_sample", "polygon_arrays"]
 
 #: vertices a polygon may have after two clips (a light has at most 8)
 AREA_MAX_VERTICES = 10
-
-
-def _dot(a, b):
-    return np.sum(a * b, axis=-1)
 
 
 def area_angle(y, x):
@@ -66,7 +62,7 @@ def area_clip(p, e, count, c):
         return idx
 
     with np.errstate(divide="ignore", invalid="ignore"):
-        for i in range(size):
+        for i in range(int(count.max()) if n else 0):  # beyond every polygon's count nothing is put
             active = i < count
             nxt = np.where(i + 1 < count, i + 1, 0)
             d_a, d_b = d[:, i], d[rows, nxt]
