@@ -20,8 +20,9 @@
 //   (normal_map.glsl) where n is valid, before the G-buffer is written and before shading: both see the mapped normal.
 // HAS_FACE: the triangle's own normal, from the derivatives of the interpolated position (the slope of the shadow
 //   bias, shadows.glsl): a G-buffer plane, and shadow_face_normal when shading.
+// HAS_OBJECT: the G-buffer plane of the point in the object's own frame (xyz [m], w = 1), for the frame passes.
 // NAIVE_NORMAL: n by plain_normalize where the key proves it safe, common.glsl.
-// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, HAS_FACE, NUM_LOD_TEXTURES,
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, HAS_FACE, HAS_OBJECT, NUM_LOD_TEXTURES,
 // GBUFFER_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
 // NAIVE_NORMAL, RUNTIME_SWITCHES, SWITCH(flag).
 
@@ -106,6 +107,10 @@ layout(location = GBUFFER_LOD_LOCATION) out vec4 out_lod;
 #if HAS_FACE
 layout(location = GBUFFER_FACE_LOCATION) out vec4 out_face;
 #endif
+#if HAS_OBJECT
+invariant in vec3 v_object;
+layout(location = GBUFFER_OBJECT_LOCATION) out vec4 out_object;
+#endif
 #else
 #if NEEDS_VIEW
 uniform vec4 u_eye;  // homogeneous eye (e, w): the view vector at x is normalize(e - w x)
@@ -184,6 +189,9 @@ void main()
 #endif
 #if HAS_FACE
     out_face = vec4(face, 1.0);
+#endif
+#if HAS_OBJECT
+    out_object = vec4(v_object, 1.0);
 #endif
 #else
 #if HAS_INPUTS

@@ -13,8 +13,9 @@
 // vertex colour: HAS_COLOR, a surface input reads it; material_inputs() runs here when shading per vertex):
 // 2, 3 and 5 in glphong's own draws, pyrender's packed order inside pyrender (the key says which).
 // Outputs are invariant so the radiance and the G-buffer programs interpolate identical inputs.
-// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, *_LOCATION, SHADE_PER_VERTEX, ALPHA_MASK,
-// TWO_SIDED, NEEDS_VIEW, RUNTIME_SWITCHES, SWITCH(flag).
+// HAS_OBJECT (G-buffer programs of the frame passes): v_object = p, the point in the object's own frame [m].
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_OBJECT, *_LOCATION, SHADE_PER_VERTEX,
+// ALPHA_MASK, TWO_SIDED, NEEDS_VIEW, RUNTIME_SWITCHES, SWITCH(flag).
 
 const float GOURAUD_MAX = 1.2676506002282294e30;  // 2^100: per-vertex radiance saturates here
 layout(location = 0) in vec3 in_position;
@@ -60,6 +61,9 @@ invariant out vec2 v_uv;
 #endif
 #if HAS_COLOR
 invariant out vec3 v_color;
+#endif
+#if HAS_OBJECT
+invariant out vec3 v_object;
 #endif
 #endif
 
@@ -112,6 +116,9 @@ void main()
 #endif
 #if HAS_COLOR
     v_color = in_color;
+#endif
+#if HAS_OBJECT
+    v_object = in_position;
 #endif
 #endif
     gl_Position = u_view_projection * world;

@@ -17,16 +17,16 @@ class Frame:
 
     Attributes
     ----------
-    radiance : (H, W, 3) float32 ndarray
-        Linear radiance [W/(m^2 sr)], row 0 at the top, never clamped.  With multisampling
+    radiance : (H, W, 3) float32 ndarray or None
+        Linear radiance [W/(m^2 sr)], row 0 at the top, never clamped (None where ``passes`` leaves it out).  With multisampling
         or supersampling, pixels on silhouettes hold the coverage-weighted average (the
         background counts as 0).  A writable view into the one RGBA readback (GL's bottom-up
         rows flipped by a negative stride; no copy is made): ``numpy.ascontiguousarray`` gives
         C order where a consumer needs it.
     mask : (H, W) bool ndarray
-        Pixels covered by geometry (any sample).
+        Pixels covered by geometry (any sample; the pixel centre where the radiance is left out).
     coverage : (H, W) float32 ndarray
-        Fraction of the pixel's samples covered by geometry (0 or 1 with one sample).
+        Fraction of the pixel's samples covered by geometry (0 or 1 with one sample, or without the radiance).
     depth : (H, W) float32 ndarray or None
         With ``render(scene, depth=True)``: linear depth [m], the distance of the surface point at
         the pixel centre from the camera along its viewing axis (view-space ``-z``; not the distance
@@ -36,6 +36,11 @@ class Frame:
         With ``render(scene, normals=True)``: the world-space unit shading normal at the pixel centre
         (interpolated, renormalised, flipped toward the viewer on the back faces of two-sided
         materials, as shaded), 0 where not covered or where the normal is zero or not finite.
+    distance, normal_camera, uv, instance, category, object_coordinates, nocs, flow, backward_flow : ndarray or None
+        The frame passes ``render(scene, passes=...)`` asks for (`glphong.gpu.passes`: each one's meaning, shape, unit
+        and dtype); None where not asked for.
+    passes : tuple of str
+        The passes the frame holds, in `glphong.gpu.passes.PASSES` order.
     exposure : float
         The linear exposure a notebook shows the frame at (``_repr_png_``: Jupyter displays a `Frame`
         as a PNG of ``to_srgb8(exposure)``, the exact sRGB curve); 1 unless given (`with_exposure`).
@@ -47,26 +52,42 @@ class Frame:
     depth: np.ndarray = None
     normal: np.ndarray = None
     exposure: float = 1.0
+    distance: np.ndarray = None
+    normal_camera: np.ndarray = None
+    uv: np.ndarray = None
+    instance: np.ndarray = None
+    category: np.ndarray = None
+    object_coordinates: np.ndarray = None
+    nocs: np.ndarray = None
+    flow: np.ndarray = None
+    backward_flow: np.ndarray = None
+    passes: tuple = ("radiance",)
 
     def with_exposure(self, exposure):
         """The same frame (arrays shared, not copied) shown at ``exposure`` in a notebook."""
         return replace(self, exposure=_validate.scalar("exposure", exposure, low_inclusive=False))
 
     def _repr_png_(self):
-        """PNG bytes of the frame at ``self.exposure`` (exact sRGB curve): how Jupyter shows a Frame."""
-        return png_bytes(self.radiance, self.exposure)
+        """PNG bytes of the frame at ``self.exposure`` (exact sRGB curve): how Jupyter shows a Frame (None without
+        the radiance)."""
+        return None if self.radiance is None else png_bytes(self.radiance, self.exposure)
+
+    def _radiance(self):
+        if self.radiance is None:
+            raise ValueError("this frame holds no radiance: render with 'radiance' among the passes")
+        return self.radiance
 
     def to_srgb8(self, exposure=1.0):
         """8-bit sRGB image, (H, W, 3) uint8 (see `glphong.imaging.encode_srgb8`)."""
-        return encode_srgb8(self.radiance, exposure)
+        return encode_srgb8(self._radiance(), exposure)
 
     def save_png(self, path, exposure=1.0, compress_level=1):
         """Tone-map with ``exposure``, encode with the exact sRGB curve, write a PNG (`glphong.imaging.save_png`)."""
-        save_png(path, self.radiance, exposure, compress_level)
+        save_png(path, self._radiance(), exposure, compress_level)
 
     def save_npy(self, path):
         """Write the raw float32 radiance ``(H, W, 3)`` as ``.npy``."""
-        save_npy(path, self.radiance)
+        save_npy(path, self._radiance())
 
 
 @dataclass(frozen=True)
@@ -98,6 +119,9 @@ class GBuffer:
     face : (H, W, 3) float32 ndarray or None
         The covered triangle's own unit normal (either orientation), where a light casts shadows (the shadow
         bias's slope, docs/design.md section 12).
+    object_coordinates : (H, W, 3) float32 ndarray or None
+        The covered point in its object's own frame [m] (the interpolated vertex position before the pose), where
+        a frame pass asks for it (`glphong.gpu.passes`).
     """
 
     position: np.ndarray
@@ -109,3 +133,4 @@ class GBuffer:
     color: np.ndarray = None
     lod: np.ndarray = None
     face: np.ndarray = None
+    object_coordinates: np.ndarray = None

@@ -16,8 +16,9 @@ import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.gpu.frame import Frame, GBuffer
-from glphong.gpu.resources import (ORPHANS, ORPHANS_LOCK, MeshBuffers, ObjectEntry, available_memory, release_orphans,
-                                   release_resources, release_targets)
+from glphong.gpu.passes import check_passes, derive_passes, gbuffer_planes, requested_passes
+from glphong.gpu.resources import (ORPHANS, ORPHANS_LOCK, MeshBuffers, ObjectEntry, available_memory, make_target,
+                                   release_orphans, release_resources, release_targets)
 from glphong.gpu.contexts import check_not_forked, create_context
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
@@ -221,15 +222,22 @@ class Renderer:
             self._size = size
 
     @_one_call_at_a_time
-    def render(self, scene, depth=False, normals=False):
-        """Render the scene's shaded radiance (linear float32).
+    def render(self, scene, depth=False, normals=False, passes=None, next_scene=None, previous_scene=None):
+        """Render the scene's shaded radiance (linear float32) and the frame passes asked for.
 
         Parameters
         ----------
         scene : Scene
         depth, normals : bool
-            Also return linear depth [m] and world-space normals (`Frame.depth`, `Frame.normal`), from
-            one G-buffer pass at the output size.
+            Also the 'depth' and 'normal' passes (as ``passes`` naming them).
+        passes : sequence of str, optional
+            The passes to return (`glphong.gpu.passes.PASSES`: 'radiance', 'depth', 'distance', 'normal',
+            'normal_camera', 'uv', 'instance', 'category', 'object_coordinates', 'nocs', 'flow', 'backward_flow'),
+            default ``('radiance',)``.  All but the radiance come from one G-buffer draw at the output size, one
+            sample per pixel; without 'radiance' nothing is shaded.
+        next_scene, previous_scene : Scene, optional
+            The same objects in the same order at their poses in the next (previous) frame, and that frame's
+            camera: what 'flow' ('backward_flow') reads.
 
         Returns
         -------
@@ -239,7 +247,16 @@ class Renderer:
         for name, flag in (("depth", depth), ("normals", normals)):
             if not isinstance(flag, (bool, np.bool_)):
                 raise TypeError(f"{name} must be a bool, True or False (got {flag!r})")
-        geometry = self.gbuffer(scene) if depth or normals else None  # the lock is re-entrant
+        names = requested_passes(passes, depth, normals)
+        check_passes(scene, names, next_scene, previous_scene)
+        geometry = [n for n in names if n != "radiance"]
+        extra = {}
+        if geometry:  # the lock is re-entrant
+            gbuffer = self.gbuffer(scene, gbuffer_planes(geometry))
+            extra = derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
+        if "radiance" not in names:
+            return Frame(radiance=None, mask=gbuffer.mask, coverage=gbuffer.mask.astype(np.float32), passes=names,
+                         **extra)
         with self.context:
             fbo = self._draw_radiance(scene)
             rgba = self._read(fbo, self._internal_size, components=4)
@@ -249,15 +266,7 @@ class Renderer:
             rgba = rgba.reshape(self.height, s, self.width, s, 4).mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
         # views of the one readback (rows flipped by strides): no copy after the driver's
         coverage = rgba[..., 3]
-        extra = {}
-        if depth:
-            camera = scene.camera
-            forward = -camera.pose[:3, 2]
-            along = np.einsum("ijk,k->ij", geometry.position - camera.pose[:3, 3], forward)
-            extra["depth"] = np.where(geometry.mask, along, 0.0).astype(np.float32)
-        if normals:
-            extra["normal"] = geometry.normal
-        return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, **extra)
+        return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, passes=names, **extra)
 
     @_one_call_at_a_time
     def render_srgb8(self, scene, exposure=1.0, resolve="display"):
@@ -312,19 +321,27 @@ class Renderer:
         return rgb
 
     @_one_call_at_a_time
-    def gbuffer(self, scene):
+    def gbuffer(self, scene, planes=()):
         """Render the per-pixel shading inputs of the scene (one sample per pixel, output size).
+
+        Parameters
+        ----------
+        scene : Scene
+        planes : iterable of str
+            Planes to write besides those the scene's shading reads (`glphong.shaders.options.GBUFFER_PLANES`:
+            'uv', 'object', ...), as the frame passes ask for them.
 
         Returns
         -------
         GBuffer
         """
         self._check_scene(scene)
-        needs = binding(scene).gbuffer_needs()
+        planes = frozenset(planes)
+        needs = binding(scene).gbuffer_needs() | planes
         extras = [n for n in GBUFFER_PLANES if n in needs]
         with self.context:
             fbo = self._target(("gbuffer", *extras))
-            self._draw(scene, "gbuffer", fbo)
+            self._draw(scene, "gbuffer", fbo, planes=planes)
             planes = [self._read(fbo, self._size, components=4, attachment=i) for i in range(2 + len(extras))]
             self.context.check_error("rendering the G-buffer")
         position, normal = planes[:2]
@@ -337,10 +354,12 @@ class Renderer:
                        uv=np.ascontiguousarray(extra["uv"][..., :2]) if "uv" in extra else None,
                        color=np.ascontiguousarray(extra["color"][..., :3]) if "color" in extra else None,
                        lod=np.ascontiguousarray(extra["lod"]) if "lod" in extra else None,
-                       face=np.ascontiguousarray(extra["face"][..., :3]) if "face" in extra else None)
+                       face=np.ascontiguousarray(extra["face"][..., :3]) if "face" in extra else None,
+                       object_coordinates=np.ascontiguousarray(extra["object"][..., :3]) if "object" in extra else None)
 
-    def program_key(self, scene, obj, output="radiance"):
-        """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading)."""
+    def program_key(self, scene, obj, output="radiance", planes=frozenset()):
+        """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading); ``planes``: a
+        G-buffer's planes beyond the scene's (`gbuffer`)."""
         per_vertex = output == "radiance" and self.shading == "vertex"
         if output == "radiance" and not self.specialise:
             if any(k.shadowed for k in binding(scene).light_keys()):
@@ -348,6 +367,8 @@ class Renderer:
                                  "render it with specialise=True")
             return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex, scene.lights)
         key = binding(scene).program_key(obj, output)
+        if planes:
+            key = replace(key, **{f"has_{name}": True for name in planes})
         if key.shadow_slots:
             if per_vertex:
                 raise ValueError("shadows are looked up per pixel: a scene with lights with shadows=True needs "
@@ -396,7 +417,7 @@ class Renderer:
         return self._shadow_maps.draw(bound.shadow_setups(lights, self.shadow_map_size), casters, self.programs,
                                       lambda mesh, program: self._mesh_buffers(mesh).vertex_array(self._mgl, program))
 
-    def _draw(self, scene, output, fbo, frame_values=None):
+    def _draw(self, scene, output, fbo, frame_values=None, planes=frozenset()):
         aspect = self.width / self.height
         self._purge_dead_meshes()
         shadow_values = self._shadow_values(scene, output)
@@ -409,7 +430,7 @@ class Renderer:
         forward = tuple(-camera.pose[:3, 2])
         near, far = camera.znear, camera.zfar
         mirrored = culled = False
-        for program, frame_pack, entry in self._draw_list(scene, output, aspect, frame_values, shadow_values):
+        for program, frame_pack, entry in self._draw_list(scene, output, aspect, frame_values, shadow_values, planes):
             program.write(frame_pack)
             program.write(entry.pack)
             if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
@@ -423,7 +444,7 @@ class Renderer:
         self._mgl.front_face = "ccw"
         self._mgl.disable(moderngl.CULL_FACE)
 
-    def _draw_list(self, scene, output, aspect, frame_values=None, shadow_values=None):
+    def _draw_list(self, scene, output, aspect, frame_values=None, shadow_values=None, planes=frozenset()):
         """``(program, frame pack, object entry)`` per object, in order.
 
         Per frame, the uniforms every object shares (camera, lights) are packed once per program key;
@@ -432,11 +453,12 @@ class Renderer:
         index are what they were: objects, materials and poses are immutable.  The uber-shader's key is
         the scene's, the same for every object (made once per frame).  ``frame_values`` are uniforms the
         call adds to every program's frame pack (the display programs' ``u_exposure``), ``shadow_values`` the
-        shadow maps, added to the programs that read them."""
+        shadow maps, added to the programs that read them; ``planes`` a G-buffer's planes beyond the scene's (kept apart
+        from the plain G-buffer's entries)."""
         drop = self.formulation == "naive"
         bound = binding(scene)
         state = (output, bound.light_keys(), scene.ambient_radiance, self.formulation,
-                 self.shading, self.specialise, self.culling, self.numerics)
+                 self.shading, self.specialise, self.culling, self.numerics, planes)
         camera = scene.camera
         shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
         frame_packs = {}
@@ -445,11 +467,11 @@ class Renderer:
             per_object = entries.get(obj)
             if per_object is None:
                 per_object = entries[obj] = {}
-            entry = per_object.get(output)
+            entry = per_object.get((output, planes) if planes else output)
             if entry is not None and entry.camera is not camera and not self._same_view_piece(entry, obj, camera):
                 entry = None
             if shared is not None or entry is None or entry.state != state or entry.index != index:
-                key = shared or self.program_key(scene, obj, output)
+                key = shared or self.program_key(scene, obj, output, planes)
                 program = self.programs.get(key)
                 values = bound.uniform_values(index, key, aspect) if shared is not None else \
                     bound.object_uniform_values(index, key)
@@ -458,7 +480,7 @@ class Renderer:
                 entry = ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
                                      None if sphere is None else (tuple(sphere[0]), sphere[1]), camera=camera)
                 if shared is None:
-                    per_object[output] = entry
+                    per_object[(output, planes) if planes else output] = entry
             frame = frame_packs.get(entry.program)
             if frame is None:
                 values = {} if shared is not None else bound.frame_uniform_values(entry.key, aspect)
@@ -499,32 +521,12 @@ class Renderer:
         if fbo is not None:
             return fbo
         try:
-            fbo = self._targets[name] = self._make_target(name)
+            fbo = self._targets[name] = make_target(self._mgl, name, self._size, self._internal_size, self.samples)
         except moderngl.Error as exc:
             raise RuntimeError(f"the driver could not make a {self._internal_size[0]}x{self._internal_size[1]} "
                                f"render target ({self.context.renderer_name}: {exc}); it needs about "
                                f"{self.render_target_bytes() / 2**30:.2f} GiB with the G-buffer and readback: "
                                "use a smaller size, supersample or samples") from None
-        return fbo
-
-    def _make_target(self, name):
-        mgl = self._mgl
-        if isinstance(name, tuple) and name[0] == "gbuffer":
-            colors = [mgl.renderbuffer(self._size, 4, dtype="f4") for _ in range(len(name) + 1)]
-            fbo = mgl.framebuffer(colors, mgl.depth_renderbuffer(self._size))
-        elif name == "radiance" and self.samples > 1:
-            fbo = mgl.framebuffer([mgl.renderbuffer(self._internal_size, 4, samples=self.samples, dtype="f4")],
-                                  mgl.depth_renderbuffer(self._internal_size, samples=self.samples))
-        elif name == "display":  # 8-bit display values, multisampled like the radiance target
-            fbo = mgl.framebuffer([mgl.renderbuffer(self._size, 4, samples=self.samples if self.samples > 1 else 0)],
-                                  mgl.depth_renderbuffer(self._size, samples=self.samples if self.samples > 1 else 0))
-        elif name in ("radiance", "resolve"):
-            texture = mgl.texture(self._internal_size, 4, dtype="f4")
-            texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
-            depth = mgl.depth_renderbuffer(self._internal_size) if name == "radiance" else None
-            fbo = mgl.framebuffer([texture], depth)
-        else:  # srgb8
-            fbo = mgl.framebuffer([mgl.renderbuffer(self._size, 4)])
         return fbo
 
     def _mesh_buffers(self, mesh):

@@ -10,12 +10,34 @@ import threading
 import weakref
 from dataclasses import dataclass
 
+import moderngl
 import numpy as np
 
 from glphong.gpu.contexts import EGLDisplayTerminatedError
 
-__all__ = ["MeshBuffers", "ObjectEntry", "available_memory", "release_resources", "release_targets", "release_orphans",
-           "ORPHANS", "ORPHANS_LOCK"]
+__all__ = ["MeshBuffers", "ObjectEntry", "available_memory", "make_target", "release_resources", "release_targets",
+           "release_orphans", "ORPHANS", "ORPHANS_LOCK"]
+
+
+def make_target(mgl, name, size, internal_size, samples):
+    """A renderer's framebuffer ``name``: ``('gbuffer', *planes)`` (RGBA32F position, normal and each plane, with
+    depth, at the output ``size``), 'radiance' (RGBA32F at the ``internal_size``, multisampled renderbuffers with
+    ``samples > 1``, else a texture), 'resolve' (its single-sampled texture), 'display' (8-bit, multisampled like
+    the radiance) or 'srgb8' (8-bit at the output size)."""
+    if isinstance(name, tuple) and name[0] == "gbuffer":
+        colors = [mgl.renderbuffer(size, 4, dtype="f4") for _ in range(len(name) + 1)]
+        return mgl.framebuffer(colors, mgl.depth_renderbuffer(size))
+    if name == "radiance" and samples > 1:
+        return mgl.framebuffer([mgl.renderbuffer(internal_size, 4, samples=samples, dtype="f4")],
+                               mgl.depth_renderbuffer(internal_size, samples=samples))
+    if name == "display":  # 8-bit display values, multisampled like the radiance target
+        return mgl.framebuffer([mgl.renderbuffer(size, 4, samples=samples if samples > 1 else 0)],
+                               mgl.depth_renderbuffer(size, samples=samples if samples > 1 else 0))
+    if name in ("radiance", "resolve"):
+        texture = mgl.texture(internal_size, 4, dtype="f4")
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        return mgl.framebuffer([texture], mgl.depth_renderbuffer(internal_size) if name == "radiance" else None)
+    return mgl.framebuffer([mgl.renderbuffer(size, 4)])  # srgb8
 
 
 @dataclass(eq=False)

@@ -14,7 +14,10 @@ from glphong.scene.from_trimesh import build_from_trimesh
 from glphong.lights import AmbientLight, LightModel, registered_lights
 from glphong.materials import Material
 
-__all__ = ["Scene", "SceneObject"]
+__all__ = ["Scene", "SceneObject", "MAX_ID"]
+
+#: the largest instance id or category (the passes are uint32; 0 is the background)
+MAX_ID = 2 ** 32 - 1
 
 _LIGHT_WORDS = "glphong lights (PointLight, SpotLight, DirectionalLight, UnattenuatedPointLight or a LightModel of yours)"
 
@@ -33,6 +36,11 @@ class SceneObject:
     name : str
     casts_shadow : bool
         Drawn into the shadow maps of the scene's shadowing lights (default True).
+    instance_id : int
+        The object's id in the frame's ``instance`` pass and the masks written from it: 1 to ``2^32 - 1``, unique
+        in its scene (0 is the background).
+    category : int
+        Its class in the ``category`` pass (COCO's ``category_id``): 0 to ``2^32 - 1``.
     """
 
     mesh: MeshData
@@ -40,6 +48,8 @@ class SceneObject:
     pose: np.ndarray
     name: str
     casts_shadow: bool = True
+    instance_id: int = 1
+    category: int = 0
 
     @property
     def mirrored(self):
@@ -106,7 +116,7 @@ class Scene:
         self._lights.append(light)
         return light
 
-    def add(self, mesh, material, pose=None, smooth=True, name=None, casts_shadow=True):
+    def add(self, mesh, material, pose=None, smooth=True, name=None, casts_shadow=True, instance_id=None, category=0):
         """Add a mesh drawn with a material.
 
         Parameters
@@ -122,6 +132,11 @@ class Scene:
         casts_shadow : bool
             Whether the object is drawn into the shadow maps of lights with ``shadows=True`` (default True); every
             object receives shadows.
+        instance_id : int, optional
+            Its id in the ``instance`` pass (`glphong.Renderer.render`): 1 to ``2^32 - 1``, unique in the scene;
+            default ``1 +`` the object's index.
+        category : int
+            Its class in the ``category`` pass, 0 to ``2^32 - 1`` (default 0).
 
         Returns
         -------
@@ -140,13 +155,30 @@ class Scene:
 
             if not isinstance(mesh, trimesh.Trimesh):
                 raise TypeError(f"mesh must be a trimesh.Trimesh or a glphong.scene.geometry.MeshData (got {type(mesh).__name__})")
+        label = name or f"object{len(self._objects)}"
+        instance_id = self._instance_id(label, instance_id)
+        category = _validate.positive_int(f"object {label!r}: category", category, 0, MAX_ID)
         pose = np.array(_validate.affine_transform("pose", np.eye(4) if pose is None else pose), dtype=np.float64)
         pose.setflags(write=False)
         data = mesh if isinstance(mesh, MeshData) else MeshData.from_trimesh(mesh, smooth=bool(smooth))
-        _check_mesh_serves(data, material, name or f"object{len(self._objects)}")
-        obj = SceneObject(data, material, pose, name or f"object{len(self._objects)}", bool(casts_shadow))
+        _check_mesh_serves(data, material, label)
+        obj = SceneObject(data, material, pose, label, bool(casts_shadow), instance_id, category)
         self._objects.append(obj)
         return obj
+
+    def _instance_id(self, label, value):
+        """``value`` checked (an int in [1, MAX_ID], not another object's), or the default ``1 +`` the index."""
+        if value is None:
+            value = len(self._objects) + 1
+            default = " (the default, 1 + its index: give instance_id= to choose another)"
+        else:
+            value = _validate.positive_int(f"object {label!r}: instance_id", value, 1, MAX_ID)
+            default = ""
+        for other in self._objects:
+            if other.instance_id == value:
+                raise ValueError(f"object {label!r}: instance_id {value}{default} is already object {other.name!r}'s; "
+                                 "ids are unique in a scene")
+        return value
 
     @classmethod
     def from_trimesh(cls, trimesh_scene, camera=None, lights=None, ambient=None, materials=None, vertex_colors="srgb"):

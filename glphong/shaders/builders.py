@@ -248,8 +248,9 @@ def lod_slots(images):
 
 def gbuffer_key(material, needs=(), lod_textures=0):
     """The G-buffer-program key of one material: its two-sided flag, the scene's extra G-buffer outputs
-    ``needs`` ('tangent', 'uv', 'color', 'lod') and the number of its textures whose level of detail it
-    writes."""
+    ``needs`` ('tangent', 'uv', 'color', 'lod', 'face', 'object') and the number of its textures whose level of
+    detail it writes."""
     return ProgramKey(output="gbuffer", has_normal=True, two_sided=material.two_sided,
                       has_tangent="tangent" in needs, has_uv="uv" in needs, has_color="color" in needs,
-                      has_lod="lod" in needs, lod_textures=lod_textures, has_face="face" in needs)
+                      has_lod="lod" in needs, lod_textures=lod_textures, has_face="face" in needs,
+                      has_object="object" in needs)

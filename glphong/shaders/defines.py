@@ -21,6 +21,7 @@ def program_defines(key):
         ("HAS_INPUTS", b(bool(key.inputs))),
         ("HAS_LOD", b(key.has_lod)),
         ("HAS_FACE", b(key.has_face)),
+        ("HAS_OBJECT", b(key.has_object)),
         ("NORMAL_MAP", b(key.normal_map)),
         ("ALPHA_MASK", str(key.alpha_mask)),
         *((f"{name.upper()}_LOCATION", str(where)) for name, where in

@@ -196,6 +196,9 @@ class ProgramKey:
     has_face : bool
         Whether the fragment stage computes the triangle's own (geometric) normal from the derivatives of the
         position (the shadow bias's slope; for a G-buffer program: whether it writes it, the 'face' plane).
+    has_object : bool
+        G-buffer programs only: whether it writes the point in the object's own frame (the interpolated vertex
+        position before the pose), the 'object' plane of the frame passes.
     shadow_size : int
         Texels along a side of each shadow map (the renderer's ``shadow_map_size``; 0 without shadowed lights).
     shadow_filter : int
@@ -226,6 +229,7 @@ class ProgramKey:
     normal_map: bool = False
     alpha_mask: int = 0
     has_face: bool = False
+    has_object: bool = False
     shadow_size: int = 0
     shadow_filter: int = 0
     shadow_pass: str = None

@@ -20,8 +20,9 @@ NUMERICS_PIECES = tuple(NUMERICS_DEFINES)
 #: the pieces whose specialised form is the textbook one (set by formulation='naive' too; lobe_tail is not: the naive
 #: lobes are pow())
 TEXTBOOK_PIECES = ("falloff", "light", "normal", "view")
-#: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed)
-GBUFFER_PLANES = ("tangent", "uv", "color", "lod", "face")
+#: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed); 'object':
+#: the point in the object's own frame (the frame passes' object coordinates, NOCS and flow)
+GBUFFER_PLANES = ("tangent", "uv", "color", "lod", "face", "object")
 #: how a surface input is made (``<MODEL>_<PARAM>_INPUT`` is the mode's index plus 1)
 INPUT_MODES = ("texture", "vertex", "texture*vertex")
 #: textured parameters per material (one G-buffer plane of levels of detail)

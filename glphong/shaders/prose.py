@@ -20,8 +20,8 @@ def left_out(key, absent_terms=()):
     """
     if key.output == "gbuffer":
         return ["all shading code and lights (the G-buffer program writes the shading inputs only)",
-                "radiance output"] + [f"{name} output (no drawn term needs it)" for name in GBUFFER_PLANES
-                                      if name not in key.gbuffer_planes()]
+                "radiance output"] + [f"{name} output (no {'pass asks' if name == 'object' else 'drawn term needs'} it)"
+                                      for name in GBUFFER_PLANES if name not in key.gbuffer_planes()]
     if key.output == "shadow":
         return ["all shading code (the shadow pass writes each caster's distance from the light)"]
     if key.uber:

@@ -1,0 +1,178 @@
+"""The frame passes: what a render gives besides the radiance, from one G-buffer draw (docs/design.md section 15).
+
+Each pass is a per-pixel array at the output size, row 0 at the top, sampled at the pixel centre (the G-buffer is
+drawn with one sample per pixel whatever the renderer's ``samples`` and ``supersample``), 0 where no object covers
+the centre:
+
+- ``depth`` (H, W) float32 [m]: the point's distance from the camera along its viewing axis, ``(p - e) . f``.
+- ``distance`` (H, W) float32 [m]: its range along the pixel's ray, ``|p - e|`` (an orthographic camera's rays start
+  on its plane: the depth).
+- ``normal`` (H, W, 3) float32: the world-space unit shading normal as shaded (the two-sided flip and a normal map
+  included); ``normal_camera``: the same in OpenCV's camera frame (x right, y down, z forward), ``R_cv n`` with
+  ``R_cv = diag(1, -1, -1) R^T``.
+- ``uv`` (H, W, 2) float32: the interpolated texture coordinates (every object needs uvs).
+- ``instance``, ``category`` (H, W) uint32: the covering object's `SceneObject.instance_id` and ``category``; 0 the
+  background.
+- ``object_coordinates`` (H, W, 3) float32 [m]: the point in its object's own frame (the pose undone, interpolated
+  from the vertices' object-frame positions); ``nocs``: that point in the unit cube of the mesh's axis-aligned box,
+  ``(o - lo) / (hi - lo)`` per axis (0.5 on an axis where the box is flat), clamped to [0, 1] (the float32
+  interpolation puts a point on the box's face up to an ulp outside it).
+- ``flow``, ``backward_flow`` (H, W, 2) float32 [px], x right, y down: where the point, moving with its own object,
+  lands in ``next_scene`` (the same objects in the same order at their next poses, seen by its camera) minus the
+  pixel centre; from ``previous_scene`` for the backward one.  Kubric's convention: a pure projection, occlusion in
+  the other frame ignored; NaN where the point is not in front of the other camera (its ``w <= 0``).
+"""
+import numpy as np
+
+from glphong.scene.scene import Scene
+
+__all__ = ["PASSES", "GEOMETRY_PASSES", "requested_passes", "gbuffer_planes", "check_passes", "derive_passes",
+           "opencv_rotation"]
+
+#: every pass `glphong.Renderer.render` gives, in the order a `Frame` lists them
+PASSES = ("radiance", "depth", "distance", "normal", "normal_camera", "uv", "instance", "category",
+          "object_coordinates", "nocs", "flow", "backward_flow")
+#: the passes made from the G-buffer draw
+GEOMETRY_PASSES = PASSES[1:]
+_FROM_OBJECT = ("object_coordinates", "nocs", "flow", "backward_flow")
+
+
+def requested_passes(passes, depth=False, normals=False):
+    """The passes of a call, checked and in `PASSES` order: ``passes`` (default ``('radiance',)``) plus 'depth' and
+    'normal' where the older flags ask for them.
+
+    Raises
+    ------
+    TypeError
+        ``passes`` not a sequence of str.
+    ValueError
+        An unknown name (the known ones listed).
+    """
+    if passes is None:
+        names = ["radiance"]
+    elif isinstance(passes, str):
+        names = [passes]
+    else:
+        try:
+            names = list(passes)
+        except TypeError:
+            raise TypeError(f"passes must be a sequence of pass names (got {type(passes).__name__})") from None
+    for name in names:
+        if not isinstance(name, str):
+            raise TypeError(f"passes must be a sequence of pass names, str (got {name!r})")
+        if name not in PASSES:
+            raise ValueError(f"unknown pass {name!r}; the passes are {', '.join(PASSES)}")
+    chosen = set(names) | ({"depth"} if depth else set()) | ({"normal"} if normals else set())
+    return tuple(name for name in PASSES if name in chosen)
+
+
+def gbuffer_planes(names):
+    """The G-buffer planes (beyond position and normal) the passes ``names`` read (frozenset of str)."""
+    return frozenset(("uv",) if "uv" in names else ()) | frozenset(
+        ("object",) if any(n in _FROM_OBJECT for n in names) else ())
+
+
+def check_passes(scene, names, next_scene=None, previous_scene=None):
+    """Whether ``scene`` can have the passes ``names``; raises ValueError naming the pass and the fix."""
+    if "uv" in names:
+        for obj in scene.objects:
+            if obj.mesh.uvs is None:
+                raise ValueError(f"the 'uv' pass needs texture coordinates on every object, and object {obj.name!r} "
+                                 "has none: give its MeshData uvs=, load a mesh with uvs, or leave 'uv' out")
+    for name, other, argument in (("flow", next_scene, "next_scene"), ("backward_flow", previous_scene,
+                                                                        "previous_scene")):
+        if name in names:
+            _check_corresponds(scene, other, name, argument)
+        elif other is not None:
+            raise ValueError(f"{argument} is given but the {name!r} pass is not asked for: add it to passes")
+
+
+def _check_corresponds(scene, other, name, argument):
+    if other is None:
+        raise ValueError(f"the {name!r} pass needs {argument}: the same objects, in the same order, at their "
+                         "poses in that frame, seen by its camera")
+    if not isinstance(other, Scene):
+        raise TypeError(f"{argument} must be a glphong.Scene (got {type(other).__name__})")
+    if len(other.objects) != len(scene.objects):
+        raise ValueError(f"the {name!r} pass needs {argument} to hold the same objects in the same order: it has "
+                         f"{len(other.objects)} objects, the scene {len(scene.objects)}")
+    for i, (a, b) in enumerate(zip(scene.objects, other.objects)):
+        if a.mesh is not b.mesh:
+            raise ValueError(f"the {name!r} pass needs {argument} to hold the same objects in the same order: its "
+                             f"object {i} ({b.name!r}) has another mesh than the scene's ({a.name!r}); add the same "
+                             "MeshData (scene.objects[i].mesh) at the other pose")
+
+
+def opencv_rotation(camera):
+    """World-to-camera rotation of OpenCV's frame (x right, y down, z forward), (3, 3) float64:
+    ``diag(1, -1, -1) R^T`` with ``R`` the camera pose's rotation."""
+    return np.diag([1.0, -1.0, -1.0]) @ camera.pose[:3, :3].T
+
+
+def derive_passes(scene, gbuffer, names, next_scene=None, previous_scene=None):
+    """The geometry passes ``names`` of a G-buffer (`glphong.gpu.frame.GBuffer` with the planes `gbuffer_planes`
+    asks for): a dict of name to array (module docstring)."""
+    mask = gbuffer.mask
+    index = np.where(mask, gbuffer.object_index, 0)
+    camera = scene.camera
+    out = {}
+    position = gbuffer.position.astype(np.float64)
+    eye = camera.eye
+    if "depth" in names or "distance" in names:
+        depth = np.einsum("ijk,k->ij", position - camera.position, -camera.pose[:3, 2])
+        out["depth"] = np.where(mask, depth, 0.0).astype(np.float32)
+        if "distance" in names:
+            distance = np.linalg.norm(position - eye[:3], axis=-1) if eye[3] == 1.0 else depth
+            out["distance"] = np.where(mask, distance, 0.0).astype(np.float32)
+    if "normal" in names:
+        out["normal"] = gbuffer.normal
+    if "normal_camera" in names:
+        out["normal_camera"] = (gbuffer.normal.astype(np.float64) @ opencv_rotation(camera).T).astype(np.float32)
+    if "uv" in names:
+        out["uv"] = np.where(mask[..., None], gbuffer.uv, 0.0).astype(np.float32)
+    for name in ("instance", "category"):
+        if name in names:
+            table = np.array([0] + [getattr(o, "instance_id" if name == "instance" else "category")
+                                    for o in scene.objects], np.uint32)
+            out[name] = table[np.where(mask, gbuffer.object_index + 1, 0)]
+    if any(n in names for n in _FROM_OBJECT):
+        obj = np.where(mask[..., None], gbuffer.object_coordinates, 0.0).astype(np.float32)
+        if "object_coordinates" in names:
+            out["object_coordinates"] = obj
+        if "nocs" in names:
+            out["nocs"] = _nocs(scene, obj, index, mask)
+        for name, other in (("flow", next_scene), ("backward_flow", previous_scene)):
+            if name in names:
+                out[name] = _flow(obj, index, mask, other, gbuffer.mask.shape)
+    return out
+
+
+def _nocs(scene, obj, index, mask):
+    """``(o - lo) / (hi - lo)`` per axis with each object's box (0.5 on a flat axis), clamped to [0, 1], (H, W, 3)
+    float32."""
+    lo = np.array([o.mesh.positions.min(axis=0) for o in scene.objects], np.float64).reshape(-1, 3)
+    hi = np.array([o.mesh.positions.max(axis=0) for o in scene.objects], np.float64).reshape(-1, 3)
+    span = hi - lo
+    with np.errstate(divide="ignore", invalid="ignore"):
+        nocs = np.clip(np.where(span[index] > 0, (obj - lo[index]) / span[index], 0.5), 0.0, 1.0)
+    return np.where(mask[..., None], nocs, 0.0).astype(np.float32)
+
+
+def _flow(obj, index, mask, other, shape):
+    """Where each covered point lands in ``other`` minus the pixel centre [px], (H, W, 2) float32: the point moved
+    by its object's pose there and projected by that scene's camera (its projection matrix, clip to window
+    coordinates); NaN where its ``w <= 0`` (not in front of the camera), 0 where not covered."""
+    height, width = shape
+    camera = other.camera
+    clip_from_world = camera.projection_matrix(width / height) @ camera.view_matrix()
+    poses = np.array([clip_from_world @ o.pose for o in other.objects]).reshape(-1, 4, 4)
+    point = np.concatenate([obj.astype(np.float64), np.ones(shape + (1,))], axis=-1)
+    clip = np.einsum("hwij,hwj->hwi", poses[index], point)
+    w = clip[..., 3]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = (clip[..., 0] / w + 1.0) * (0.5 * width)
+        y = (1.0 - clip[..., 1] / w) * (0.5 * height)
+    rows, cols = np.mgrid[0:height, 0:width]
+    flow = np.stack([x - (cols + 0.5), y - (rows + 0.5)], axis=-1)
+    flow = np.where((w > 0)[..., None], flow, np.nan)
+    return np.where(mask[..., None], flow, 0.0).astype(np.float32)
