@@ -1,10 +1,12 @@
 """Pixel-by-pixel cross-check of a GPU render against the float64 twin (docs/design.md section 4)."""
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from glphong.checks import reference
 from glphong.checks.tolerances import BAND, point_band
+from glphong.checks.verify_passes import verify_passes
+from glphong.gpu.passes import requested_passes
 from glphong.gpu.renderer import Renderer
 
 __all__ = ["VerifyReport", "verify", "compare", "relative_error"]
@@ -41,6 +43,8 @@ class VerifyReport:
         twin against the GPU, under the band).
     exact_error : (H, W) float64 ndarray or None
         The quadrature's absolute error estimate per pixel.
+    passes : dict of str to glphong.checks.verify_passes.PassReport
+        Each frame pass ``verify(..., passes=...)`` asked for against its twin (empty without).
     """
 
     gpu: np.ndarray
@@ -54,6 +58,7 @@ class VerifyReport:
     shadow_band: np.ndarray = None
     exact: np.ndarray = None
     exact_error: np.ndarray = None
+    passes: dict = field(default_factory=dict)
 
     @property
     def method_error(self):
@@ -103,8 +108,8 @@ class VerifyReport:
 
     @property
     def passed(self):
-        """True when every covered pixel lies in the band and the coverage masks agree."""
-        return self.outside_count == 0 and self.mask_mismatch == 0
+        """True when every covered pixel lies in the band, the coverage masks agree and every pass checked passes."""
+        return self.outside_count == 0 and self.mask_mismatch == 0 and all(p.passed for p in self.passes.values())
 
     @property
     def shadow_band_count(self):
@@ -122,15 +127,19 @@ class VerifyReport:
         figures = self.method_error_figures()
         if figures is not None:
             out["method_mean_error"], out["method_max_error"] = figures
+        if self.passes:
+            out["passes"] = {name: report.summary() for name, report in self.passes.items()}
         return out
 
     def __str__(self):
         s = self.summary()
         method = (f"; method against exact: mean rel err {s['method_mean_error']:.3g}, max {s['method_max_error']:.3g}"
                   if "method_max_error" in s else "")
+        passes = "".join(f"; {name} {'pass' if p['passed'] else 'FAIL'} (max err {p['max_error']:.3g}, outside "
+                         f"{p['outside']})" for name, p in s.get("passes", {}).items())
         return (f"{'PASS' if s['passed'] else 'FAIL'}: {s['covered_pixels']} px, max rel err {s['max_relative_error']:.3g}, "
                 f"rms rel err {s['rms_relative_error']:.3g}, outside band {s['outside_band']}, "
-                f"non-finite {s['nonfinite']}, mask mismatch {s['mask_mismatch']}{method}")
+                f"non-finite {s['nonfinite']}, mask mismatch {s['mask_mismatch']}{method}{passes}")
 
 
 def relative_error(value, reference):
@@ -172,9 +181,10 @@ def compare(gpu, reference_radiance, low, high, mask):
     return rel, outside
 
 
-def verify(scene, renderer, band=BAND, exact=None):
+def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None, previous_scene=None):
     """Render ``scene``, shade its G-buffer with the float64 twin, compare under the band; where the scene has
-    extended lights, also the twin against their exact integrals (the method error map).
+    extended lights, also the twin against their exact integrals (the method error map); and each frame pass asked
+    for against its own twin (`glphong.checks.verify_passes`).
 
     Parameters
     ----------
@@ -183,6 +193,10 @@ def verify(scene, renderer, band=BAND, exact=None):
     band : glphong.checks.tolerances.BandConstants
     exact : bool, optional
         Compute the exact integrals (`VerifyReport.exact`); default: where the scene has extended lights.
+    passes : sequence of str, optional
+        Frame passes to check besides the radiance (`glphong.Renderer.render`'s names; 'radiance' is always checked).
+    next_scene, previous_scene : Scene, optional
+        What 'flow' and 'backward_flow' read (as in `glphong.Renderer.render`).
 
     Returns
     -------
@@ -201,8 +215,10 @@ def verify(scene, renderer, band=BAND, exact=None):
     if renderer.shading != "pixel" or renderer.samples != 1 or renderer.supersample != 1:
         raise ValueError("verify needs a Renderer with shading='pixel', samples=1 and supersample=1 "
                          f"(got {renderer!r}); compare other options with glphong.checks.raycast instead")
+    names = requested_passes(passes)
     with renderer._lock:  # one call: no resize from another thread between the two passes
-        frame = renderer.render(scene)
+        frame = renderer.render(scene, passes=("radiance",) + names, next_scene=next_scene,
+                                previous_scene=previous_scene)
         gbuffer = renderer.gbuffer(scene)
     ref, low, high, shadow_band = twin_and_band(scene, gbuffer, band, renderer.shadow_settings)
     mask = frame.mask & gbuffer.mask
@@ -210,9 +226,11 @@ def verify(scene, renderer, band=BAND, exact=None):
     if exact is None:
         exact = any(light.extent == "extended" for light in scene.lights)
     exact_radiance, exact_error = exact_image(scene, gbuffer, renderer.shadow_settings) if exact else (None, None)
+    geometry = tuple(n for n in names if n != "radiance")
     return VerifyReport(gpu=frame.radiance, reference=ref, low=low, high=high, relative_error=rel,
                         outside=outside, mask=mask, mask_mismatch=int((frame.mask != gbuffer.mask).sum()),
-                        shadow_band=shadow_band, exact=exact_radiance, exact_error=exact_error)
+                        shadow_band=shadow_band, exact=exact_radiance, exact_error=exact_error,
+                        passes=verify_passes(scene, frame, geometry, next_scene, previous_scene) if geometry else {})
 
 
 def exact_image(scene, gbuffer, shadows=None, closed_forms=True):

@@ -111,68 +111,69 @@ def opencv_rotation(camera):
 
 def derive_passes(scene, gbuffer, names, next_scene=None, previous_scene=None):
     """The geometry passes ``names`` of a G-buffer (`glphong.gpu.frame.GBuffer` with the planes `gbuffer_planes`
-    asks for): a dict of name to array (module docstring)."""
+    asks for): a dict of name to array (module docstring), computed on the covered pixels only."""
     mask = gbuffer.mask
-    index = np.where(mask, gbuffer.object_index, 0)
+    index = gbuffer.object_index[mask]
     camera = scene.camera
     out = {}
-    position = gbuffer.position.astype(np.float64)
-    eye = camera.eye
+
+    def image(values, dtype=np.float32):  # the covered pixels' values in an image, 0 elsewhere
+        full = np.zeros(mask.shape + values.shape[1:], dtype)
+        full[mask] = values
+        return full
+
     if "depth" in names or "distance" in names:
-        depth = np.einsum("ijk,k->ij", position - camera.position, -camera.pose[:3, 2])
-        out["depth"] = np.where(mask, depth, 0.0).astype(np.float32)
+        position = gbuffer.position[mask].astype(np.float64)
+        depth = np.einsum("ij,j->i", position - camera.position, -camera.pose[:3, 2])
+        out["depth"] = image(depth)
         if "distance" in names:
-            distance = np.linalg.norm(position - eye[:3], axis=-1) if eye[3] == 1.0 else depth
-            out["distance"] = np.where(mask, distance, 0.0).astype(np.float32)
+            eye = camera.eye
+            out["distance"] = image(np.linalg.norm(position - eye[:3], axis=-1) if eye[3] == 1.0 else depth)
     if "normal" in names:
         out["normal"] = gbuffer.normal
     if "normal_camera" in names:
-        out["normal_camera"] = (gbuffer.normal.astype(np.float64) @ opencv_rotation(camera).T).astype(np.float32)
+        out["normal_camera"] = image(gbuffer.normal[mask].astype(np.float64) @ opencv_rotation(camera).T)
     if "uv" in names:
-        out["uv"] = np.where(mask[..., None], gbuffer.uv, 0.0).astype(np.float32)
+        out["uv"] = image(gbuffer.uv[mask])
     for name in ("instance", "category"):
         if name in names:
-            table = np.array([0] + [getattr(o, "instance_id" if name == "instance" else "category")
-                                    for o in scene.objects], np.uint32)
-            out[name] = table[np.where(mask, gbuffer.object_index + 1, 0)]
+            table = np.array([getattr(o, "instance_id" if name == "instance" else "category") for o in scene.objects],
+                             np.uint32)
+            out[name] = image(table[index], np.uint32)
     if any(n in names for n in _FROM_OBJECT):
-        obj = np.where(mask[..., None], gbuffer.object_coordinates, 0.0).astype(np.float32)
+        obj = gbuffer.object_coordinates[mask]
         if "object_coordinates" in names:
-            out["object_coordinates"] = obj
+            out["object_coordinates"] = image(obj)
         if "nocs" in names:
-            out["nocs"] = _nocs(scene, obj, index, mask)
+            out["nocs"] = image(_nocs(scene, obj, index))
         for name, other in (("flow", next_scene), ("backward_flow", previous_scene)):
             if name in names:
-                out[name] = _flow(obj, index, mask, other, gbuffer.mask.shape)
+                out[name] = image(_flow(obj, index, np.nonzero(mask), other, mask.shape))
     return out
 
 
-def _nocs(scene, obj, index, mask):
-    """``(o - lo) / (hi - lo)`` per axis with each object's box (0.5 on a flat axis), clamped to [0, 1], (H, W, 3)
-    float32."""
+def _nocs(scene, obj, index):
+    """``(o - lo) / (hi - lo)`` per axis with each object's box (0.5 on a flat axis), clamped to [0, 1], (N, 3)
+    float64 for points ``obj`` (N, 3) of objects ``index`` (N,)."""
     lo = np.array([o.mesh.positions.min(axis=0) for o in scene.objects], np.float64).reshape(-1, 3)
     hi = np.array([o.mesh.positions.max(axis=0) for o in scene.objects], np.float64).reshape(-1, 3)
-    span = hi - lo
+    span = (hi - lo)[index]
     with np.errstate(divide="ignore", invalid="ignore"):
-        nocs = np.clip(np.where(span[index] > 0, (obj - lo[index]) / span[index], 0.5), 0.0, 1.0)
-    return np.where(mask[..., None], nocs, 0.0).astype(np.float32)
+        return np.clip(np.where(span > 0, (obj - lo[index]) / span, 0.5), 0.0, 1.0)
 
 
-def _flow(obj, index, mask, other, shape):
-    """Where each covered point lands in ``other`` minus the pixel centre [px], (H, W, 2) float32: the point moved
-    by its object's pose there and projected by that scene's camera (its projection matrix, clip to window
-    coordinates); NaN where its ``w <= 0`` (not in front of the camera), 0 where not covered."""
+def _flow(obj, index, pixels, other, shape):
+    """Where each point ``obj`` (N, 3) of objects ``index`` (N,) at ``pixels`` (rows (N,), columns (N,)) lands in
+    ``other`` minus its pixel centre [px], (N, 2) float64: moved by its object's pose there and projected by that
+    scene's camera (its projection and view matrices, clip to window coordinates); NaN where ``w <= 0`` (not in front
+    of the camera)."""
     height, width = shape
     camera = other.camera
     clip_from_world = camera.projection_matrix(width / height) @ camera.view_matrix()
     poses = np.array([clip_from_world @ o.pose for o in other.objects]).reshape(-1, 4, 4)
-    point = np.concatenate([obj.astype(np.float64), np.ones(shape + (1,))], axis=-1)
-    clip = np.einsum("hwij,hwj->hwi", poses[index], point)
-    w = clip[..., 3]
+    clip = np.einsum("nij,nj->ni", poses[index, :, :3], obj.astype(np.float64)) + poses[index, :, 3]
+    w = clip[:, 3]
     with np.errstate(divide="ignore", invalid="ignore"):
-        x = (clip[..., 0] / w + 1.0) * (0.5 * width)
-        y = (1.0 - clip[..., 1] / w) * (0.5 * height)
-    rows, cols = np.mgrid[0:height, 0:width]
-    flow = np.stack([x - (cols + 0.5), y - (rows + 0.5)], axis=-1)
-    flow = np.where((w > 0)[..., None], flow, np.nan)
-    return np.where(mask[..., None], flow, 0.0).astype(np.float32)
+        x = (clip[:, 0] / w + 1.0) * (0.5 * width) - (pixels[1] + 0.5)
+        y = (1.0 - clip[:, 1] / w) * (0.5 * height) - (pixels[0] + 0.5)
+    return np.where((w > 0)[:, None], np.stack([x, y], axis=-1), np.nan)
