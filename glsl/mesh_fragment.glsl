@@ -21,9 +21,12 @@
 // HAS_FACE: the triangle's own normal, from the derivatives of the interpolated position (the slope of the shadow
 //   bias, shadows.glsl): a G-buffer plane, and shadow_face_normal when shading.
 // HAS_OBJECT: the G-buffer plane of the point in the object's own frame (xyz [m], w = 1), for the frame passes.
+// WRITES_PLANES (radiance programs of the frame passes, multiple render targets): beside the radiance, the
+//   position plane (w = object id + 1) at PASS_POSITION_LOCATION and, with PASS_NORMAL, PASS_OBJECT, PASS_UV, the
+//   normal, object and uv planes at their PASS_*_LOCATION, each exactly as the G-buffer program writes it.
 // NAIVE_NORMAL: n by plain_normalize where the key proves it safe, common.glsl.
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, HAS_FACE, HAS_OBJECT, NUM_LOD_TEXTURES,
-// GBUFFER_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
+// GBUFFER_*_LOCATION, WRITES_PLANES, PASS_NORMAL, PASS_OBJECT, PASS_UV, PASS_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
 // NAIVE_NORMAL, RUNTIME_SWITCHES, SWITCH(flag).
 
 invariant in vec3 v_position;
@@ -112,6 +115,20 @@ invariant in vec3 v_object;
 layout(location = GBUFFER_OBJECT_LOCATION) out vec4 out_object;
 #endif
 #else
+#if WRITES_PLANES
+uniform float u_object_id;
+layout(location = PASS_POSITION_LOCATION) out vec4 out_position;
+#if PASS_NORMAL
+layout(location = PASS_NORMAL_LOCATION) out vec4 out_normal;
+#endif
+#if PASS_OBJECT
+invariant in vec3 v_object;
+layout(location = PASS_OBJECT_LOCATION) out vec4 out_object;
+#endif
+#if PASS_UV
+layout(location = PASS_UV_LOCATION) out vec4 out_uv;
+#endif
+#endif
 #if NEEDS_VIEW
 uniform vec4 u_eye;  // homogeneous eye (e, w): the view vector at x is normalize(e - w x)
 #else
@@ -204,6 +221,18 @@ void main()
     out_radiance = vec4(srgb_encode(u_exposure * shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye)), 1.0);
 #else
     out_radiance = vec4(shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye), 1.0);
+#endif
+#if WRITES_PLANES
+    out_position = vec4(v_position, u_object_id + 1.0);  // the G-buffer's planes, as OUTPUT_GBUFFER writes them
+#if PASS_NORMAL
+    out_normal = vec4(n, 1.0);
+#endif
+#if PASS_OBJECT
+    out_object = vec4(v_object, 1.0);
+#endif
+#if PASS_UV
+    out_uv = vec4(uv, 0.0, 1.0);
+#endif
 #endif
 #endif
 }

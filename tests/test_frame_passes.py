@@ -193,3 +193,27 @@ def test_the_depth_flag_and_the_depth_pass_agree(glphong_make_renderer):
     assert a.passes == ("radiance", "depth", "normal")
     assert np.array_equal(a.depth, b.depth) and np.array_equal(a.normal, b.normal)
     assert np.array_equal(a.radiance, b.radiance)
+
+
+def test_one_draw_gives_the_radiance_and_the_planes_of_the_separate_draws(glphong_backend, glphong_make_renderer):
+    """With one sample per pixel the passes come from the shading draw itself (multiple render targets): its radiance
+    is bit-identical to a radiance-only render, and every pass to the one derived from the separate G-buffer draw
+    (the path a multisampled renderer takes)."""
+    from glphong.gpu.passes import derive_passes, gbuffer_planes
+    camera = glphong.PerspectiveCamera.look_at((0.4, 0.3, 3.0), (0.0, 0.0, 0.0), yfov=0.7)
+    scene = _sphere_scene(camera)
+    plane = primitives.plane(1.5)
+    scene.add(plane, glphong.Lambert(0.4), pose=_cube_pose(0.3, (0.2, -0.4, -0.5)),
+              instance_id=3, category=1)
+    later = _sphere_scene(camera)
+    later.add(plane, glphong.Lambert(0.4), pose=_cube_pose(0.35, (0.25, -0.4, -0.5)), instance_id=3, category=1)
+    renderer = glphong_make_renderer(W, H, glphong_backend)
+    names = tuple(p for p in PASSES if p != "backward_flow")
+    frame = renderer.render(scene, passes=names, next_scene=later)
+    assert renderer.program_key(scene, scene.objects[0], "radiance", ("position", "normal", "uv")).pass_planes
+    assert np.array_equal(frame.radiance, renderer.render(scene).radiance)
+    geometry = [n for n in names if n != "radiance"]
+    separate = derive_passes(scene, renderer.gbuffer(scene, gbuffer_planes(geometry)), geometry, next_scene=later)
+    for name in geometry:
+        assert np.array_equal(getattr(frame, name), separate[name], equal_nan=True), name
+    assert frame.instance.max() == 7 and (frame.instance == 3).sum() > 100

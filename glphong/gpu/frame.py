@@ -134,3 +134,16 @@ class GBuffer:
     lod: np.ndarray = None
     face: np.ndarray = None
     object_coordinates: np.ndarray = None
+
+    @classmethod
+    def from_planes(cls, position, normal, planes):
+        """The G-buffer of read-back RGBA planes: ``position`` (H, W, 4) (w: object index + 1, 0 where not covered),
+        ``normal`` (H, W, 4) or None (then left None: a frame pass's draw that did not write it), ``planes`` dict of
+        extra plane name (`glphong.shaders.options.GBUFFER_PLANES`) to (H, W, 4)."""
+        mask = position[..., 3] > 0.0
+        channels = {"tangent": 4, "uv": 2, "color": 3, "lod": 4, "face": 3, "object": 3}
+        extra = {("object_coordinates" if name == "object" else name): np.ascontiguousarray(plane[..., :channels[name]])
+                 for name, plane in planes.items()}
+        return cls(position=np.ascontiguousarray(position[..., :3]),
+                   normal=None if normal is None else np.ascontiguousarray(normal[..., :3]),
+                   object_index=np.where(mask, np.rint(position[..., 3]).astype(np.int64) - 1, -1), mask=mask, **extra)

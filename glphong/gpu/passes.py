@@ -113,18 +113,22 @@ def derive_passes(scene, gbuffer, names, next_scene=None, previous_scene=None):
     """The geometry passes ``names`` of a G-buffer (`glphong.gpu.frame.GBuffer` with the planes `gbuffer_planes`
     asks for): a dict of name to array (module docstring), computed on the covered pixels only."""
     mask = gbuffer.mask
-    index = gbuffer.object_index[mask]
+    flat = np.flatnonzero(mask)  # the covered pixels, row-major: gathers and scatters by index, not by mask
+    index = gbuffer.object_index.reshape(-1)[flat]
     camera = scene.camera
     out = {}
 
+    def covered(plane):  # (N, C) values of a G-buffer plane at the covered pixels
+        return plane.reshape(-1, plane.shape[-1])[flat] if plane.ndim == 3 else plane.reshape(-1)[flat]
+
     def image(values, dtype=np.float32):  # the covered pixels' values in an image, 0 elsewhere
-        full = np.zeros(mask.shape + values.shape[1:], dtype)
-        full[mask] = values
-        return full
+        full = np.zeros((mask.size,) + values.shape[1:], dtype)
+        full[flat] = values
+        return full.reshape(mask.shape + values.shape[1:])
 
     if "depth" in names or "distance" in names:
-        position = gbuffer.position[mask].astype(np.float64)
-        depth = np.einsum("ij,j->i", position - camera.position, -camera.pose[:3, 2])
+        position = covered(gbuffer.position).astype(np.float64)
+        depth = (position - camera.position) @ -camera.pose[:3, 2]
         out["depth"] = image(depth)
         if "distance" in names:
             eye = camera.eye
@@ -132,31 +136,35 @@ def derive_passes(scene, gbuffer, names, next_scene=None, previous_scene=None):
     if "normal" in names:
         out["normal"] = gbuffer.normal
     if "normal_camera" in names:
-        out["normal_camera"] = image(gbuffer.normal[mask].astype(np.float64) @ opencv_rotation(camera).T)
+        out["normal_camera"] = image(covered(gbuffer.normal).astype(np.float64) @ opencv_rotation(camera).T)
     if "uv" in names:
-        out["uv"] = image(gbuffer.uv[mask])
+        out["uv"] = image(covered(gbuffer.uv))
     for name in ("instance", "category"):
         if name in names:
             table = np.array([getattr(o, "instance_id" if name == "instance" else "category") for o in scene.objects],
                              np.uint32)
             out[name] = image(table[index], np.uint32)
     if any(n in names for n in _FROM_OBJECT):
-        obj = gbuffer.object_coordinates[mask]
+        obj = covered(gbuffer.object_coordinates)
         if "object_coordinates" in names:
             out["object_coordinates"] = image(obj)
         if "nocs" in names:
             out["nocs"] = image(_nocs(scene, obj, index))
         for name, other in (("flow", next_scene), ("backward_flow", previous_scene)):
             if name in names:
-                out[name] = image(_flow(obj, index, np.nonzero(mask), other, mask.shape))
+                out[name] = image(_flow(obj, index, np.divmod(flat, mask.shape[1]), other, mask.shape))
     return out
 
 
 def _nocs(scene, obj, index):
     """``(o - lo) / (hi - lo)`` per axis with each object's box (0.5 on a flat axis), clamped to [0, 1], (N, 3)
     float64 for points ``obj`` (N, 3) of objects ``index`` (N,)."""
-    lo = np.array([o.mesh.positions.min(axis=0) for o in scene.objects], np.float64).reshape(-1, 3)
-    hi = np.array([o.mesh.positions.max(axis=0) for o in scene.objects], np.float64).reshape(-1, 3)
+    boxes = {}  # each mesh's box once, however many objects share it
+    for o in scene.objects:
+        if id(o.mesh) not in boxes:
+            boxes[id(o.mesh)] = (o.mesh.positions.min(axis=0), o.mesh.positions.max(axis=0))
+    lo = np.array([boxes[id(o.mesh)][0] for o in scene.objects], np.float64).reshape(-1, 3)
+    hi = np.array([boxes[id(o.mesh)][1] for o in scene.objects], np.float64).reshape(-1, 3)
     span = (hi - lo)[index]
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.clip(np.where(span > 0, (obj - lo[index]) / span, 0.5), 0.0, 1.0)

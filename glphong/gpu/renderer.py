@@ -18,13 +18,13 @@ from glphong.core import validate as _validate
 from glphong.gpu.frame import Frame, GBuffer
 from glphong.gpu.passes import check_passes, derive_passes, gbuffer_planes, requested_passes
 from glphong.gpu.resources import (ORPHANS, ORPHANS_LOCK, MeshBuffers, ObjectEntry, available_memory, make_target,
-                                   release_orphans, release_resources, release_targets)
+                                   read_attachment, release_orphans, release_resources, release_targets)
 from glphong.gpu.contexts import check_not_forked, create_context
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
 from glphong.shaders.builders import uber_key
 from glphong.shaders.keys import EncodeKey
-from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES
+from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, PASS_PLANES
 from glphong.shaders.numerics import NUMERICS, allowed_pieces, view_decision, with_numerics
 from glphong.gpu.shadows import ShadowMaps
 from glphong.gpu.programs import ProgramCache
@@ -251,6 +251,9 @@ class Renderer:
         check_passes(scene, names, next_scene, previous_scene)
         geometry = [n for n in names if n != "radiance"]
         extra = {}
+        if geometry and "radiance" in names and self.samples == 1 and self.supersample == 1 \
+                and self.shading == "pixel" and self.specialise:
+            return self._render_with_planes(scene, names, geometry, next_scene, previous_scene)
         if geometry:  # the lock is re-entrant
             gbuffer = self.gbuffer(scene, gbuffer_planes(geometry))
             extra = derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
@@ -259,12 +262,31 @@ class Renderer:
                          **extra)
         with self.context:
             fbo = self._draw_radiance(scene)
-            rgba = self._read(fbo, self._internal_size, components=4)
+            rgba = read_attachment(fbo, self._internal_size, components=4)
             self.context.check_error("rendering radiance")
         s = self.supersample
         if s > 1:
             rgba = rgba.reshape(self.height, s, self.width, s, 4).mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
         # views of the one readback (rows flipped by strides): no copy after the driver's
+        coverage = rgba[..., 3]
+        return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, passes=names, **extra)
+
+    def _render_with_planes(self, scene, names, geometry, next_scene, previous_scene):
+        """The radiance and the geometry passes from one draw: each radiance program also writes the G-buffer planes
+        the passes read (multiple render targets, `glphong.shaders.options.PASS_PLANES`), where one sample per pixel
+        at the output size is what the radiance is drawn with too."""
+        planes = gbuffer_planes(geometry)
+        normal = any(n in ("normal", "normal_camera") for n in geometry)
+        pass_planes = tuple(p for p in PASS_PLANES if p == "position" or (p == "normal" and normal) or p in planes)
+        with self.context:
+            fbo = self._target(("radiance", *pass_planes))
+            self._draw(scene, "radiance", fbo, planes=pass_planes)
+            rgba = read_attachment(fbo, self._size, components=4)
+            read = {name: read_attachment(fbo, self._size, components=4, attachment=1 + i)
+                    for i, name in enumerate(pass_planes)}
+            self.context.check_error("rendering radiance and the frame passes' planes")
+        gbuffer = GBuffer.from_planes(read.pop("position"), read.pop("normal", None), read)
+        extra = derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
         coverage = rgba[..., 3]
         return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, passes=names, **extra)
 
@@ -305,7 +327,7 @@ class Renderer:
                     resolved = self._target("srgb8")
                     self._mgl.copy_framebuffer(resolved, target)
                     target = resolved
-                rgb = self._read(target, self._size, components=3, dtype="f1")
+                rgb = read_attachment(target, self._size, components=3, dtype="f1")
                 self.context.check_error("rendering display values")
                 return rgb
             texture = self._draw_radiance(scene).color_attachments[0]
@@ -316,7 +338,7 @@ class Renderer:
             program.bind({"u_radiance": 0, "u_exposure": exposure})
             self._mgl.disable(moderngl.DEPTH_TEST)
             self._fullscreen(program).render(moderngl.TRIANGLES, vertices=3)
-            rgb = self._read(out, self._size, components=3, dtype="f1")  # 'f1': normalised bytes
+            rgb = read_attachment(out, self._size, components=3, dtype="f1")  # 'f1': normalised bytes
             self.context.check_error("encoding sRGB")
         return rgb
 
@@ -342,20 +364,9 @@ class Renderer:
         with self.context:
             fbo = self._target(("gbuffer", *extras))
             self._draw(scene, "gbuffer", fbo, planes=planes)
-            planes = [self._read(fbo, self._size, components=4, attachment=i) for i in range(2 + len(extras))]
+            planes = [read_attachment(fbo, self._size, components=4, attachment=i) for i in range(2 + len(extras))]
             self.context.check_error("rendering the G-buffer")
-        position, normal = planes[:2]
-        extra = dict(zip(extras, planes[2:]))
-        mask = position[..., 3] > 0.0
-        object_index = np.where(mask, np.rint(position[..., 3]).astype(np.int64) - 1, -1)
-        return GBuffer(position=np.ascontiguousarray(position[..., :3]), normal=np.ascontiguousarray(normal[..., :3]),
-                       object_index=object_index, mask=mask,
-                       tangent=np.ascontiguousarray(extra["tangent"]) if "tangent" in extra else None,
-                       uv=np.ascontiguousarray(extra["uv"][..., :2]) if "uv" in extra else None,
-                       color=np.ascontiguousarray(extra["color"][..., :3]) if "color" in extra else None,
-                       lod=np.ascontiguousarray(extra["lod"]) if "lod" in extra else None,
-                       face=np.ascontiguousarray(extra["face"][..., :3]) if "face" in extra else None,
-                       object_coordinates=np.ascontiguousarray(extra["object"][..., :3]) if "object" in extra else None)
+        return GBuffer.from_planes(planes[0], planes[1], dict(zip(extras, planes[2:])))
 
     def program_key(self, scene, obj, output="radiance", planes=frozenset()):
         """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading); ``planes``: a
@@ -367,7 +378,10 @@ class Renderer:
                                  "render it with specialise=True")
             return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex, scene.lights)
         key = binding(scene).program_key(obj, output)
-        if planes:
+        if planes and output == "radiance":  # the frame passes' planes beside the radiance (`_render_with_planes`)
+            key = replace(key, pass_planes=tuple(planes), has_object="object" in planes,
+                          has_uv=key.has_uv or "uv" in planes)
+        elif planes:
             key = replace(key, **{f"has_{name}": True for name in planes})
         if key.shadow_slots:
             if per_vertex:
@@ -501,14 +515,6 @@ class Renderer:
             return False
         entry.camera = camera
         return True
-
-    @staticmethod
-    def _read(fbo, size, components, attachment=0, dtype="f4"):
-        """The attachment as a new writable (H, W, components) array, row 0 at the top (a view with a
-        negative row stride: GL's rows run bottom-up), read straight into it."""
-        data = np.empty((size[1], size[0], components), np.float32 if dtype == "f4" else np.uint8)
-        fbo.read_into(data, components=components, attachment=attachment, dtype=dtype)
-        return data[::-1]
 
     def _fullscreen(self, program):
         vao = self._targets.get(("fullscreen", program.key))

@@ -15,18 +15,24 @@ import numpy as np
 
 from glphong.gpu.contexts import EGLDisplayTerminatedError
 
-__all__ = ["MeshBuffers", "ObjectEntry", "available_memory", "make_target", "release_resources", "release_targets",
+__all__ = ["MeshBuffers", "ObjectEntry", "available_memory", "make_target", "read_attachment", "release_resources", "release_targets",
            "release_orphans", "ORPHANS", "ORPHANS_LOCK"]
 
 
 def make_target(mgl, name, size, internal_size, samples):
     """A renderer's framebuffer ``name``: ``('gbuffer', *planes)`` (RGBA32F position, normal and each plane, with
-    depth, at the output ``size``), 'radiance' (RGBA32F at the ``internal_size``, multisampled renderbuffers with
+    depth, at the output ``size``), ``('radiance', *planes)`` (RGBA32F radiance and each of the frame passes' planes,
+    one sample per pixel at the output size), 'radiance' (RGBA32F at the ``internal_size``, multisampled renderbuffers with
     ``samples > 1``, else a texture), 'resolve' (its single-sampled texture), 'display' (8-bit, multisampled like
     the radiance) or 'srgb8' (8-bit at the output size)."""
     if isinstance(name, tuple) and name[0] == "gbuffer":
         colors = [mgl.renderbuffer(size, 4, dtype="f4") for _ in range(len(name) + 1)]
         return mgl.framebuffer(colors, mgl.depth_renderbuffer(size))
+    if isinstance(name, tuple) and name[0] == "radiance":  # one sample per pixel, the frame passes' planes beside
+        texture = mgl.texture(size, 4, dtype="f4")
+        texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
+        planes = [mgl.renderbuffer(size, 4, dtype="f4") for _ in range(len(name) - 1)]
+        return mgl.framebuffer([texture, *planes], mgl.depth_renderbuffer(size))
     if name == "radiance" and samples > 1:
         return mgl.framebuffer([mgl.renderbuffer(internal_size, 4, samples=samples, dtype="f4")],
                                mgl.depth_renderbuffer(internal_size, samples=samples))
@@ -38,6 +44,14 @@ def make_target(mgl, name, size, internal_size, samples):
         texture.filter = (moderngl.NEAREST, moderngl.NEAREST)
         return mgl.framebuffer([texture], mgl.depth_renderbuffer(internal_size) if name == "radiance" else None)
     return mgl.framebuffer([mgl.renderbuffer(size, 4)])  # srgb8
+
+
+def read_attachment(fbo, size, components, attachment=0, dtype="f4"):
+    """The attachment of ``fbo`` as a new writable (H, W, components) array (``size`` (W, H)), row 0 at the top (a
+    view with a negative row stride: GL's rows run bottom-up), read straight into it."""
+    data = np.empty((size[1], size[0], components), np.float32 if dtype == "f4" else np.uint8)
+    fbo.read_into(data, components=components, attachment=attachment, dtype=dtype)
+    return data[::-1]
 
 
 @dataclass(eq=False)

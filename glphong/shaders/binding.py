@@ -166,8 +166,9 @@ class SceneBinding:
         values = {"u_model": obj.pose}
         if key.has_normal:
             values["u_normal_matrix"] = obj.normal_matrix
-        if key.output == "gbuffer":
+        if key.output == "gbuffer" or key.pass_planes:
             values["u_object_id"] = float(index)
+        if key.output == "gbuffer":
             values.update(obj.material.surface_uniform_values(key))  # the mapped normal, the alpha test
             if key.lod_textures:  # the radiance program's textures, whose levels of detail the G-buffer records
                 spec = self.program_key(obj)

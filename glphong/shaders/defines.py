@@ -41,6 +41,10 @@ def program_defines(key):
     if key.output == "gbuffer":  # extra planes follow position and normal, packed in this order
         out += [(f"GBUFFER_{name.upper()}_LOCATION", str(2 + i)) for i, name in enumerate(key.gbuffer_planes())]
     if key.output not in ("gbuffer", "shadow"):
+        # the frame passes' planes beside the radiance (multiple render targets), each at its location from 1
+        out.append(("WRITES_PLANES", b(bool(key.pass_planes))))
+        out += [(f"PASS_{name.upper()}", b(name in key.pass_planes)) for name in ("normal", "object", "uv")]
+        out += [(f"PASS_{name.upper()}_LOCATION", str(1 + i)) for i, name in enumerate(key.pass_planes)]
         out.append(("NEEDS_VIEW", b(key.needs_view)))
         if key.shadow_slots:
             out += [("SHADOW_MAP_SIZE", str(key.shadow_size)), ("SHADOW_FILTER_RADIUS", str(key.shadow_filter))]

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 from glphong.core.glsl_files import library_chunks
 from glphong.shaders.defines import program_defines
 from glphong.shaders.generated import LIGHTS_CHUNK, LOD_CHUNK, MATERIAL_CHUNK, lights_chunk, lod_chunk, material_chunk
-from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, NUMERICS_PIECES, OUTPUTS, SHADOW_PASSES
+from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, NUMERICS_PIECES, OUTPUTS, PASS_PLANES, SHADOW_PASSES
 from glphong.shaders.prose import describe_key, left_out
 from glphong.shaders.stages import shading_chunks, stage_chunks
 
@@ -197,8 +197,11 @@ class ProgramKey:
         Whether the fragment stage computes the triangle's own (geometric) normal from the derivatives of the
         position (the shadow bias's slope; for a G-buffer program: whether it writes it, the 'face' plane).
     has_object : bool
-        G-buffer programs only: whether it writes the point in the object's own frame (the interpolated vertex
-        position before the pose), the 'object' plane of the frame passes.
+        Whether the program interpolates the point in the object's own frame (the vertex position before the pose);
+        a G-buffer program then writes it, the 'object' plane of the frame passes.
+    pass_planes : tuple of str
+        Radiance programs only: the planes (`glphong.shaders.options.PASS_PLANES`, in that order) it writes beside the
+        radiance, at locations 1, 2, ...: the frame passes from the shading draw itself (multiple render targets).
     shadow_size : int
         Texels along a side of each shadow map (the renderer's ``shadow_map_size``; 0 without shadowed lights).
     shadow_filter : int
@@ -230,6 +233,7 @@ class ProgramKey:
     alpha_mask: int = 0
     has_face: bool = False
     has_object: bool = False
+    pass_planes: tuple = ()
     shadow_size: int = 0
     shadow_filter: int = 0
     shadow_pass: str = None
@@ -240,7 +244,11 @@ class ProgramKey:
                 not all(isinstance(t, TermKey) for t in self.terms) or not all(isinstance(k, LightKey) for k in self.lights) \
                 or self.shadow_pass not in SHADOW_PASSES or \
                 tuple(sorted(set(self.numerics))) != tuple(self.numerics) or \
-                not set(self.numerics) <= set(NUMERICS_PIECES):
+                not set(self.numerics) <= set(NUMERICS_PIECES) or \
+                tuple(n for n in PASS_PLANES if n in self.pass_planes) != tuple(self.pass_planes) or \
+                (self.pass_planes and (self.output != "radiance" or self.pass_planes[0] != "position" or
+                                       ("object" in self.pass_planes) != self.has_object or
+                                       ("uv" in self.pass_planes and not self.has_uv))):
             raise ValueError(f"invalid ProgramKey {self}")
 
     @property

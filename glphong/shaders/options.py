@@ -2,7 +2,7 @@
 planes, how a surface input is made, and the limits (docs/design.md sections 3, 5 and 8)."""
 
 __all__ = ["UBER_MAX_LIGHTS", "OUTPUTS", "SHADOW_PASSES", "FORMULATIONS", "NUMERICS_DEFINES", "NUMERICS_PIECES",
-           "TEXTBOOK_PIECES", "GBUFFER_PLANES", "INPUT_MODES", "MAX_TEXTURED_INPUTS"]
+           "TEXTBOOK_PIECES", "GBUFFER_PLANES", "PASS_PLANES", "INPUT_MODES", "MAX_TEXTURED_INPUTS"]
 
 #: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
 UBER_MAX_LIGHTS = 8
@@ -23,6 +23,10 @@ TEXTBOOK_PIECES = ("falloff", "light", "normal", "view")
 #: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed); 'object':
 #: the point in the object's own frame (the frame passes' object coordinates, NOCS and flow)
 GBUFFER_PLANES = ("tangent", "uv", "color", "lod", "face", "object")
+#: the planes a radiance program may write beside the radiance for the frame passes (multiple render targets, in this
+#: order from location 1; a program writes the ones its key's ``pass_planes`` names): the world position with the object's
+#: index + 1 in w, the shading normal, the point in the object's frame, the uv
+PASS_PLANES = ("position", "normal", "object", "uv")
 #: how a surface input is made (``<MODEL>_<PARAM>_INPUT`` is the mode's index plus 1)
 INPUT_MODES = ("texture", "vertex", "texture*vertex")
 #: textured parameters per material (one G-buffer plane of levels of detail)
