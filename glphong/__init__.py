@@ -11,7 +11,7 @@ Typical use::
         frame = r.render(scene)          # frame.radiance: (256, 256, 3) float32, W/(m^2 sr)
         report = glphong.verify(scene, r)
 """
-from glphong import _moved, materials
+from glphong import _moved, datasets, materials
 from glphong.analysis import tabulate as _tabulate  # noqa: F401 - registers MeasuredBRDF.from_model's tabulator
 from glphong.checks import reference
 from glphong.core import filesafety, imaging, radiometry
@@ -52,5 +52,5 @@ __all__ = [
     "NormalizedBlinnPhong", "CookTorrance", "GltfPBR", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
     "DielectricFresnel", "Texture", "VertexColors", "NormalMap", "AlphaMask", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
-    "imaging", "lights", "materials", "primitives", "radiometry", "reference", "filesafety", "__version__",
+    "datasets", "imaging", "lights", "materials", "primitives", "radiometry", "reference", "filesafety", "__version__",
 ]
