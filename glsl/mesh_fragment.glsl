@@ -12,7 +12,7 @@
 //   with HAS_COLOR the interpolated vertex colour (rgb); with HAS_LOD the level of detail of each of the
 //   object's NUM_LOD_TEXTURES textures (gbuffer_levels_of_detail(), generated; 0 beyond): the inputs of
 //   material_inputs();
-//   locations 0 position, 1 normal, then the extra planes at GBUFFER_<PLANE>_LOCATION (key.py packs them).
+//   locations 0 position, 1 normal, then the extra planes at PLANE_<PLANE>_LOCATION (defines.py packs them).
 // HAS_INPUTS: material_inputs(uv, colour) sets the surface inputs (the generated material chunk) before shading.
 // ALPHA_MASK (1 constant, 2 textured alpha): fragments with alpha below the cutoff are discarded, in every program
 //   that draws the object's surface (radiance, G-buffer, per-vertex), so the G-buffer covers what the radiance does.
@@ -21,12 +21,12 @@
 // HAS_FACE: the triangle's own normal, from the derivatives of the interpolated position (the slope of the shadow
 //   bias, shadows.glsl): a G-buffer plane, and shadow_face_normal when shading.
 // HAS_OBJECT: the G-buffer plane of the point in the object's own frame (xyz [m], w = 1), for the frame passes.
-// WRITES_PLANES (radiance programs of the frame passes, multiple render targets): beside the radiance, the
-//   position plane (w = object id + 1) at PASS_POSITION_LOCATION and, with PASS_NORMAL, PASS_OBJECT, PASS_UV, the
-//   normal, object and uv planes at their PASS_*_LOCATION, each exactly as the G-buffer program writes it.
+// WRITES_PLANES (G-buffer programs, and radiance programs of the frame passes: multiple render targets beside the
+//   radiance): the position plane (w = object id + 1) at PLANE_POSITION_LOCATION and, with PLANE_NORMAL,
+//   PLANE_OBJECT, PLANE_UV, the normal, object and uv planes at their PLANE_*_LOCATION, the same in either program.
 // NAIVE_NORMAL: n by plain_normalize where the key proves it safe, common.glsl.
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, HAS_FACE, HAS_OBJECT, NUM_LOD_TEXTURES,
-// GBUFFER_*_LOCATION, WRITES_PLANES, PASS_NORMAL, PASS_OBJECT, PASS_UV, PASS_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
+// WRITES_PLANES, PLANE_NORMAL, PLANE_OBJECT, PLANE_UV, PLANE_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
 // NAIVE_NORMAL, RUNTIME_SWITCHES, SWITCH(flag).
 
 invariant in vec3 v_position;
@@ -91,44 +91,34 @@ uniform float u_two_sided;
 uniform sampler2D u_normal_map_texture;
 uniform float u_normal_map_scale;
 #endif
-#if OUTPUT_GBUFFER
-uniform float u_object_id;
-layout(location = 0) out vec4 out_position;
-layout(location = 1) out vec4 out_normal;
-#if HAS_TANGENT
-layout(location = GBUFFER_TANGENT_LOCATION) out vec4 out_tangent;
-#endif
-#if HAS_UV
-layout(location = GBUFFER_UV_LOCATION) out vec4 out_uv;
-#endif
-#if HAS_COLOR
-layout(location = GBUFFER_COLOR_LOCATION) out vec4 out_color;
-#endif
-#if HAS_LOD
-layout(location = GBUFFER_LOD_LOCATION) out vec4 out_lod;
-#endif
-#if HAS_FACE
-layout(location = GBUFFER_FACE_LOCATION) out vec4 out_face;
-#endif
-#if HAS_OBJECT
-invariant in vec3 v_object;
-layout(location = GBUFFER_OBJECT_LOCATION) out vec4 out_object;
-#endif
-#else
 #if WRITES_PLANES
 uniform float u_object_id;
-layout(location = PASS_POSITION_LOCATION) out vec4 out_position;
-#if PASS_NORMAL
-layout(location = PASS_NORMAL_LOCATION) out vec4 out_normal;
+layout(location = PLANE_POSITION_LOCATION) out vec4 out_position;
+#if PLANE_NORMAL
+layout(location = PLANE_NORMAL_LOCATION) out vec4 out_normal;
 #endif
-#if PASS_OBJECT
+#if PLANE_OBJECT
 invariant in vec3 v_object;
-layout(location = PASS_OBJECT_LOCATION) out vec4 out_object;
+layout(location = PLANE_OBJECT_LOCATION) out vec4 out_object;
 #endif
-#if PASS_UV
-layout(location = PASS_UV_LOCATION) out vec4 out_uv;
+#if PLANE_UV
+layout(location = PLANE_UV_LOCATION) out vec4 out_uv;
 #endif
 #endif
+#if OUTPUT_GBUFFER
+#if HAS_TANGENT
+layout(location = PLANE_TANGENT_LOCATION) out vec4 out_tangent;
+#endif
+#if HAS_COLOR
+layout(location = PLANE_COLOR_LOCATION) out vec4 out_color;
+#endif
+#if HAS_LOD
+layout(location = PLANE_LOD_LOCATION) out vec4 out_lod;
+#endif
+#if HAS_FACE
+layout(location = PLANE_FACE_LOCATION) out vec4 out_face;
+#endif
+#else
 #if NEEDS_VIEW
 uniform vec4 u_eye;  // homogeneous eye (e, w): the view vector at x is normalize(e - w x)
 #else
@@ -188,13 +178,8 @@ void main()
     }
 #endif
 #if OUTPUT_GBUFFER
-    out_position = vec4(v_position, u_object_id + 1.0);
-    out_normal = vec4(n, 1.0);
 #if HAS_TANGENT
     out_tangent = tangent;
-#endif
-#if HAS_UV
-    out_uv = vec4(uv, 0.0, 1.0);
 #endif
 #if HAS_COLOR
     out_color = vec4(color, 1.0);
@@ -206,9 +191,6 @@ void main()
 #endif
 #if HAS_FACE
     out_face = vec4(face, 1.0);
-#endif
-#if HAS_OBJECT
-    out_object = vec4(v_object, 1.0);
 #endif
 #else
 #if HAS_INPUTS
@@ -222,17 +204,17 @@ void main()
 #else
     out_radiance = vec4(shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye), 1.0);
 #endif
+#endif
 #if WRITES_PLANES
-    out_position = vec4(v_position, u_object_id + 1.0);  // the G-buffer's planes, as OUTPUT_GBUFFER writes them
-#if PASS_NORMAL
+    out_position = vec4(v_position, u_object_id + 1.0);  // the G-buffer's planes, in either program
+#if PLANE_NORMAL
     out_normal = vec4(n, 1.0);
 #endif
-#if PASS_OBJECT
+#if PLANE_OBJECT
     out_object = vec4(v_object, 1.0);
 #endif
-#if PASS_UV
+#if PLANE_UV
     out_uv = vec4(uv, 0.0, 1.0);
-#endif
 #endif
 #endif
 }

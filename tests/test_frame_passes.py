@@ -79,10 +79,8 @@ def _project(points, r, t):
     return np.stack([FX * cam[..., 0] / cam[..., 2] + CX, FY * cam[..., 1] / cam[..., 2] + CY], axis=-1)
 
 
-def _cube_pose(angle, shift):
-    c, s = np.cos(angle), np.sin(angle)
-    pose = np.eye(4)
-    pose[:3, :3] = [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
+def _cube_pose(angle, shift):  # a turn of ``angle`` [rad] about +y, then ``shift`` [m]
+    pose = trimesh.transformations.rotation_matrix(angle, (0.0, 1.0, 0.0))
     pose[:3, 3] = shift
     return pose
 

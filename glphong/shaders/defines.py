@@ -7,6 +7,19 @@ from glphong.shaders.options import INPUT_MODES, NUMERICS_DEFINES, TEXTBOOK_PIEC
 __all__ = ["program_defines"]
 
 
+def _plane_defines(key):
+    """Which G-buffer planes the fragment stage writes, and where: a G-buffer program position at 0, normal at 1 and
+    its extra planes packed after them in `GBUFFER_PLANES` order; a radiance program writing the frame passes' planes
+    (``key.pass_planes``) each at its place from 1, the radiance at 0 (multiple render targets)."""
+    if key.output == "gbuffer":
+        where = {"position": 0, "normal": 1} | {name: 2 + i for i, name in enumerate(key.gbuffer_planes())}
+    else:
+        where = {name: 1 + i for i, name in enumerate(key.pass_planes)}
+    out = [("WRITES_PLANES", "1" if where else "0")]
+    out += [(f"PLANE_{name.upper()}", "1" if name in where else "0") for name in ("normal", "object", "uv")]
+    return out + [(f"PLANE_{name.upper()}_LOCATION", str(i)) for name, i in where.items()]
+
+
 def program_defines(key):
     """The generated ``#define`` lines of ``key`` (a `ProgramKey`) as (name, value) pairs, in the order the
     program's source lists them."""
@@ -38,13 +51,9 @@ def program_defines(key):
     ]
     if key.output == "shadow":
         out.append(("SHADOW_ORTHO", b(key.shadow_pass == "ortho")))
-    if key.output == "gbuffer":  # extra planes follow position and normal, packed in this order
-        out += [(f"GBUFFER_{name.upper()}_LOCATION", str(2 + i)) for i, name in enumerate(key.gbuffer_planes())]
+    if key.output != "shadow":
+        out += _plane_defines(key)
     if key.output not in ("gbuffer", "shadow"):
-        # the frame passes' planes beside the radiance (multiple render targets), each at its location from 1
-        out.append(("WRITES_PLANES", b(bool(key.pass_planes))))
-        out += [(f"PASS_{name.upper()}", b(name in key.pass_planes)) for name in ("normal", "object", "uv")]
-        out += [(f"PASS_{name.upper()}_LOCATION", str(1 + i)) for i, name in enumerate(key.pass_planes)]
         out.append(("NEEDS_VIEW", b(key.needs_view)))
         if key.shadow_slots:
             out += [("SHADOW_MAP_SIZE", str(key.shadow_size)), ("SHADOW_FILTER_RADIUS", str(key.shadow_filter))]

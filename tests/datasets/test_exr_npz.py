@@ -39,10 +39,8 @@ DOCUMENTED = {
 }
 
 
-def _pose(angle, shift):
-    c, s = np.cos(angle), np.sin(angle)
-    pose = np.eye(4)
-    pose[:3, :3] = [[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]]
+def _pose(angle, shift):  # a turn of ``angle`` [rad] about +y, then ``shift`` [m]
+    pose = trimesh.transformations.rotation_matrix(angle, (0.0, 1.0, 0.0))
     pose[:3, 3] = shift
     return pose
 
