@@ -40,6 +40,8 @@ _ARGUMENTS = {
     "batch_turntable": lambda out: ["8", str(out)],
     "continuous_version": lambda out: [str(out / "continuous_version.png")],
     "test_my_shader": lambda out: [str(out / "test_my_shader.png")],
+    # the BOP scene beside the example's folder: its masks and images are data, not pictures to embed
+    "data_for_training": lambda out: [str(out / "data_for_training.png"), str(OUT / "bop-data_for_training")],
 }
 #: frames per row of a contact sheet of radiance frames
 _SHEET_COLUMNS = 4

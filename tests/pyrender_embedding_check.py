@@ -69,6 +69,8 @@ def main(platform):
         ours = g.render_srgb8(glphong_scene)
         frame = g.render(glphong_scene)
         own_chunks = [g.programs.get(binding(glphong_scene).program_key(o)).key.fragment_chunks() for o in glphong_scene.objects]
+    with glphong.Renderer(width, height, backend=platform, numerics="stable") as g:  # the frame passes of a pyrender scene
+        passes = g.render(glphong_scene, passes=("depth", "instance"))
     interior = frame.coverage == 1.0
     for _ in range(2):  # erode by 2 px: silhouettes are compared apart
         interior[1:-1, 1:-1] &= interior[:-2, 1:-1] & interior[2:, 1:-1] & interior[1:-1, :-2] & interior[1:-1, 2:]
@@ -95,6 +97,19 @@ def main(platform):
         "directional_irradiance": list(directional.irradiance),
         "ambient": list(ambient.radiance),
     }
+    # pyrender's depth (view-axis z, multisampled on EGL) against the converted scene's depth pass, on the interior
+    # pixels whose 5x5 neighbourhood sees one object (its edges over another object apart)
+    ids = passes.instance
+    same = np.zeros(ids.shape, bool)
+    same[2:-2, 2:-2] = True
+    for dy in range(-2, 3):
+        for dx in range(-2, 3):
+            same[2:-2, 2:-2] &= ids[2 + dy:ids.shape[0] - 2 + dy, 2 + dx:ids.shape[1] - 2 + dx] == ids[2:-2, 2:-2]
+    inside = interior & same & (depth > 0)
+    result["passes"] = {"instances": sorted(int(i) for i in np.unique(passes.instance)),
+                        "objects": len(glphong_scene.objects),
+                        "depth_max_relative": float(np.max(np.abs(passes.depth[inside] - depth[inside]) / depth[inside])),
+                        "depth_pixels": int(inside.sum())}
     result["converted"] = _converted(platform, renderer, width, height)
     result["non_indexed"] = _non_indexed(platform, renderer, width, height)
     # refusals

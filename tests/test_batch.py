@@ -54,6 +54,27 @@ def test_pool_frames_equal_serial_and_resume(tmp_path, serial):
         render_many(turntable_scene, [lambda: 0], W, H, tmp_path / "other", workers=1, progress=False)
 
 
+def test_frame_passes_in_a_batch(tmp_path, serial):
+    """fmt='npz' writes each frame's passes (glphong.datasets.save_npz), equal to a serial render's; the passes are
+    part of the batch (another set in the same folder is another batch); flow, which needs a second scene, and
+    passes with a radiance-only format are refused by name."""
+    from glphong.datasets import load_npz
+    out = tmp_path / "passes"
+    passes = ("radiance", "depth", "instance")
+    paths = render_many(turntable_scene, ANGLES[:3], W, H, out, fmt="npz", passes=passes, workers=1, progress=False)
+    with glphong.Renderer(W, H) as renderer:
+        for angle, path, radiance in zip(ANGLES, paths, serial):
+            arrays, frame = load_npz(path), renderer.render(turntable_scene(angle), passes=passes)
+            assert np.array_equal(arrays["radiance"], radiance) and np.array_equal(arrays["depth"], frame.depth)
+            assert arrays["instance"].dtype == np.uint32 and np.array_equal(arrays["instance"], frame.instance)
+    with pytest.raises(BatchError, match="holds another batch"):
+        render_many(turntable_scene, ANGLES[:3], W, H, out, fmt="npz", passes=("depth",), workers=1, progress=False)
+    with pytest.raises(ValueError, match="flow need the next or previous scene"):
+        render_many(turntable_scene, ANGLES, W, H, tmp_path / "flow", fmt="npz", passes=("flow",), progress=False)
+    with pytest.raises(ValueError, match="holds the radiance alone"):
+        render_many(turntable_scene, ANGLES, W, H, tmp_path / "png", fmt="png", passes=("depth",), progress=False)
+
+
 def _dying_module(tmp_path, name):
     """Write and import module ``name`` in ``tmp_path``: its ``dying_scene`` kills its process (``os._exit``)
     the first time it meets the angle 90 (a marker file remembers), else builds the turntable scene."""

@@ -15,6 +15,7 @@ from glphong.batch.workers import _local_dask, _render_chunk, _spawn_pool
 from glphong.core import validate as _validate
 from glphong.core.timing import progress_bar
 from glphong.core.version import __version__
+from glphong.gpu.passes import requested_passes
 
 __all__ = ["render_many"]
 
@@ -48,7 +49,7 @@ def _render_round(folder, executor, submit, frames_per_task, bar):
 
 
 def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy", frames_per_task=1,
-                workers=None, progress=True, **options):
+                workers=None, progress=True, passes=None, **options):
     """Render one frame per spec into ``out_dir`` and return the frame paths in spec order.
 
     Parameters
@@ -66,9 +67,13 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
         process, shut down at the end; a given executor is used as it is and left running (a Dask client's:
         ``client.get_executor()``).  ``'dask'``: a local Dask cluster of ``workers`` single-threaded
         worker processes (``dask.distributed.LocalCluster``, from the ``[dask]`` extra), closed at the end.
-    fmt : {'npy', 'png'}
+    fmt : {'npy', 'png', 'npz', 'exr'}
         float32 radiance ``.npy`` of shape ``(height, width, 3)`` (default) or an 8-bit sRGB PNG at
-        exposure 1.
+        exposure 1; or each frame's ``passes`` in one ``.npz`` (`glphong.datasets.save_npz`) or OpenEXR file
+        (`glphong.datasets.save_exr`, the extra ``exr``).
+    passes : sequence of str, optional
+        With ``fmt`` 'npz' or 'exr': the frame passes to render and write (`glphong.Renderer.render`'s names but
+        'flow' and 'backward_flow', which need a second scene), default ``('radiance',)``.
     frames_per_task : int
         Frames a task renders in a row (fewer round trips for small frames).
     progress : bool
@@ -92,13 +97,15 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
     specs = list(specs)
     width = _validate.positive_int("width", width, 1, 16384)
     height = _validate.positive_int("height", height, 1, 16384)
-    fmt = _validate.choice("fmt", fmt, ("npy", "png"))
+    fmt = _validate.choice("fmt", fmt, ("npy", "png", "npz", "exr"))
+    passes = _batch_passes(passes, fmt)
     frames_per_task = _validate.positive_int("frames_per_task", frames_per_task)
     if not callable(scene_fn):
         raise TypeError(f"scene_fn must be a callable spec -> Scene (got {type(scene_fn).__name__})")
     if isinstance(executor, str):
         _validate.choice("executor", executor, ("dask",))
-    batch = {"glphong": __version__, "width": width, "height": height, "format": fmt,
+    batch = {"glphong": __version__, "width": width, "height": height, "format": fmt, **({"passes": list(passes)} if
+                                                                                         passes else {}),
              "options": {k: repr(v) for k, v in sorted(options.items())}, "specs": [_spec_hash(s) for s in specs]}
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -106,13 +113,27 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
     workers = workers or os.cpu_count() or 1
 
     def submit(chunk):
-        return scene_fn, [(i, specs[i]) for i in chunk], width, height, str(out), fmt, options
+        return scene_fn, [(i, specs[i]) for i in chunk], width, height, str(out), fmt, options, passes
 
     with _BatchFolder(out, batch, paths) as folder:
         if folder.missing:
             _render_missing(folder, submit, executor, workers, frames_per_task, progress_bar(
                 len(folder.missing), progress, unit="frame"))
     return paths
+
+
+def _batch_passes(passes, fmt):
+    """The passes a batch writes (a tuple; empty for 'npy' and 'png', which hold the radiance alone)."""
+    if fmt in ("npy", "png"):
+        if passes is not None:
+            raise ValueError(f"fmt={fmt!r} holds the radiance alone: write frame passes with fmt='npz' or 'exr'")
+        return ()
+    names = requested_passes(passes)
+    motion = [n for n in names if n in ("flow", "backward_flow")]
+    if motion:
+        raise ValueError(f"render_many renders one scene a frame: {', '.join(motion)} need the next or previous "
+                         "scene (render them with Renderer.render(scene, passes=..., next_scene=...))")
+    return names
 
 
 #: pools that may break in a row without a frame written before a batch stops (a killed worker costs a round,

@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 from glphong.batch.folder import _CLOEXEC, _NOFOLLOW, _file_digest, _frame_name
+from glphong.datasets import save_exr, save_npz
 from glphong.gpu.renderer import Renderer
 
 _PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
@@ -104,8 +105,10 @@ def _write_frame(frame, final, out_dir, fmt):
     try:
         if fmt == "npy":
             np.save(temporary, np.ascontiguousarray(frame.radiance, dtype=np.float32))
-        else:
+        elif fmt == "png":
             frame.save_png(temporary)
+        else:  # every pass of the frame
+            (save_npz if fmt == "npz" else save_exr)(temporary, frame)
         handle = os.open(temporary, os.O_RDONLY | _NOFOLLOW | _CLOEXEC)
         try:
             written = _file_digest(handle)
@@ -118,7 +121,7 @@ def _write_frame(frame, final, out_dir, fmt):
     return written
 
 
-def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options):
+def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options, passes=()):
     """In a worker: render ``items`` (``(index, spec)`` pairs) with the worker's renderer and write each frame
     atomically.
 
@@ -137,7 +140,7 @@ def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options):
     records, pending = [], None
     try:
         for index, spec in items:
-            frame = renderer.render(scene_fn(spec))
+            frame = renderer.render(scene_fn(spec), passes=passes or None)
             if pending is not None:  # the previous frame's file, written while this one rendered
                 records.append(pending.result())
             pending = _writer().submit(_write_record, index, frame, out_dir, fmt)

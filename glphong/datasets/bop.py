@@ -14,7 +14,7 @@ and writes, under ``folder/{scene_id:06d}/``::
 
 ``k`` is the object's place in ``scene_gt.json``'s list for the image: the order of ``scene.objects``.
 
-The conventions followed are the BOP toolkit's (github.com/thodan/bop_toolkit, docs/bop_datasets_format.md):
+The conventions followed are the BOP toolkit's (github.com/thodan/bop_toolkit and its format page, bop_datasets_format.md):
 
 - ``bop_toolkit_lib/inout.py``: ``save_json`` (keys the im_id as a string, sorted numerically, one image a line,
   each value ``json.dumps(v, sort_keys=True)``), ``save_scene_camera`` / ``save_scene_gt`` (matrices flattened

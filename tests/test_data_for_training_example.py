@@ -1,0 +1,30 @@
+"""examples/data_for_training.py: its BOP scene holds both images and its three objects, its picture the five panels,
+and every pass it verifies passes (the example asserts it)."""
+import importlib.util
+import json
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "data_for_training.py"
+
+
+def _example():
+    spec = importlib.util.spec_from_file_location("data_for_training", EXAMPLE)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_example_writes_its_bop_scene_and_picture(tmp_path):
+    example = _example()
+    frame = example.main(str(tmp_path / "picture.png"), str(tmp_path / "bop"))
+    picture = np.asarray(Image.open(tmp_path / "picture.png"))
+    width, height = example.SIZE
+    assert picture.shape == (height, 5 * width + 4 * 4, 3)
+    gt = json.loads((tmp_path / "bop" / "000000" / "scene_gt.json").read_text())
+    assert sorted(gt) == ["0", "1"] and [len(v) for v in gt.values()] == [3, 3]
+    assert set(np.unique(frame.instance)) == {0, 1, 2, 3}
+    moving = frame.mask & (np.hypot(frame.flow[..., 0], frame.flow[..., 1]) > 0.5)
+    assert moving.sum() > 0.5 * frame.mask.sum()  # every object moves between the frames
