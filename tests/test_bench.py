@@ -88,7 +88,7 @@ def test_speed_report_in_process(tmp_path):
         assert set(row["ms"]) == {"glphong float", "glphong stable", "naive floor", "glphong 4x 8-bit"}
         assert all(v > 0 for v in row["ms"].values()) and all(v >= 0 for v in row["spread"].values())
     assert report.rows[SCENES.index("1000 objects")]["objects"] == 100  # the quick stand-in
-    assert report.python_per_object["objects"] == 100 and report.png["save_ms"] > report.png["encode_ms"] > 0
+    assert report.python_per_object["objects"] == 100 and report.png["save_ms"] > 0 and report.png["encode_ms"] > 0  # positive: no timing compared in a test
     assert set(report.fits) == {"per object", "per pixel and light", "per triangle"}
     text = report.format()
     assert all(name in text for name in SCENES) and "Python per object" in text
