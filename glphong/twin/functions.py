@@ -113,7 +113,9 @@ def safe_normalize(x):
         ``|x|`` computed as ``s sqrt((x/s).(x/s))``, 0 where not valid.
     """
     x = np.asarray(x)
-    s = np.max(np.abs(x), axis=-1)
+    a = np.abs(x)
+    # max|x_i| of the three components pairwise: exact as np.max (NaN too), without a reduction along a short axis
+    s = np.maximum(np.maximum(a[..., 0], a[..., 1]), a[..., 2]) if x.shape[-1] == 3 else np.max(a, axis=-1)
     valid = (s > 0) & (s <= FLT_MAX)
     s_safe = np.where(valid, s, 1).astype(x.dtype)[..., None]
     with np.errstate(invalid="ignore", over="ignore"):
