@@ -2,7 +2,8 @@
 
 Ten icospheres (subdivision 4: 5120 triangles each) under a point light, 256x256, llvmpipe or whatever the backend
 gives; the cases interleaved in one process, each rendered 20 times after a warm-up, the median printed
-(``python benchmarks/frame_passes.py [backend] [repeats]``).
+(``python benchmarks/frame_passes.py [backend] [repeats]``); with ``--pyrender``: radiance, depth and instance
+against pyrender's colour render and SEG render of the same scene.
 """
 import sys
 import time
@@ -58,5 +59,34 @@ def main(backend="egl", repeats=20):
         print(f"| {name} | {1e3 * median:.1f} | {median / base:.2f}x |")
 
 
+
+
+def against_pyrender(backend="egl", repeats=20):
+    """glphong's radiance, depth and instance passes (one draw) against pyrender's way to the same (a colour render
+    with its depth, then a SEG render), the same scene, one process, interleaved; medians [ms]."""
+    from glphong.bench.pyrender_peer import PyrenderRenderer
+    scene = spheres_scene()
+    renderer = glphong.Renderer(256, 256, backend=backend)
+    peer = PyrenderRenderer(256, 256, platform=backend).prepare(scene)
+    ours = lambda: renderer.render(scene, passes=("radiance", "depth", "instance"))  # noqa: E731
+    theirs = peer.render_segmentation
+    frame, (_, depth, instance) = ours(), theirs()
+    agree = float(np.mean(frame.instance == instance))
+    times = {"glphong radiance, depth, instance (one draw)": [], "pyrender colour + depth, then SEG": []}
+    for _ in range(repeats):
+        for name, fn in zip(times, (ours, theirs)):
+            start = time.perf_counter()
+            fn()
+            times[name].append(time.perf_counter() - start)
+    peer.release()
+    print(f"{backend}, 256x256, {len(scene.objects)} spheres, median of {repeats}; ids agree on {100 * agree:.2f} % "
+          f"of pixels; pyrender's colour render {'4x multisampled' if peer.samples > 1 else 'one sample a pixel'}")
+    for name, values in times.items():
+        print(f"| {name} | {1e3 * np.median(values):.1f} |")
+
+
 if __name__ == "__main__":
-    main(sys.argv[1] if len(sys.argv) > 1 else "egl", int(sys.argv[2]) if len(sys.argv) > 2 else 20)
+    arguments = [a for a in sys.argv[1:] if a != "--pyrender"]
+    backend = arguments[0] if arguments else "egl"
+    repeats = int(arguments[1]) if len(arguments) > 1 else 20
+    (against_pyrender if "--pyrender" in sys.argv else main)(backend, repeats)

@@ -194,6 +194,24 @@ def test_pyrender_coverage_matches_glphong_egl(pyrender_egl, make_renderer, name
     np.testing.assert_array_equal(renderer.render(scene).radiance, frame.radiance)
 
 
+def test_pyrender_segmentation_gives_the_ids_glphong_does(pyrender_egl, make_renderer):
+    """The benchmark's pyrender peer for frame passes (`PyrenderRenderer.render_segmentation`: a colour render and a
+    SEG render): its ids are the objects' index + 1, those of glphong's instance pass on every pixel but silhouettes,
+    its depth glphong's depth pass inside, up to the slope across the half pixel its multisampled depth is off the
+    centre (the floor is seen at a grazing angle)."""
+    scene = sphere_scene(glphong.Lambert(0.5), directional=True)
+    scene.add(trimesh.creation.box((0.6, 0.6, 0.6)), glphong.Lambert(0.3),
+              pose=trimesh.transformations.translation_matrix((0.9, 0.2, 0.6)))
+    frame = make_renderer(WIDTH, HEIGHT, "egl").render(scene, passes=("instance", "depth"))
+    with PyrenderRenderer(WIDTH, HEIGHT, "egl") as pyr:
+        colour, depth, instance = pyr.prepare(scene).render_segmentation()
+    assert colour.shape == (HEIGHT, WIDTH, 3) and set(np.unique(instance)) == set(range(len(scene.objects) + 1))
+    assert np.mean(instance == frame.instance) > 0.98
+    inside = (instance == frame.instance) & (instance > 0)
+    relative = np.abs(depth[inside] - frame.depth[inside]) / frame.depth[inside]
+    assert inside.sum() > 500 and np.median(relative) < 2e-2  # pyrender's depth is one of its 4 samples, off centre
+
+
 def test_pyrender_renderer_refuses_second_platform(pyrender_egl):
     with pytest.raises(RuntimeError, match="new process"):
         PyrenderRenderer(8, 8, "osmesa")

@@ -296,6 +296,7 @@ class PyrenderRenderer:
         self.platform = platform
         self.samples = PYRENDER_SAMPLES if platform == "egl" else 1
         self.scene = None
+        self._names = []
         os.environ["PYOPENGL_PLATFORM"] = platform  # pyrender picks its context class from it at construction
         self._renderer = self._pyrender.OffscreenRenderer(self.width, self.height)
 
@@ -303,6 +304,7 @@ class PyrenderRenderer:
         """Convert ``scene`` once (`to_pyrender`); returns self."""
         self.scene = to_pyrender(scene, aspect_ratio=self.width / self.height, platform=self.platform,
                                  double_sided=self.double_sided)
+        self._names = [obj.name for obj in scene.objects]
         return self
 
     def render(self):
@@ -312,6 +314,31 @@ class PyrenderRenderer:
             raise RuntimeError("this PyrenderRenderer has been released")
         colour, _depth = self._renderer.render(self.scene)
         return colour
+
+    def render_segmentation(self):
+        """pyrender's way to the colour, the depth and which object each pixel sees: a colour render (its depth
+        buffer read back with it) and a ``RenderFlags.SEG`` render with a colour per mesh node (pyrender issue 15's
+        answer), the ids read back from the colours.
+
+        Returns
+        -------
+        colour : (H, W, 3) uint8
+        depth : (H, W) float32
+            pyrender's depth [m] (view-axis z, 0 on the background).
+        instance : (H, W) uint32
+            The prepared scene's object index + 1 of the node seen, 0 the background (objects' names must be unique).
+        """
+        if self._renderer is None:
+            raise RuntimeError("this PyrenderRenderer has been released")
+        nodes = {node.name: node for node in self.scene.mesh_nodes}
+        if len(nodes) != len(self._names) or set(nodes) != set(self._names):
+            raise ValueError("render_segmentation needs the scene's objects to have unique names")
+        colours = {nodes[name]: (index + 1, 0, 0) for index, name in enumerate(self._names)}  # ids below 256
+        if len(colours) > 255:
+            raise ValueError("render_segmentation encodes ids in one 8-bit channel: 255 objects at most")
+        colour, depth = self._renderer.render(self.scene)
+        segmentation, _ = self._renderer.render(self.scene, flags=self._pyrender.RenderFlags.SEG, seg_node_map=colours)
+        return colour, depth, segmentation[..., 0].astype(np.uint32)
 
     def release(self):
         """Delete pyrender's renderer and its context, as `glphong.integrations.pyrender.release` does (on EGL
