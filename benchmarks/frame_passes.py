@@ -70,7 +70,7 @@ def against_pyrender(backend="egl", repeats=20):
     peer = PyrenderRenderer(256, 256, platform=backend).prepare(scene)
     ours = lambda: renderer.render(scene, passes=("radiance", "depth", "instance"))  # noqa: E731
     theirs = peer.render_segmentation
-    frame, (_, depth, instance) = ours(), theirs()
+    frame, (_, _, instance) = ours(), theirs()
     agree = float(np.mean(frame.instance == instance))
     times = {"glphong radiance, depth, instance (one draw)": [], "pyrender colour + depth, then SEG": []}
     for _ in range(repeats):
