@@ -2,6 +2,7 @@
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -167,3 +168,25 @@ def test_frame_shows_itself_in_a_notebook(make_renderer):
     shown = np.asarray(Image.open(BytesIO(frame._repr_png_())))
     assert shown.shape == (16, 24, 3) and np.array_equal(shown, frame.to_srgb8(0.6))
     assert not np.array_equal(shown, frame.to_srgb8(1.0))
+
+
+def test_render_file_writes_its_frame_passes(tmp_path, capsys):
+    """``glphong render FILE --passes ... --passes-out ... --verify``: the passes written (.npz and .exr), each
+    checked against its twin; a pass the file cannot give, or an unknown one, is a one-line error."""
+    from glphong.datasets import load_exr, load_npz
+    from glphong.tools.cli import main
+    torus = str(Path(__file__).resolve().parent.parent / "examples" / "data" / "torus.obj")
+    npz = tmp_path / "t.npz"
+    assert main(["render", torus, "--width", "48", "--height", "36", "--out", str(tmp_path / "t.png"),
+                 "--passes", "depth,instance,normal_camera", "--passes-out", str(npz), "--verify"]) == 0
+    out = capsys.readouterr().out
+    assert "depth pass" in out and "instance pass" in out and "PASS" in out
+    arrays = load_npz(npz)
+    assert set(arrays) == {"radiance", "depth", "instance", "normal_camera", "coverage"}
+    assert arrays["instance"].max() == 1 and arrays["depth"].max() > 0
+    assert main(["render", torus, "--width", "16", "--height", "12", "--out", str(tmp_path / "u.png"),
+                 "--passes", "nocs", "--passes-out", str(tmp_path / "u.exr")]) == 0
+    assert set(load_exr(tmp_path / "u.exr")) == {"radiance", "nocs", "coverage"}
+    with pytest.raises(SystemExit):
+        main(["render", torus, "--passes", "flow"])
+    assert "--passes takes depth" in capsys.readouterr().err

@@ -18,9 +18,11 @@ from glphong.checks.stability import CASES, CaseExpectations, run_stability
 from glphong.checks.verify import verify
 from glphong.core.imaging import save_npy
 from glphong.core.version import __version__
+from glphong.datasets import save_exr, save_npz
 from glphong.formats.load import load_scene
 from glphong.gpu.contexts import BackendUnavailableError
 from glphong.gpu.describe import describe, format_descriptions
+from glphong.gpu.passes import GEOMETRY_PASSES
 from glphong.gpu.renderer import Renderer
 from glphong.lights import registered_lights
 from glphong.materials import registered_models
@@ -94,15 +96,23 @@ def _render_file(args):
     with Renderer(args.width, args.height, backend=args.backend, samples=args.samples,
                   numerics=args.numerics) as renderer:
         start = time.perf_counter()
-        frame = renderer.render(scene)
+        try:
+            frame = renderer.render(scene, passes=("radiance", *(args.passes or ())))
+        except ValueError as exc:  # a pass the file cannot give ('uv' on a mesh without uvs)
+            print_error("render", exc)
+            return EXIT_BAD_INPUT
         seconds = time.perf_counter() - start
         frame.save_png(out, exposure=exposure)
+        if args.passes:
+            passes_out = args.passes_out or str(Path(args.file).with_suffix(".npz").name)
+            (save_exr if passes_out.lower().endswith(".exr") else save_npz)(passes_out, frame)
+            print(f"wrote {passes_out}: {', '.join(frame.passes)}")
         if args.npy:
             frame.save_npy(args.npy)
         print(f"wrote {out}: {args.file}, {len(scene.objects)} object(s), {args.width}x{args.height} on "
               f"{renderer.backend} in {seconds:.2f} s")
         if args.verify:
-            result = verify(scene, renderer)
+            result = verify(scene, renderer, passes=args.passes)
             print(f"cross-check against the float64 twin: {result}")
             return 0 if result.passed else 1
     return 0
@@ -303,6 +313,24 @@ def _writable(text):
     return text
 
 
+def _pass_list(text):
+    """``--passes``: comma-separated frame pass names a single scene file can give (not 'radiance', always written,
+    nor the flows, which need the next or previous scene)."""
+    names = tuple(n.strip() for n in text.split(",") if n.strip())
+    known = [n for n in GEOMETRY_PASSES if n not in ("flow", "backward_flow")]
+    unknown = [n for n in names if n not in known]
+    if not names or unknown:
+        raise argparse.ArgumentTypeError(f"--passes takes {', '.join(known)}, comma-separated (got {text!r})")
+    return names
+
+
+def _passes_path(text):
+    """``--passes-out``: a .npz or .exr path in an existing folder."""
+    if not text.lower().endswith((".npz", ".exr")):
+        raise argparse.ArgumentTypeError(f"--passes-out must end in .npz or .exr (got {text!r})")
+    return _writable(text)
+
+
 def _png_path(text):
     """``--out``: a path ending in .png, in an existing folder."""
     if not text.lower().endswith(".png"):
@@ -389,6 +417,12 @@ def build_parser():
                         help="with FILE: a turntable of N PNG frames (worker processes) into --out, a folder "
                              "(default FILE's name + _frames)")
     render.add_argument("--npy", default=None, type=_writable, help="also write the raw float32 radiance to this .npy path")
+    render.add_argument("--passes", default=None, type=_pass_list,
+                        help="with FILE: frame passes to write beside the PNG, comma-separated (depth, distance, "
+                             "normal, normal_camera, uv, instance, category, object_coordinates, nocs; "
+                             "docs/data_for_training.md), into --passes-out")
+    render.add_argument("--passes-out", default=None, type=_passes_path,
+                        help="with --passes: a .npz or .exr path (default the file's name with .npz)")
     render.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"))
     render.add_argument("--tile", type=_tile_size, default=128, help="tile size in pixels, 1 to 1024 (default 128)")
     render.add_argument("--exposure", type=_positive_float, default=None,
