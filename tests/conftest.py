@@ -1,8 +1,10 @@
 """Shared fixtures: OpenGL contexts on each backend, skipped where unavailable."""
+import importlib.util
 import json
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -131,3 +133,15 @@ def pyrender_check():
         return json.loads(out.stdout.strip().splitlines()[-1])
 
     return run
+
+
+@pytest.fixture
+def load_example():
+    """``load_example(name)``: the module of ``examples/<name>.py``, executed afresh (its ``main`` not run)."""
+    def load(name):
+        spec = importlib.util.spec_from_file_location(name, Path(__file__).resolve().parent.parent / "examples" /
+                                                      f"{name}.py")
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        return module
+    return load

@@ -107,14 +107,8 @@ def test_a_killed_worker_costs_no_frame(tmp_path, serial):
     assert sorted(os.listdir(out)) == sorted([os.path.basename(p) for p in paths] + BOOKKEEPING)
 
 
-def test_example_batch_turntable(tmp_path):
-    import importlib.util
-    from pathlib import Path
-
-    spec = importlib.util.spec_from_file_location(
-        "batch_turntable", Path(__file__).resolve().parent.parent / "examples" / "batch_turntable.py")
-    example = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(example)
+def test_example_batch_turntable(tmp_path, load_example):
+    example = load_example("batch_turntable")
     paths = example.main(frames=4, out_dir=str(tmp_path / "t"), size=24)
     assert len(paths) == 4 and all(np.load(p).shape == (24, 24, 3) for p in paths)
 

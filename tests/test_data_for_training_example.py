@@ -1,24 +1,13 @@
 """examples/data_for_training.py: its BOP scene holds both images and its three objects, its picture the five panels,
 and every pass it verifies passes (the example asserts it)."""
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 from PIL import Image
 
-EXAMPLE = Path(__file__).resolve().parent.parent / "examples" / "data_for_training.py"
 
-
-def _example():
-    spec = importlib.util.spec_from_file_location("data_for_training", EXAMPLE)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_the_example_writes_its_bop_scene_and_picture(tmp_path):
-    example = _example()
+def test_the_example_writes_its_bop_scene_and_picture(tmp_path, load_example):
+    example = load_example("data_for_training")
     frame = example.main(str(tmp_path / "picture.png"), str(tmp_path / "bop"))
     picture = np.asarray(Image.open(tmp_path / "picture.png"))
     width, height = example.SIZE

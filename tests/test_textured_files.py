@@ -149,14 +149,8 @@ def test_save_gltf_refuses_textures_it_cannot_store(tmp_path):
     assert TextureImage(NOISE).pixels8().tolist() == NOISE.tolist()
 
 
-def test_example_textured_scene(tmp_path):
-    import importlib.util
-    from pathlib import Path
-
-    spec = importlib.util.spec_from_file_location(
-        "textured_scene", Path(__file__).resolve().parent.parent / "examples" / "textured_scene.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
+def test_example_textured_scene(tmp_path, load_example):
+    module = load_example("textured_scene")
     report, difference = module.main(tmp_path)
     assert report.passed and report.covered_pixels > 50000
     assert difference < 3e-5

@@ -23,9 +23,6 @@ What is tested, on both backends where a GPU is involved (fixture ``glphong_back
   Fresnel, equals ``F(h.l)`` at the highlight (to 2 %) and grows from 0.04 at normal view to above 0.5 at
   88 degrees, while without Fresnel the peak does not grow toward grazing.
 """
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -183,16 +180,8 @@ def test_the_uber_shader_holds_phong_with_and_without_fresnel_in_one_program(glp
 
 
 # --------------------------------------------------------------------------- the grazing brightening
-def _example():
-    path = Path(__file__).resolve().parents[2] / "examples" / "fresnel_grazing.py"
-    spec = importlib.util.spec_from_file_location("fresnel_grazing", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
-def test_a_fresnel_floor_brightens_toward_grazing(glphong_make_renderer):
-    example = _example()
+def test_a_fresnel_floor_brightens_toward_grazing(glphong_make_renderer, load_example):
+    example = load_example("fresnel_grazing")
     renderer = glphong_make_renderer(*example.SIZE, "egl")
     rows = example.measure(renderer)
     assert [r["view_angle_deg"] for r in rows] == list(example.VIEW_ANGLES_DEG)
