@@ -135,6 +135,28 @@ def pyrender_check():
     return run
 
 
+#: tests that each take 10 s or more (CI's --durations), run first: a long test started last keeps one worker busy
+#: alone at the end of the run (longest first is the classic schedule for parallel workers); the rest keep their order
+LONG_FIRST = (
+    "tests/test_docs.py::test_the_site_builds",
+    "tests/test_docs.py::test_docs_python_block_runs[measured_brdfs.md",
+    "tests/test_custom_material_example.py::test_its_stability_cases_run_from_the_command_line",
+    "tests/lights/test_light_mechanism.py::test_cli_stability_imports_a_light_kind",
+    "tests/lights/test_area_lights.py::test_the_continuous_version_example_runs",
+    "tests/test_stability.py::test_naive_formulation_fails_where_the_design_says",
+    "tests/test_numerics.py::test_stability_suite_in_auto_mode",
+    "tests/materials/test_measured.py::test_cli_brdf_and_plots_of_a_measured_file",
+    "tests/test_stability.py::test_cli_stability_json",
+)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Move the `LONG_FIRST` tests to the front of the run, in that order."""
+    def rank(item):
+        return next((i for i, prefix in enumerate(LONG_FIRST) if item.nodeid.startswith(prefix)), len(LONG_FIRST))
+    items.sort(key=rank)  # stable: the others keep their collection order
+
+
 @pytest.fixture
 def load_example():
     """``load_example(name)``: the module of ``examples/<name>.py``, executed afresh (its ``main`` not run)."""
