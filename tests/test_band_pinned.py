@@ -32,11 +32,11 @@ def test_constants_are_the_design_values():
 
 @pytest.mark.parametrize("delta, q", [(1e-4, 1e4), (1e-6, 1e6), (0.02, 50.0), (0.3, 2.0), (1e-9, 1e7)])
 def test_lobe_band_closed_form(delta, q):
-    """high = (1 - (c - C eps)^2/2)^q (1 + eps (A + B lambda_hi)), low likewise with c + C eps,
+    """high = (1 - (c - C eps (1 + c))^2/2)^q (1 + eps (A + B lambda_hi)), low likewise with c + C eps (1 + c),
     c = sqrt(2 delta), lambda = -ln(value)."""
     c = math.sqrt(2.0 * delta)
-    hi_core = cos_power(0.5 * (c - C * EPS) ** 2, q)
-    lo_core = cos_power(0.5 * (c + C * EPS) ** 2, q)
+    hi_core = cos_power(0.5 * (c - C * EPS * (1.0 + c)) ** 2, q)
+    lo_core = cos_power(0.5 * (c + C * EPS * (1.0 + c)) ** 2, q)
     high = hi_core * (1.0 + EPS * (A + B * -math.log(hi_core)))
     low = lo_core * (1.0 - EPS * (A + B * -math.log(lo_core)))
     got_low, got_high = tolerances.lobe_band(np.array([delta]), q)

@@ -4,7 +4,7 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 import glphong
@@ -162,6 +162,8 @@ def _random_unit(rng, count):
        log_q=st.floats(-1.0, 7.0), q_zero=st.booleans(),
        log_d=st.floats(-19.0, 19.0), log_power=st.floats(-30.0, 38.0),
        log_normal=st.floats(-30.0, 30.0), seed=st.integers(0, 2**32 - 1))
+# found by CI (2026-12-07): v.r = 0.048 at q = 3.16, the chord's error 7.8 eps, beyond the flat C eps the band had
+@example(lobe="phong", log_q=0.5, q_zero=False, log_d=0.0, log_power=3.0, log_normal=0.0, seed=12508)
 def test_shade_is_in_band_and_finite(session_gl, lobe, log_q, q_zero, log_d, log_power, log_normal, seed):
     """Random directions and parameters in the documented ranges: GPU within the band, never NaN or Inf."""
     rng = np.random.default_rng(seed)
