@@ -480,11 +480,11 @@ def test_flow_needs_its_scene_and_the_same_meshes():
     scene.add(_cube(), glphong.Lambert(0.5))
     other.add(_cube(), glphong.Lambert(0.5))  # an equal mesh, but another object
     hits = ft.cast_pixels(scene, 8, 8)
-    with pytest.raises(ValueError, match="'flow' needs next_scene"):
+    with pytest.raises(ValueError, match="'flow' pass needs next_scene"):
         ft.twin_passes(scene, hits, ["depth", "flow"])
-    with pytest.raises(ValueError, match="'backward_flow' needs previous_scene"):
+    with pytest.raises(ValueError, match="'backward_flow' pass needs previous_scene"):
         ft.pass_bands(scene, hits, ["backward_flow"], next_scene=scene)
-    with pytest.raises(ValueError, match="'flow'.*must correspond"):
+    with pytest.raises(ValueError, match="'flow' pass needs next_scene to hold the same objects"):
         ft.twin_passes(scene, hits, ["flow"], next_scene=other)
     with pytest.raises(ValueError, match="unknown passes"):
         ft.twin_passes(scene, hits, ["albedo"])

@@ -63,6 +63,7 @@ import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.definitions.surface import alpha_masked
+from glphong.gpu.passes import check_corresponds
 from glphong.twin.band import EPS
 from glphong.twin.functions import dot, safe_normalize
 from glphong.checks.raycast import T_MIN
@@ -411,21 +412,9 @@ def _normal(scene, hits):
 
 def _ids(scene, hits, name):
     """(S, H, W) int64: the hit objects' ``instance_id`` or ``category`` (``name``), 0 where none."""
-    values = np.array([getattr(obj, "instance_id", k + 1) if name == "instance" else getattr(obj, "category", 0)
-                       for k, obj in enumerate(scene.objects)] + [0], dtype=np.int64)
+    values = np.array([getattr(obj, "instance_id" if name == "instance" else "category") for obj in scene.objects]
+                      + [0], dtype=np.int64)
     return values[hits.object_index]  # index -1: the trailing 0
-
-
-def _other_scene(scene, other, name):
-    """``other`` checked to be ``scene`` at another time: the same meshes at the same indices."""
-    if other is None:
-        raise ValueError(f"the pass {name!r} needs {_OTHER_SCENE[name]}")
-    same = len(other.objects) == len(scene.objects) and all(
-        a.mesh is b.mesh for a, b in zip(scene.objects, other.objects))
-    if not same:
-        raise ValueError(f"the pass {name!r}: {_OTHER_SCENE[name]}'s objects must correspond to the scene's (the same "
-                         "count and the same mesh object at each index)")
-    return other
 
 
 def _flow(scene, hits, other, oc):
@@ -479,8 +468,9 @@ def twin_passes(scene, hits, names, next_scene=None, previous_scene=None, which=
         objects do not correspond.
     """
     names = _check_names(names)
-    others = {n: _other_scene(scene, next_scene if n == "flow" else previous_scene, n)
-              for n in names if n in _OTHER_SCENE}
+    others = {n: next_scene if n == "flow" else previous_scene for n in names if n in _OTHER_SCENE}
+    for name, other in others.items():
+        check_corresponds(scene, other, name, _OTHER_SCENE[name])
     if _validate.choice("which", which, ("nearest", "tie")) == "tie":
         hits = hits.ties()
     hit = hits.object_index >= 0
@@ -561,13 +551,15 @@ def _id_sets(near, tie):
     return np.moveaxis(np.where(values == none, -1, values), 0, -1)
 
 
-def pass_bands(scene, hits, names, next_scene=None, previous_scene=None):
+def pass_bands(scene, hits, names, next_scene=None, previous_scene=None, nearest=None):
     """The interval each GPU pass must lie in at every pixel.
 
     Parameters
     ----------
     scene, hits, names, next_scene, previous_scene
         As `twin_passes` takes them.
+    nearest : dict, optional
+        ``twin_passes(scene, hits, names, next_scene, previous_scene)`` where the caller has it (not computed again).
 
     Returns
     -------
@@ -579,7 +571,9 @@ def pass_bands(scene, hits, names, next_scene=None, previous_scene=None):
     """
     names = _check_names(names)
     views = (hits, hits.ties())
-    values = [twin_passes(scene, view, names, next_scene, previous_scene) for view in views]
+    if nearest is None:
+        nearest = twin_passes(scene, hits, names, next_scene, previous_scene)
+    values = [nearest, twin_passes(scene, views[1], names, next_scene, previous_scene)]
     tie = hits.tie_object_index >= 0
     others = {"flow": next_scene, "backward_flow": previous_scene}
     out = {}

@@ -83,7 +83,7 @@ def verify_passes(scene, frame, names, next_scene=None, previous_scene=None):
     height, width = frame.mask.shape
     hits = cast_pixels(scene, width, height, SAMPLE_OFFSETS)
     values = twin_passes(scene, hits, names, next_scene, previous_scene)
-    bands = pass_bands(scene, hits, names, next_scene, previous_scene)
+    bands = pass_bands(scene, hits, names, next_scene, previous_scene, nearest=values)
     return {name: _compare(name, getattr(frame, name), values[name][0], bands[name]) for name in names}
 
 

@@ -26,7 +26,8 @@ import numpy as np
 
 from glphong.scene.scene import Scene
 
-__all__ = ["PASSES", "GEOMETRY_PASSES", "requested_passes", "gbuffer_planes", "check_passes", "derive_passes",
+__all__ = ["PASSES", "GEOMETRY_PASSES", "requested_passes", "gbuffer_planes", "check_passes", "check_corresponds",
+           "derive_passes",
            "opencv_rotation"]
 
 #: every pass `glphong.Renderer.render` gives, in the order a `Frame` lists them
@@ -82,12 +83,14 @@ def check_passes(scene, names, next_scene=None, previous_scene=None):
     for name, other, argument in (("flow", next_scene, "next_scene"), ("backward_flow", previous_scene,
                                                                         "previous_scene")):
         if name in names:
-            _check_corresponds(scene, other, name, argument)
+            check_corresponds(scene, other, name, argument)
         elif other is not None:
             raise ValueError(f"{argument} is given but the {name!r} pass is not asked for: add it to passes")
 
 
-def _check_corresponds(scene, other, name, argument):
+def check_corresponds(scene, other, name, argument):
+    """Whether ``other`` (the ``argument`` of pass ``name``, 'next_scene' or 'previous_scene') is ``scene`` at another
+    time: a Scene holding the same MeshData objects in the same order; raises ValueError (TypeError) naming the fix."""
     if other is None:
         raise ValueError(f"the {name!r} pass needs {argument}: the same objects, in the same order, at their "
                          "poses in that frame, seen by its camera")
