@@ -230,7 +230,8 @@ def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None,
     return VerifyReport(gpu=frame.radiance, reference=ref, low=low, high=high, relative_error=rel,
                         outside=outside, mask=mask, mask_mismatch=int((frame.mask != gbuffer.mask).sum()),
                         shadow_band=shadow_band, exact=exact_radiance, exact_error=exact_error,
-                        passes=verify_passes(scene, frame, geometry, next_scene, previous_scene) if geometry else {})
+                        passes=verify_passes(scene, frame, geometry, next_scene, previous_scene,
+                                             renderer.matte_samples) if geometry else {})
 
 
 def exact_image(scene, gbuffer, shadows=None, closed_forms=True):

@@ -12,7 +12,9 @@ and ``UINT`` for the ids, so that a round trip is bit-exact (NaN flow included):
 - ``uv``: ``uv.U``, ``uv.V``, FLOAT;
 - ``instance``, ``category``: ``instance.id``, ``category.id`` (0 the background), UINT;
 - ``flow``, ``backward_flow`` [px], x right, y down: ``flow.X``, ``flow.Y``, ``backward_flow.X``,
-  ``backward_flow.Y``, FLOAT.
+  ``backward_flow.Y``, FLOAT;
+- the ``matte`` pass's k entries: ``matte.id0`` to ``matte.id<k-1>`` (UINT) and ``matte.fraction0`` to
+  ``matte.fraction<k-1>`` (FLOAT), entry 0 the largest share (`MATTE_CHANNELS`).
 
 The radiance, alpha and depth take the channel names every EXR reader knows (``R G B A Z``); every other pass is a
 layer named by the pass, its components the axes (``X Y Z``, ``U V`` for texture coordinates), as Blender's
@@ -31,9 +33,9 @@ import numpy as np
 
 from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
 from glphong.core.atomic_files import write_atomically
-from glphong.datasets.npz import LAYOUT, frame_arrays
+from glphong.datasets.npz import LAYOUT, MAX_MATTE_K, frame_arrays
 
-__all__ = ["EXR_CHANNELS", "save_exr", "load_exr"]
+__all__ = ["EXR_CHANNELS", "MATTE_CHANNELS", "save_exr", "load_exr"]
 
 _AXES = ("X", "Y", "Z")
 #: each array's channels in the file, in component order
@@ -45,7 +47,26 @@ EXR_CHANNELS = {
     "nocs": tuple(f"nocs.{a}" for a in _AXES), "flow": ("flow.X", "flow.Y"),
     "backward_flow": ("backward_flow.X", "backward_flow.Y"), "coverage": ("A",),
 }
+#: the prefix of each matte array's channels, followed by the entry's number 0 to k - 1
+MATTE_CHANNELS = {"matte_ids": "matte.id", "matte_fractions": "matte.fraction"}
 _MAGIC = b"\x76\x2f\x31\x01"
+
+
+def _matte_count(prefix, present):
+    """How many channels ``prefix0``, ``prefix1``, ... the file has in a row from 0."""
+    k = 0
+    while k < MAX_MATTE_K and f"{prefix}{k}" in present:
+        k += 1
+    return k
+
+
+def _channels_of(name, present=None, k=None):
+    """The channels of array ``name``: `EXR_CHANNELS`'s, or a matte array's ``k`` (given, or as many as ``present``
+    holds in a row from 0)."""
+    if name in EXR_CHANNELS:
+        return EXR_CHANNELS[name]
+    prefix = MATTE_CHANNELS[name]
+    return tuple(f"{prefix}{j}" for j in range(_matte_count(prefix, present) if k is None else k))
 
 
 def _openexr(path):
@@ -82,7 +103,7 @@ def save_exr(path, frame):
     OpenEXR = _openexr(path)
     channels = {}
     for name, array in frame_arrays(frame).items():
-        names = EXR_CHANNELS[name]
+        names = _channels_of(name, k=array.shape[2] if array.ndim == 3 else None)
         planes = [array] if array.ndim == 2 else [array[..., i] for i in range(array.shape[2])]
         channels.update({channel: np.ascontiguousarray(plane) for channel, plane in zip(names, planes)})
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
@@ -119,7 +140,8 @@ def _header(OpenEXR, path, data, limits):
     if width * height * len(names) * 8 > limits.decoded_bytes:
         raise SceneFileError(path, f"header: {len(names)} channels of {width} x {height} pixels, more than "
                              f"{limits.decoded_bytes} bytes (glphong.filesafety.Limits.decoded_bytes)")
-    ours = [n for group in EXR_CHANNELS.values() for n in group]
+    ours = [n for group in EXR_CHANNELS.values() for n in group] + [
+        n for n in names if any(n.startswith(prefix) for prefix in MATTE_CHANNELS.values())]
     subsampled = [n for n in ours if n in sampling and sampling[n] != (1, 1)]
     if subsampled:
         raise SceneFileError(path, f"header: channels {subsampled} are subsampled; expected one sample per pixel")
@@ -161,8 +183,8 @@ def load_exr(path, passes=None, limits=None):
     limits = limits or LIMITS
     path = Path(path)
     for name in passes or ():
-        if name not in EXR_CHANNELS:
-            raise ValueError(f"unknown name {name!r}; the names are {', '.join(EXR_CHANNELS)}")
+        if name not in LAYOUT:
+            raise ValueError(f"unknown name {name!r}; the names are {', '.join(LAYOUT)}")
     OpenEXR = _openexr(path)
     data = read_bytes(path, limits)
     if data[:4] != _MAGIC:
@@ -170,7 +192,13 @@ def load_exr(path, passes=None, limits=None):
     height, width, present = _header(OpenEXR, path, data, limits)
     wanted = set(passes or ())
     chosen = []
-    for name, group in EXR_CHANNELS.items():
+    groups = {name: _channels_of(name, present) for name in LAYOUT}
+    for name, group in groups.items():
+        if name in MATTE_CHANNELS and not group:
+            if name in wanted:
+                raise SceneFileError(path, f"no {name!r}: expected the channels {MATTE_CHANNELS[name]}0 to "
+                                     f"{MATTE_CHANNELS[name]}<k-1>; the file has {sorted(present)[:24]}")
+            continue
         found = [c for c in group if c in present]
         if found and len(found) < len(group):
             raise SceneFileError(path, f"channels {found} of {name!r} without {[c for c in group if c not in found]}; "
@@ -185,19 +213,23 @@ def load_exr(path, passes=None, limits=None):
     try:
         with OpenEXR.File(io.BytesIO(data), separate_channels=True) as exr:
             channels = exr.channels()
-            out = {name: _pass(OpenEXR, path, channels, name, height, width) for name in chosen}
+            out = {name: _pass(OpenEXR, path, channels, name, groups[name], height, width) for name in chosen}
     except SceneFileError:
         raise
     except Exception as exc:  # OpenEXR's errors on truncated or corrupt pixel data
         raise SceneFileError(path, f"unreadable OpenEXR pixels ({type(exc).__name__}: {exc})") from None
+    if ("matte_ids" in out) != ("matte_fractions" in out) or (
+            "matte_ids" in out and out["matte_ids"].shape != out["matte_fractions"].shape):
+        raise SceneFileError(path, f"channels {', '.join(MATTE_CHANNELS.values())}: expected both, with the same "
+                             "number of entries")
     return out
 
 
-def _pass(OpenEXR, path, channels, name, height, width):
-    """One name's array from its channels, each checked for pixel type and size."""
+def _pass(OpenEXR, path, channels, name, group, height, width):
+    """One name's array from its channels ``group``, each checked for pixel type and size."""
     components, dtype = LAYOUT[name]
     planes = []
-    for channel in EXR_CHANNELS[name]:
+    for channel in group:
         if channel not in channels:  # listed in the header, but no pixels read (a truncated file)
             raise SceneFileError(path, f"channel {channel!r}: no pixel data (a truncated or corrupt file)")
         kind = channels[channel].type()

@@ -19,22 +19,43 @@ from glphong.core.atomic_files import write_atomically
 from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
 from glphong.gpu.passes import PASSES
 
-__all__ = ["LAYOUT", "frame_arrays", "save_npz", "load_npz"]
+__all__ = ["LAYOUT", "PASS_ARRAYS", "MAX_MATTE_K", "pass_arrays", "frame_arrays", "save_npz", "load_npz"]
 
 _F4, _U4 = np.dtype(np.float32), np.dtype(np.uint32)
-#: each array a frame file may hold: name -> (components, dtype); components None for an (H, W) array, else k for
-#: (H, W, k).  The passes of `glphong.gpu.passes.PASSES` in its order, then ``coverage``.
+#: each array a frame file may hold: name -> (components, dtype); components None for an (H, W) array, an int c for
+#: (H, W, c), "k" for the matte's (H, W, k) with any k from 1 to `MAX_MATTE_K` (both matte arrays the same k).  The
+#: passes of `glphong.gpu.passes.PASSES` in its order (the 'matte' pass as its two arrays), then ``coverage``.
 LAYOUT = {
     "radiance": (3, _F4), "depth": (None, _F4), "distance": (None, _F4), "normal": (3, _F4),
     "normal_camera": (3, _F4), "uv": (2, _F4), "instance": (None, _U4), "category": (None, _U4),
     "object_coordinates": (3, _F4), "nocs": (3, _F4), "flow": (2, _F4), "backward_flow": (2, _F4),
-    "coverage": (None, _F4),
+    "matte_ids": ("k", _U4), "matte_fractions": ("k", _F4), "coverage": (None, _F4),
 }
-assert tuple(LAYOUT)[:-1] == PASSES
+#: the arrays of each pass that is not one array of its own name
+PASS_ARRAYS = {"matte": ("matte_ids", "matte_fractions")}
+#: the most matte entries a pixel may have in a file (`glphong.Renderer`'s ``matte_k`` at most)
+MAX_MATTE_K = 16
+assert tuple(LAYOUT)[:-1] == tuple(a for p in PASSES for a in PASS_ARRAYS.get(p, (p,)))
+
+
+def pass_arrays(names):
+    """The array names of the passes ``names`` (tuple of str, `LAYOUT`'s order)."""
+    arrays = {a for p in names for a in PASS_ARRAYS.get(p, (p,))}
+    return tuple(n for n in LAYOUT if n in arrays)
+
+
+def _components_ok(components, shape):
+    """Whether an array of ``shape`` has `LAYOUT`'s ``components``."""
+    if components is None:
+        return len(shape) == 2
+    if len(shape) != 3:
+        return False
+    return 1 <= shape[2] <= MAX_MATTE_K if components == "k" else shape[2] == components
 
 
 def _shape_text(components):
-    return "(H, W)" if components is None else f"(H, W, {components})"
+    return "(H, W)" if components is None else f"(H, W, {components})" + (
+        f" with k from 1 to {MAX_MATTE_K}" if components == "k" else "")
 
 
 def frame_arrays(frame):
@@ -64,7 +85,7 @@ def frame_arrays(frame):
     if names is None or isinstance(names, str):
         raise TypeError(f"expected a glphong Frame (renderer.render(...)), got {type(frame).__name__}")
     arrays, size = {}, None
-    for name in [n for n in LAYOUT if n in names] + ["coverage"]:
+    for name in list(pass_arrays([n for n in names if n in PASSES])) + ["coverage"]:
         value = getattr(frame, name, None)
         if value is None:
             if name == "coverage":
@@ -72,8 +93,7 @@ def frame_arrays(frame):
             raise ValueError(f"frame.passes lists {name!r} but frame.{name} is None")
         value = np.asarray(value)
         components, dtype = LAYOUT[name]
-        ndim = 2 if components is None else 3
-        if value.dtype != dtype or value.ndim != ndim or (components is not None and value.shape[2] != components):
+        if value.dtype != dtype or not _components_ok(components, value.shape):
             raise ValueError(f"frame.{name} is {value.dtype} {value.shape}; expected {dtype} {_shape_text(components)}")
         if size is None:
             size = value.shape[:2]
@@ -81,7 +101,10 @@ def frame_arrays(frame):
             raise ValueError(f"frame.{name} is {value.shape[0]} x {value.shape[1]} pixels (H x W), the frame's other "
                              f"passes {size[0]} x {size[1]}")
         arrays[name] = np.ascontiguousarray(value)
-    unknown = [n for n in names if n not in LAYOUT]
+    if "matte_ids" in arrays and arrays["matte_ids"].shape != arrays["matte_fractions"].shape:
+        raise ValueError(f"frame.matte_ids is {arrays['matte_ids'].shape}, frame.matte_fractions "
+                         f"{arrays['matte_fractions'].shape}; expected the same (H, W, k)")
+    unknown = [n for n in names if n not in PASSES]
     if unknown:
         raise ValueError(f"frame.passes lists unknown passes {unknown}; the passes are {', '.join(PASSES)}")
     if not arrays:
@@ -136,9 +159,8 @@ def _read_header(path, member, stream):
 def _check_member(path, member, name, header, size, limits):
     shape, _, dtype = header
     components, expected = LAYOUT[name]
-    ndim = 2 if components is None else 3
-    if (dtype.kind, dtype.itemsize) != (expected.kind, expected.itemsize) or dtype.hasobject or len(shape) != ndim or (
-            components is not None and shape[2] != components):
+    if (dtype.kind, dtype.itemsize) != (expected.kind, expected.itemsize) or dtype.hasobject or \
+            not _components_ok(components, shape):
         raise SceneFileError(path, f"{dtype} {shape}; expected {expected} {_shape_text(components)}", member)
     if min(shape) < 1:
         raise SceneFileError(path, f"shape {shape}; expected every dimension >= 1", member)
@@ -149,7 +171,7 @@ def _check_member(path, member, name, header, size, limits):
     if not 0 < pixels <= limits.image_pixels:
         raise SceneFileError(path, f"{shape[0]} x {shape[1]} pixels; expected 1 to {limits.image_pixels} "
                              "(glphong.filesafety.Limits.image_pixels)", member)
-    return tuple(shape[:2]), pixels * (components or 1) * 8
+    return tuple(shape[:2]), pixels * (shape[2] if len(shape) == 3 else 1) * 8
 
 
 def load_npz(path, passes=None, limits=None):
@@ -219,6 +241,9 @@ def load_npz(path, passes=None, limits=None):
                 if stream.read(1):  # read to the end, where zipfile checks the CRC-32
                     raise SceneFileError(path, "data beyond the array its header describes", member)
             out[name] = np.ascontiguousarray(array, dtype=LAYOUT[name][1])
+        if ("matte_ids" in out) != ("matte_fractions" in out) or (
+                "matte_ids" in out and out["matte_ids"].shape != out["matte_fractions"].shape):
+            raise SceneFileError(path, "matte_ids and matte_fractions: expected both, of the same (H, W, k)")
     except SceneFileError:
         raise
     except (zipfile.BadZipFile, zlib.error, ValueError, EOFError, OSError, NotImplementedError, RuntimeError) as exc:

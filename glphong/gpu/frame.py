@@ -39,6 +39,11 @@ class Frame:
     distance, normal_camera, uv, instance, category, object_coordinates, nocs, flow, backward_flow : ndarray or None
         The frame passes ``render(scene, passes=...)`` asks for (`glphong.gpu.passes`: each one's meaning, shape, unit
         and dtype); None where not asked for.
+    matte_ids : (H, W, k) uint32 ndarray or None
+        The 'matte' pass: per pixel the ``instance_id`` of the ``k`` objects with the largest share of its square, by
+        share descending (ties by id ascending), 0 padding (`glphong.gpu.matte`).
+    matte_fractions : (H, W, k) float32 ndarray or None
+        Their shares of the pixel's area, descending, 0 padding; a pixel's sum is its covered share.
     passes : tuple of str
         The passes the frame holds, in `glphong.gpu.passes.PASSES` order.
     exposure : float
@@ -61,6 +66,8 @@ class Frame:
     nocs: np.ndarray = None
     flow: np.ndarray = None
     backward_flow: np.ndarray = None
+    matte_ids: np.ndarray = None
+    matte_fractions: np.ndarray = None
     passes: tuple = ("radiance",)
 
     def with_exposure(self, exposure):

@@ -21,9 +21,12 @@ the centre:
   lands in ``next_scene`` (the same objects in the same order at their next poses, seen by its camera) minus the
   pixel centre; from ``previous_scene`` for the backward one.  Kubric's convention: a pure projection, occlusion in
   the other frame ignored; NaN where the point is not in front of the other camera (its ``w <= 0``).
+- ``matte``: ``matte_ids`` (H, W, k) uint32 and ``matte_fractions`` (H, W, k) float32, each pixel's ``k`` objects
+  of largest share of its square, from a draw of its own at ``s x s`` samples a pixel (`glphong.gpu.matte`).
 """
 import numpy as np
 
+from glphong.gpu.matte import matte_objects
 from glphong.scene.scene import Scene
 
 __all__ = ["PASSES", "GEOMETRY_PASSES", "requested_passes", "gbuffer_planes", "check_passes", "check_corresponds",
@@ -32,9 +35,9 @@ __all__ = ["PASSES", "GEOMETRY_PASSES", "requested_passes", "gbuffer_planes", "c
 
 #: every pass `glphong.Renderer.render` gives, in the order a `Frame` lists them
 PASSES = ("radiance", "depth", "distance", "normal", "normal_camera", "uv", "instance", "category",
-          "object_coordinates", "nocs", "flow", "backward_flow")
-#: the passes made from the G-buffer draw
-GEOMETRY_PASSES = PASSES[1:]
+          "object_coordinates", "nocs", "flow", "backward_flow", "matte")
+#: the passes made from the G-buffer draw (the radiance draw's planes where it is asked for)
+GEOMETRY_PASSES = PASSES[1:-1]
 _FROM_OBJECT = ("object_coordinates", "nocs", "flow", "backward_flow")
 
 
@@ -75,6 +78,8 @@ def gbuffer_planes(names):
 
 def check_passes(scene, names, next_scene=None, previous_scene=None):
     """Whether ``scene`` can have the passes ``names``; raises ValueError naming the pass and the fix."""
+    if "matte" in names:
+        matte_objects(scene)
     if "uv" in names:
         for obj in scene.objects:
             if obj.mesh.uvs is None:

@@ -27,6 +27,7 @@ from glphong.shaders.keys import EncodeKey
 from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, PASS_PLANES
 from glphong.shaders.numerics import NUMERICS, allowed_pieces, view_decision, with_numerics
 from glphong.gpu.shadows import ShadowMaps
+from glphong.gpu.matte import MATTE_K, MATTE_SAMPLES, TILE, Matte
 from glphong.gpu.programs import ProgramCache
 from glphong.scene.scene import Scene
 
@@ -100,6 +101,12 @@ class Renderer:
         object needs.  False: every object drawn with the uber-shader (every built-in term,
         the scene's own terms and up to 8 lights per kind compiled in, switched by uniforms),
         for measuring what specialisation buys.
+    matte_samples : int
+        Samples per pixel along each axis of the 'matte' pass, 1 to 64 (default `glphong.gpu.matte.MATTE_SAMPLES`,
+        32: 1024 samples a pixel); an object's share of a pixel is off by at most about ``1 / (2 matte_samples)`` per
+        straight boundary crossing the pixel (docs/design.md section 15).
+    matte_k : int
+        Objects kept per pixel by the 'matte' pass, 1 to 16 (default 4).
 
     Examples
     --------
@@ -109,7 +116,9 @@ class Renderer:
 
     def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
                  formulation="stable", specialise=True, culling="auto", device=None, shadow_map_size=1024,
-                 shadow_filter_radius=0, numerics="auto"):
+                 shadow_filter_radius=0, numerics="auto", matte_samples=MATTE_SAMPLES, matte_k=MATTE_K):
+        self.matte_samples = _validate.positive_int("matte_samples", matte_samples, 1, 64)
+        self.matte_k = _validate.positive_int("matte_k", matte_k, 1, 16)
         self.shadow_map_size = _validate.positive_int("shadow_map_size", shadow_map_size, 16, 8192)
         self.shadow_filter_radius = _validate.positive_int("shadow_filter_radius", shadow_filter_radius, 0, 8)
         self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
@@ -151,6 +160,7 @@ class Renderer:
         self._meshes = {}
         self._targets = {}
         self._shadow_maps = ShadowMaps(self._mgl, self._targets)
+        self._matte = Matte(self._mgl, self._targets, min(TILE, self._max_size))
         self._entries = weakref.WeakKeyDictionary()  # SceneObject -> {output: ObjectEntry}
 
     def render_target_bytes(self, size=None):
@@ -232,9 +242,10 @@ class Renderer:
             Also the 'depth' and 'normal' passes (as ``passes`` naming them).
         passes : sequence of str, optional
             The passes to return (`glphong.gpu.passes.PASSES`: 'radiance', 'depth', 'distance', 'normal',
-            'normal_camera', 'uv', 'instance', 'category', 'object_coordinates', 'nocs', 'flow', 'backward_flow'),
-            default ``('radiance',)``.  All but the radiance come from one G-buffer draw at the output size, one
-            sample per pixel; without 'radiance' nothing is shaded.
+            'normal_camera', 'uv', 'instance', 'category', 'object_coordinates', 'nocs', 'flow', 'backward_flow',
+            'matte'), default ``('radiance',)``.  All but the radiance and the matte come from one G-buffer draw at
+            the output size, one sample per pixel (the radiance draw itself where it allows), the matte from a draw
+            of its own at ``matte_samples`` squared samples a pixel; without 'radiance' nothing is shaded.
         next_scene, previous_scene : Scene, optional
             The same objects in the same order at their poses in the next (previous) frame, and that frame's
             camera: what 'flow' ('backward_flow') reads.
@@ -249,17 +260,20 @@ class Renderer:
                 raise TypeError(f"{name} must be a bool, True or False (got {flag!r})")
         names = requested_passes(passes, depth, normals)
         check_passes(scene, names, next_scene, previous_scene)
-        geometry = [n for n in names if n != "radiance"]
-        extra = {}
+        geometry = [n for n in names if n not in ("radiance", "matte")]
+        extra = self._draw_matte(scene) if "matte" in names else {}
         if geometry and "radiance" in names and self.samples == 1 and self.supersample == 1 \
                 and self.shading == "pixel" and self.specialise:
-            return self._render_with_planes(scene, names, geometry, next_scene, previous_scene)
+            return self._render_with_planes(scene, names, geometry, next_scene, previous_scene, extra)
         if geometry:  # the lock is re-entrant
             gbuffer = self.gbuffer(scene, gbuffer_planes(geometry))
-            extra = derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
+            extra |= derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
         if "radiance" not in names:
-            return Frame(radiance=None, mask=gbuffer.mask, coverage=gbuffer.mask.astype(np.float32), passes=names,
-                         **extra)
+            if geometry:
+                mask = gbuffer.mask
+            else:  # the matte alone: covered where any sample is
+                mask = extra["matte_fractions"][..., 0] > 0.0
+            return Frame(radiance=None, mask=mask, coverage=mask.astype(np.float32), passes=names, **extra)
         with self.context:
             fbo = self._draw_radiance(scene)
             rgba = read_attachment(fbo, self._internal_size, components=4)
@@ -271,7 +285,17 @@ class Renderer:
         coverage = rgba[..., 3]
         return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, passes=names, **extra)
 
-    def _render_with_planes(self, scene, names, geometry, next_scene, previous_scene):
+    def _draw_matte(self, scene):
+        """The 'matte' pass's arrays (`glphong.gpu.matte.Matte.draw`), dict of frame attribute to array."""
+        with self.context:
+            self._purge_dead_meshes()
+            ids, fractions = self._matte.draw(scene, self._size, self.matte_samples, self.matte_k, self.programs,
+                                              lambda mesh, program: self._mesh_buffers(mesh).vertex_array(self._mgl,
+                                                                                                           program))
+            self.context.check_error("drawing the matte pass")
+        return {"matte_ids": ids, "matte_fractions": fractions}
+
+    def _render_with_planes(self, scene, names, geometry, next_scene, previous_scene, extra):
         """The radiance and the geometry passes from one draw: each radiance program also writes the G-buffer planes
         the passes read (multiple render targets, `glphong.shaders.options.PASS_PLANES`), where one sample per pixel
         at the output size is what the radiance is drawn with too."""
@@ -286,7 +310,7 @@ class Renderer:
                     for i, name in enumerate(pass_planes)}
             self.context.check_error("rendering radiance and the frame passes' planes")
         gbuffer = GBuffer.from_planes(read.pop("position"), read.pop("normal", None), read)
-        extra = derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
+        extra = extra | derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
         coverage = rgba[..., 3]
         return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, passes=names, **extra)
 

@@ -8,7 +8,7 @@ from glphong.definitions.material import registered_models
 from glphong.shaders.keys import LightKey, ProgramKey, TermKey
 from glphong.shaders.options import MAX_TEXTURED_INPUTS, UBER_MAX_LIGHTS
 
-__all__ = ["light_keys", "term_keys", "program_key", "gbuffer_key", "uber_key", "response_key", "shadow_key",
+__all__ = ["light_keys", "term_keys", "program_key", "gbuffer_key", "uber_key", "response_key", "shadow_key", "matte_key",
            "lod_slots"]
 
 
@@ -228,6 +228,11 @@ def uber_key(materials, output="radiance", formulation="stable", shade_per_verte
 def shadow_key(shadow_pass):
     """The key of a shadow pass (a caster's distance from the light, glsl/shadow_fragment.glsl): 'cube' or 'ortho'."""
     return ProgramKey(output="shadow", has_normal=False, two_sided=False, shadow_pass=shadow_pass)
+
+
+def matte_key():
+    """The key of the matte pass (each sample's object index plus one, glsl/matte_fragment.glsl)."""
+    return ProgramKey(output="matte", has_normal=False, two_sided=False)
 
 
 def lod_slots(images):

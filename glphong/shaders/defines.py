@@ -51,9 +51,9 @@ def program_defines(key):
     ]
     if key.output == "shadow":
         out.append(("SHADOW_ORTHO", b(key.shadow_pass == "ortho")))
-    if key.output != "shadow":
+    if key.output not in ("shadow", "matte"):
         out += _plane_defines(key)
-    if key.output not in ("gbuffer", "shadow"):
+    if key.output not in ("gbuffer", "shadow", "matte"):
         out.append(("NEEDS_VIEW", b(key.needs_view)))
         if key.shadow_slots:
             out += [("SHADOW_MAP_SIZE", str(key.shadow_size)), ("SHADOW_FILTER_RADIUS", str(key.shadow_filter))]

@@ -146,7 +146,7 @@ class ProgramKey:
 
     Attributes
     ----------
-    output : {'radiance', 'gbuffer', 'points', 'display'}
+    output : {'radiance', 'gbuffer', 'points', 'display', 'response', 'shadow', 'matte'}
         Shaded radiance, the G-buffer of shading inputs, radiance at arbitrary points
         (a vertex-only program whose ``shade_point()`` result is captured by transform feedback), or
         display values (exposure and sRGB applied after shading) for pyrender's 8-bit framebuffer,
@@ -345,7 +345,7 @@ class ProgramKey:
         """Text of the chunks generated from the key (label -> GLSL)."""
         if self.output == "gbuffer":
             return {LOD_CHUNK: lod_chunk(self)} if self.lod_textures else {}
-        if self.output == "shadow":
+        if self.output in ("shadow", "matte"):
             return {}
         out = {MATERIAL_CHUNK: material_chunk(self)}
         if self.lights and self.output != "response":

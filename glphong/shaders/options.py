@@ -7,7 +7,7 @@ __all__ = ["UBER_MAX_LIGHTS", "OUTPUTS", "SHADOW_PASSES", "FORMULATIONS", "NUMER
 #: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
 UBER_MAX_LIGHTS = 8
 
-OUTPUTS = ("radiance", "gbuffer", "points", "display", "response", "shadow")
+OUTPUTS = ("radiance", "gbuffer", "points", "display", "response", "shadow", "matte")
 SHADOW_PASSES = (None, "cube", "ortho")
 FORMULATIONS = ("stable", "naive")
 #: the pieces of arithmetic that Renderer(numerics='auto') specialises where the scene's ranges prove it (docs/design.md

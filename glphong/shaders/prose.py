@@ -24,6 +24,8 @@ def left_out(key, absent_terms=()):
                                       for name in GBUFFER_PLANES if name not in key.gbuffer_planes()]
     if key.output == "shadow":
         return ["all shading code (the shadow pass writes each caster's distance from the light)"]
+    if key.output == "matte":
+        return ["all shading code (the matte pass writes each sample's object)"]
     if key.uber:
         return ["nothing: the uber-shader compiles every built-in term and the scene's own and switches at run time"]
     out = []

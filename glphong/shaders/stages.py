@@ -90,6 +90,7 @@ STAGES = {
     "points": {"vertex": SHADING + ("shade_points",), "fragment": ()},
     "response": {"vertex": ("common", LIBRARY, TERMS, MATERIAL_CHUNK, "response_points"), "fragment": ()},
     "shadow": {"vertex": ("mesh_vertex",), "fragment": ("common", "shadow_fragment")},
+    "matte": {"vertex": ("mesh_vertex",), "fragment": ("matte_fragment",)},
 }
 
 

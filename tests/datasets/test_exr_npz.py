@@ -19,7 +19,7 @@ import glphong
 from glphong import primitives
 from glphong.core.filesafety import Limits, SceneFileError
 from glphong.datasets.exr import EXR_CHANNELS, load_exr, save_exr
-from glphong.datasets.npz import load_npz, save_npz
+from glphong.datasets.npz import load_npz, pass_arrays, save_npz
 from glphong.gpu.passes import PASSES
 from glphong.scene.geometry import MeshData
 
@@ -27,6 +27,7 @@ W, H = 64, 48
 SPHERE = primitives.sphere(3, 0.5)
 BOX = MeshData.from_trimesh(trimesh.creation.box((0.8, 0.6, 0.6)), smooth=False)
 NAMES = ("radiance",) + tuple(n for n in PASSES[1:] if n != "uv")
+ARRAYS = pass_arrays(NAMES)  # the 'matte' pass is two arrays, matte_ids and matte_fractions
 #: the channels the module docstring promises, and their pixel types
 DOCUMENTED = {
     "R": "FLOAT", "G": "FLOAT", "B": "FLOAT", "A": "FLOAT", "Z": "FLOAT", "distance.Z": "FLOAT",
@@ -36,6 +37,7 @@ DOCUMENTED = {
     "object_coordinates.X": "FLOAT", "object_coordinates.Y": "FLOAT", "object_coordinates.Z": "FLOAT",
     "nocs.X": "FLOAT", "nocs.Y": "FLOAT", "nocs.Z": "FLOAT",
     "flow.X": "FLOAT", "flow.Y": "FLOAT", "backward_flow.X": "FLOAT", "backward_flow.Y": "FLOAT",
+    **{f"matte.id{j}": "UINT" for j in range(4)}, **{f"matte.fraction{j}": "FLOAT" for j in range(4)},
 }
 
 
@@ -74,8 +76,9 @@ def _same_bits(a, b):
 
 
 def _check_round_trip(frame, loaded):
-    assert list(loaded) == list(NAMES) + ["coverage"]
-    for name in NAMES:
+    assert list(loaded) == list(ARRAYS) + ["coverage"]
+    assert ARRAYS[-2:] == ("matte_ids", "matte_fractions") and loaded["matte_ids"].shape == (H, W, 4)
+    for name in ARRAYS:
         assert _same_bits(loaded[name], getattr(frame, name)), name
     assert _same_bits(loaded["coverage"], frame.coverage)
     assert loaded["instance"].dtype == loaded["category"].dtype == np.uint32
@@ -88,7 +91,7 @@ def test_npz_round_trip_is_bit_exact(tmp_path, frame):
     assert [p.name for p in tmp_path.iterdir()] == ["frame.npz"]  # no temporary file left
     _check_round_trip(frame, load_npz(path))
     with np.load(path, allow_pickle=False) as plain:  # NumPy reads it unaided
-        assert sorted(plain.files) == sorted(list(NAMES) + ["coverage"])
+        assert sorted(plain.files) == sorted(list(ARRAYS) + ["coverage"])
 
 
 def test_exr_round_trip_is_bit_exact_with_documented_channels(tmp_path, frame):
@@ -104,7 +107,8 @@ def test_exr_round_trip_is_bit_exact_with_documented_channels(tmp_path, frame):
         assert _same_bits(channels["flow.Y"].pixels, np.ascontiguousarray(frame.flow[..., 1]))
         assert _same_bits(channels["instance.id"].pixels, frame.instance)
         assert _same_bits(channels["A"].pixels, frame.coverage)
-    assert {c for group in EXR_CHANNELS.values() for c in group} == set(DOCUMENTED) | {"uv.U", "uv.V"}
+    assert {c for group in EXR_CHANNELS.values() for c in group} == {
+        c for c in DOCUMENTED if not c.startswith("matte.")} | {"uv.U", "uv.V"}
 
 
 def test_uv_round_trip(tmp_path, glphong_make_renderer):
@@ -329,3 +333,19 @@ def test_missing_extra_is_named(tmp_path, glphong_make_renderer, monkeypatch):
     with pytest.raises(ImportError, match=r"optional extra 'exr' \(pip install 'glphong\[exr\]'"):
         save_exr(tmp_path / "f.exr", frame)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_matte_arrays_come_in_pairs_of_one_k(tmp_path, frame):
+    from dataclasses import replace
+    with pytest.raises(ValueError, match="matte_ids is .*matte_fractions"):
+        save_npz(tmp_path / "bad.npz", replace(frame, matte_fractions=frame.matte_fractions[..., :3].copy()))
+    with pytest.raises(ValueError, match=r"frame.matte_ids is uint32 \(48, 64, 17\)"):
+        save_npz(tmp_path / "bad.npz", replace(frame, matte_ids=np.zeros((H, W, 17), np.uint32)))
+    np.savez(tmp_path / "half.npz", matte_ids=frame.matte_ids)
+    with pytest.raises(SceneFileError, match="matte_ids and matte_fractions: expected both"):
+        load_npz(tmp_path / "half.npz")
+    k2 = replace(frame, matte_ids=frame.matte_ids[..., :2].copy(), matte_fractions=frame.matte_fractions[..., :2].copy())
+    save_exr(tmp_path / "k2.exr", k2)
+    loaded = load_exr(tmp_path / "k2.exr", passes=("matte_ids",))
+    assert _same_bits(loaded["matte_ids"], k2.matte_ids) and _same_bits(loaded["matte_fractions"], k2.matte_fractions)
+    assert not list(tmp_path.glob("bad*"))
