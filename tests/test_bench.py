@@ -60,7 +60,7 @@ def test_tables_and_files(tiny_report, tmp_path):
     rows = list(csv.DictReader(open(paths[0])))
     assert len(rows) == len(tiny_report.points)
     data = json.load(open(paths[1]))
-    assert {"points", "curves", "scaling", "targets"} <= set(data)
+    assert {"points", "curves", "scaling", "targets", "matte"} <= set(data)
     from PIL import Image
 
     assert Image.open(paths[2]).size[0] > 400  # the work-precision diagram
@@ -71,7 +71,7 @@ def test_quick_cases_and_pyrender_reported_when_missing(monkeypatch):
     only_pyrender = [m for m in methods(quick=True) if m.kind == "pyrender"]
     monkeypatch.setitem(__import__("sys").modules, "pyrender", None)  # import pyrender -> ImportError
     report = run_bench(32, 24, cases=quick_cases()[:1], method_list=only_pyrender, repeats=1, reference_samples=1,
-                       scaling=False, targets=False, progress=False, continuous=False)
+                       scaling=False, targets=False, progress=False, continuous=False, matte=False)
     assert report.points == [] and "pyrender is not installed" in report.skipped[0]
 
 
@@ -101,3 +101,21 @@ def test_cli_bench_speed_quick(tmp_path):
                           "--out", str(tmp_path / "s")], capture_output=True, text=True, timeout=600)
     assert out.returncode == 0, out.stderr[-3000:]
     assert "float/floor" in out.stdout and (tmp_path / "s_speed.json").exists()
+
+
+def test_matte_rows_error_against_time(tiny_report, tmp_path, capsys):
+    """The matte pass's row family (glphong.bench.matte): every scene at s = 4 and 32 within its tolerance, the
+    default within 1/64; ``glphong bench --matte --quick`` prints the table and writes the rows."""
+    from glphong.bench.matte import matte_scenes
+    from glphong.tools.cli import main
+
+    rows = tiny_report.matte
+    assert {(r["case"], r["matte_samples"]) for r in rows} == {(c, s) for c in matte_scenes() for s in (4, 32)}
+    for r in rows:
+        assert r["seconds"] > 0 and r["radiance_seconds"] > 0 and 0 < r["worst"] <= r["tolerance"]
+        assert r["rms"] <= r["worst"]
+    assert max(r["worst"] for r in rows if r["matte_samples"] == 32) <= 1 / 64
+    assert "matte: error against the exact coverage" in tiny_report.format_tables()
+    assert main(["bench", "--matte", "--quick", "--repeats", "1", "--out", str(tmp_path / "b")]) == 0
+    assert "1/worst" in capsys.readouterr().out
+    assert len(json.load(open(tmp_path / "b_matte.json"))) == len(rows)

@@ -5,18 +5,18 @@
 - a screen-aligned rectangle with fractional borders (orthographic): the GPU's shares are exactly the fraction of the
   s x s cell centres inside the rectangle, computed here by hand, on every tiling (tiles smaller than the image
   included); and within ``1 / (2 s)`` of the exact shares;
-- against the exact coverage (glphong.checks.coverage_twin, itself tested against hand areas): two overlapping
-  triangles, a sphere's edge, interpenetrating meshes, an object partly outside the image and a camera from OpenCV
-  intrinsics off centre: the default (s = 32) within 1/64 in every pixel, s = 4, 8, 16 within ``1 / s``;
+- against the exact coverage (glphong.checks.coverage_twin, itself tested against hand areas) on the scenes of
+  ``glphong bench --matte`` (glphong.bench.matte.matte_scenes): two overlapping triangles, a sphere's edge,
+  interpenetrating meshes, an object partly outside the image and a camera from OpenCV intrinsics off centre: the
+  default (s = 32) within 1/64 in every pixel, s = 4, 8, 16 within ``1 / s``;
 - `glphong.verify` passes the matte, and fails planted errors (a swapped id, a share off by 2 / s, a lost entry);
 - bad input: a textured alpha mask, matte_samples and matte_k out of range; the matte alone gives a frame's mask.
 """
 import numpy as np
 import pytest
-import trimesh
 
 import glphong
-from glphong import primitives
+from glphong.bench.matte import matte_scenes
 from glphong.checks.coverage_twin import exact_coverage
 from glphong.checks.verify_passes import compare_matte, matte_error
 from glphong.gpu.matte import MATTE_SAMPLES, count_samples, matte_tolerance, tile_matrix
@@ -95,67 +95,12 @@ def test_rectangle_shares_are_the_cell_centres_inside(glphong_backend, glphong_m
     assert np.abs(frame.matte_fractions[..., 0] - exact).max() <= 1.0 / s  # a corner: two edges of 1 / (2 s)
 
 
-def _triangles_scene():
-    scene = _ortho_scene()
-    front = MeshData(np.array([[-1.7, -1.3, 0.5], [1.45, -0.9, 0.5], [-0.2, 1.35, 0.5]], np.float32),
-                     np.tile([0.0, 0.0, 1.0], (3, 1)), np.array([[0, 1, 2]], np.uint32))
-    back = MeshData(np.array([[-0.6, -1.4, 0.0], [1.9, 0.3, 0.0], [-1.2, 1.1, 0.0]], np.float32),
-                    np.tile([0.0, 0.0, 1.0], (3, 1)), np.array([[0, 1, 2]], np.uint32))
-    scene.add(back, glphong.Lambert(0.5), instance_id=4)
-    scene.add(front, glphong.Lambert(0.5), instance_id=2)
-    return scene, (W, H)
-
-
-def _sphere_edge_scene():
-    camera = glphong.PerspectiveCamera.look_at((0.0, 0.3, 3.0), (0.0, 0.0, 0.0), yfov=0.8)
-    scene = glphong.Scene(camera, [glphong.PointLight((2.0, 2.0, 3.0), 50.0)])
-    scene.add(primitives.sphere(3, 0.8), glphong.Phong(0.2, 0.4, 20.0))
-    return scene, (48, 36)
-
-
-def _interpenetrating_scene():
-    scene, size = _sphere_edge_scene()
-    pose = np.eye(4)
-    pose[:3, 3] = (0.5, 0.1, 0.45)
-    scene.add(primitives.sphere(2, 0.4), glphong.Phong(0.2, 0.4, 20.0), pose=pose)
-    box = trimesh_box()
-    pose = np.eye(4)
-    pose[:3, 3] = (-0.7, -0.4, 0.3)
-    scene.add(box, glphong.Lambert(0.3), pose=pose)
-    return scene, size
-
-
-def trimesh_box():
-    return MeshData.from_trimesh(trimesh.creation.box((0.6, 0.5, 0.7)), smooth=False)
-
-
-def _partly_outside_scene():
-    size = (48, 36)
-    camera = glphong.PerspectiveCamera.look_at((0.9, 0.2, 2.2), (0.9, 0.2, 0.0), yfov=0.8)
-    out = glphong.Scene(camera, [glphong.PointLight((2.0, 2.0, 3.0), 50.0)])
-    out.add(primitives.sphere(3, 0.8), glphong.Phong(0.2, 0.4, 20.0))
-    return out, size
-
-
-def _opencv_scene():
-    camera = glphong.IntrinsicsCamera(40.0, 38.0, 19.3, 11.8, 44, 30,
-                                      pose=glphong.opencv_pose(np.eye(3), np.array([0.1, -0.05, 3.0])))
-    scene = glphong.Scene(camera, [glphong.PointLight((2.0, 2.0, -3.0), 50.0)])
-    scene.add(primitives.sphere(3, 0.7), glphong.Phong(0.2, 0.4, 20.0))
-    pose = np.eye(4)
-    pose[:3, 3] = (0.5, 0.3, -0.4)
-    scene.add(trimesh_box(), glphong.Lambert(0.3), pose=pose)
-    return scene, (44, 30)
-
-
-SCENES = {"two overlapping triangles": _triangles_scene, "a sphere's edge": _sphere_edge_scene,
-          "interpenetrating meshes": _interpenetrating_scene, "partly outside the image": _partly_outside_scene,
-          "OpenCV intrinsics off centre": _opencv_scene}
+SCENES = matte_scenes()  # the row family of ``glphong bench --matte``
 
 
 @pytest.mark.parametrize("name", SCENES)
 def test_against_the_exact_coverage(glphong_backend, glphong_make_renderer, name):
-    scene, (width, height) = SCENES[name]()
+    scene, (width, height) = SCENES[name]
     exact_ids, exact_fractions = exact_coverage(scene, width, height)
     assert (exact_fractions > 0).sum(axis=-1).max() >= (1 if "edge" in name or "outside" in name else 2)
     worst = {}
@@ -171,7 +116,7 @@ def test_against_the_exact_coverage(glphong_backend, glphong_make_renderer, name
 
 
 def test_verify_passes_the_matte_and_fails_planted_errors(glphong_make_renderer):
-    scene, (width, height) = _interpenetrating_scene()
+    scene, (width, height) = SCENES["interpenetrating meshes"]
     renderer = glphong_make_renderer(width, height, "egl", matte_samples=8)
     report = glphong.verify(scene, renderer, passes=("matte",))
     assert report.passed and report.passes["matte"].passed
@@ -198,7 +143,7 @@ def test_errors_and_a_matte_alone(glphong_make_renderer):
             glphong.Renderer(4, 4, matte_samples=bad)
     with pytest.raises((ValueError, TypeError), match="matte_k"):
         glphong.Renderer(4, 4, matte_k=17)
-    scene, size = _sphere_edge_scene()
+    scene, size = matte_scenes()["a sphere's edge"]  # its own: a textured object is added below
     renderer = glphong_make_renderer(*size, "egl", matte_k=2)
     frame = renderer.render(scene, passes=("matte", "instance"))
     assert frame.matte_ids.shape == size[::-1] + (2,) and frame.passes == ("instance", "matte")

@@ -25,6 +25,7 @@ from glphong.scene.scene import Scene
 from glphong.core.timing import alternating_medians, median_seconds, progress_bar
 from glphong.bench.continuous import continuous_points
 from glphong.bench.floor import HandWrittenRenderer
+from glphong.bench.matte import MATTE_SAMPLE_VALUES, format_matte, matte_points
 from glphong.bench.pyrender_peer import PyrenderRenderer, pyrender_decode, pyrender_unavailable
 from glphong.checks import reference as ref
 from glphong.checks.raycast import AnalyticObject, Plane, Sphere, compare_to_reference, render_reference
@@ -169,6 +170,7 @@ class BenchReport:
     scaling: list = field(default_factory=list)
     targets: list = field(default_factory=list)
     skipped: list = field(default_factory=list)
+    matte: list = field(default_factory=list)
 
     def curves(self):
         """Per method and knob value: geometric-mean relative RMS over the cases and mean frame time."""
@@ -234,6 +236,8 @@ class BenchReport:
         if self.targets:
             lines.append("\nspeed (same process, median after warm-up, readback included):")
             lines += [f"  {t['name']:58s} {t['value']:6.2f}{t['unit']}   ({t['detail']})" for t in self.targets]
+        if self.matte:
+            lines += ["", format_matte(self.matte)]
         lines += [f"skipped: {s}" for s in self.skipped]
         return "\n".join(lines)
 
@@ -308,7 +312,7 @@ def _available(method):
 
 
 def run_bench(width=256, height=192, cases=None, method_list=None, repeats=5, reference_samples=6,
-              scaling=True, targets=True, progress=True, continuous=True):
+              scaling=True, targets=True, progress=True, continuous=True, matte=True):
     """Run the work-precision report.
 
     Parameters
@@ -327,6 +331,8 @@ def run_bench(width=256, height=192, cases=None, method_list=None, repeats=5, re
         Also measure the scaling table and the speed ratios.
     continuous : bool
         Also the area lights' methods against their exact integrals (`glphong.bench.continuous`).
+    matte : bool
+        Also the matte pass's error against run time (`glphong.bench.matte`).
     progress : bool
         Show a tqdm progress bar (when tqdm is installed).
 
@@ -358,6 +364,8 @@ def run_bench(width=256, height=192, cases=None, method_list=None, repeats=5, re
         bar.close()
     if continuous:  # the lecture's continuous version: area lights against their exact integrals
         report.points += continuous_points(family_scene, width, height, repeats, quick=len(cases) <= 2)
+    if matte:
+        report.matte = matte_points(samples=(4, 32) if len(cases) <= 2 else MATTE_SAMPLE_VALUES, repeats=repeats)
     if scaling:
         report.scaling = scaling_table(repeats=repeats, quick=len(cases) <= 2)
     if targets:

@@ -4,6 +4,7 @@ With no arguments it renders the lecture's "Phong Examples" figure from the buil
 default scene to ``phong_examples.png`` in the current directory.
 """
 import argparse
+import json
 import sys
 import time
 import warnings
@@ -14,6 +15,7 @@ from glphong.analysis.gallery import render_gallery
 from glphong.analysis.questions import format_properties, properties
 from glphong.batch import BatchError, orbit_scene, render_many
 from glphong.bench import methods, quick_cases, run_bench, run_speed, standard_cases
+from glphong.bench.matte import MATTE_SAMPLE_VALUES, format_matte, matte_points
 from glphong.checks.stability import CASES, CaseExpectations, run_stability
 from glphong.checks.verify import verify
 from glphong.core.imaging import save_npy
@@ -214,6 +216,14 @@ def _describe(args):
 def _bench(args):
     import importlib.util
 
+    if args.matte:
+        rows = matte_points(samples=(4, 32) if args.quick else MATTE_SAMPLE_VALUES, repeats=args.repeats)
+        print(format_matte(rows))
+        path = f"{args.out}_matte.json"
+        with open(path, "w") as f:
+            json.dump(rows, f, indent=1)
+        print(f"wrote {path}")
+        return 0
     if args.speed:
         report = run_speed(sizes=(64,) if args.quick else (512, 1024), repeats=3 if args.quick else max(args.repeats, 9),
                            quick=args.quick, progress=not args.no_progress)
@@ -463,6 +473,9 @@ def build_parser():
                        "--speed: small sizes and stand-in meshes)")
     bench.add_argument("--speed", action="store_true", help="frame times on the scene family against the naive "
                        "floor and pyrender (glphong.bench.speed), instead of the work-precision report")
+    bench.add_argument("--matte", action="store_true", help="the matte pass's error against the exact coverage, "
+                       "against run time, for matte_samples 4 to 64 (glphong.bench.matte), instead of the "
+                       "work-precision report; writes PREFIX_matte.json")
     bench.add_argument("--out", default="glphong_bench", type=_writable,
                        help="output prefix: PREFIX.csv, PREFIX.json, PREFIX.png")
     bench.add_argument("--no-progress", action="store_true", help="no progress bar")
