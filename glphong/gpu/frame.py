@@ -143,14 +143,16 @@ class GBuffer:
     object_coordinates: np.ndarray = None
 
     @classmethod
-    def from_planes(cls, position, normal, planes):
+    def from_planes(cls, position, normal, planes, copy=True):
         """The G-buffer of read-back RGBA planes: ``position`` (H, W, 4) (w: object index + 1, 0 where not covered),
         ``normal`` (H, W, 4) or None (then left None: a frame pass's draw that did not write it), ``planes`` dict of
-        extra plane name (`glphong.shaders.options.GBUFFER_PLANES`) to (H, W, 4)."""
+        extra plane name (`glphong.shaders.options.GBUFFER_PLANES`) to (H, W, 4); ``copy=False``: the planes are
+        views of the given ones (strided: the frame passes gather their covered pixels from them), not C-ordered
+        copies."""
         mask = position[..., 3] > 0.0
         channels = {"tangent": 4, "uv": 2, "color": 3, "lod": 4, "face": 3, "object": 3}
-        extra = {("object_coordinates" if name == "object" else name): np.ascontiguousarray(plane[..., :channels[name]])
+        keep = np.ascontiguousarray if copy else (lambda a: a)
+        extra = {("object_coordinates" if name == "object" else name): keep(plane[..., :channels[name]])
                  for name, plane in planes.items()}
-        return cls(position=np.ascontiguousarray(position[..., :3]),
-                   normal=None if normal is None else np.ascontiguousarray(normal[..., :3]),
+        return cls(position=keep(position[..., :3]), normal=None if normal is None else keep(normal[..., :3]),
                    object_index=np.where(mask, np.rint(position[..., 3]).astype(np.int64) - 1, -1), mask=mask, **extra)

@@ -119,15 +119,17 @@ def opencv_rotation(camera):
 
 def derive_passes(scene, gbuffer, names, next_scene=None, previous_scene=None):
     """The geometry passes ``names`` of a G-buffer (`glphong.gpu.frame.GBuffer` with the planes `gbuffer_planes`
-    asks for): a dict of name to array (module docstring), computed on the covered pixels only."""
+    asks for, C-ordered or strided views of the read-back planes): a dict of name to array (module docstring),
+    computed on the covered pixels only."""
     mask = gbuffer.mask
-    flat = np.flatnonzero(mask)  # the covered pixels, row-major: gathers and scatters by index, not by mask
-    index = gbuffer.object_index.reshape(-1)[flat]
+    rows, columns = np.nonzero(mask)  # the covered pixels, row-major: gathers and scatters by index, not by mask
+    flat = rows * mask.shape[1] + columns
+    index = gbuffer.object_index[rows, columns]
     camera = scene.camera
     out = {}
 
-    def covered(plane):  # (N, C) values of a G-buffer plane at the covered pixels
-        return plane.reshape(-1, plane.shape[-1])[flat] if plane.ndim == 3 else plane.reshape(-1)[flat]
+    def covered(plane):  # (N, C) or (N,) values of a G-buffer plane at the covered pixels (a strided view is fine)
+        return plane[rows, columns]
 
     def image(values, dtype=np.float32):  # the covered pixels' values in an image, 0 elsewhere
         full = np.zeros((mask.size,) + values.shape[1:], dtype)
@@ -142,7 +144,7 @@ def derive_passes(scene, gbuffer, names, next_scene=None, previous_scene=None):
             eye = camera.eye
             out["distance"] = image(np.linalg.norm(position - eye[:3], axis=-1) if eye[3] == 1.0 else depth)
     if "normal" in names:
-        out["normal"] = gbuffer.normal
+        out["normal"] = np.ascontiguousarray(gbuffer.normal)
     if "normal_camera" in names:
         out["normal_camera"] = image(covered(gbuffer.normal).astype(np.float64) @ opencv_rotation(camera).T)
     if "uv" in names:
@@ -160,7 +162,7 @@ def derive_passes(scene, gbuffer, names, next_scene=None, previous_scene=None):
             out["nocs"] = image(_nocs(scene, obj, index))
         for name, other in (("flow", next_scene), ("backward_flow", previous_scene)):
             if name in names:
-                out[name] = image(_flow(obj, index, np.divmod(flat, mask.shape[1]), other, mask.shape))
+                out[name] = image(_flow(obj, index, (rows, columns), other, mask.shape))
     return out
 
 

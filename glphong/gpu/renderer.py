@@ -309,7 +309,7 @@ class Renderer:
             read = {name: read_attachment(fbo, self._size, components=4, attachment=1 + i)
                     for i, name in enumerate(pass_planes)}
             self.context.check_error("rendering radiance and the frame passes' planes")
-        gbuffer = GBuffer.from_planes(read.pop("position"), read.pop("normal", None), read)
+        gbuffer = GBuffer.from_planes(read.pop("position"), read.pop("normal", None), read, copy=False)
         extra = extra | derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
         coverage = rgba[..., 3]
         return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, passes=names, **extra)
