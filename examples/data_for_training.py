@@ -2,11 +2,14 @@
 side by side.
 
 Each frame is rendered once with the radiance, depth, instance, NOCS and flow passes (one draw: the radiance
-programs write the planes the passes read), checked against the float64 twin (`glphong.verify`, every pass), and
+programs write the planes the passes read) and the matte (each object's share of each pixel, from 32 x 32 samples a
+pixel), checked against the float64 twins (`glphong.verify`, every pass; the matte against the exact coverage), and
 written with `glphong.datasets.write_bop` (rgb, 16-bit depth, amodal and visible masks, scene_camera.json,
 scene_gt.json, scene_gt_info.json, as the BOP toolkit reads them).  The picture shows frame 0: the shaded image, the
-depth (near bright, the background black), the instance ids (a colour each), the NOCS (object coordinates in the unit
-cube of each mesh's box, as RGB) and the flow to frame 1 (hue: direction, saturation: length).
+depth (near bright, the background black), the instance ids (a colour each, from the pixel centre), the coverage (the
+matte: each pixel the ids' colours weighted by their shares, so edges blend as much as each object covers), the NOCS
+(object coordinates in the unit cube of each mesh's box, as RGB) and the flow to frame 1 (hue: direction,
+saturation: length).
 
 Run:  python examples/data_for_training.py [picture.png] [bop_folder]
 """
@@ -26,7 +29,7 @@ SIZE = (160, 120)
 SPHERE = primitives.sphere(3, 0.35)
 BOX = MeshData.from_trimesh(trimesh.creation.box((0.5, 0.35, 0.4)), smooth=False)
 CAPSULE = MeshData.from_trimesh(trimesh.creation.capsule(height=0.5, radius=0.15, count=(16, 16)))
-PASSES = ("radiance", "depth", "instance", "nocs", "flow")
+PASSES = ("radiance", "depth", "instance", "matte", "nocs", "flow")
 
 
 def pose(angle, shift):
@@ -53,6 +56,11 @@ def colours(ids):
     """A distinct colour for each id (0: black), (H, W, 3) float in [0, 1]."""
     palette = np.array([[0, 0, 0], [0.9, 0.3, 0.2], [0.2, 0.7, 0.3], [0.25, 0.4, 0.95], [0.9, 0.8, 0.2]])
     return palette[np.minimum(ids, len(palette) - 1)]
+
+
+def coverage_colours(ids, fractions):
+    """Each pixel's matte as colour: the ids' colours (`colours`) weighted by their shares, (H, W, 3) in [0, 1]."""
+    return np.sum(colours(ids) * fractions[..., None], axis=-2)
 
 
 def flow_colours(flow):
@@ -84,11 +92,11 @@ def main(picture="data_for_training.png", bop_folder=None):
     depth = np.where(frame.mask, 1.0 - (frame.depth - frame.depth[frame.mask].min()) / np.ptp(frame.depth[frame.mask])
                      * 0.8, 0.0)
     panels = [shaded, np.repeat(depth[..., None], 3, axis=-1), colours(frame.instance),
-              np.where(frame.mask[..., None], frame.nocs, 0.0), np.where(frame.mask[..., None], flow_colours(frame.flow), 0.0)]
+              coverage_colours(frame.matte_ids, frame.matte_fractions), np.where(frame.mask[..., None], frame.nocs, 0.0), np.where(frame.mask[..., None], flow_colours(frame.flow), 0.0)]
     gap = np.ones((SIZE[1], 4, 3))
     strip = np.concatenate([p for panel in panels for p in (panel, gap)][:-1], axis=1)
     Image.fromarray((np.clip(strip, 0.0, 1.0) * 255 + 0.5).astype(np.uint8)).save(picture)
-    print(f"wrote {picture}: shaded, depth, instance, NOCS, flow to the next frame")
+    print(f"wrote {picture}: shaded, depth, instance, coverage, NOCS, flow to the next frame")
     return frame
 
 
