@@ -21,7 +21,12 @@ CASES = {
     "every pass but uv and backward flow": (
         "radiance", "depth", "distance", "normal", "normal_camera", "instance", "category", "object_coordinates",
         "nocs", "flow"),
+    "matte alone (s = 32, the default)": ("matte",),
+    "matte alone (s = 8)": ("matte",),
+    "radiance, depth, instance, matte (s = 32)": ("radiance", "depth", "instance", "matte"),
 }
+#: ``matte_samples`` of a case (the default elsewhere)
+SAMPLES = {"matte alone (s = 8)": 8}
 
 
 def spheres_scene():
@@ -37,12 +42,13 @@ def spheres_scene():
 
 def main(backend="egl", repeats=20):
     scene = spheres_scene()
-    renderer = glphong.Renderer(256, 256, backend=backend)
+    renderers = {s: glphong.Renderer(256, 256, backend=backend, matte_samples=s) for s in {32, *SAMPLES.values()}}
+    renderer = renderers[32]
     later = spheres_scene()  # the same meshes, the same poses: flow 0, its arithmetic all the same
     for obj_now, obj_later in zip(scene.objects, later.objects):
         assert obj_now.mesh is obj_later.mesh
-    render = {name: (lambda p=passes: renderer.render(scene, passes=p, next_scene=later if "flow" in p else None))
-              for name, passes in CASES.items()}
+    render = {name: (lambda p=passes, r=renderers[SAMPLES.get(name, 32)]: r.render(
+        scene, passes=p, next_scene=later if "flow" in p else None)) for name, passes in CASES.items()}
     times = {name: [] for name in CASES}
     for name in CASES:
         render[name]()

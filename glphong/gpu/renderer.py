@@ -266,7 +266,7 @@ class Renderer:
                 and self.shading == "pixel" and self.specialise:
             return self._render_with_planes(scene, names, geometry, next_scene, previous_scene, extra)
         if geometry:  # the lock is re-entrant
-            gbuffer = self.gbuffer(scene, gbuffer_planes(geometry))
+            gbuffer = self._gbuffer(scene, gbuffer_planes(geometry), copy=False)
             extra |= derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
         if "radiance" not in names:
             if geometry:
@@ -381,6 +381,10 @@ class Renderer:
         -------
         GBuffer
         """
+        return self._gbuffer(scene, planes)
+
+    def _gbuffer(self, scene, planes=(), copy=True):
+        """`gbuffer`; ``copy=False``: its planes strided views of the read-back ones (`GBuffer.from_planes`)."""
         self._check_scene(scene)
         planes = frozenset(planes)
         needs = binding(scene).gbuffer_needs() | planes
@@ -390,7 +394,7 @@ class Renderer:
             self._draw(scene, "gbuffer", fbo, planes=planes)
             planes = [read_attachment(fbo, self._size, components=4, attachment=i) for i in range(2 + len(extras))]
             self.context.check_error("rendering the G-buffer")
-        return GBuffer.from_planes(planes[0], planes[1], dict(zip(extras, planes[2:])))
+        return GBuffer.from_planes(planes[0], planes[1], dict(zip(extras, planes[2:])), copy=copy)
 
     def program_key(self, scene, obj, output="radiance", planes=frozenset()):
         """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading); ``planes``: a
