@@ -7,12 +7,12 @@ against the radiance; with ``--family``: the speed family of docs/speed.md at 51
 render of the same scene.
 """
 import sys
-import time
 
 import numpy as np
 
 import glphong
 from glphong import primitives
+from glphong.core.timing import alternating_times
 
 CASES = {
     "radiance": ("radiance",),
@@ -55,14 +55,7 @@ def main(backend="egl", repeats=20, cases=CASES):
         assert obj_now.mesh is obj_later.mesh
     render = {name: (lambda p=passes, r=renderers[SAMPLES.get(name, 32)]: r.render(
         scene, passes=p, next_scene=later if "flow" in p else None)) for name, passes in cases.items()}
-    times = {name: [] for name in cases}
-    for name in cases:
-        render[name]()
-    for _ in range(repeats):
-        for name in cases:
-            start = time.perf_counter()
-            render[name]()
-            times[name].append(time.perf_counter() - start)
+    times = alternating_times(render, repeats, warmup=1)
     base = np.median(times["radiance"])
     print(f"{renderer.gl_renderer if hasattr(renderer, 'gl_renderer') else backend}, 256x256, "
           f"{len(scene.objects)} spheres, median of {repeats}")
@@ -85,14 +78,7 @@ def family(backend="egl", repeats=9, size=512):
     for name, scene in speed_scenes().items():
         runs = {case: (lambda p=passes: renderer.render(scene, passes=p, next_scene=scene if "flow" in p else None))
                 for case, passes in cases.items()}
-        times = {case: [] for case in cases}
-        for case in cases:
-            runs[case]()
-        for _ in range(repeats):
-            for case in cases:
-                start = time.perf_counter()
-                runs[case]()
-                times[case].append(time.perf_counter() - start)
+        times = alternating_times(runs, repeats, warmup=1)
         base = np.median(times["radiance"])
         print(f"| {name} | " + " | ".join(f"{1e3 * np.median(t):.1f} ({np.median(t) / base:.2f}x)"
                                           for t in times.values()) + " |")
@@ -109,12 +95,8 @@ def against_pyrender(backend="egl", repeats=20):
     theirs = peer.render_segmentation
     frame, (_, _, instance) = ours(), theirs()
     agree = float(np.mean(frame.instance == instance))
-    times = {"glphong radiance, depth, instance (one draw)": [], "pyrender colour + depth, then SEG": []}
-    for _ in range(repeats):
-        for name, fn in zip(times, (ours, theirs)):
-            start = time.perf_counter()
-            fn()
-            times[name].append(time.perf_counter() - start)
+    times = alternating_times({"glphong radiance, depth, instance (one draw)": ours,
+                               "pyrender colour + depth, then SEG": theirs}, repeats, warmup=0)
     peer.release()
     print(f"{backend}, 256x256, {len(scene.objects)} spheres, median of {repeats}; ids agree on {100 * agree:.2f} % "
           f"of pixels; pyrender's colour render {'4x multisampled' if peer.samples > 1 else 'one sample a pixel'}")

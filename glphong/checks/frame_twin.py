@@ -62,7 +62,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from glphong.core import validate as _validate
-from glphong.definitions.surface import alpha_masked
+from glphong.gpu.matte import drawn_objects
 from glphong.gpu.passes import check_corresponds
 from glphong.twin.band import EPS
 from glphong.twin.functions import dot, safe_normalize
@@ -183,15 +183,8 @@ def depth_tie(camera, z1, z2):
 # --------------------------------------------------------------------------- the ray cast
 def _drawn_objects(scene):
     """Indices of the objects the renderer draws; ValueError for a textured alpha mask, which is not twinned."""
-    drawn = []
-    for index, obj in enumerate(scene.objects):
-        mask = obj.material.alpha_mask
-        if mask is not None and mask.textured:
-            raise ValueError(f"object {obj.name!r} has a textured alpha mask: verify of passes does not check "
-                             "textured alpha masks yet")
-        if mask is None or not alpha_masked(np.zeros((1, 2)), np.zeros(1), mask)[0]:
-            drawn.append(index)
-    return drawn
+    return drawn_objects(scene, lambda obj: f"object {obj.name!r} has a textured alpha mask: verify of passes does not "
+                                            "check textured alpha masks yet")
 
 
 def _world_triangles(scene, drawn):

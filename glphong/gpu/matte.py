@@ -29,7 +29,7 @@ from glphong.definitions.surface import alpha_masked
 from glphong.shaders.builders import matte_key
 
 __all__ = ["MATTE_SAMPLES", "MATTE_K", "TILE", "Matte", "matte_tolerance", "tile_matrix", "count_samples",
-           "matte_objects"]
+           "drawn_objects", "matte_objects"]
 
 #: samples along each axis of a pixel (s), the default: the measured worst pixel is below 1/64 on the test scenes
 MATTE_SAMPLES = 32
@@ -45,23 +45,37 @@ def matte_tolerance(samples):
     return 1.0 / samples
 
 
-def matte_objects(scene):
-    """Indices of the objects the matte pass draws: all but those whose constant alpha lies below their cutoff.
+def drawn_objects(scene, refusal):
+    """Indices of the objects a pass draws: all but those whose constant alpha lies below their cutoff (they are not
+    seen).
 
-    Raises
-    ------
-    ValueError
-        An object's material has a textured alpha mask.
+    Parameters
+    ----------
+    scene : glphong.Scene
+    refusal : callable
+        ``refusal(obj)``: the message of the ValueError raised for an object with a textured alpha mask (which the
+        caller does not follow).
+
+    Returns
+    -------
+    list of int
     """
     drawn = []
     for index, obj in enumerate(scene.objects):
         mask = obj.material.alpha_mask
         if mask is not None and mask.textured:
-            raise ValueError(f"the 'matte' pass does not follow textured alpha masks yet, and object {obj.name!r} "
-                             "has one: leave 'matte' out, or give the material a constant alpha")
+            raise ValueError(refusal(obj))
         if mask is None or not alpha_masked(np.zeros((1, 2)), np.zeros(1), mask)[0]:
             drawn.append(index)
     return drawn
+
+
+def matte_objects(scene):
+    """Indices of the objects the matte pass draws (`drawn_objects`); ValueError naming the pass for a textured alpha
+    mask."""
+    return drawn_objects(scene, lambda obj: f"the 'matte' pass does not follow textured alpha masks yet, and object "
+                                            f"{obj.name!r} has one: leave 'matte' out, or give the material a constant "
+                                            "alpha")
 
 
 def tile_matrix(size, tile):
