@@ -9,7 +9,6 @@ import functools
 import threading
 import warnings
 import weakref
-from dataclasses import replace
 
 import moderngl
 import numpy as np
@@ -22,13 +21,13 @@ from glphong.gpu.resources import (ORPHANS, ORPHANS_LOCK, MeshBuffers, ObjectEnt
 from glphong.gpu.contexts import check_not_forked, create_context
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
-from glphong.shaders.builders import uber_key
 from glphong.shaders.keys import EncodeKey
 from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, PASS_PLANES
-from glphong.shaders.numerics import NUMERICS, allowed_pieces, view_decision, with_numerics
+from glphong.shaders.numerics import NUMERICS, allowed_pieces, view_decision
 from glphong.gpu.shadows import ShadowMaps
 from glphong.gpu.matte import MATTE_K, MATTE_SAMPLES, TILE, Matte
 from glphong.gpu.programs import ProgramCache
+from glphong.gpu.program_keys import renderer_program_key
 from glphong.scene.scene import Scene
 
 __all__ = ["Renderer", "Frame", "GBuffer"]
@@ -398,34 +397,8 @@ class Renderer:
 
     def program_key(self, scene, obj, output="radiance", planes=frozenset()):
         """The key this renderer draws ``obj`` of ``scene`` with (formulation, specialisation, shading); ``planes``: a
-        G-buffer's planes beyond the scene's (`gbuffer`)."""
-        per_vertex = output == "radiance" and self.shading == "vertex"
-        if output == "radiance" and not self.specialise:
-            if any(k.shadowed for k in binding(scene).light_keys()):
-                raise ValueError("the uber-shader holds no shadow maps, and the scene has lights with shadows=True: "
-                                 "render it with specialise=True")
-            return uber_key([o.material for o in scene.objects], output, self.formulation, per_vertex, scene.lights)
-        key = binding(scene).program_key(obj, output)
-        if planes and output == "radiance":  # the frame passes' planes beside the radiance (`_render_with_planes`)
-            key = replace(key, pass_planes=tuple(planes), has_object="object" in planes,
-                          has_uv=key.has_uv or "uv" in planes)
-        elif planes:
-            key = replace(key, **{f"has_{name}": True for name in planes})
-        if key.shadow_slots:
-            if per_vertex:
-                raise ValueError("shadows are looked up per pixel: a scene with lights with shadows=True needs "
-                                 "Renderer(shading='pixel')")
-            key = replace(key, shadow_size=self.shadow_map_size, shadow_filter=self.shadow_filter_radius)
-        if per_vertex and key.textured_inputs:
-            raise ValueError(f"object {obj.name!r}: {', '.join(f'{t}.{p}' for t, p in key.textured_inputs)} "
-                             "are textured, which needs per-pixel shading (a vertex has no texture footprint): "
-                             "use Renderer(shading='pixel')")
-        if per_vertex and key.normal_map:
-            raise ValueError(f"object {obj.name!r}: its material has a normal map, which needs per-pixel shading (a "
-                             "vertex has no texture footprint): use Renderer(shading='pixel')")
-        if key.formulation != self.formulation or key.shade_per_vertex != per_vertex:
-            key = replace(key, formulation=self.formulation, shade_per_vertex=per_vertex)
-        return with_numerics(key, scene, obj) if self.numerics == "auto" else key
+        G-buffer's planes beyond the scene's (`gbuffer`); `glphong.gpu.program_keys.renderer_program_key`."""
+        return renderer_program_key(self, scene, obj, output, planes)
 
     def _check_scene(self, scene):
         if not isinstance(scene, Scene):
