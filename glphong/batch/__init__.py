@@ -5,7 +5,9 @@ picklable top-level function ``scene_fn(spec) -> Scene`` that builds each frame'
 pickled scene would carry and re-upload its meshes).  Frames are written to ``out_dir`` as float32
 radiance ``.npy`` files of shape ``(height, width, 3)`` (or 8-bit sRGB PNG files) named by their index,
 ``frame_NNNNNN.npy``; each is written to a temporary file (``.partial-*``) and renamed, so a frame file is
-whole or absent.
+whole or absent.  With ``fmt='bop'`` each frame is an image of a BOP scene (`glphong.batch.bop_images`): the
+workers write its PNG files, each whole, and the calling process the scenes' JSON files from the entries
+the workers return.
 
 The folder of a batch
 ---------------------
@@ -18,6 +20,7 @@ The folder of a batch
     started together in one fresh folder exactly one claims it.  The GL renderer, known only after the
     first frame, is added later by an atomic replace; comparisons ignore it.  A rerun of the same batch
     renders only the frames it cannot trust; a different batch is refused (`BatchError`), never mixed.
+    A BOP batch adds its settings (depth scale, obj_ids, the hash of the images' ids).
 ``frames.jsonl``
     The journal: one JSON line ``{"index", "size", "sha256"}`` per completed frame (the size in bytes and
     the SHA-256 of the file as its worker wrote it), appended by the parent as each result comes back.  A
@@ -25,15 +28,16 @@ The folder of a batch
     each frame on disk once, to hash it); a frame with no record (its worker died before reporting, or a
     batch written before journals) or a changed one (truncated, corrupted, replaced) is rendered again and
     overwritten atomically.  The journal guards against accidents, not against someone who rewrites frames
-    and journal together.
+    and journal together.  A BOP image's line also lists each of its files (path, size, SHA-256) and holds
+    its three JSON entries, its ``sha256`` that of the record itself; it is trusted where every file matches.
 ``.lock``
     Locked (``fcntl.flock``, exclusive, non-blocking) for the whole batch: a second batch in the same
     folder, the same batch or another, raises `BatchError` while one runs.  The kernel releases the lock
     when the process holding it dies, however it dies.
 
-A folder holding frame files or a journal but no manifest (a batch that crashed before manifests were
-written first, or someone else's files) is refused rather than adopted, and so is a frame, manifest,
-journal or lock that is a symbolic link or not a regular file.
+A folder holding frame files, BOP scene folders (six digits) or a journal but no manifest (a batch that
+crashed before manifests were written first, or someone else's files) is refused rather than adopted, and
+so is a frame, manifest, journal or lock that is a symbolic link or not a regular file.
 
 Workers
 -------
@@ -60,11 +64,12 @@ Modules
 -------
 `glphong.batch.run` (`render_many`), `glphong.batch.folder` (the lock, the manifest, the journal, the
 frames on disk, `BatchError`), `glphong.batch.workers` (the pool's initializer, the worker-side
-renderer, the local Dask cluster) and `glphong.batch.scenes` (`turntable_scene`, `orbit_scene`).
+renderer, the local Dask cluster), `glphong.batch.bop_images` (``fmt='bop'``) and `glphong.batch.scenes`
+(`turntable_scene`, `orbit_scene`, `tabletop_scene`).
 """
 from glphong.batch.folder import BatchError
 from glphong.batch.run import _spec_hash, render_many  # noqa: F401 - _spec_hash: glphong.batch._spec_hash
-from glphong.batch.scenes import orbit_scene, turntable_scene
+from glphong.batch.scenes import orbit_scene, tabletop_scene, turntable_scene
 from glphong.batch.workers import _WORKER  # noqa: F401 - the worker's renderers, as glphong.batch._WORKER
 
-__all__ = ["render_many", "turntable_scene", "orbit_scene", "BatchError"]
+__all__ = ["render_many", "turntable_scene", "orbit_scene", "tabletop_scene", "BatchError"]

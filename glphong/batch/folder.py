@@ -22,7 +22,7 @@ __all__ = ["BatchError"]
 MANIFEST = "manifest.json"
 JOURNAL = "frames.jsonl"
 LOCK = ".lock"
-_JOURNAL_LINE_LIMIT = 4096  # bytes; a longer line is no record of ours
+_JOURNAL_LINE_LIMIT = 1 << 20  # bytes; a longer line is no record of ours (a BOP image's record: a few kB)
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 _CLOEXEC = getattr(os, "O_CLOEXEC", 0)
 _NONBLOCK = getattr(os, "O_NONBLOCK", 0)  # a FIFO put in a file's place does not hang its open
@@ -154,9 +154,11 @@ def _read_manifest(path, limit):
 
 
 def _foreign_file(out):
-    """The name of a frame file or journal in ``out`` (the folder has no manifest), or None."""
+    """The name of a frame file, a BOP scene folder (six digits) or a journal in ``out`` (the folder has no
+    manifest), or None."""
     with os.scandir(out) as entries:
-        return next((e.name for e in entries if e.name.startswith("frame_") or e.name == JOURNAL), None)
+        return next((e.name for e in entries if e.name.startswith("frame_") or e.name == JOURNAL
+                     or (len(e.name) == 6 and e.name.isdigit() and e.name.isascii())), None)
 
 
 def _claim_manifest(out, batch):
@@ -173,7 +175,7 @@ def _claim_manifest(out, batch):
             return dict(batch)
         except FileExistsError:
             pass  # a batch that does not lock (another host, an older glphong) claimed it first: compare
-    previous = _read_manifest(path, 65536 + 64 * len(batch["specs"]))
+    previous = _read_manifest(path, 65536 + 64 * len(batch["specs"]) + 2 * len(json.dumps(batch.get("bop", {}))))
     stored = {k: v for k, v in previous.items() if k != "renderer"}
     if stored != batch:
         differ = sorted(k for k in set(batch) | set(stored) if stored.get(k) != batch.get(k))
@@ -182,22 +184,22 @@ def _claim_manifest(out, batch):
     return previous
 
 
-def _parse_record(line, count):
-    """``(index, size, sha256)`` from a journal line, or None for a line that is not a record of a frame
-    below ``count`` (a line cut short by a crash, say)."""
+def _parse_record(line, count, parse):
+    """``(index, value)`` from a journal line, or None for a line that is not a record of a frame below ``count``
+    (a line cut short by a crash, say); ``parse(index, record)`` checks the record's value (`_FileFrames.parse`)."""
     try:
         record = json.loads(line)
-        index, size, sha256 = record["index"], record["size"], record["sha256"]
+        index = record["index"]
     except (ValueError, TypeError, KeyError):
         return None
-    if (type(index) is not int or type(size) is not int or not 0 <= index < count or size < 0
-            or not isinstance(sha256, str) or len(sha256) != 64):
+    if type(index) is not int or not 0 <= index < count:
         return None
-    return index, size, sha256
+    value = parse(index, record)
+    return None if value is None else (index, value)
 
 
-def _read_journal(path, count):
-    """The last record of each frame in the journal at ``path``: ``{index: (size, sha256)}``."""
+def _read_journal(path, count, parse):
+    """The last record of each frame in the journal at ``path``: ``{index: value}``."""
     if _regular_or_missing(path, "the frame journal") is None:
         return {}
     records = {}
@@ -207,37 +209,74 @@ def _read_journal(path, count):
                 while line and not line.endswith(b"\n"):
                     line = stream.readline(_JOURNAL_LINE_LIMIT)
                 continue
-            record = _parse_record(line, count)
+            record = _parse_record(line, count, parse)
             if record is not None:
-                records[record[0]] = record[1:]
+                records[record[0]] = record[1]
     return records
 
 
-def _frame_matches(path, record):
-    """Whether the frame file at ``path`` (a regular file) has the ``(size, sha256)`` of its record."""
-    fd = _open_regular(path, os.O_RDONLY, "a frame")
+def _file_record(size, sha256):
+    """The journal value of a file, ``{"size", "sha256"}``; None where either is not what a record holds."""
+    if type(size) is not int or size < 0 or not isinstance(sha256, str) or len(sha256) != 64:
+        return None
+    return {"size": size, "sha256": sha256}
+
+
+def _file_matches(path, size, sha256, what):
+    """Whether the file at ``path`` exists with ``size`` bytes and the hex SHA-256 ``sha256``; `BatchError` for a
+    symbolic link or a file that is not regular (``what`` names it)."""
+    if _regular_or_missing(path, what) is None:
+        return False
+    fd = _open_regular(path, os.O_RDONLY, what)
     try:
-        return os.fstat(fd).st_size == record[0] and _file_digest(fd) == record
+        return os.fstat(fd).st_size == size and _file_digest(fd) == (size, sha256)
     finally:
         os.close(fd)
 
 
-def _trusted_frames(paths, records):
-    """``{index: (size, sha256)}`` of the frames on disk that match their journal record; `BatchError` for a
-    frame path that is a symbolic link or not a regular file."""
-    trusted = {}
-    for index, path in enumerate(paths):
-        if _regular_or_missing(path, "a frame") is None:
-            continue
-        record = records.get(index)
-        if record is not None and _frame_matches(path, record):
-            trusted[index] = record
-    return trusted
+class _FileFrames:
+    """The frames of a batch that writes one file a frame (fmt 'npy', 'png', 'npz', 'exr'): a frame's journal
+    value is ``{"size", "sha256"}`` of its file as its worker wrote it.
+
+    `_BatchFolder` asks a batch's frames to ``parse`` a journal record's value, whether a frame on disk is
+    ``trusted``, to ``remove_partials``, and, as frames come back and at the end, ``recorded`` and ``finish``
+    (nothing to do here; `glphong.batch.bop_images.BopImages` writes its scenes' JSON files then).
+
+    Parameters
+    ----------
+    paths : list of str
+        The frame paths, in spec order.
+    """
+
+    def __init__(self, paths):
+        self.paths = paths
+
+    def parse(self, index, record):
+        """The value of journal ``record`` (a dict) of frame ``index``, or None where it is not one of ours."""
+        return _file_record(record.get("size"), record.get("sha256"))
+
+    def trusted(self, index, value):
+        """Whether frame ``index`` on disk matches its journal ``value`` (None: no record); `BatchError` for a
+        frame that is a symbolic link or not a regular file, recorded or not."""
+        path = self.paths[index]
+        if value is None:
+            _regular_or_missing(path, "a frame")
+            return False
+        return _file_matches(path, value["size"], value["sha256"], "a frame")
+
+    def remove_partials(self):
+        """Remove what writers that died left beyond ``.partial-*`` in the folder (nothing for these frames)."""
+
+    def recorded(self, done, indices):
+        """Frames ``indices`` were journalled; ``done`` the values of every frame done (nothing to do here)."""
+
+    def finish(self, done):
+        """The batch ends (finished or not) with the frames ``done`` (nothing to do here)."""
 
 
-def _record_line(index, size, sha256):
-    """The journal line of a frame: ``{"index", "size", "sha256"}`` and a newline."""
-    return json.dumps({"index": index, "size": size, "sha256": sha256}) + "\n"
+def _record_line(index, value):
+    """The journal line of a frame: ``{"index", ...its value}`` and a newline."""
+    return json.dumps({"index": index, **value}) + "\n"
 
 
 class _BatchFolder:
@@ -250,12 +289,13 @@ class _BatchFolder:
         The folder (it exists).
     batch : dict
         The manifest of this batch, without the GL renderer.
-    paths : list of str
-        The frame paths, in spec order.
+    frames : _FileFrames or glphong.batch.bop_images.BopImages
+        The batch's frames: their paths (``frames.paths``, in spec order), how a journal record is read and a
+        frame on disk trusted.
     """
 
-    def __init__(self, out, batch, paths):
-        self.out, self.batch, self.paths = out, batch, paths
+    def __init__(self, out, batch, frames):
+        self.out, self.batch, self.frames, self.paths = out, batch, frames, frames.paths
         self.lock = self.journal = None
         self.manifest, self.done = None, {}
 
@@ -263,10 +303,11 @@ class _BatchFolder:
         self.lock = _lock_folder(self.out)
         try:
             self.manifest = _claim_manifest(self.out, self.batch)
-            _remove_partials(self.out)  # the lock is ours: no writer of this folder is left
+            self.remove_partials()  # the lock is ours: no writer of this folder is left
             journal = self.out / JOURNAL
-            self.done = _trusted_frames(self.paths, _read_journal(journal, len(self.paths)))
-            _replace_atomically(journal, "".join(_record_line(i, *r) for i, r in sorted(self.done.items())))
+            records = _read_journal(journal, len(self.paths), self.frames.parse)
+            self.done = {i: records[i] for i in range(len(self.paths)) if self.frames.trusted(i, records.get(i))}
+            _replace_atomically(journal, "".join(_record_line(i, v) for i, v in sorted(self.done.items())))
             self.journal = _open_regular(journal, os.O_WRONLY | os.O_APPEND, "the frame journal")
         except BaseException:
             self.__exit__(None, None, None)
@@ -285,10 +326,20 @@ class _BatchFolder:
         return [i for i in range(len(self.paths)) if i not in self.done]
 
     def record(self, records):
-        """Journal the frames ``records`` (``(index, size, sha256)`` each, as a worker returned them)."""
-        for index, size, sha256 in records:
-            os.write(self.journal, _record_line(index, size, sha256).encode())
-            self.done[index] = (size, sha256)
+        """Journal the frames ``records`` (``(index, value)`` each, as a worker returned them)."""
+        for index, value in records:
+            os.write(self.journal, _record_line(index, value).encode())
+            self.done[index] = value
+        self.frames.recorded(self.done, [index for index, _ in records])
+
+    def remove_partials(self):
+        """Remove the temporary files of writers that died (`_remove_partials`, and the frames' own)."""
+        _remove_partials(self.out)
+        self.frames.remove_partials()
+
+    def finish(self):
+        """Tell the frames the batch ends, with the frames done (a BOP batch writes its scenes' JSON files)."""
+        self.frames.finish(self.done)
 
     def name_renderer(self, renderer_name):
         """Add the GL renderer to the manifest (an atomic replace) where it has none."""

@@ -4,13 +4,15 @@ The folder (lock, manifest, journal) is kept by the calling process (`glphong.ba
 are rendered by workers (`glphong.batch.workers`): a 'spawn' pool made here by default, made again where
 a worker dies, a local Dask cluster, or any ``concurrent.futures.Executor``.
 """
+import contextlib
 import hashlib
 import os
 import pickle
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
-from glphong.batch.folder import BatchError, _BatchFolder, _frame_name, _remove_partials
+from glphong.batch.bop_images import BopImages, bop_settings, manifest_entry
+from glphong.batch.folder import BatchError, _BatchFolder, _FileFrames, _frame_name
 from glphong.batch.workers import _local_dask, _render_chunk, _spawn_pool
 from glphong.core import validate as _validate
 from glphong.core.timing import progress_bar
@@ -49,7 +51,8 @@ def _render_round(folder, executor, submit, frames_per_task, bar):
 
 
 def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy", frames_per_task=1,
-                workers=None, progress=True, passes=None, **options):
+                workers=None, progress=True, passes=None, *, bop_ids=None, frames_per_scene=None, obj_ids=None,
+                depth_scale=None, count_truncated=None, **options):
     """Render one frame per spec into ``out_dir`` and return the frame paths in spec order.
 
     Parameters
@@ -61,19 +64,36 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
     width, height : int
     out_dir : str or path-like
         Made if missing.  Holds the frames, ``manifest.json``, the journal ``frames.jsonl`` and ``.lock``
-        (the `glphong.batch` docstring says what each is for).
+        (the `glphong.batch` docstring says what each is for); with ``fmt='bop'`` it is the BOP split's folder
+        (e.g. ``.../train_pbr``), holding a folder per scene.
     executor : concurrent.futures.Executor or 'dask', optional
         Default: a 'spawn' process pool of ``workers`` processes (default: the CPU count) that die with this
         process, shut down at the end; a given executor is used as it is and left running (a Dask client's:
         ``client.get_executor()``).  ``'dask'``: a local Dask cluster of ``workers`` single-threaded
         worker processes (``dask.distributed.LocalCluster``, from the ``[dask]`` extra), closed at the end.
-    fmt : {'npy', 'png', 'npz', 'exr'}
+    fmt : {'npy', 'png', 'npz', 'exr', 'bop'}
         float32 radiance ``.npy`` of shape ``(height, width, 3)`` (default) or an 8-bit sRGB PNG at
         exposure 1; or each frame's ``passes`` in one ``.npz`` (`glphong.datasets.save_npz`) or OpenEXR file
-        (`glphong.datasets.save_exr`, the extra ``exr``).
+        (`glphong.datasets.save_exr`, the extra ``exr``); or ``'bop'``: each frame an image of a BOP scene,
+        ``out_dir/{scene_id:06d}/``, the files `glphong.datasets.write_bop` writes, byte for byte
+        (`glphong.batch.bop_images`: the workers write the images' files, this process the scenes' JSON files).
     passes : sequence of str, optional
         With ``fmt`` 'npz' or 'exr': the frame passes to render and write (`glphong.Renderer.render`'s names but
         'flow' and 'backward_flow', which need a second scene), default ``('radiance',)``.
+    bop_ids : sequence of (int, int), optional
+        With ``fmt='bop'``: each spec's ``(scene_id, im_id)`` (0 to 999999), each pair once.
+    frames_per_scene : int, optional
+        With ``fmt='bop'`` and no ``bop_ids``: frame ``i`` is image ``i % frames_per_scene`` of scene
+        ``i // frames_per_scene`` (default 1000, BlenderProc's ``frames_per_chunk``: BOP's ``train_pbr`` layout).
+    obj_ids : mapping of int to int, or 'category', optional
+        With ``fmt='bop'``: each object's BOP ``obj_id`` by its ``instance_id``, or ``'category'`` (each object's
+        ``category`` is its obj_id, BlenderProc's ``category_id``); default the instance_id, as
+        `glphong.datasets.write_bop` takes it.
+    depth_scale : float, optional
+        With ``fmt='bop'``: millimetres per unit of the 16-bit depth PNGs (default 0.1).
+    count_truncated : bool, optional
+        With ``fmt='bop'``: ``px_count_all`` and ``bbox_obj`` count the silhouette beyond the image (default
+        True, the toolkit's way), as in `glphong.datasets.write_bop`.
     frames_per_task : int
         Frames a task renders in a row (fewer round trips for small frames).
     progress : bool
@@ -84,42 +104,59 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
     Returns
     -------
     list of str
-        The frame paths, ``out_dir/frame_NNNNNN.npy``, in spec order.
+        The frame paths, ``out_dir/frame_NNNNNN.npy``, in spec order (``fmt='bop'``: each image's
+        ``out_dir/{scene_id:06d}/rgb/{im_id:06d}.png``).
 
     Raises
     ------
     BatchError
         A spec cannot be pickled; another batch is running in ``out_dir``; ``out_dir`` holds another
         batch's manifest, or frame files without a manifest; a frame, the manifest, the journal or the lock
-        is a symbolic link or not a regular file.
+        is a symbolic link or not a regular file; with ``fmt='bop'``, a scene folder (six digits) without a
+        manifest, or a file in the place of a scene's folder.
+    TypeError, ValueError
+        A bad argument (which one named): BOP arguments with another ``fmt``, ``bop_ids`` not one pair per spec
+        or a pair twice; and from the workers, a scene that cannot be written as BOP (`glphong.datasets.write_bop`
+        says which).
     """
 
     specs = list(specs)
     width = _validate.positive_int("width", width, 1, 16384)
     height = _validate.positive_int("height", height, 1, 16384)
-    fmt = _validate.choice("fmt", fmt, ("npy", "png", "npz", "exr"))
+    fmt = _validate.choice("fmt", fmt, ("npy", "png", "npz", "exr", "bop"))
     passes = _batch_passes(passes, fmt)
+    bop = bop_settings(fmt, len(specs), width, height, options, bop_ids, frames_per_scene, obj_ids, depth_scale,
+                       count_truncated)
     frames_per_task = _validate.positive_int("frames_per_task", frames_per_task)
     if not callable(scene_fn):
         raise TypeError(f"scene_fn must be a callable spec -> Scene (got {type(scene_fn).__name__})")
     if isinstance(executor, str):
         _validate.choice("executor", executor, ("dask",))
-    batch = {"glphong": __version__, "width": width, "height": height, "format": fmt, **({"passes": list(passes)} if
-                                                                                         passes else {}),
+    batch = {"glphong": __version__, "width": width, "height": height, "format": fmt,
+             **({"passes": list(passes)} if passes else {}), **({"bop": manifest_entry(bop)} if bop else {}),
              "options": {k: repr(v) for k, v in sorted(options.items())}, "specs": [_spec_hash(s) for s in specs]}
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    paths = [str(out / _frame_name(i, fmt)) for i in range(len(specs))]
+    frames = BopImages(out, bop["ids"]) if bop else _FileFrames([str(out / _frame_name(i, fmt))
+                                                                 for i in range(len(specs))])
     workers = workers or os.cpu_count() or 1
 
     def submit(chunk):
-        return scene_fn, [(i, specs[i]) for i in chunk], width, height, str(out), fmt, options, passes
+        settings = {"ids": {i: bop["ids"][i] for i in chunk}, **{k: v for k, v in bop.items() if k != "ids"}} \
+            if bop else None
+        return scene_fn, [(i, specs[i]) for i in chunk], width, height, str(out), fmt, options, passes, settings
 
-    with _BatchFolder(out, batch, paths) as folder:
-        if folder.missing:
-            _render_missing(folder, submit, executor, workers, frames_per_task, progress_bar(
-                len(folder.missing), progress, unit="frame"))
-    return paths
+    with _BatchFolder(out, batch, frames) as folder:
+        try:
+            if folder.missing:
+                _render_missing(folder, submit, executor, workers, frames_per_task, progress_bar(
+                    len(folder.missing), progress, unit="frame"))
+        except BaseException:
+            with contextlib.suppress(Exception):  # the batch's own error is the one to see
+                folder.finish()
+            raise
+        folder.finish()
+    return frames.paths
 
 
 def _batch_passes(passes, fmt):
@@ -127,6 +164,11 @@ def _batch_passes(passes, fmt):
     if fmt in ("npy", "png"):
         if passes is not None:
             raise ValueError(f"fmt={fmt!r} holds the radiance alone: write frame passes with fmt='npz' or 'exr'")
+        return ()
+    if fmt == "bop":
+        if passes is not None:
+            raise ValueError("fmt='bop' writes what BOP holds (rgb, depth, mask, mask_visib and the scene's JSON "
+                             "files): write other passes with fmt='npz' or 'exr'")
         return ()
     names = requested_passes(passes)
     motion = [n for n in names if n in ("flow", "backward_flow")]
@@ -162,7 +204,7 @@ def _render_missing(folder, submit, executor, workers, frames_per_task, bar):
             if broken and own:
                 executor.shutdown(wait=True, cancel_futures=True)  # every worker gone: none is writing now
                 executor = None
-                _remove_partials(folder.out)  # a worker killed with its pool may have left a half-written file
+                folder.remove_partials()  # a worker killed with its pool may have left a half-written file
             elif folder.missing and not broken:
                 missing = folder.missing
                 raise BatchError(f"{len(missing)} frame(s) were not written, e.g. {folder.paths[missing[0]]}")
@@ -175,4 +217,4 @@ def _render_missing(folder, submit, executor, workers, frames_per_task, bar):
             for closing in cluster:
                 closing.close()
     if own or cluster is not None:
-        _remove_partials(folder.out)  # the workers are gone: no writer is left
+        folder.remove_partials()  # the workers are gone: no writer is left

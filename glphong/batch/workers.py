@@ -16,9 +16,11 @@ import tempfile
 import threading
 import time
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
+from functools import partial
 from pathlib import Path
 
 import numpy as np
+from glphong.batch.bop_images import bop_job
 from glphong.batch.folder import _CLOEXEC, _NOFOLLOW, _file_digest, _frame_name
 from glphong.datasets import save_exr, save_npz
 from glphong.gpu.renderer import Renderer
@@ -121,38 +123,58 @@ def _write_frame(frame, final, out_dir, fmt):
     return written
 
 
-def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options, passes=()):
+def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options, passes=(), bop=None):
     """In a worker: render ``items`` (``(index, spec)`` pairs) with the worker's renderer and write each frame
-    atomically.
+    atomically, its files encoded and written on the writer thread while the next frame renders.
+
+    Parameters
+    ----------
+    scene_fn, items, width, height, out_dir, fmt, options, passes
+        As `glphong.batch.render_many` gave them (``out_dir`` a str).
+    bop : dict, optional
+        With ``fmt='bop'``: ``{"ids": {index: (scene_id, im_id)}, "obj_ids", "depth_scale", "count_truncated"}``
+        (`glphong.batch.bop_images.bop_job`).
 
     Returns
     -------
     records : list of tuple
-        ``(index, size, sha256)`` of each frame written: its size in bytes and the file's hex SHA-256.
+        ``(index, value)`` of each frame written: its journal value (``{"size", "sha256"}`` of the file; a BOP
+        image's files and JSON entries, `glphong.batch.bop_images.BopImages`).
     renderer_name : str
         The worker's GL renderer.
     """
 
-    key = (width, height, tuple(sorted(options.items())))
-    renderer = _WORKER.get(key)
-    if renderer is None or renderer.context is None:
-        renderer = _WORKER[key] = Renderer(width, height, **options)
+    renderer = _renderer(width, height, options)
     records, pending = [], None
     try:
         for index, spec in items:
-            frame = renderer.render(scene_fn(spec), passes=passes or None)
-            if pending is not None:  # the previous frame's file, written while this one rendered
+            if fmt == "bop":  # the GPU's part here, the files' on the writer thread
+                job = bop_job(renderer, scene_fn(spec), index, out_dir, bop,
+                              partial(_renderer, 3 * width, 3 * height, options))
+            else:
+                job = partial(_write_record, index, renderer.render(scene_fn(spec), passes=passes or None), out_dir,
+                              fmt)
+            if pending is not None:  # the previous frame's files, written while this one rendered
                 records.append(pending.result())
-            pending = _writer().submit(_write_record, index, frame, out_dir, fmt)
+            pending = _writer().submit(job)
     finally:
         if pending is not None:  # a frame being written is finished (or its error raised) before this returns
             records.append(pending.result())
     return records, renderer.context.renderer_name
 
 
+def _renderer(width, height, options):
+    """The worker's renderer of that size and those options, made on first use and kept (`_WORKER`)."""
+    key = (width, height, tuple(sorted(options.items())))
+    renderer = _WORKER.get(key)
+    if renderer is None or renderer.context is None:
+        renderer = _WORKER[key] = Renderer(width, height, **options)
+    return renderer
+
+
 def _write_record(index, frame, out_dir, fmt):
     size, sha256 = _write_frame(frame, Path(out_dir) / _frame_name(index, fmt), out_dir, fmt)
-    return index, size, sha256
+    return index, {"size": size, "sha256": sha256}
 
 
 def _writer():

@@ -37,14 +37,18 @@ What differs from the toolkit, on purpose: the visible mask is exact (the instan
 sees the object), where the toolkit estimates it from depth with a 15 mm tolerance (``visibility.py``,
 ``estimate_visib_mask_gt``); it is what that estimate approximates.
 
+The whole silhouettes are what one render per object alone (at the image's size, and on the large canvas) gives,
+made from fewer renders (`glphong.datasets.bop_masks`: objects whose projected boxes are apart share one, an object
+inside the image needs no large canvas).  The pieces `write_bop` is made of (`image_entries`, `render_image`,
+`image_files`, and `glphong.datasets.bop_files`) also make the images of a batch (``render_many(..., fmt='bop')``,
+`glphong.batch.bop_images`), so both write the same bytes.
+
 Units: glphong's scenes are in metres; BOP's translations and depths are in millimetres, and its object models
 (``models/obj_{obj_id:06d}.ply``) are in millimetres too: export each mesh scaled by 1000 for the model files
 (`write_bop` writes the images, not the models).
 """
-import json
 import os
 import re
-import secrets
 from collections.abc import Mapping
 
 import numpy as np
@@ -52,6 +56,9 @@ import numpy as np
 from glphong.core import validate as _validate
 from glphong.core.filesafety import SceneFileError
 from glphong.core.imaging import png_bytes
+from glphong.datasets.bop_files import check_entries, image_folders, json_text, load_json, same_camera, write_files
+from glphong.datasets.bop_files import json_paths as _json_paths
+from glphong.datasets.bop_masks import gt_info, silhouettes
 from glphong.datasets.depth_png import depth_to_png_units, encode_gray_png
 from glphong.gpu.passes import opencv_rotation
 from glphong.gpu.renderer import Renderer
@@ -72,9 +79,6 @@ _MAX_OBJ_ID = 2 ** 31 - 1
 #: tolerance of the rigid-pose check: ``max |R^T R - I| <= 1e-6`` (a float32-made rotation passes; a scale of
 #: 1.00001 does not)
 _RIGID_TOL = 1e-6
-#: what makes an image's camera: a rewrite of the image must keep them (its depth_scale may change: the depth image
-#: is rewritten with it)
-_CAMERA_KEYS = ("cam_K", "cam_R_w2c", "cam_t_w2c")
 _MASK_NAME = re.compile(r"^(\d{6})_(\d{6})\.png$")
 
 
@@ -179,16 +183,24 @@ def bop_model_to_camera(camera, pose):
 
 # -- checks of the arguments ------------------------------------------------------------------------------------------
 
-def _object_ids(scene, obj_ids):
-    """BOP's obj_id of each of ``scene.objects`` (list of int), from ``obj_ids`` (instance id to obj_id) or the
-    instance ids."""
-    instances = [int(o.instance_id) for o in scene.objects]
+def obj_id_table(obj_ids):
+    """``obj_ids`` checked: a dict of instance_id (int) to BOP obj_id (int in [1, 2^31 - 1]), ``'category'`` or
+    None.
+
+    Raises
+    ------
+    TypeError
+        Not a mapping or ``'category'``, or a key that is not an int.
+    ValueError
+        A value that is not an obj_id, or another string.
+    """
     if obj_ids is None:
-        too_big = [i for i in instances if i > _MAX_OBJ_ID]
-        if too_big:
-            raise ValueError(f"obj_ids is not given, so each object's instance_id is its BOP obj_id, and instance_id "
-                             f"{too_big[0]} exceeds {_MAX_OBJ_ID}: pass obj_ids={{instance_id: obj_id}}")
-        return instances
+        return None
+    if isinstance(obj_ids, str):
+        if obj_ids != "category":
+            raise ValueError(f"obj_ids must be a mapping of instance_id to BOP obj_id or 'category' (each object's "
+                             f"category is its obj_id), got {obj_ids!r}")
+        return obj_ids
     if not isinstance(obj_ids, Mapping):
         raise TypeError(f"obj_ids must be a mapping of instance_id to BOP obj_id, e.g. {{1: 5, 2: 5}} (got "
                         f"{type(obj_ids).__name__})")
@@ -199,6 +211,26 @@ def _object_ids(scene, obj_ids):
         if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or not 1 <= int(value) <= _MAX_OBJ_ID:
             raise ValueError(f"obj_ids[{key!r}] must be a BOP obj_id, an int in [1, {_MAX_OBJ_ID}] (got {value!r})")
         table[int(key)] = int(value)
+    return table
+
+
+def _object_ids(scene, obj_ids):
+    """BOP's obj_id of each of ``scene.objects`` (list of int), from ``obj_ids`` (instance id to obj_id) or the
+    instance ids."""
+    instances = [int(o.instance_id) for o in scene.objects]
+    table = obj_id_table(obj_ids)
+    if table == "category":
+        wrong = [(o.name, int(o.category)) for o in scene.objects if not 1 <= int(o.category) <= _MAX_OBJ_ID]
+        if wrong:
+            raise ValueError(f"obj_ids='category' makes each object's category its BOP obj_id, which must be in [1, "
+                             f"{_MAX_OBJ_ID}]: object {wrong[0][0]!r} has category {wrong[0][1]}")
+        return [int(o.category) for o in scene.objects]
+    if table is None:
+        too_big = [i for i in instances if i > _MAX_OBJ_ID]
+        if too_big:
+            raise ValueError(f"obj_ids is not given, so each object's instance_id is its BOP obj_id, and instance_id "
+                             f"{too_big[0]} exceeds {_MAX_OBJ_ID}: pass obj_ids={{instance_id: obj_id}}")
+        return instances
     missing = [(o.name, i) for o, i in zip(scene.objects, instances) if i not in table]
     if missing:
         listed = ", ".join(f"{name!r} (instance_id {i})" for name, i in missing)
@@ -222,152 +254,108 @@ def _check_not_files(paths):
             raise ValueError(f"{path} must be a folder (it exists and is not one): choose another folder")
 
 
-# -- the JSON files ---------------------------------------------------------------------------------------------------
+# -- one image: checked, rendered, encoded ----------------------------------------------------------------------------
 
-def _load_json(path):
-    """The image dict of one of a scene's JSON files, ``{im_id (int): value}``; ``{}`` where the file does not
-    exist.  Keys are the im_id as a string (bop_toolkit ``inout.load_json(keys_to_int=True)``)."""
-    if not os.path.lexists(path):
-        return {}
-    if not os.path.isfile(path):
-        raise SceneFileError(path, "expected a BOP JSON file, found something that is not a regular file")
-    try:
-        with open(path, encoding="utf-8") as handle:
-            content = json.load(handle)
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise SceneFileError(path, f"not readable as JSON ({exc}); fix or remove the file") from None
-    if not isinstance(content, dict):
-        raise SceneFileError(path, f"expected a JSON object of im_id to entry (got a {type(content).__name__})")
-    images = {}
-    for key, value in content.items():
-        if not (isinstance(key, str) and key.isdigit() and key.isascii()):
-            raise SceneFileError(path, f"expected keys that are im_ids, non-negative integers (got {key!r})")
-        if int(key) in images:
-            raise SceneFileError(path, f"im_id {int(key)} appears twice (key {key!r})")
-        images[int(key)] = value
-    return images
+def image_entries(scene, width, height, obj_ids, depth_scale):
+    """The image's ``scene_camera`` entry and ``scene_gt`` list, every check of the scene made first.
 
+    Parameters
+    ----------
+    scene : Scene
+    width, height : int
+        The image's size [px].
+    obj_ids : mapping of int to int or None
+        As `write_bop`'s.
+    depth_scale : float
+        [mm per unit of the depth PNG], checked.
 
-def _check_entries(path, images, kind):
-    """Each image's entry of the file is of the right shape (a dict of the camera, or a list of dicts)."""
-    for im_id, value in images.items():
-        if kind == "camera":
-            if not isinstance(value, dict):
-                raise SceneFileError(path, f"expected a JSON object for each image (got a {type(value).__name__})",
-                                     where=f'"{im_id}"')
-        elif not (isinstance(value, list) and all(isinstance(v, dict) for v in value)):
-            raise SceneFileError(path, "expected a list of JSON objects for each image", where=f'"{im_id}"')
+    Returns
+    -------
+    camera : dict
+        ``cam_K``, ``cam_R_w2c``, ``cam_t_w2c`` [mm], ``depth_scale``.
+    gt : list of dict
+        ``cam_R_m2c``, ``cam_t_m2c`` [mm], ``obj_id`` per object, in the order of ``scene.objects``.
 
-
-def _same_camera(path, im_id, old, new):
-    """Whether the stored camera ``old`` of ``im_id`` is ``new``; the fields that differ otherwise (list of str)."""
-    differ = []
-    for key in _CAMERA_KEYS:
-        if key not in old:
-            differ.append(f"{key} (missing in the file)")
-            continue
-        want = np.atleast_1d(np.asarray(new[key], dtype=np.float64))
-        try:
-            have = np.atleast_1d(np.asarray(old[key], dtype=np.float64))
-        except (TypeError, ValueError):
-            raise SceneFileError(path, f"{key} must be numbers (got {old[key]!r})", where=f'"{im_id}"') from None
-        if have.shape != want.shape:
-            raise SceneFileError(path, f"{key} must hold {want.size} numbers (got {have.size})", where=f'"{im_id}"')
-        if not np.allclose(have, want, rtol=1e-9, atol=1e-9):
-            differ.append(f"{key} (file {have.tolist()}, now {want.tolist()})")
-    return differ
+    Raises
+    ------
+    TypeError, ValueError
+        An orthographic or unknown camera, a pose that is not rigid, obj_ids that miss an object.
+    """
+    cam_k = bop_camera_matrix(scene.camera, width, height)
+    r_w2c, t_w2c = bop_world_to_camera(scene.camera)
+    ids = _object_ids(scene, obj_ids)
+    gt = []
+    for obj, obj_id in zip(scene.objects, ids):
+        _rigid(f"the pose of object {obj.name!r} (instance_id {obj.instance_id})", obj.pose)
+        r_m2c, t_m2c = bop_model_to_camera(scene.camera, obj.pose)
+        gt.append({"cam_R_m2c": r_m2c.flatten().tolist(), "cam_t_m2c": t_m2c.tolist(), "obj_id": obj_id})
+    camera_entry = {"cam_K": cam_k.flatten().tolist(), "cam_R_w2c": r_w2c.flatten().tolist(),
+                    "cam_t_w2c": t_w2c.tolist(), "depth_scale": depth_scale}
+    return camera_entry, gt
 
 
-def _json_text(images):
-    """The file's text as bop_toolkit ``inout.save_json`` writes a dict: one image a line, im_ids in increasing order,
-    each value ``json.dumps(v, sort_keys=True)``."""
-    lines = [f'  "{im_id}": {json.dumps(images[im_id], sort_keys=True, allow_nan=False)}' for im_id in sorted(images)]
-    return "{\n" + ",\n".join(lines) + ("\n" if lines else "") + "}"
+def render_image(scene, renderer, count_truncated, large=None):
+    """The GPU's part of an image: the frame (radiance, depth, instance) and each object's whole silhouette
+    (`glphong.datasets.bop_masks.silhouettes`; ``large`` as there).
+
+    Returns
+    -------
+    frame : glphong.gpu.frame.Frame
+    shapes : list of (inside, outside)
+        Per object: ``inside`` (H, W) bool, ``outside`` ``(ys, xs)`` int64 [px] beyond the image.
+    """
+    frame = renderer.render(scene, passes=("radiance", "depth", "instance"))
+    k = bop_camera_matrix(scene.camera, renderer.width, renderer.height)
+    return frame, silhouettes(scene, renderer, k, bool(count_truncated), large)
 
 
-# -- the masks and their numbers --------------------------------------------------------------------------------------
+def image_files(scene, frame, shapes, im_id, depth_scale, exposure):
+    """The CPU's part of an image: its PNG files' bytes and its ``scene_gt_info`` list.
 
-def _bbox(ys, xs):
-    """bop_toolkit ``misc.calc_2d_bbox(xs, ys)`` (clip=False): ``[x_min, y_min, x_max - x_min, y_max - y_min]``."""
-    x0, y0 = int(xs.min()), int(ys.min())
-    return [x0, y0, int(xs.max()) - x0, int(ys.max()) - y0]
+    Parameters
+    ----------
+    scene : Scene
+    frame, shapes
+        From `render_image`.
+    im_id : int
+    depth_scale, exposure : float
 
+    Returns
+    -------
+    files : dict of (str, str) to bytes
+        ``(folder, file name)``: ``('rgb', '000007.png')``, ``('depth', ...)``, then ``('mask', '000007_000000.png')``
+        and ``('mask_visib', ...)`` per object, in that order.
+    info : list of dict
+        The image's ``scene_gt_info`` entries, per object.
 
-def _alone(scene, obj, camera=None):
-    """A scene of ``scene``'s camera (or ``camera``) and lights holding ``obj`` alone, as it is."""
-    single = Scene(scene.camera if camera is None else camera, scene.lights, scene.ambient)
-    single.add(obj.mesh, obj.material, pose=obj.pose, name=obj.name, casts_shadow=obj.casts_shadow,
-               instance_id=obj.instance_id, category=obj.category)
-    return single
-
-
-def _silhouettes(scene, renderer, count_truncated):
-    """Each object's silhouette rendered alone: ``(inside, outside)`` per object, ``inside`` (H, W) bool the
-    image's pixels, ``outside`` ``(ys, xs)`` int arrays of the pixels beyond the image on a canvas three times its
-    size (bop_toolkit ``calc_gt_info.py``), empty without ``count_truncated``."""
-    width, height = renderer.width, renderer.height
-    inside = [renderer.render(_alone(scene, obj), passes=("instance",)).instance != 0 for obj in scene.objects]
-    empty = (np.zeros(0, np.int64), np.zeros(0, np.int64))
-    if not count_truncated or not scene.objects:
-        return [(m, empty) for m in inside]
-    if 3 * max(width, height) * renderer.supersample > 16384:
-        raise ValueError(f"count_truncated=True renders each object on a canvas three times the image's size "
-                         f"({3 * width}x{3 * height}), beyond the renderer's 16384 px (supersample "
-                         f"{renderer.supersample}): pass count_truncated=False (px_count_all and bbox_obj then count "
-                         "the image's pixels only)")
-    k = bop_camera_matrix(scene.camera, width, height)
-    large = IntrinsicsCamera(k[0, 0], k[1, 1], k[0, 2] + width, k[1, 2] + height, 3 * width, 3 * height,
-                             pose=scene.camera.pose, znear=scene.camera.znear, zfar=scene.camera.zfar)
-    out = []
-    renderer.resize(3 * width, 3 * height)
-    try:
-        for obj, mask in zip(scene.objects, inside):
-            big = renderer.render(_alone(scene, obj, large), passes=("instance",)).instance != 0
-            big[height:2 * height, width:2 * width] = False  # the image's own pixels come from the exact render
-            ys, xs = np.nonzero(big)
-            out.append((mask, (ys - height, xs - width)))
-    finally:
-        renderer.resize(width, height)
-    return out
+    Raises
+    ------
+    ValueError
+        A depth the 16-bit PNG cannot hold at ``depth_scale``.
+    """
+    depth_units = depth_to_png_units(frame.depth, depth_scale)
+    im = f"{im_id:06d}"
+    files = {("rgb", f"{im}.png"): png_bytes(frame.radiance, exposure),
+             ("depth", f"{im}.png"): encode_gray_png(depth_units)}
+    info, blank = [], []
+    for k, (obj, (inside, outside)) in enumerate(zip(scene.objects, shapes)):
+        visible = frame.instance == obj.instance_id
+        info.append(gt_info(inside, outside, visible, depth_units))
+        whole = _mask_png(inside, blank)
+        files[("mask", f"{im}_{k:06d}.png")] = whole
+        files[("mask_visib", f"{im}_{k:06d}.png")] = whole if np.array_equal(visible, inside) else \
+            _mask_png(visible, blank)
+    return files, info
 
 
-def _gt_info(inside, outside, visible, depth_units):
-    """One object's ``scene_gt_info`` entry (bop_toolkit ``scripts/calc_gt_info.py``)."""
-    px_count_all = int(inside.sum()) + int(outside[0].size)
-    px_count_valid = int(np.count_nonzero(depth_units[inside]))
-    px_count_visib = int(visible.sum())
-    bbox_obj = bbox_visib = [-1, -1, -1, -1]
-    if px_count_visib > 0:  # the toolkit gives both boxes only where something is visible
-        ys, xs = np.nonzero(inside)
-        bbox_obj = _bbox(np.concatenate([ys, outside[0]]), np.concatenate([xs, outside[1]]))
-        bbox_visib = _bbox(*np.nonzero(visible))
-    return {"bbox_obj": bbox_obj, "bbox_visib": bbox_visib, "px_count_all": px_count_all,
-            "px_count_valid": px_count_valid, "px_count_visib": px_count_visib,
-            "visib_fract": px_count_visib / float(px_count_all) if px_count_all > 0 else 0.0}
-
-
-# -- writing ----------------------------------------------------------------------------------------------------------
-
-def _write_temp(directory, name, data):
-    """``data`` (bytes) in a new temporary file beside ``directory/name`` (a fresh name, opened exclusively, with
-    the permissions any new file gets: the umask's); its path."""
-    temp = os.path.join(directory, f".{name}.{secrets.token_hex(8)}.tmp")
-    with open(temp, "xb") as handle:
-        try:
-            handle.write(data)
-        except BaseException:
-            handle.close()
-            os.unlink(temp)
-            raise
-    return temp
-
-
-def _remove(paths):
-    for path in paths:
-        try:
-            os.unlink(path)
-        except OSError:
-            pass
+def _mask_png(mask, blank):
+    """A mask's 8-bit PNG (255 inside, 0 outside); an empty mask's bytes are made once, in ``blank`` (a list): the
+    same image gives the same bytes."""
+    if mask.any():
+        return encode_gray_png(mask.astype(np.uint8) * np.uint8(255))
+    if not blank:
+        blank.append(encode_gray_png(np.zeros(mask.shape, np.uint8)))
+    return blank[0]
 
 
 def write_bop(folder, scene, renderer, scene_id=0, im_id=0, obj_ids=None, *, depth_scale=DEFAULT_DEPTH_SCALE,
@@ -392,14 +380,15 @@ def write_bop(folder, scene, renderer, scene_id=0, im_id=0, obj_ids=None, *, dep
         Seen by a `PerspectiveCamera` or `IntrinsicsCamera` (an `OrthographicCamera` has no BOP equivalent); every
         object's pose rigid (rotation and translation, no scale or shear).  Scene units are metres.
     renderer : Renderer
-        Renders the image at its size (``renderer.width x renderer.height``).  With ``count_truncated`` it is
-        resized to three times that size and back for the amodal silhouettes: do not share it with another thread
-        during the call.
+        Renders the image at its size (``renderer.width x renderer.height``).  With ``count_truncated``, where an
+        object may reach beyond the image, it is resized to three times that size and back for the amodal
+        silhouettes: do not share it with another thread during the call.
     scene_id, im_id : int
         0 to 999999.
-    obj_ids : mapping of int to int, optional
+    obj_ids : mapping of int to int, or 'category', optional
         Each object's BOP ``obj_id`` (>= 1) by its ``instance_id``; every object of the scene needs one (several
-        instances may share an obj_id).  Default: the object's instance_id.
+        instances may share an obj_id).  ``'category'``: each object's ``category`` (`glphong.Scene.add`) is its
+        obj_id (BlenderProc's ``category_id``).  Default: the object's instance_id.
     depth_scale : float
         Millimetres per unit of the 16-bit depth PNG, recorded in ``scene_camera.json`` (default 0.1: 0.1 mm steps
         up to 6.5535 m, a scale BOP's datasets commonly use).  A depth beyond ``65535 depth_scale`` mm is an
@@ -440,68 +429,36 @@ def write_bop(folder, scene, renderer, scene_id=0, im_id=0, obj_ids=None, *, dep
     exposure = _validate.scalar("exposure", exposure, low=0.0, low_inclusive=False)
     if not isinstance(count_truncated, (bool, np.bool_)):
         raise TypeError(f"count_truncated must be a bool, True or False (got {count_truncated!r})")
-    width, height = renderer.width, renderer.height
-    cam_k = bop_camera_matrix(scene.camera, width, height)
-    r_w2c, t_w2c = bop_world_to_camera(scene.camera)
-    ids = _object_ids(scene, obj_ids)
-    gt = []
-    for obj, obj_id in zip(scene.objects, ids):
-        _rigid(f"the pose of object {obj.name!r} (instance_id {obj.instance_id})", obj.pose)
-        r_m2c, t_m2c = bop_model_to_camera(scene.camera, obj.pose)
-        gt.append({"cam_R_m2c": r_m2c.flatten().tolist(), "cam_t_m2c": t_m2c.tolist(), "obj_id": obj_id})
-    camera_entry = {"cam_K": cam_k.flatten().tolist(), "cam_R_w2c": r_w2c.flatten().tolist(),
-                    "cam_t_w2c": t_w2c.tolist(), "depth_scale": depth_scale}
+    camera_entry, gt = image_entries(scene, renderer.width, renderer.height, obj_ids, depth_scale)
 
     root = os.path.join(folder, f"{scene_id:06d}")
-    dirs = {name: os.path.join(root, name) for name in ("rgb", "depth", "mask", "mask_visib")}
+    dirs = image_folders(root)
     _check_not_files([folder, root, *dirs.values()])
-    json_paths = {name: os.path.join(root, f"{name}.json") for name in ("scene_camera", "scene_gt", "scene_gt_info")}
+    json_paths = _json_paths(root)
     stored = {}
     for name, path in json_paths.items():
-        stored[name] = _load_json(path)
-        _check_entries(path, stored[name], "camera" if name == "scene_camera" else "list")
+        stored[name] = load_json(path)
+        check_entries(path, stored[name], "camera" if name == "scene_camera" else "list")
     if im_id in stored["scene_camera"]:
-        differ = _same_camera(json_paths["scene_camera"], im_id, stored["scene_camera"][im_id], camera_entry)
+        differ = same_camera(json_paths["scene_camera"], im_id, stored["scene_camera"][im_id], camera_entry)
         if differ:
             raise SceneFileError(json_paths["scene_camera"], f"im_id {im_id} is already written there with another "
                                  f"camera ({'; '.join(differ)}): write another im_id, or remove image {im_id} "
                                  "(its files and entries) first")
 
     # -- render, and everything derived, still before writing
-    frame = renderer.render(scene, passes=("radiance", "depth", "instance"))
-    depth_units = depth_to_png_units(frame.depth, depth_scale)
-    silhouettes = _silhouettes(scene, renderer, bool(count_truncated))
-    info, payloads = [], {}
-    im = f"{im_id:06d}"
-    payloads[("rgb", f"{im}.png")] = png_bytes(frame.radiance, exposure)
-    payloads[("depth", f"{im}.png")] = encode_gray_png(depth_units)
-    for k, (obj, (inside, outside)) in enumerate(zip(scene.objects, silhouettes)):
-        visible = frame.instance == obj.instance_id
-        info.append(_gt_info(inside, outside, visible, depth_units))
-        payloads[("mask", f"{im}_{k:06d}.png")] = encode_gray_png(inside.astype(np.uint8) * np.uint8(255))
-        payloads[("mask_visib", f"{im}_{k:06d}.png")] = encode_gray_png(visible.astype(np.uint8) * np.uint8(255))
+    frame, shapes = render_image(scene, renderer, count_truncated)
+    files, info = image_files(scene, frame, shapes, im_id, depth_scale, exposure)
+    targets = [(os.path.join(dirs[kind], name), data) for (kind, name), data in files.items()]
     entries = {"scene_camera": camera_entry, "scene_gt": gt, "scene_gt_info": info}
     for name, images in stored.items():
         images[im_id] = entries[name]
-        payloads[(None, json_paths[name])] = _json_text(images).encode("utf-8")
+        targets.append((json_paths[name], json_text(images).encode("utf-8")))
 
     # -- write: temporary files first, then the moves
     for path in dirs.values():
         os.makedirs(path, exist_ok=True)
-    moves = []
-    try:
-        for (kind, name), data in payloads.items():
-            target = name if kind is None else os.path.join(dirs[kind], name)
-            moves.append((_write_temp(os.path.dirname(target), os.path.basename(target), data), target))
-    except BaseException:
-        _remove(temp for temp, _ in moves)
-        raise
-    for i, (temp, target) in enumerate(moves):
-        try:
-            os.replace(temp, target)
-        except BaseException:
-            _remove(temp for temp, _ in moves[i:])
-            raise
+    write_files(targets)
     # masks of objects beyond this image's count, from an earlier write of the same im_id, are no longer true
     count = len(scene.objects)
     for kind in ("mask", "mask_visib"):
@@ -509,6 +466,7 @@ def write_bop(folder, scene, renderer, scene_id=0, im_id=0, obj_ids=None, *, dep
             match = _MASK_NAME.match(entry)
             if match and int(match.group(1)) == im_id and int(match.group(2)) >= count:
                 os.unlink(os.path.join(dirs[kind], entry))
+    im = f"{im_id:06d}"
     return {"rgb": os.path.join(dirs["rgb"], f"{im}.png"), "depth": os.path.join(dirs["depth"], f"{im}.png"),
             "mask": [os.path.join(dirs["mask"], f"{im}_{k:06d}.png") for k in range(count)],
             "mask_visib": [os.path.join(dirs["mask_visib"], f"{im}_{k:06d}.png") for k in range(count)],
