@@ -109,7 +109,8 @@ def pieces(backend, frames, size):
                               lambda: renderer.render(scene, passes=("radiance", "depth", "instance")))
                 k = bop_camera_matrix(scene.camera, size, size)
                 counted = dict(calls)
-                shapes = timed("BOP: whole silhouettes", lambda: silhouettes(scene, renderer, k, True, lambda: large))
+                shapes = timed("BOP: whole silhouettes", lambda: silhouettes(scene, renderer, k, True, lambda: large,
+                                                                                 visible=frame.instance))
                 for name in renders:
                     renders[name] += calls[name] - counted[name]
                 files, _ = timed("BOP: PNG encodes and scene_gt_info",

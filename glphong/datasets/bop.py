@@ -306,7 +306,7 @@ def render_image(scene, renderer, count_truncated, large=None):
     """
     frame = renderer.render(scene, passes=("radiance", "depth", "instance"))
     k = bop_camera_matrix(scene.camera, renderer.width, renderer.height)
-    return frame, silhouettes(scene, renderer, k, bool(count_truncated), large)
+    return frame, silhouettes(scene, renderer, k, bool(count_truncated), large, visible=frame.instance)
 
 
 def image_files(scene, frame, shapes, im_id, depth_scale, exposure):

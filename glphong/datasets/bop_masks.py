@@ -27,6 +27,11 @@ from fewer renders:
   being rendered.  Objects that may reach beyond the border are rendered on the large canvas, grouped as
   above.
 - **An object whose box misses the canvas** covers none of it: an empty silhouette, not rendered.
+- **An object apart from all others needs no render at all.**  Where an object's region in the image meets no
+  other object's region, no other fragment competes inside it, so the frame's own instance pass (``visible``, drawn
+  with the same ``invariant gl_Position = u_view_projection * (u_model p)`` as every program's vertex stage, the
+  same culling and the same viewport) is its whole silhouette in the image; a mask with a pixel outside its region
+  is rendered instead, as a check.
 
 The files are the same, byte for byte, as from one render per object and canvas (``tests/datasets/
 test_bop_batch.py`` compares them with that reference, objects inside and across the border, hidden and apart).
@@ -176,7 +181,7 @@ def _outside(mask, pixels):
     return int(np.count_nonzero(mask)) != int(np.count_nonzero(mask[y0:y1 + 1, x0:x1 + 1]))
 
 
-def silhouettes(scene, renderer, k, count_truncated, large=None):
+def silhouettes(scene, renderer, k, count_truncated, large=None, visible=None):
     """Each object's whole silhouette, as rendered alone (module docstring).
 
     Parameters
@@ -192,6 +197,8 @@ def silhouettes(scene, renderer, k, count_truncated, large=None):
     large : callable, optional
         Returns a renderer of the large canvas (three times the image's size, ``renderer``'s options) to use
         instead of resizing ``renderer``: called where an object needs it (a batch's worker keeps one).
+    visible : (H, W) uint32 ndarray, optional
+        The scene's instance pass as ``renderer`` drew it: the silhouette of an object apart from all others.
 
     Returns
     -------
@@ -208,7 +215,16 @@ def silhouettes(scene, renderer, k, count_truncated, large=None):
                          "count the image's pixels only)")
     indices = list(range(len(scene.objects)))
     boxes = object_boxes(scene, k)
-    inside = _coverage(renderer, scene, scene.camera, indices, [_pixels(b, width, height) for b in boxes])
+    pixels = [_pixels(b, width, height) for b in boxes]
+    inside = {}
+    if visible is not None:  # objects apart from all others: the frame's own instance pass
+        for i in indices:
+            if pixels[i] is not None and not any(pixels[j] is not None and _meet(pixels[i], pixels[j])
+                                                 for j in indices if j != i):
+                mask = visible == scene.objects[i].instance_id
+                if not _outside(mask, pixels[i]):
+                    inside[i] = mask
+    inside.update(_coverage(renderer, scene, scene.camera, [i for i in indices if i not in inside], pixels))
     outside = {i: _EMPTY for i in indices}
     if count_truncated and scene.objects:
         cut = [i for i in indices if not _within(boxes[i], width, height)]

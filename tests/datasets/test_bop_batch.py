@@ -159,12 +159,39 @@ def test_silhouettes_equal_one_render_per_object(glphong_backend, glphong_make_r
     assert any(o[0].size for _, o in expected) == (most_large > 0)  # the cases that need the canvas have a cut part
 
 
+#: the image-size renders left when the frame's own instance pass gives the objects apart from all others
+FROM_THE_FRAME = {"apart, inside": 0, "one hides another": 2, "across each border": 0, "wholly outside the image": 0,
+                  "through the near plane": 2, "a textured neighbour": 0}
+
+
+@pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
+def test_silhouettes_from_the_frame_equal_one_render_per_object(glphong_backend, glphong_make_renderer, case):
+    """An object whose region meets no other's takes its silhouette from the frame's instance pass (drawn by the
+    radiance program with its planes: the same invariant gl_Position): the same pixels, fewer renders."""
+    name, placed, znear, _ = case
+    scene = _case(placed, znear)
+    renderer = glphong_make_renderer(W, H, glphong_backend)
+    expected = reference_silhouettes(scene, renderer, True)
+    frame = renderer.render(scene, passes=("radiance", "depth", "instance"))
+    calls = []
+    render = renderer.render
+    renderer.render = lambda *a, **k: calls.append(renderer.width) or render(*a, **k)
+    try:
+        got = silhouettes(scene, renderer, bop_camera_matrix(scene.camera, W, H), True, visible=frame.instance)
+    finally:
+        renderer.render = render
+    for (inside, outside), (want_inside, want_outside) in zip(got, expected):
+        assert np.array_equal(inside, want_inside)
+        assert np.array_equal(outside[0], want_outside[0]) and np.array_equal(outside[1], want_outside[1])
+    assert calls.count(W) == FROM_THE_FRAME[name], calls
+
+
 def test_write_bop_files_equal_the_reference(glphong_backend, glphong_make_renderer, tmp_path, monkeypatch):
     renderer = glphong_make_renderer(W, H, glphong_backend)
     scenes = [_case(placed, znear) for _, placed, znear, _ in CASES] + [tabletop_scene(s) for s in range(3)]
     for i, scene in enumerate(scenes):
         write_bop(tmp_path / "new", scene, renderer, im_id=i)
-    monkeypatch.setattr(bop_module, "silhouettes", lambda s, r, k, c, large: reference_silhouettes(s, r, c))
+    monkeypatch.setattr(bop_module, "silhouettes", lambda s, r, k, c, large, visible=None: reference_silhouettes(s, r, c))
     for i, scene in enumerate(scenes):
         write_bop(tmp_path / "reference", scene, renderer, im_id=i)
     assert snapshot(tmp_path / "new") == snapshot(tmp_path / "reference")
