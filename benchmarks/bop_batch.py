@@ -7,7 +7,7 @@ random view; at 256x256 about one object in fifteen reaches beyond the image's b
 start or the renderers' first programs), the two alternating in each round; the median of the rounds per backend.
 Then the pieces of a BOP image in this process, one after another (no writer thread): the frame (radiance, depth,
 instance), the whole silhouettes (`glphong.datasets.bop_masks.silhouettes`, the large canvas on a renderer of its own
-as in a batch's worker, and how many renders it made at the image's size and on the large canvas), the PNG encodes
+as in a batch's worker, and how many objects it drew alone at the image's size and on the large canvas), the PNG encodes
 and ``scene_gt_info``, the writes; the PNG frame's render and save; and, for comparison, the silhouettes as
 `write_bop` made them before (one render per object alone, and one per object on the large canvas).
 
@@ -89,13 +89,17 @@ def pieces(backend, frames, size):
         return out
 
     for target in (renderer, large):
-        render = target.render
+        render, draw = target.render, target.silhouettes
 
         def counting(*args, _render=render, _name="large" if target is large else "image", **keywords):
             calls[_name] += 1
             return _render(*args, **keywords)
 
-        target.render = counting
+        def drawing(scene, indices, _draw=draw, _name="large" if target is large else "image"):
+            calls[_name] += len(indices)  # an object drawn alone
+            return _draw(scene, indices)
+
+        target.render, target.silhouettes = counting, drawing
     with tempfile.TemporaryDirectory() as folder:
         dirs = image_folders(os.path.join(folder, "000000"))
         for path in dirs.values():
@@ -147,8 +151,8 @@ def main(argv=None):
               f"BOP {bop / png:.2f}x PNG (rounds: png {', '.join(f'{r:.1f}' for r in rates['png'])}; "
               f"bop {', '.join(f'{r:.1f}' for r in rates['bop'])})")
         times, renders = pieces(backend, args.frames, args.size)
-        print(f"  in this process, ms per frame (silhouettes: {renders['image']:.2f} renders at the image's size, "
-              f"{renders['large']:.2f} on the large canvas, per frame):")
+        print(f"  in this process, ms per frame (silhouettes: {renders['image']:.2f} objects drawn alone at the image's "
+              f"size, {renders['large']:.2f} on the large canvas, per frame):")
         for name, ms in times.items():
             print(f"    {name:45s} {ms:6.2f}")
         print(f"    {'BOP: total':45s} {sum(v for k, v in times.items() if k.startswith('BOP')):6.2f}")

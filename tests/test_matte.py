@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 import glphong
+from glphong import primitives
 from glphong.bench.matte import matte_scenes
 from glphong.checks.coverage_twin import exact_coverage
 from glphong.checks.verify_passes import compare_matte, matte_error
@@ -157,3 +158,39 @@ def test_errors_and_a_matte_alone(glphong_make_renderer):
     scene.add(lace, glphong.Lambert(0.5, alpha_mask=glphong.AlphaMask(0.5, texture)), name="lace")
     with pytest.raises(ValueError, match="'matte' pass .* object 'lace' has one"):
         renderer.render(scene, passes=("matte",))
+
+
+def test_silhouettes_are_the_instance_pass_of_each_object_alone(glphong_backend, glphong_make_renderer):
+    """Renderer.silhouettes (one small draw per object, the matte program) gives, pixel for pixel, what the instance
+    pass of each object rendered alone covers: a closed mesh (back faces culled), a mirrored pose, a flat plane seen
+    from behind, an object cut by the near plane, an object hidden by its constant alpha; a textured alpha mask is
+    refused by name."""
+    camera = glphong.PerspectiveCamera.look_at((0.3, 0.2, 2.5), (0.0, 0.0, 0.0), yfov=0.9, znear=0.5)
+    scene = glphong.Scene(camera, [glphong.PointLight((2.0, 2.0, 3.0), 50.0)])
+    sphere = primitives.sphere(2, 0.5)
+    mirrored = np.diag([-1.0, 1.0, 1.0, 1.0])
+    mirrored[:3, 3] = (0.6, 0.1, 0.0)
+    behind = np.eye(4)
+    behind[:3, 3] = (-0.4, -0.3, -0.8)
+    near = np.eye(4)
+    near[:3, 3] = (0.1, 0.0, 1.9)  # its front reaches the near plane (2.5 - 0.5 from the eye)
+    scene.add(sphere, glphong.Lambert(0.5), instance_id=3)
+    scene.add(sphere, glphong.Lambert(0.5), pose=mirrored, instance_id=5)
+    scene.add(primitives.plane(0.8), glphong.Lambert(0.5), pose=behind @ np.diag([1.0, 1.0, -1.0, 1.0]), instance_id=6)
+    scene.add(sphere, glphong.Lambert(0.5), pose=near, instance_id=8)
+    scene.add(sphere, glphong.Lambert(0.5, alpha_mask=glphong.AlphaMask(0.5, 0.2)), instance_id=9)
+    renderer = glphong_make_renderer(40, 30, glphong_backend)
+    masks = renderer.silhouettes(scene)
+    for obj, mask in zip(scene.objects, masks):
+        alone = glphong.Scene(camera, scene.lights)
+        alone.add(obj.mesh, obj.material, pose=obj.pose, instance_id=obj.instance_id)
+        expected = renderer.render(alone, passes=("instance",)).instance == obj.instance_id
+        assert np.array_equal(mask, expected), obj.instance_id
+    assert all(m.any() for m in masks[:4]) and not masks[4].any()
+    assert [m.sum() for m in renderer.silhouettes(scene, [1, 0])] == [masks[1].sum(), masks[0].sum()]
+    texture = glphong.Texture(np.array([[255, 0]], np.uint8), 1.0, srgb=False, channel="r")
+    rect = _rect(-1, 1, -1, 1)
+    lace = MeshData(rect.positions, rect.normals, [[0, 1, 2], [0, 2, 3]], uvs=[[0, 0], [1, 0], [1, 1], [0, 1]])
+    scene.add(lace, glphong.Lambert(0.5, alpha_mask=glphong.AlphaMask(0.5, texture)), name="lace", instance_id=11)
+    with pytest.raises(ValueError, match="object 'lace' has one"):
+        renderer.silhouettes(scene)

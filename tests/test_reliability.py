@@ -112,13 +112,13 @@ def test_renderers_dropped_without_release_are_released(backend, make_context, t
 
 # --------------------------------------------------------------------------- sizes and raw errors
 def test_sizes_are_checked_against_the_context_and_memory_before_any_work(glphong_backend, monkeypatch):
-    from glphong.gpu import renderer as renderer_module
+    from glphong.gpu import resources as resources_module
 
     with pytest.raises(ValueError, match=r"width must be in \[1, 16384\]"):
         glphong.Renderer(16385, 8, backend=glphong_backend)
     with pytest.raises(ValueError, match=r"times supersample must be at most 16384"):
         glphong.Renderer(4096, 8, backend=glphong_backend, supersample=8)
-    monkeypatch.setattr(renderer_module, "available_memory", lambda: 2 ** 30)  # a 1 GiB machine
+    monkeypatch.setattr(resources_module, "available_memory", lambda: 2 ** 30)  # a 1 GiB machine
     with pytest.raises(ValueError, match=r"needs about 1\.8 GiB .* has 1\.0 GiB available"):
         glphong.Renderer(4096, 4096, backend=glphong_backend)
     r = glphong.Renderer(512, 512, backend=glphong_backend)

@@ -13,15 +13,11 @@ from fewer renders:
   vertices' projected bounding box, widened by a margin (one pixel, plus ``1e-5`` of ``f S / z_min``: ``S`` the
   coordinates' magnitude, for float32 arithmetic on the GPU), is covered by no triangle of the object.  An object
   with a vertex nearer than ``znear / 2`` (or behind the camera) is bounded by nothing: the whole canvas.
-- **Objects whose boxes are apart share a render.**  Objects are put, in order, into the first group none of
-  whose members' boxes meets theirs, and a group is rendered as one scene (the same camera, lights and
-  objects, each with its pose and instance_id).  A pixel inside an object's box is covered by no other member
-  of its group, so where that object covers it no other fragment competes, and the group's instance pass equals
-  the object alone there; outside its box the object covers nothing.  That holds where each member is drawn
-  by the same program with the same uniforms as when alone: the G-buffer program of the object
-  (`glphong.Renderer.program_key`, which depends on the scene's G-buffer needs too) is compared for the group
-  and alone, and a member whose key differs is rendered alone.  As a check on the boxes, a group where any
-  member shows a pixel outside its box is rendered again one object at a time.
+- **One small draw per object.**  `glphong.Renderer.silhouettes` draws each object by itself into an integer
+  target, one sample per pixel at the pixel centre, with the same ``invariant gl_Position = u_view_projection *
+  (u_model p)`` every program's vertex stage computes from the same uniforms, and the same back-face culling: the
+  pixels the object's instance pass covers when it is rendered alone, without building a scene, a G-buffer and its
+  planes for it.  A scene with a textured alpha mask (which that draw does not follow) renders each object alone.
 - **No large canvas for an object inside the image.**  An object whose widened box lies within the image's
   pixel centres covers no pixel of the large canvas beyond the image: its truncated part is empty without
   being rendered.  Objects that may reach beyond the border are rendered on the large canvas, grouped as
@@ -40,7 +36,7 @@ import math
 
 import numpy as np
 
-from glphong.gpu.passes import gbuffer_planes, opencv_rotation
+from glphong.gpu.passes import opencv_rotation
 from glphong.scene.camera import IntrinsicsCamera
 from glphong.scene.scene import Scene
 
@@ -50,8 +46,6 @@ __all__ = ["silhouettes", "object_boxes", "gt_info"]
 MARGIN_PX = 1.0
 #: the relative error allowed to the GPU's float32 transform of a vertex, times ``f S / z_min`` [px]
 FLOAT32_ALLOWANCE = 1e-5
-#: the instance pass's G-buffer planes (beyond position and normal), as `glphong.Renderer.render` draws them
-_INSTANCE_PLANES = gbuffer_planes(("instance",))
 _EMPTY = (np.zeros(0, np.int64), np.zeros(0, np.int64))
 
 
@@ -126,53 +120,25 @@ def _subscene(scene, objects, camera):
     return out
 
 
-def _groups(indices, pixels):
-    """``indices`` with a canvas region, in groups whose members' regions are pairwise apart (first fit)."""
-    groups = []
-    for i in indices:
-        for group in groups:
-            if not any(_meet(pixels[i], pixels[j]) for j in group):
-                group.append(i)
-                break
-        else:
-            groups.append([i])
-    return groups
-
-
 def _coverage(renderer, scene, camera, indices, pixels):
     """``{index: (H, W) bool}``: where each of ``scene.objects[indices]`` covers the renderer's canvas when
-    rendered alone (seen by ``camera``), from as few renders as is exact (module docstring); ``pixels`` the
-    region of each object (`_pixels`, None: nothing)."""
+    rendered alone, seen by ``camera``: `glphong.Renderer.silhouettes` (each object drawn by itself, one small draw
+    each), or, in a scene with a textured alpha mask (which that draw does not follow) or on a canvas beyond
+    ``renderer.silhouette_limit``, the instance pass of each object rendered alone; ``pixels`` the region of each object (`_pixels`, None: nothing, not drawn)."""
     objects = scene.objects
-    shape = (renderer.height, renderer.width)
-    out = {i: np.zeros(shape, bool) for i in indices if pixels[i] is None}
-    queue = _groups([i for i in indices if pixels[i] is not None], pixels)
-    while queue:
-        group = queue.pop(0)
-        together = _subscene(scene, [objects[i] for i in group], camera)
-        if len(group) > 1:
-            apart = [i for i, obj in zip(group, together.objects) if not _same_program(renderer, together, obj, scene,
-                                                                                       camera)]
-            if apart:  # drawn by another program in the group than alone: alone
-                queue.extend([i] for i in apart)
-                rest = [i for i in group if i not in apart]
-                if rest:
-                    queue.append(rest)
-                continue
-        instance = renderer.render(together, passes=("instance",)).instance
-        masks = {i: instance == objects[i].instance_id for i in group}
-        if len(group) > 1 and any(_outside(masks[i], pixels[i]) for i in group):
-            queue.extend([i] for i in group)  # a box that did not hold its object: one at a time
-            continue
-        out.update(masks)
+    out = {i: np.zeros((renderer.height, renderer.width), bool) for i in indices if pixels[i] is None}
+    drawn = [i for i in indices if pixels[i] is not None]
+    if not drawn:
+        return out
+    seen = scene if camera is scene.camera else _subscene(scene, objects, camera)
+    if max(renderer.width, renderer.height) > renderer.silhouette_limit or any(
+            o.material.alpha_mask is not None and o.material.alpha_mask.textured for o in objects):
+        for i in drawn:
+            alone = _subscene(scene, [objects[i]], camera)
+            out[i] = renderer.render(alone, passes=("instance",)).instance == objects[i].instance_id
+        return out
+    out.update(zip(drawn, renderer.silhouettes(seen, drawn)))
     return out
-
-
-def _same_program(renderer, together, obj, scene, camera):
-    """Whether ``obj`` of the group's scene ``together`` is drawn by the program that draws it alone (G-buffer)."""
-    alone = _subscene(scene, [obj], camera)
-    return (renderer.program_key(together, obj, "gbuffer", _INSTANCE_PLANES)
-            == renderer.program_key(alone, alone.objects[0], "gbuffer", _INSTANCE_PLANES))
 
 
 def _outside(mask, pixels):

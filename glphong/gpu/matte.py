@@ -219,6 +219,64 @@ class Matte:
                 counts[row:row + h, column:column + w] = n
         return ids, (counts / float(samples * samples)).astype(np.float32)
 
+    def silhouettes(self, scene, size, indices, programs, vertex_array, culled):
+        """Where each object ``indices`` of ``scene`` covers the image when drawn alone (its whole silhouette).
+
+        Each object is drawn by itself into the cleared target, one sample per pixel at the pixel centre, no depth
+        test, by the matte program: its vertex stage computes the same ``invariant gl_Position`` from the same
+        uniforms as every program's, and the cull state is the one the renderer draws the object with, so the
+        pixels are those a render of the object alone covers (its alpha mask apart: `matte_objects` refuses a
+        textured one, and a constant alpha below its cutoff hides the object).
+
+        Parameters
+        ----------
+        scene : glphong.Scene
+        size : (int, int)
+            ``(W, H)`` [px], at most the tile.
+        indices : sequence of int
+        programs, vertex_array
+            As `draw`.
+        culled : callable
+            ``culled(obj)``: ``(cull, mirrored)``, whether the renderer culls the object's back faces and whether
+            its pose mirrors (clockwise front faces).
+
+        Returns
+        -------
+        list of (H, W) bool ndarray
+        """
+        width, height = size
+        if max(size) > self.tile:
+            raise ValueError(f"silhouettes are drawn at most {self.tile} px a side (got {width}x{height})")
+        drawn = set(matte_objects(scene))
+        program = programs.get(matte_key())
+        camera = scene.camera
+        view_projection = camera.projection_matrix(width / height) @ camera.view_matrix()
+        fbo = self._target()
+        mgl = self._mgl
+        mgl.disable(moderngl.DEPTH_TEST | moderngl.BLEND)
+        fbo.use()
+        viewport = (0, 0, width, height)
+        fbo.viewport = viewport
+        out = []
+        try:
+            for index in indices:
+                fbo.clear(0, 0, 0, 0, viewport=viewport)
+                obj = scene.objects[index]
+                if index in drawn:
+                    cull, mirrored = culled(obj)
+                    (mgl.enable if cull else mgl.disable)(moderngl.CULL_FACE)
+                    mgl.front_face = "cw" if mirrored else "ccw"
+                    program.bind({"u_model": obj.pose, "u_view_projection": view_projection,
+                                  "u_object_id": float(index)})
+                    vertex_array(obj.mesh, program).render(moderngl.TRIANGLES)
+                data = np.empty((height, width), np.uint32)
+                fbo.read_into(data, viewport=viewport, components=1, dtype="u4")
+                out.append(data[::-1] != 0)
+        finally:
+            mgl.front_face = "ccw"
+            mgl.disable(moderngl.CULL_FACE)
+        return out
+
     def _target(self):
         fbo = self._targets.get("matte")
         if fbo is None:

@@ -7,7 +7,6 @@ as float32 with row 0 at the top.
 """
 import functools
 import threading
-import warnings
 import weakref
 
 import moderngl
@@ -16,10 +15,10 @@ import numpy as np
 from glphong.core import validate as _validate
 from glphong.gpu.frame import Frame, GBuffer
 from glphong.gpu.passes import check_passes, derive_passes, gbuffer_planes, requested_passes
-from glphong.gpu.resources import (ORPHANS, ORPHANS_LOCK, MeshBuffers, ObjectEntry, available_memory, make_target,
-                                   read_attachment, release_orphans, release_resources, release_targets)
+from glphong.gpu.resources import (MeshBuffers, ObjectEntry, check_target_size, gl_object_count, make_target, orphan,
+                                   read_attachment, release_orphans, release_resources, release_targets, target_bytes)
 from glphong.gpu.contexts import check_not_forked, create_context
-from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
+from glphong.scene.culling import closed_outward, culling_decision, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
 from glphong.shaders.keys import EncodeKey
 from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, PASS_PLANES
@@ -163,32 +162,13 @@ class Renderer:
         self._entries = weakref.WeakKeyDictionary()  # SceneObject -> {output: ObjectEntry}
 
     def render_target_bytes(self, size=None):
-        """Memory the render targets and one float32 readback need at ``size`` (default the current one) [bytes].
-
-        Radiance target RGBA32F plus depth at the internal (supersampled) size, times the samples, a
-        resolve target when multisampling, the 8-bit display target and depth times the samples and
-        its resolve, the G-buffer (up to four RGBA32F planes and depth) at the output size, and the
-        float32 readback of the internal size.
-        """
-        w, h = size or self._size
-        internal = w * h * self.supersample ** 2
-        samples = self.samples
-        radiance = internal * (16 + 4) * samples + (internal * 16 if samples > 1 else 0)
-        display = w * h * (4 + 4) * samples + w * h * 4  # render_srgb8's 8-bit target and its resolve
-        return radiance + display + w * h * (4 * 16 + 4) + internal * 16
+        """Memory the render targets and one float32 readback need at ``size`` (default the current one) [bytes]
+        (`glphong.gpu.resources.target_bytes`)."""
+        return target_bytes(size or self._size, self.supersample, self.samples)
 
     def _check_limits(self, size, renderer_name):
         """The size against the context's limits and the memory it needs, before any work starts."""
-        internal = (size[0] * self.supersample, size[1] * self.supersample)
-        if max(internal) > self._max_size:
-            raise ValueError(f"width and height times supersample must be at most this context's largest "
-                             f"render target, {self._max_size} pixels ({renderer_name}) (got {internal[0]}x{internal[1]})")
-        needed = self.render_target_bytes(size)
-        available = available_memory()
-        if available is not None and needed > 0.8 * available:
-            raise ValueError(f"a {size[0]}x{size[1]} renderer (supersample {self.supersample}, samples {self.samples}) "
-                             f"needs about {needed / 2**30:.1f} GiB for its render targets and readback; this machine "
-                             f"has {available / 2**30:.1f} GiB available (at most 80% of it may be used)")
+        check_target_size(size, self.supersample, self.samples, self._max_size, renderer_name)
 
     def _check_size(self, width, height):
         size = (_validate.positive_int("width", width, 1, 16384), _validate.positive_int("height", height, 1, 16384))
@@ -289,10 +269,39 @@ class Renderer:
         with self.context:
             self._purge_dead_meshes()
             ids, fractions = self._matte.draw(scene, self._size, self.matte_samples, self.matte_k, self.programs,
-                                              lambda mesh, program: self._mesh_buffers(mesh).vertex_array(self._mgl,
-                                                                                                           program))
+                                              self._vertex_array)
             self.context.check_error("drawing the matte pass")
         return {"matte_ids": ids, "matte_fractions": fractions}
+
+    @property
+    def silhouette_limit(self):
+        """The largest image side [px] `silhouettes` draws (its target's: 2048, or the context's largest)."""
+        return self._matte.tile
+
+    @_one_call_at_a_time
+    def silhouettes(self, scene, indices=None):
+        """Each object's whole silhouette: where it covers the image drawn alone, one sample per pixel at its centre
+        (the instance pass of the object alone, from one small draw each; `glphong.gpu.matte.Matte.silhouettes`);
+        images up to `silhouette_limit` a side.
+
+        Parameters
+        ----------
+        scene : Scene
+        indices : sequence of int, optional
+            The objects (default all).
+
+        Returns
+        -------
+        list of (H, W) bool ndarray
+        """
+        self._check_scene(scene)
+        indices = range(len(scene.objects)) if indices is None else indices
+        culled = lambda obj: (self.culling == "auto" and culling_decision(obj, scene.camera)[0], obj.mirrored)  # noqa: E731 - as `_draw` decides
+        with self.context:
+            self._purge_dead_meshes()
+            out = self._matte.silhouettes(scene, self._size, indices, self.programs, self._vertex_array, culled)
+            self.context.check_error("drawing silhouettes")
+        return out
 
     def _render_with_planes(self, scene, names, geometry, next_scene, previous_scene, extra):
         """The radiance and the geometry passes from one draw: each radiance program also writes the G-buffer planes
@@ -430,7 +439,7 @@ class Renderer:
             return {}
         casters = [obj for obj in scene.objects if obj.casts_shadow]
         return self._shadow_maps.draw(bound.shadow_setups(lights, self.shadow_map_size), casters, self.programs,
-                                      lambda mesh, program: self._mesh_buffers(mesh).vertex_array(self._mgl, program))
+                                      self._vertex_array)
 
     def _draw(self, scene, output, fbo, frame_values=None, planes=frozenset()):
         aspect = self.width / self.height
@@ -490,7 +499,7 @@ class Renderer:
                 program = self.programs.get(key)
                 values = bound.uniform_values(index, key, aspect) if shared is not None else \
                     bound.object_uniform_values(index, key)
-                vao = self._mesh_buffers(obj.mesh).vertex_array(self._mgl, program)
+                vao = self._vertex_array(obj.mesh, program)
                 sphere = world_sphere(obj.mesh, obj.pose) if self.culling == "auto" and closed_outward(obj.mesh)[0] else None
                 entry = ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
                                      None if sphere is None else (tuple(sphere[0]), sphere[1]), camera=camera)
@@ -536,6 +545,9 @@ class Renderer:
                                "use a smaller size, supersample or samples") from None
         return fbo
 
+    def _vertex_array(self, mesh, program):
+        return self._mesh_buffers(mesh).vertex_array(self._mgl, program)
+
     def _mesh_buffers(self, mesh):
         entry = self._meshes.get(id(mesh))
         if entry is None or entry.owner() is not mesh:
@@ -553,11 +565,7 @@ class Renderer:
 
     def gl_object_count(self):
         """Number of GL objects this renderer holds (programs, textures, buffers, vertex arrays, targets)."""
-        meshes = sum(1 + len(e.buffers) + len(e.vertex_arrays) for e in self._meshes.values())
-        targets = sum(1 if name[0] == "fullscreen" else
-                      1 + len(f.color_attachments) + (f.depth_attachment is not None)
-                      for name, f in self._targets.items())
-        return len(self.programs) + len(self.programs.textures) + meshes + targets
+        return gl_object_count(self.programs, self._meshes, self._targets)
 
     @_one_call_at_a_time
     def release(self):
@@ -582,14 +590,7 @@ class Renderer:
             return
         state = (self.context, self._meshes, self._targets, self.programs)
         self.context = None
-        with ORPHANS_LOCK:
-            ORPHANS.append(functools.partial(release_resources, *state))
-        try:
-            warnings.warn("a glphong.Renderer was never released: its GL objects are released at the next "
-                          "glphong call (call release() or use 'with glphong.Renderer(...) as r:')",
-                          ResourceWarning, stacklevel=2)
-        except Exception:  # noqa: BLE001 - warnings turned into errors must not keep the resources
-            pass
+        orphan(*state)
 
     def __repr__(self):
         state = "released" if self.context is None else self.backend

@@ -6,7 +6,9 @@ or at exit: the collector may run anywhere, inside pyrender's draw or on another
 is unsafe).
 """
 import atexit
+import functools
 import threading
+import warnings
 import weakref
 from dataclasses import dataclass
 
@@ -15,8 +17,8 @@ import numpy as np
 
 from glphong.gpu.contexts import EGLDisplayTerminatedError
 
-__all__ = ["MeshBuffers", "ObjectEntry", "available_memory", "make_target", "read_attachment", "release_resources", "release_targets",
-           "release_orphans", "ORPHANS", "ORPHANS_LOCK"]
+__all__ = ["MeshBuffers", "ObjectEntry", "available_memory", "target_bytes", "check_target_size", "make_target", "read_attachment", "release_resources", "release_targets",
+           "release_orphans", "gl_object_count", "orphan", "ORPHANS", "ORPHANS_LOCK"]
 
 
 def make_target(mgl, name, size, internal_size, samples):
@@ -68,6 +70,35 @@ class ObjectEntry:
     sphere: tuple = None  # ((x, y, z), radius) in the world where the mesh's back faces may be culled
     checked: object = None
     camera: object = None  # the camera the key's 'view' piece was decided for (numerics='auto')
+
+
+def target_bytes(size, supersample, samples):
+    """Memory a renderer's render targets and one float32 readback need at ``size`` (W, H) [bytes].
+
+    Radiance target RGBA32F plus depth at the internal (supersampled) size, times the samples, a resolve target when
+    multisampling, the 8-bit display target and depth times the samples and its resolve, the G-buffer (up to four
+    RGBA32F planes and depth) at the output size, and the float32 readback of the internal size.
+    """
+    w, h = size
+    internal = w * h * supersample ** 2
+    radiance = internal * (16 + 4) * samples + (internal * 16 if samples > 1 else 0)
+    display = w * h * (4 + 4) * samples + w * h * 4  # render_srgb8's 8-bit target and its resolve
+    return radiance + display + w * h * (4 * 16 + 4) + internal * 16
+
+
+def check_target_size(size, supersample, samples, max_size, renderer_name):
+    """``size`` (W, H) times ``supersample`` against the context's largest target ``max_size`` and the memory
+    `target_bytes` needs against `available_memory`; ValueError saying which."""
+    internal = (size[0] * supersample, size[1] * supersample)
+    if max(internal) > max_size:
+        raise ValueError(f"width and height times supersample must be at most this context's largest "
+                         f"render target, {max_size} pixels ({renderer_name}) (got {internal[0]}x{internal[1]})")
+    needed = target_bytes(size, supersample, samples)
+    available = available_memory()
+    if available is not None and needed > 0.8 * available:
+        raise ValueError(f"a {size[0]}x{size[1]} renderer (supersample {supersample}, samples {samples}) "
+                         f"needs about {needed / 2**30:.1f} GiB for its render targets and readback; this machine "
+                         f"has {available / 2**30:.1f} GiB available (at most 80% of it may be used)")
 
 
 def available_memory():
@@ -160,6 +191,29 @@ def release_resources(context, meshes, targets, programs):
         context._released = True
         return
     context.recycle()  # every GL object is released: the context may serve another renderer
+
+
+def gl_object_count(programs, meshes, targets):
+    """Number of GL objects a renderer holds: its programs (a `glphong.gpu.programs.ProgramCache`) and their textures,
+    its meshes' buffers and vertex arrays (dict of `MeshBuffers`), its targets' framebuffers and attachments."""
+    mesh_objects = sum(1 + len(e.buffers) + len(e.vertex_arrays) for e in meshes.values())
+    target_objects = sum(1 if name[0] == "fullscreen" else 1 + len(f.color_attachments) + (f.depth_attachment is not None)
+                         for name, f in targets.items())
+    return len(programs) + len(programs.textures) + mesh_objects + target_objects
+
+
+def orphan(context, meshes, targets, programs):
+    """Hand a renderer dropped without ``release()`` to the next glphong call (`ORPHANS`), and warn as an unclosed
+    file does: moderngl never frees GL objects on garbage collection, and GL work inside the collector could run
+    inside someone else's draw."""
+    with ORPHANS_LOCK:
+        ORPHANS.append(functools.partial(release_resources, context, meshes, targets, programs))
+    try:
+        warnings.warn("a glphong.Renderer was never released: its GL objects are released at the next "
+                      "glphong call (call release() or use 'with glphong.Renderer(...) as r:')",
+                      ResourceWarning, stacklevel=3)
+    except Exception:  # noqa: BLE001 - warnings turned into errors must not keep the resources
+        pass
 
 
 @atexit.register

@@ -135,6 +135,9 @@ CASES = [
     ("wholly outside the image", [(2.5, 0.0, 0.0), (0.0, 0.0, 0.0)], 0.05, (1, 1)),
     ("through the near plane", [(0.0, 0.0, 2.7), (0.5, 0.2, 0.0)], 0.4, (2, 1)),
     ("a textured neighbour", [(-0.6, 0.0, 0.0), (0.6, 0.0, 0.0, glphong.Lambert(kd=TEXTURE))], 0.05, (2, 0)),
+    ("a textured alpha mask", [(-0.1, 0.0, 0.0), (0.2, 0.1, 0.3, glphong.Lambert(0.5, alpha_mask=glphong.AlphaMask(
+        0.5, glphong.Texture(np.array([[255, 0], [0, 255]], np.uint8), 1.0, srgb=False, channel="r"))))],
+     0.05, (2, 0)),
 ]
 
 
@@ -159,31 +162,36 @@ def test_silhouettes_equal_one_render_per_object(glphong_backend, glphong_make_r
     assert any(o[0].size for _, o in expected) == (most_large > 0)  # the cases that need the canvas have a cut part
 
 
-#: the image-size renders left when the frame's own instance pass gives the objects apart from all others
+#: the objects drawn alone at the image's size when the frame's own instance pass gives those apart from all others
 FROM_THE_FRAME = {"apart, inside": 0, "one hides another": 2, "across each border": 0, "wholly outside the image": 0,
-                  "through the near plane": 2, "a textured neighbour": 0}
+                  "through the near plane": 2, "a textured neighbour": 0, "a textured alpha mask": 0}
 
 
 @pytest.mark.parametrize("case", CASES, ids=[c[0] for c in CASES])
 def test_silhouettes_from_the_frame_equal_one_render_per_object(glphong_backend, glphong_make_renderer, case):
     """An object whose region meets no other's takes its silhouette from the frame's instance pass (drawn by the
-    radiance program with its planes: the same invariant gl_Position): the same pixels, fewer renders."""
+    radiance program with its planes: the same invariant gl_Position); the others are drawn alone
+    (`glphong.Renderer.silhouettes`): the same pixels as one render per object, no render of a scene."""
     name, placed, znear, _ = case
     scene = _case(placed, znear)
     renderer = glphong_make_renderer(W, H, glphong_backend)
     expected = reference_silhouettes(scene, renderer, True)
     frame = renderer.render(scene, passes=("radiance", "depth", "instance"))
-    calls = []
-    render = renderer.render
+    calls, drawn = [], []
+    render, draw = renderer.render, renderer.silhouettes
     renderer.render = lambda *a, **k: calls.append(renderer.width) or render(*a, **k)
+    renderer.silhouettes = lambda s, i: drawn.extend([renderer.width] * len(i)) or draw(s, i)
     try:
         got = silhouettes(scene, renderer, bop_camera_matrix(scene.camera, W, H), True, visible=frame.instance)
     finally:
-        renderer.render = render
+        renderer.render, renderer.silhouettes = render, draw
     for (inside, outside), (want_inside, want_outside) in zip(got, expected):
         assert np.array_equal(inside, want_inside)
         assert np.array_equal(outside[0], want_outside[0]) and np.array_equal(outside[1], want_outside[1])
-    assert calls.count(W) == FROM_THE_FRAME[name], calls
+    if "alpha" in name:  # a draw of its own does not follow a textured alpha mask: each object rendered alone
+        assert drawn == [] and calls == [W, W], calls
+    else:
+        assert calls == [] and drawn.count(W) == FROM_THE_FRAME[name], drawn
 
 
 def test_write_bop_files_equal_the_reference(glphong_backend, glphong_make_renderer, tmp_path, monkeypatch):
