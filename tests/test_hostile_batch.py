@@ -23,13 +23,13 @@ import subprocess
 import sys
 import textwrap
 import time
-from concurrent.futures import Executor, Future
 
 import numpy as np
 import pytest
 
 import glphong
 import glphong.batch
+from glphong.testing import InlineExecutor
 from glphong.batch import BatchError, render_many, turntable_scene
 
 pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGKILL"), reason="POSIX processes and signals")
@@ -38,24 +38,6 @@ W = H = 16
 ANGLES = [0.0, 30.0, 60.0, 90.0, 120.0, 150.0]
 OTHER_ANGLES = [45.0, 135.0, 225.0, 315.0]
 ORPHAN_LIMIT_S = 15.0
-
-
-class InlineExecutor(Executor):
-    """Runs each task in this process as it is submitted; ``before(n)`` is called before the n-th task."""
-
-    def __init__(self, before=None):
-        self.before, self.submitted = before, 0
-
-    def submit(self, fn, /, *args, **kwargs):
-        future = Future()
-        if self.before is not None:
-            self.before(self.submitted)
-        self.submitted += 1
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as exc:  # noqa: BLE001 - a task's error travels in its future
-            future.set_exception(exc)
-        return future
 
 
 @pytest.fixture(scope="module", autouse=True)

@@ -22,7 +22,8 @@ The package's modules: ``assertions`` (the ``assert_*_matches``), ``backends`` (
 `renderer_factory`), the GLSL function toolkit ``glsl_runner`` (`glsl_function`), ``glsl_source`` (reading and
 ``#include``), ``glsl_types`` (values as 32-bit patterns), ``glsl_builtins`` (`glsl`), ``glsl_compare``
 (`assert_glsl_matches`), ``glsl_arguments`` (`edge_inputs`, `glsl_inputs`), ``probe`` (glphong's own chunk functions
-through `glsl_function`), and ``plugin`` (the fixtures; ``import glphong.testing`` does not import pytest).  It
+through `glsl_function`), ``executors`` (`InlineExecutor`: a batch's tasks run in the calling process, for
+testing batch pipelines), and ``plugin`` (the fixtures; ``import glphong.testing`` does not import pytest).  It
 stands on `glphong.evaluation` (`evaluate`, `direction_sets` and the closed-form helpers, re-exported here) and on
 the render check (`glphong.checks`: the twin, the tolerance band, `glphong.verify`).
 
@@ -42,12 +43,13 @@ from glphong.testing import glsl_builtins as glsl
 from glphong.testing.assertions import (TwinMismatch, assert_light_matches, assert_render_matches, assert_twin_matches,
                                         light_points)
 from glphong.testing.backends import renderer_factory, require_backend
+from glphong.testing.executors import InlineExecutor
 from glphong.testing.glsl_arguments import edge_inputs, edge_values, glsl_inputs, glsl_values, unit_float32
 from glphong.testing.glsl_compare import GlslMismatch, GlslUndefinedWarning, assert_glsl_matches, ulp32, ulps_between
 from glphong.testing.glsl_runner import GlslFunction, glsl_function, subnormal_flushing
 from glphong.testing.glsl_source import GlslSourceError
 
-__all__ = ["evaluate", "direction_sets", "assert_twin_matches", "assert_render_matches", "assert_light_matches",
+__all__ = ["InlineExecutor", "evaluate", "direction_sets", "assert_twin_matches", "assert_render_matches", "assert_light_matches",
            "light_points", "TwinMismatch",
            "frame_around", "direction", "rotate_toward", "float32_units", "cosine_power_interval",
            "require_backend", "renderer_factory",

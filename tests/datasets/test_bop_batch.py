@@ -19,7 +19,6 @@ import hashlib
 import json
 import os
 import sys
-from concurrent.futures import Executor, Future
 
 import numpy as np
 import pytest
@@ -27,6 +26,7 @@ import pytest
 import glphong
 import glphong.datasets.bop as bop_module
 from glphong import primitives
+from glphong.testing import InlineExecutor
 from glphong.batch import BatchError, render_many, tabletop_scene
 from glphong.datasets import write_bop
 from glphong.datasets.bop import bop_camera_matrix
@@ -35,24 +35,6 @@ from glphong.scene.camera import IntrinsicsCamera
 
 W, H = 64, 48
 LIGHTS = [glphong.PointLight((2.0, 2.0, 3.0), 50.0)]
-
-
-class InlineExecutor(Executor):
-    """Runs each task in this process as it is submitted; ``before(n)`` is called before the n-th task."""
-
-    def __init__(self, before=None):
-        self.before, self.submitted = before, 0
-
-    def submit(self, fn, /, *args, **kwargs):
-        future = Future()
-        if self.before is not None:
-            self.before(self.submitted)
-        self.submitted += 1
-        try:
-            future.set_result(fn(*args, **kwargs))
-        except BaseException as exc:  # noqa: BLE001 - a task's error travels in its future
-            future.set_exception(exc)
-        return future
 
 
 def snapshot(folder, skip=("manifest.json", "frames.jsonl", ".lock")):
