@@ -20,6 +20,7 @@ class InlineExecutor(Executor):
         self.before, self.submitted = before, 0
 
     def submit(self, fn, /, *args, **kwargs):
+        """Run ``fn`` with the given arguments now; a `concurrent.futures.Future` holding its result or its error."""
         future = Future()
         if self.before is not None:
             self.before(self.submitted)
