@@ -1,8 +1,12 @@
 """The speed family's peers (glphong.bench.peers): PyVista (in the test extra) and Open3D (the bench extra only;
 skipped with the reason where it is not installed).  Each draws the family's scenes with the settings matched to
 glphong's, reads back an 8-bit image of the right size with the object where glphong shows it, and coexists with
-glphong's renderers made after it (a VTK plotter made on EGL terminates the display, docs/speed.md)."""
+glphong's renderers made after it.  Each runs in a process of its own: a VTK plotter made on EGL terminates the
+display every context of the process shares (this worker's pooled contexts too), and Open3D keeps its renderer for
+the process."""
 import importlib.util
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -33,15 +37,22 @@ def _check_against_glphong(peer_class, **options):
             peer.release()
 
 
+def _in_a_process(call):
+    out = subprocess.run([sys.executable, "-c", f"import sys; sys.path.insert(0, {str(__file__.rsplit('/', 1)[0])!r}); "
+                          f"import test_peers as t; {call}; print('checked')"], capture_output=True, text=True,
+                         timeout=300, env={**__import__("os").environ, "EGL_PLATFORM": "surfaceless"})
+    assert out.returncode == 0 and "checked" in out.stdout, out.stderr[-3000:]
+
+
 def test_pyvista_draws_the_scene_where_glphong_does():
     pytest.importorskip("pyvista", reason="PyVista is not installed (the extra 'bench' or 'test')")
-    _check_against_glphong(PyVistaRenderer, anti_aliasing=False)
+    _in_a_process("t._check_against_glphong(t.PyVistaRenderer, anti_aliasing=False)")
 
 
 @pytest.mark.skipif(importlib.util.find_spec("open3d") is None,
                     reason="Open3D is not installed (the extra 'bench'; 0.19 on llvmpipe: 0.20 needs Vulkan)")
 def test_open3d_draws_the_scene_where_glphong_does():
-    _check_against_glphong(Open3DRenderer, post_processing=False)
+    _in_a_process("t._check_against_glphong(t.Open3DRenderer, post_processing=False)")
 
 
 def test_the_matched_settings():
