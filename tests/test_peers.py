@@ -16,6 +16,7 @@ from glphong.bench.peers import Open3DRenderer, PyVistaRenderer, diffuse_colour,
 from glphong.bench.speed import speed_scenes
 
 SIZE = 48
+PEERS = (PyVistaRenderer, Open3DRenderer)  # what the subprocesses take from this module (`_in_a_process`)
 
 
 def _check_against_glphong(peer_class, **options):
