@@ -360,6 +360,8 @@ def exact_reflection(position, f, wo, lit, key, uniforms, material, lights=None,
     out = np.zeros(position.shape)
     error = np.zeros(len(position))
     for light_key, twin, p, closed, _ in extended_lights(key, uniforms, np.float64, lights):
+        if hasattr(twin, "exact_twin"):  # a kind whose exact closed forms are not its shader's (the environment's map)
+            twin = twin.exact_twin()
         exact = [t for t in closed if twin.closed_form_is_exact(
             t.integral.form, _exponent(t, terms[t.name].values_from_uniforms(uniforms, dtype=np.float64))
             if t.integral.form != "irradiance" else None)]

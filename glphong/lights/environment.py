@@ -337,6 +337,13 @@ class EnvironmentLight(ExtendedLight):
             raise TypeError("EnvironmentLight.exact needs the light itself (its map), not a bare twin")
         return environment_integral(n, self.radiance, integrand, rotation=self.rotation, clip=clip)
 
+    def exact_twin(self):
+        """What `glphong.checks.reference.exact_reflection` reads in this light's place: the exact irradiance of the
+        map in closed form (`_ExactEnvironment`; the shader's cube map is not exact), and `exact` for the rest."""
+        if not hasattr(self, "radiance"):
+            raise TypeError("EnvironmentLight.exact_twin needs the light itself (its map), not a bare twin")
+        return _ExactEnvironment(self)
+
     @classmethod
     def example(cls, **overrides):
         """A small sky (8 x 16 texels brightening toward the zenith, one bright texel for a sun)."""
@@ -368,3 +375,24 @@ class EnvironmentLight(ExtendedLight):
             ("constant sky, lobe q = 100", cls(sky, order=2, samples=1), 100.0),
             ("constant sky, lobe q = 2.5", cls(sky, order=2, samples=1), 2.5),
             ("constant sky, lobe q = 1e3", cls(sky, order=2, samples=1), 1e3)))
+
+
+class _ExactEnvironment:
+    """An environment light's exact integrals, in the twin's calling convention (`EnvironmentLight.exact_twin`): the
+    irradiance ``E(n)`` of the map at the world normals, each texel wholly above the horizon ``L_k (n . M_k)`` and each
+    one the horizon crosses in closed form (`glphong.twin.environment.irradiance` with ``crossed='closed'``: about
+    1e-12 relative, against the quadrature's 1e-9), so a term of irradiance form is reflected exactly at the cost of
+    the map's rows and crossed texels a normal, not its texels; every other term by `EnvironmentLight.exact`."""
+
+    def __init__(self, light):
+        self.light = light
+
+    def closed_form_is_exact(self, form, q=None):
+        return form == "irradiance"
+
+    def irradiance(self, x, n, p):
+        return env.irradiance(self.light.radiance, np.asarray(n, np.float64) @ self.light.rotation,
+                              crossed="closed")[0]
+
+    def exact(self, x, n, p, integrand, clip=()):
+        return self.light.exact(x, n, p, integrand, clip)
