@@ -221,7 +221,7 @@ def view_direction(position, n_valid, eye, key):
     return wo, n_valid & ok_v
 
 
-def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=None):
+def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=None, incident=None):
     """E6 at each point (shade.glsl's ``shade_point``).
 
     Parameters
@@ -243,6 +243,9 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=Non
         What the extended lights reflect, ``extended(position, f, wo, lit, key, uniforms, material) -> (N, 3)``:
         default `extended_reflection` (the shader's methods); `glphong.checks.verify.exact_image` passes the exact
         integrals.
+    incident : list, optional
+        `incident_light` of these points, where the caller has it already (`glphong.checks.verify.twin_and_band`
+        shares it with the band); its first three entries per light are read.
 
     Returns
     -------
@@ -254,7 +257,8 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=Non
     if key.num_lights == 0:
         return radiance
     wo, lit = view_direction(position, n_valid, eye, key)
-    for i, (valid, wi, irradiance) in enumerate(incident_light(position, key, uniforms)):
+    lights = incident_light(position, key, uniforms) if incident is None else [light[:3] for light in incident]
+    for i, (valid, wi, irradiance) in enumerate(lights):
         if f.visibility is not None and f.visibility[i] is not None:  # the ray-cast shadow (checks.shadows)
             irradiance = irradiance * f.visibility[i][0][:, None]
         n_dot_l = _dot(f.n, wi)

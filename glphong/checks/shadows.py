@@ -29,7 +29,7 @@ import numpy as np
 import trimesh
 
 from glphong.core.validate import FLT_MAX
-from glphong.twin.functions import perpendiculars
+from glphong.twin.functions import dot, perpendiculars
 
 __all__ = ["shadow_visibility", "shadow_plane_angle", "shadow_plane_length", "shadow_bias", "SHADOW_QUANTUM", "RING"]
 
@@ -102,7 +102,11 @@ def _first_hits(intersector, origins, directions):
     if len(ray):
         t = np.einsum("ij,ij->i", location - origins[ray], directions[ray])
         keep = t > 0.0
-        np.minimum.at(out, ray[keep], t[keep])
+        rays = ray[keep]
+        if np.all(rays[1:] > rays[:-1]):  # each ray once, in order (Embree's first hits): a plain assignment
+            out[rays] = np.minimum(out[rays], t[keep])
+        else:
+            np.minimum.at(out, rays, t[keep])
     return out
 
 
@@ -117,7 +121,7 @@ def _ring(u, radius):
 def _plane_distance(n, point, origins, directions):
     """Distance along each ray to the plane through ``point`` with normal ``n`` (inf where it is not ahead)."""
     with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.sum(n * (point - origins), axis=-1) / np.sum(n * directions, axis=-1)
+        t = dot(n, point - origins) / dot(n, directions)
     return np.where(np.isfinite(t) & (t > 0.0), t, np.inf)
 
 
@@ -157,7 +161,7 @@ def shadow_visibility(scene, setup, position, normal, filter_radius):
             u = v / d[:, None]
         m = np.max(np.abs(u), axis=1)  # a cube texel along u subtends at most texel m (glsl/shadows.glsl)
         reach, radius = reach * m, band * m
-        c = np.abs(np.sum(normal * u, axis=1))
+        c = np.abs(dot(normal, u))
         plane = shadow_plane_angle(d, c, reach)
         ring, _ = _ring(u, radius)
         origins = np.broadcast_to(light, (RING + 1, n_points, 3))

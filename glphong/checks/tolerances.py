@@ -61,7 +61,7 @@ def _textured_band(term, f, wi, wo, n_dot_l, u, band):
     return low, high
 
 
-def point_band(key, u, position, n, n_valid, material, band=BAND):
+def point_band(key, u, position, n, n_valid, material, band=BAND, incident=None):
     """Interval the GPU's ``shade_point()`` must return at given points.
 
     Each lit term contributes its own band (`glphong.materials.MaterialModel.band`: the model's
@@ -81,6 +81,9 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
     n_valid : (N,) bool ndarray
     material : glphong.materials.Material
     band : BandConstants
+    incident : list, optional
+        ``incident_light(position, key, u, band=band)`` where the caller has it already (`glphong.checks.verify`'s
+        twin shares it).
 
     Returns
     -------
@@ -94,7 +97,8 @@ def point_band(key, u, position, n, n_valid, material, band=BAND):
     if key.num_lights:
         wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
         tol = band.D * EPS
-        for i, (valid, wi, irradiance, (e_low, e_high)) in enumerate(ref.incident_light(position, key, u, band=band)):
+        lights = ref.incident_light(position, key, u, band=band) if incident is None else incident
+        for i, (valid, wi, irradiance, (e_low, e_high)) in enumerate(lights):
             terms += 1
             if f.visibility is not None and f.visibility[i] is not None:  # the shadow map's interval
                 _, v_low, v_high = f.visibility[i]

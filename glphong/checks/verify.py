@@ -267,8 +267,11 @@ def twin_and_band(scene, gbuffer, band=BAND, shadows=None):
     low, high = np.zeros_like(ref), np.zeros_like(ref)
     shadow_band = np.zeros(gbuffer.mask.shape, bool)
     for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, band=band, shadows=shadows):
-        ref[selection] = reference.shade_point(position, f, n_valid, u.get("u_eye"), key, u, obj.material)
-        low[selection], high[selection] = point_band(key, u, position, f, n_valid, obj.material, band)
+        # the lights' directions and irradiance, computed once for the twin and its band
+        lights = reference.incident_light(position, key, u, band=band) if key.num_lights else []
+        ref[selection] = reference.shade_point(position, f, n_valid, u.get("u_eye"), key, u, obj.material,
+                                               incident=lights)
+        low[selection], high[selection] = point_band(key, u, position, f, n_valid, obj.material, band, incident=lights)
         for v in f.visibility or ():
             if v is not None:
                 shadow_band[selection] |= v[1] != v[2]

@@ -90,9 +90,9 @@ def plain_normalize(x):
     valid; the same returns as `safe_normalize` ((..., 3) -> valid (...), x_hat (..., 3), length (...))."""
     x = np.asarray(x)
     with np.errstate(invalid="ignore", over="ignore", divide="ignore", under="ignore"):
-        xx = _dot(x, x).astype(x.dtype)
-        x_hat = (x * (1 / np.sqrt(xx))[..., None]).astype(x.dtype)  # x * inversesqrt(x.x), as in GLSL
-        length = np.sqrt(xx).astype(x.dtype)
+        xx = _dot(x, x).astype(x.dtype, copy=False)
+        x_hat = (x * (1 / np.sqrt(xx))[..., None]).astype(x.dtype, copy=False)  # x * inversesqrt(x.x), as in GLSL
+        length = np.sqrt(xx).astype(x.dtype, copy=False)
     return np.ones(x.shape[:-1], dtype=bool), x_hat, length
 
 
@@ -117,12 +117,16 @@ def safe_normalize(x):
     # max|x_i| of the three components pairwise: exact as np.max (NaN too), without a reduction along a short axis
     s = np.maximum(np.maximum(a[..., 0], a[..., 1]), a[..., 2]) if x.shape[-1] == 3 else np.max(a, axis=-1)
     valid = (s > 0) & (s <= FLT_MAX)
-    s_safe = np.where(valid, s, 1).astype(x.dtype)[..., None]
+    everywhere = bool(valid.all())  # then the masks below pick their first value throughout: left out
+    s_safe = (s if everywhere else np.where(valid, s, 1)).astype(x.dtype, copy=False)[..., None]
     with np.errstate(invalid="ignore", over="ignore"):
-        y = np.where(valid[..., None], x / s_safe, 0).astype(x.dtype)
-        yy = np.where(valid, _dot(y, y), 1).astype(x.dtype)
-        length = np.where(valid, s_safe[..., 0] * np.sqrt(yy), 0).astype(x.dtype)
-        x_hat = (y * (1 / np.sqrt(yy))[..., None]).astype(x.dtype)  # y * inversesqrt(y.y), as in GLSL
+        y = x / s_safe if everywhere else np.where(valid[..., None], x / s_safe, 0)
+        y = y.astype(x.dtype, copy=False)
+        yy = (_dot(y, y) if everywhere else np.where(valid, _dot(y, y), 1)).astype(x.dtype, copy=False)
+        root = np.sqrt(yy)
+        length = s_safe[..., 0] * root if everywhere else np.where(valid, s_safe[..., 0] * root, 0)
+        length = np.asarray(length).astype(x.dtype, copy=False)
+        x_hat = (y * (1 / root)[..., None]).astype(x.dtype, copy=False)  # y * inversesqrt(y.y), as in GLSL
     return valid, x_hat, length
 
 
@@ -149,12 +153,12 @@ def frame_from_tangent(n, tangent):
     along = _dot(n, xyz)
     projected, t, length = safe_normalize(xyz - along[..., None] * n)
     projected = projected & (length > FRAME_PARALLEL_LIMIT * np.abs(along))
-    s = np.where(n[..., 2] >= 0, 1.0, -1.0).astype(n.dtype)
+    s = np.where(n[..., 2] >= 0, 1.0, -1.0).astype(n.dtype, copy=False)
     with np.errstate(divide="ignore", invalid="ignore"):
         a = -1.0 / (s + n[..., 2])
         fallback = np.stack([1.0 + s * n[..., 0] * n[..., 0] * a, s * n[..., 0] * n[..., 1] * a, -s * n[..., 0]], axis=-1)
-    t = np.where(projected[..., None], t, fallback).astype(n.dtype)
-    b = (np.where(tangent[..., 3] < 0, -1.0, 1.0)[..., None] * np.cross(n, t)).astype(n.dtype)
+    t = np.where(projected[..., None], t, fallback).astype(n.dtype, copy=False)
+    b = (np.where(tangent[..., 3] < 0, -1.0, 1.0)[..., None] * np.cross(n, t)).astype(n.dtype, copy=False)
     return t, b
 
 
@@ -188,11 +192,11 @@ def surface_normal(n, t, b, texel, scale):
     """
     n = np.asarray(n)
     dtype = n.dtype
-    m = (np.asarray(texel, dtype) * dtype.type(2) - dtype.type(1)).astype(dtype)
+    m = (np.asarray(texel, dtype) * dtype.type(2) - dtype.type(1)).astype(dtype, copy=False)
     s = np.asarray(scale, dtype)[..., None] if np.ndim(scale) else dtype.type(scale)
-    p = (t * (m[..., 0:1] * s) + b * (m[..., 1:2] * s) + n * m[..., 2:3]).astype(dtype)
+    p = (t * (m[..., 0:1] * s) + b * (m[..., 1:2] * s) + n * m[..., 2:3]).astype(dtype, copy=False)
     valid, mapped, _ = safe_normalize(p)
-    return np.where(valid[..., None], mapped, n).astype(dtype)
+    return np.where(valid[..., None], mapped, n).astype(dtype, copy=False)
 
 
 # --------------------------------------------------------------------------- lights.glsl
@@ -259,12 +263,12 @@ def log_one_minus_series(delta):
     dtype = delta.dtype if delta.dtype.kind == "f" else np.float64
     delta = delta.astype(dtype)
     with np.errstate(divide="ignore", invalid="ignore"):
-        two_sigma = ((2 * delta) / (2 - delta)).astype(dtype)
-        t = (0.25 * (two_sigma * two_sigma)).astype(dtype)
+        two_sigma = ((2 * delta) / (2 - delta)).astype(dtype, copy=False)
+        t = (0.25 * (two_sigma * two_sigma)).astype(dtype, copy=False)
         series = np.zeros_like(two_sigma)
         for k in reversed(range(_series_terms(dtype))):
-            series = (series * t + dtype.type(1.0) / dtype.type(2 * k + 1)).astype(dtype)
-    return (-two_sigma * series).astype(dtype)
+            series = (series * t + dtype.type(1.0) / dtype.type(2 * k + 1)).astype(dtype, copy=False)
+    return (-two_sigma * series).astype(dtype, copy=False)
 
 
 def log_one_minus(delta):
@@ -275,8 +279,8 @@ def log_one_minus(delta):
     delta = delta.astype(dtype)
     small = delta < 0.5
     with np.errstate(divide="ignore", invalid="ignore"):
-        direct = np.log(np.where(small, 0.5, 1 - delta)).astype(dtype)
-    return np.where(small, log_one_minus_series(np.where(small, delta, 0)), direct).astype(dtype)
+        direct = np.log(np.where(small, 0.5, 1 - delta)).astype(dtype, copy=False)
+    return np.where(small, log_one_minus_series(np.where(small, delta, 0)), direct).astype(dtype, copy=False)
 
 
 def lobe_from_delta(delta, q, tail_zero=False):
@@ -293,7 +297,7 @@ def lobe_from_delta(delta, q, tail_zero=False):
     with np.errstate(over="ignore", invalid="ignore"):
         value = np.exp(np.maximum(q * log_one_minus(np.where(inside, delta, 0)), dtype.type(-104)))
     value = np.where(inside, value, 0)
-    return np.where(q == 0, 1, value).astype(dtype)
+    return np.where(q == 0, 1, value).astype(dtype, copy=False)
 
 
 def phong_delta(n, wi, wo):
@@ -325,19 +329,19 @@ def blinn_delta(n, wi, wo):
     ok_h, h, h_len = safe_normalize(wi + wo)
     valid = (_dot(n, wo) > 0) & ok_h & (h_len > BLINN_HALF_FLOOR)
     e = h - n
-    return valid, np.where(valid, 0.5 * _dot(e, e), 2).astype(e.dtype)
+    return valid, np.where(valid, 0.5 * _dot(e, e), 2).astype(e.dtype, copy=False)
 
 
 def blinn_lobe(n, wi, wo, q):
     """``max(n.h, 0)^q``, 0 where `blinn_delta` is not valid (lobe.glsl); (...)."""
     valid, delta = blinn_delta(n, wi, wo)
-    return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype)
+    return np.where(valid, lobe_from_delta(delta, q), 0).astype(delta.dtype, copy=False)
 
 
 def half_cosine(wi, wo):
     """``h.l`` with ``h = (l + v)/|l + v|``, 0 where ``l + v`` does not normalise (lobe.glsl); (...)."""
     ok, h, _ = safe_normalize(wi + wo)
-    return np.where(ok, _dot(h, wi), 0).astype(h.dtype)
+    return np.where(ok, _dot(h, wi), 0).astype(h.dtype, copy=False)
 
 
 # --------------------------------------------------------------------------- fresnel.glsl
@@ -371,7 +375,7 @@ def fresnel_dielectric(ior, c):
         g_minus_c = a / safe
         q = (c * g_plus_c - 1) / (c * g_minus_c + 1)
         f = 0.5 * (ratio * ratio) * (1 + q * q)
-    return np.where((g2 < 0) | (g_plus_c <= 0), 1, np.minimum(f, 1)).astype(dtype)
+    return np.where((g2 < 0) | (g_plus_c <= 0), 1, np.minimum(f, 1)).astype(dtype, copy=False)
 
 
 # --------------------------------------------------------------------------- angle.glsl
@@ -388,7 +392,8 @@ def atan2_first_quadrant(y, x):
 def light_term(response, irradiance):
     """``response * E``, exactly 0 where ``E = 0`` (shade.glsl): an overflowed response never makes NaN."""
     with np.errstate(invalid="ignore", over="ignore"):
-        return np.where(irradiance == 0, 0.0, response * irradiance).astype(np.result_type(response, irradiance))
+        value = np.where(irradiance == 0, 0.0, response * irradiance)
+        return value.astype(np.result_type(response, irradiance), copy=False)
 
 
 def perpendiculars(v):
@@ -421,17 +426,18 @@ def microfacet_geometry(n, wi, wo, n_dot_l):
     ok, h, h_len = safe_normalize(wi + wo)
     dtype = h.dtype
     one = dtype.type(1)
-    nv = np.sum(n * wo, axis=-1).astype(dtype)
+    nv = _dot(n, wo).astype(dtype, copy=False)
     n_dot_l = np.asarray(n_dot_l).astype(dtype)
     valid = ok & (nv > 0) & (n_dot_l > 0)
-    length = np.where(valid, h_len, one).astype(dtype)
+    length = np.where(valid, h_len, one).astype(dtype, copy=False)
     with np.errstate(divide="ignore", over="ignore", under="ignore", invalid="ignore"):
-        nh = np.where(valid, (n_dot_l + nv) / length, one).astype(dtype)
+        nh = np.where(valid, (n_dot_l + nv) / length, one).astype(dtype, copy=False)
         e = h - n
-        delta = (dtype.type(0.5) * np.sum(e * e, axis=-1)).astype(dtype)
-        sin2 = np.maximum(delta * (dtype.type(2) - delta), dtype.type(0)).astype(dtype)
-        tan2 = np.where(valid, sin2 / (nh * nh), dtype.type(0)).astype(dtype)
-    return valid, np.where(valid, nv, one).astype(dtype), nh, (dtype.type(0.5) * length).astype(dtype), tan2
+        delta = (dtype.type(0.5) * _dot(e, e)).astype(dtype, copy=False)
+        sin2 = np.maximum(delta * (dtype.type(2) - delta), dtype.type(0)).astype(dtype, copy=False)
+        tan2 = np.where(valid, sin2 / (nh * nh), dtype.type(0)).astype(dtype, copy=False)
+    return (valid, np.where(valid, nv, one).astype(dtype, copy=False), nh,
+            (dtype.type(0.5) * length).astype(dtype, copy=False), tan2)
 
 
 def microfacet_ggx(tan2, a2):
@@ -442,7 +448,7 @@ def microfacet_ggx(tan2, a2):
     a2 = np.asarray(a2).astype(dtype)
     big = dtype.type(FLT_MAX)
     with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-        s = (a2 + tan2).astype(dtype)
-        r = (dtype.type(1) + (dtype.type(1) - a2) / s).astype(dtype)
-        value = ((a2 * r) * (np.minimum(r, big) * dtype.type(1 / np.pi))).astype(dtype)
-        return np.where(s > 0, np.minimum(value, big), dtype.type(0)).astype(dtype)
+        s = (a2 + tan2).astype(dtype, copy=False)
+        r = (dtype.type(1) + (dtype.type(1) - a2) / s).astype(dtype, copy=False)
+        value = ((a2 * r) * (np.minimum(r, big) * dtype.type(1 / np.pi))).astype(dtype, copy=False)
+        return np.where(s > 0, np.minimum(value, big), dtype.type(0)).astype(dtype, copy=False)
