@@ -130,10 +130,7 @@ def run(args):
     lambert = glphong.Lambert(0.8)
     exact = None
     for R in args.resolutions:
-        lt = light(resolution=R)
-        start = time.perf_counter()
-        lt.uniform_value("irradiance")
-        build = time.perf_counter() - start
+        lt, build = built(light(resolution=R), "irradiance")
         sc = scene(lambert, lt)
         frame = small.render(sc)
         if exact is None:
@@ -148,10 +145,7 @@ def run(args):
         if R in (9, max(args.resolutions)):  # the default and the finest
             error_maps.append((f"Lambert, R = {R}", signed_error(frame.radiance, exact, frame.mask, args.threshold)))
     for order in args.sh_orders:  # Lambert by the harmonics (irradiance='sh')
-        lt = light(order=order, irradiance="sh")
-        start = time.perf_counter()
-        lt.uniform_value("sh")
-        build = time.perf_counter() - start
+        lt, build = built(light(order=order, irradiance="sh"), "sh")
         sc = scene(lambert, lt)
         frame = small.render(sc)
         row = {"term": "lambert sh", "knob": "order", "value": order, "build_s": build,
@@ -165,10 +159,7 @@ def run(args):
         lobe = glphong.Phong(0.0, 1.0, q)
         exact = None
         for order in args.orders:
-            lt = light(order=order)
-            start = time.perf_counter()
-            lt.uniform_value("sh")
-            build = time.perf_counter() - start
+            lt, build = built(light(order=order), "sh")
             sc = scene(lobe, lt)
             frame = lobe_small.render(sc)
             if exact is None:
@@ -213,6 +204,13 @@ def check_split(args):
                  + exact_image(scene(lobe, glphong.EnvironmentLight(sun, order=2)), gb)[0])
         print(json.dumps({"full_s": full_s, "full": full[gb.mask].tolist(), "split": split[gb.mask].tolist(),
                           "max_relative": float(np.max(np.abs(full - split)[gb.mask] / np.abs(full[gb.mask])))}))
+
+
+def built(light_, uniform):
+    """``(light, seconds)``: the light with its host-side table ``uniform`` built (the one-time cost, timed)."""
+    start = time.perf_counter()
+    light_.uniform_value(uniform)
+    return light_, time.perf_counter() - start
 
 
 def main():

@@ -25,15 +25,20 @@ def _masks_crossed(above, below, W):  # what the runs' complement was before: (K
     return np.nonzero(~(lit | dark))
 
 
+def _cot(theta):
+    """cot of the rows' edge angles, +-inf at the poles (as the irradiance's row runs take them)."""
+    with np.errstate(divide="ignore"):
+        cot = np.cos(theta) / np.sin(theta)
+    cot[0], cot[-1] = np.inf, -np.inf
+    return cot
+
+
 @pytest.mark.parametrize("shape", [(2, 4), (3, 5), (8, 16), (31, 17), (32, 64)])
 def test_crossed_texels_from_the_runs_equal_the_masks(shape):
     H, W = shape
     n = _normals(200, 1)
     theta, _ = env.texel_edges(H, W)
-    with np.errstate(divide="ignore"):
-        cot = np.cos(theta) / np.sin(theta)
-    cot[0], cot[-1] = np.inf, -np.inf
-    above, below = env._row_runs(n, cot, W)
+    above, below = env._row_runs(n, _cot(theta), W)
     for got, want in zip(env._crossed_texels(above, below, W), _masks_crossed(above, below, W)):
         assert np.array_equal(got, want)
 
@@ -57,10 +62,7 @@ def test_crossed_texels_in_closed_form_against_the_rule(shape):
     H, W = shape
     n = _normals(150, 4)
     theta, phi = env.texel_edges(H, W)
-    with np.errstate(divide="ignore"):
-        cot = np.cos(theta) / np.sin(theta)
-    cot[0], cot[-1] = np.inf, -np.inf
-    k, r, c = env._crossed_texels(*env._row_runs(n, cot, W), W)
+    k, r, c = env._crossed_texels(*env._row_runs(n, _cot(theta), W), W)
     args = (n[k], theta[r], theta[r + 1], phi[c], phi[c + 1])
     rule, _ = env._crossed(*args, 12, 1e-12)
     closed, ok = env._crossed_closed(*args)
