@@ -18,6 +18,7 @@ glphong's trust model (docs: "Files from anyone"):
 
 The limits are module-wide defaults (`LIMITS`), overridable per call (``load_scene(..., limits=...)``).
 """
+import json
 import os
 import re
 import stat
@@ -29,8 +30,8 @@ from urllib.parse import unquote
 
 import numpy as np
 
-__all__ = ["SceneFileError", "Limits", "LIMITS", "resolve_reference", "read_bytes", "read_text", "open_image",
-           "decode_image"]
+__all__ = ["SceneFileError", "Limits", "LIMITS", "resolve_reference", "read_bytes", "read_text", "parse_json",
+           "open_image", "decode_image"]
 
 
 class SceneFileError(ValueError):
@@ -204,6 +205,20 @@ def read_text(path, limits=None, source=None, where=None):
     if data.startswith((b"\xff\xfe", b"\xfe\xff")):
         return data.decode("utf-16", errors="replace")
     return data.decode("utf-8-sig", errors="replace")
+
+
+def parse_json(path, data, what="a JSON document"):
+    """The JSON value of ``data`` (bytes, UTF-8 with or without a byte-order mark) read from ``path``; a
+    `SceneFileError` naming the line and column for invalid JSON, and for nesting deeper than Python's recursion
+    limit (``what`` says what the file should have been)."""
+    try:
+        return json.loads(data.decode("utf-8-sig"))
+    except UnicodeDecodeError as exc:
+        raise SceneFileError(path, f"the JSON is not UTF-8 (byte {exc.start})") from None
+    except json.JSONDecodeError as exc:
+        raise SceneFileError(path, f"not valid JSON: {exc.msg}", f"line {exc.lineno} column {exc.colno}") from None
+    except RecursionError:
+        raise SceneFileError(path, f"JSON nested too deeply to be {what}") from None
 
 
 #: image formats glphong decodes from scene files (Pillow is asked for these plugins only)

@@ -9,7 +9,7 @@ import secrets
 
 import numpy as np
 
-from glphong.core.filesafety import SceneFileError
+from glphong.core.filesafety import SceneFileError, parse_json, read_bytes
 
 __all__ = ["load_json", "check_entries", "same_camera", "json_text", "json_paths", "image_folders", "write_files",
            "write_json_files", "remove_masks_beyond", "remove_temporaries"]
@@ -25,16 +25,11 @@ JSON_NAMES = ("scene_camera", "scene_gt", "scene_gt_info")
 
 def load_json(path):
     """The image dict of one of a scene's JSON files, ``{im_id (int): value}``; ``{}`` where the file does not
-    exist.  Keys are the im_id as a string (bop_toolkit ``inout.load_json(keys_to_int=True)``)."""
+    exist; a `SceneFileError` for one that is not a regular file, is larger than ``LIMITS.file_bytes``, or is not
+    JSON.  Keys are the im_id as a string (bop_toolkit ``inout.load_json(keys_to_int=True)``)."""
     if not os.path.lexists(path):
         return {}
-    if not os.path.isfile(path):
-        raise SceneFileError(path, "expected a BOP JSON file, found something that is not a regular file")
-    try:
-        with open(path, encoding="utf-8") as handle:
-            content = json.load(handle)
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise SceneFileError(path, f"not readable as JSON ({exc}); fix or remove the file") from None
+    content = parse_json(path, read_bytes(path), "a BOP scene file")  # a regular file within Limits.file_bytes
     if not isinstance(content, dict):
         raise SceneFileError(path, f"expected a JSON object of im_id to entry (got a {type(content).__name__})")
     images = {}

@@ -22,14 +22,13 @@ by name.
 """
 import base64
 import binascii
-import json
 import struct
 import warnings
 from pathlib import Path
 
 import numpy as np
 
-from glphong.core.filesafety import LIMITS, SceneFileError, decode_image, read_bytes, resolve_reference
+from glphong.core.filesafety import LIMITS, SceneFileError, decode_image, parse_json, read_bytes, resolve_reference
 from glphong.formats.gltf_validate import COMPONENT_BYTES, TYPE_WIDTHS, validate_gltf
 from glphong.scene.geometry import MeshData
 
@@ -90,17 +89,6 @@ def glb_chunks(path, data):
     return data[20:start], binary
 
 
-def _parse_json(path, text):
-    try:
-        return json.loads(text.decode("utf-8-sig"))
-    except UnicodeDecodeError as exc:
-        raise SceneFileError(path, f"the JSON is not UTF-8 (byte {exc.start})") from None
-    except json.JSONDecodeError as exc:
-        raise SceneFileError(path, f"not valid JSON: {exc.msg}", f"line {exc.lineno} column {exc.colno}") from None
-    except RecursionError:
-        raise SceneFileError(path, "JSON nested too deeply to be a glTF document") from None
-
-
 def _draco_available():
     try:
         import DracoPy  # noqa: F401 - optional dependency, probed only
@@ -141,7 +129,7 @@ class GltfFile:
         self.binary = None
         if data[:4] == b"glTF":
             data, self.binary = glb_chunks(self.path, data)
-        self.document = _parse_json(self.path, data)
+        self.document = parse_json(self.path, data, "a glTF document")
         validate_gltf(self.path, self.document, self.limits)
         self._check_required()
         self._buffers, self._accessors, self._images, self._meshes = {}, {}, {}, {}

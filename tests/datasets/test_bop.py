@@ -378,6 +378,7 @@ BAD = [
     ("depth_scale 0", dict(depth_scale=0.0), None, ValueError, "depth_scale"),
     ("another camera", dict(scene=_moved_camera), None, SceneFileError, "another camera"),
     ("scene_gt.json not JSON", {}, _corrupt("{ nope"), SceneFileError, "scene_gt.json"),
+    ("scene_gt.json nested too deeply", {}, _corrupt("[" * 200000), SceneFileError, "nested too deeply"),
     ("scene_gt.json a list", {}, _corrupt("[]"), SceneFileError, "scene_gt.json"),
     ("scene_gt.json bad key", {}, _corrupt('{"x": []}'), SceneFileError, "scene_gt.json"),
     ("scene_gt.json bad entry", {}, _corrupt('{"0": 5}'), SceneFileError, "scene_gt.json"),
