@@ -6,8 +6,8 @@ settings matched to glphong's: the same triangles (vertex positions, normals and
 (its pose and vertical field of view, near and far planes), the same size, one light per glphong point light at its
 position, and the image read back to a numpy array; at the peer's defaults (PyVista's anti-aliasing as its theme
 sets it: 4x MSAA on llvmpipe; Open3D's post-processing on) or single-sampled (``anti_aliasing=False``,
-``post_processing=False``).  Materials become each peer's own lit material with the diffuse colour ``clip(pi kd,
-0, 1)`` (the shading differs: these are speed peers, not reference images).
+``post_processing=False``).  Materials become each peer's own lit material with the diffuse colour of their albedo
+clipped to [0, 1], as for pyrender (the shading differs: these are speed peers, not reference images).
 
 Both are optional (the extra ``bench``): imported only inside these classes, with an ImportError naming the extra;
 each is meant to run in a process of its own with glphong (their GL contexts live beside glphong's there).  Making a
@@ -18,6 +18,7 @@ PyVista plotter on EGL (VTK 9.7) terminates the EGL display every context of the
 """
 import numpy as np
 
+from glphong.bench.pyrender_peer import pyrender_base_color
 from glphong.lights import PointLight
 from glphong.scene.camera import PerspectiveCamera
 
@@ -32,12 +33,9 @@ def _require(module, peer):
 
 
 def diffuse_colour(material):
-    """The peer's diffuse colour of a glphong material: ``clip(pi kd, 0, 1)`` (RGB, floats), grey 0.5 without ``kd``."""
-    kd = getattr(material, "kd", None)
-    if kd is None or not np.all(np.isfinite(np.asarray(kd, np.float64))):
-        return (0.5, 0.5, 0.5)
-    rgb = np.broadcast_to(np.asarray(kd, np.float64) * np.pi, (3,))
-    return tuple(float(c) for c in np.clip(rgb, 0.0, 1.0))
+    """The peer's diffuse colour of a glphong material: its albedo as its terms' definitions give it
+    (`glphong.bench.pyrender_peer.pyrender_base_color`: Lambert ``pi k_d``), clipped to [0, 1], RGB floats."""
+    return tuple(float(c) for c in np.clip(pyrender_base_color(material), 0.0, 1.0))
 
 
 def posed_triangles(obj):
@@ -120,6 +118,8 @@ class PyVistaRenderer:
 #: Open3D's renderers, one per size for the process: a second ``OffscreenRenderer`` alive beside another aborts the
 #: process when either is destroyed (Open3D 0.19: "Trying to destroy nonexistent resource"), so they are kept
 _OPEN3D = {}
+#: how many point lights the size's Open3D renderer holds (removed by the next `Open3DRenderer.prepare`)
+_OPEN3D_LIGHTS = {}
 
 
 class Open3DRenderer:
@@ -181,7 +181,3 @@ class Open3DRenderer:
 
     def release(self):
         self.renderer = None  # the size's renderer lives on (`_OPEN3D`)
-
-
-#: how many point lights the size's Open3D renderer holds (removed by the next `Open3DRenderer.prepare`)
-_OPEN3D_LIGHTS = {}
