@@ -378,7 +378,7 @@ def _uvs(obj):
 
 def _bounds(mesh):
     """``(lo, extent)`` of the mesh's positions per axis, each (3,) float64 [m]."""
-    lo, hi = mesh.positions.min(axis=0).astype(np.float64), mesh.positions.max(axis=0).astype(np.float64)
+    lo, hi = mesh.box
     return lo, hi - lo
 
 

@@ -199,12 +199,8 @@ def _per_object(table, index):
 def _nocs(scene, obj, index):
     """``(o - lo) / (hi - lo)`` per axis with each object's box (0.5 on a flat axis), clamped to [0, 1], (N, 3)
     float64 for points ``obj`` (N, 3) float64 of objects ``index`` (N,)."""
-    boxes = {}  # each mesh's box once, however many objects share it
-    for o in scene.objects:
-        if id(o.mesh) not in boxes:
-            boxes[id(o.mesh)] = (o.mesh.positions.min(axis=0), o.mesh.positions.max(axis=0))
-    lo = np.array([boxes[id(o.mesh)][0] for o in scene.objects], np.float64).reshape(-1, 3)
-    hi = np.array([boxes[id(o.mesh)][1] for o in scene.objects], np.float64).reshape(-1, 3)
+    lo = np.array([o.mesh.box[0] for o in scene.objects], np.float64).reshape(-1, 3)  # `MeshData.box`: kept
+    hi = np.array([o.mesh.box[1] for o in scene.objects], np.float64).reshape(-1, 3)
     out = np.empty(obj.shape)
     with np.errstate(divide="ignore", invalid="ignore"):
         for axis, (low, span) in enumerate(zip(_per_object(lo, index), _per_object(hi - lo, index))):

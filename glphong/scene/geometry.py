@@ -83,6 +83,18 @@ class MeshData:
                 a.setflags(write=False)
 
     @property
+    def box(self):
+        """``(lo, hi)``: the positions' axis-aligned bounding box, each (3,) float64 [m] (read-only; computed once:
+        the positions are immutable).  The NOCS pass maps it to the unit cube (`glphong.gpu.passes`)."""
+        box = getattr(self, "_box", None)
+        if box is None:
+            box = tuple(a.astype(np.float64) for a in (self.positions.min(axis=0), self.positions.max(axis=0)))
+            for a in box:
+                a.setflags(write=False)
+            self._box = box
+        return box
+
+    @property
     def has_tangents(self):
         """True when the mesh supplies tangents or UVs to derive them from."""
         return self._tangents is not None or self.uvs is not None
