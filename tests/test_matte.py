@@ -19,7 +19,7 @@ import glphong
 from glphong import primitives
 from glphong.bench.matte import matte_scenes
 from glphong.checks.coverage_twin import exact_coverage
-from glphong.checks.verify_passes import compare_matte, matte_error
+from glphong.checks.verify_passes import compare_matte, matte_error, verify_passes
 from glphong.gpu.matte import MATTE_SAMPLES, count_samples, matte_tolerance, tile_matrix
 from glphong.scene.geometry import MeshData
 
@@ -162,7 +162,7 @@ def test_errors_and_a_matte_alone(glphong_make_renderer):
 
 def test_silhouettes_are_the_instance_pass_of_each_object_alone(glphong_backend, glphong_make_renderer):
     """Renderer.silhouettes (one small draw per object, the matte program) gives, pixel for pixel, what the instance
-    pass of each object rendered alone covers: a closed mesh (back faces culled), a mirrored pose, a flat plane seen
+    pass of each object rendered alone covers, itself checked against the float64 ray cast (`verify_passes`): a closed mesh (back faces culled), a mirrored pose, a flat plane seen
     from behind, an object cut by the near plane, an object hidden by its constant alpha; a textured alpha mask is
     refused by name."""
     camera = glphong.PerspectiveCamera.look_at((0.3, 0.2, 2.5), (0.0, 0.0, 0.0), yfov=0.9, znear=0.5)
@@ -184,8 +184,9 @@ def test_silhouettes_are_the_instance_pass_of_each_object_alone(glphong_backend,
     for obj, mask in zip(scene.objects, masks):
         alone = glphong.Scene(camera, scene.lights)
         alone.add(obj.mesh, obj.material, pose=obj.pose, instance_id=obj.instance_id)
-        expected = renderer.render(alone, passes=("instance",)).instance == obj.instance_id
-        assert np.array_equal(mask, expected), obj.instance_id
+        frame = renderer.render(alone, passes=("instance",))
+        assert verify_passes(alone, frame, ("instance",))["instance"].passed  # that pass against the float64 ray cast
+        assert np.array_equal(mask, frame.instance == obj.instance_id), obj.instance_id
     assert all(m.any() for m in masks[:4]) and not masks[4].any()
     assert [m.sum() for m in renderer.silhouettes(scene, [1, 0])] == [masks[1].sum(), masks[0].sum()]
     texture = glphong.Texture(np.array([[255, 0]], np.uint8), 1.0, srgb=False, channel="r")
