@@ -17,6 +17,7 @@ import numpy as np
 
 from glphong.core.atomic_files import write_atomically
 from glphong.core.filesafety import LIMITS, SceneFileError, read_bytes
+from glphong.gpu.matte import MAX_MATTE_K
 from glphong.gpu.passes import PASSES
 
 __all__ = ["LAYOUT", "PASS_ARRAYS", "MAX_MATTE_K", "pass_arrays", "frame_arrays", "save_npz", "load_npz"]
@@ -33,8 +34,6 @@ LAYOUT = {
 }
 #: the arrays of each pass that is not one array of its own name
 PASS_ARRAYS = {"matte": ("matte_ids", "matte_fractions")}
-#: the most matte entries a pixel may have in a file (`glphong.Renderer`'s ``matte_k`` at most)
-MAX_MATTE_K = 16
 assert tuple(LAYOUT)[:-1] == tuple(a for p in PASSES for a in PASS_ARRAYS.get(p, (p,)))
 
 

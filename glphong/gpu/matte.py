@@ -28,13 +28,17 @@ import numpy as np
 from glphong.definitions.surface import alpha_masked
 from glphong.shaders.builders import matte_key
 
-__all__ = ["MATTE_SAMPLES", "MATTE_K", "TILE", "Matte", "matte_tolerance", "tile_matrix", "count_samples",
+__all__ = ["MATTE_SAMPLES", "MATTE_K", "MAX_MATTE_K", "MAX_MATTE_SAMPLES", "TILE", "Matte", "matte_tolerance", "tile_matrix", "count_samples",
            "drawn_objects", "matte_objects"]
 
 #: samples along each axis of a pixel (s), the default: the measured worst pixel is below 1/64 on the test scenes
 MATTE_SAMPLES = 32
 #: entries kept per pixel, the default (Cryptomatte's usual depth)
 MATTE_K = 4
+#: the most entries a pixel may keep (`glphong.Renderer`'s ``matte_k``; the frame files hold as many)
+MAX_MATTE_K = 16
+#: the most samples per axis (`glphong.Renderer`'s ``matte_samples``)
+MAX_MATTE_SAMPLES = 64
 #: the largest tile drawn at once [samples a side]: 16 MiB of uint32
 TILE = 2048
 

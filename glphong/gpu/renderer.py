@@ -24,7 +24,7 @@ from glphong.shaders.keys import EncodeKey
 from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, PASS_PLANES
 from glphong.shaders.numerics import NUMERICS, allowed_pieces, view_decision
 from glphong.gpu.shadows import ShadowMaps
-from glphong.gpu.matte import MATTE_K, MATTE_SAMPLES, TILE, Matte
+from glphong.gpu.matte import MATTE_K, MATTE_SAMPLES, MAX_MATTE_K, MAX_MATTE_SAMPLES, TILE, Matte
 from glphong.gpu.programs import ProgramCache
 from glphong.gpu.program_keys import renderer_program_key
 from glphong.scene.scene import Scene
@@ -115,8 +115,8 @@ class Renderer:
     def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
                  formulation="stable", specialise=True, culling="auto", device=None, shadow_map_size=1024,
                  shadow_filter_radius=0, numerics="auto", matte_samples=MATTE_SAMPLES, matte_k=MATTE_K):
-        self.matte_samples = _validate.positive_int("matte_samples", matte_samples, 1, 64)
-        self.matte_k = _validate.positive_int("matte_k", matte_k, 1, 16)
+        self.matte_samples = _validate.positive_int("matte_samples", matte_samples, 1, MAX_MATTE_SAMPLES)
+        self.matte_k = _validate.positive_int("matte_k", matte_k, 1, MAX_MATTE_K)
         self.shadow_map_size = _validate.positive_int("shadow_map_size", shadow_map_size, 16, 8192)
         self.shadow_filter_radius = _validate.positive_int("shadow_filter_radius", shadow_filter_radius, 0, 8)
         self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
