@@ -70,7 +70,7 @@ class PyVistaRenderer:
     ----------
     width, height : int
     anti_aliasing : bool
-        True: the plotter's default (its theme's multisampling: 4x MSAA on llvmpipe); False:
+        True: the plotter's default (its theme asks for 8x MSAA; the render window holds 4 samples on llvmpipe, read back as GetMultiSamples() = 4); False:
         ``disable_anti_aliasing()``, one sample a pixel.
     """
 
