@@ -70,8 +70,8 @@ class PyVistaRenderer:
     ----------
     width, height : int
     anti_aliasing : bool
-        True: the plotter's default (its theme asks for 8x MSAA; the render window holds 4 samples on llvmpipe, read back as GetMultiSamples() = 4); False:
-        ``disable_anti_aliasing()``, one sample a pixel.
+        True: the plotter's default (its theme asks for 8x MSAA; on llvmpipe the render window holds 4 samples,
+        ``GetMultiSamples()``); False: ``disable_anti_aliasing()``, one sample a pixel.
     """
 
     def __init__(self, width, height, anti_aliasing=True):
