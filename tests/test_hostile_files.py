@@ -9,7 +9,9 @@ loads or says why.  Every file is made here by the test.
   12000 x 12000 pixels, an OBJ ``mtllib`` FIFO; a legal 3000-deep node chain loads.
 - Raw errors: out-of-range and negative indices, bad JSON, deep JSON, glTF 1.0, unknown required extensions,
   an EPS image; and a seeded fuzz of 400 mutated documents raises nothing but `SceneFileError`.
-- Formats: strips, fans, sparse accessors, Draco, skins and morph targets (one warning), points skipped.
+- Formats: strips, fans, sparse accessors, Draco, skins and morph targets (one warning), points skipped; an
+  extension used and not applied is named in a warning, one glphong applies is not (meshopt, KTX2, WebP,
+  quantization, variants and uv sets: tests/gltf).
 - The Khronos Duck case: a camera and no light gets the default light with a warning; ``lights=[]`` stays dark.
 - An MTL with ``map_Ks`` and its image present loads (it crashed).
 """
@@ -276,7 +278,7 @@ def test_memory_and_time_hostile_files_in_a_subprocess(tmp_path, run_isolated):
     (lambda d: d["meshes"][0]["primitives"][0].update(mode=9), r"primitives\[0\]\.mode"),
     (lambda d: d.update(asset={"version": "1.0"}), "glTF 1.0"),
     (lambda d: d.update(meshes={"m": {}}), "glTF 1.0"),
-    (lambda d: d.update(extensionsRequired=["EXT_meshopt_compression"]), "requires EXT_meshopt_compression: meshopt"),
+    (lambda d: d.update(extensionsRequired=["EXT_mesh_gpu_instancing"]), "requires EXT_mesh_gpu_instancing: GPU inst"),
     (lambda d: d.update(extensionsRequired=["VENDOR_magic"]), "requires VENDOR_magic"),
     (lambda d: d["scenes"][0]["nodes"].append(0), "reached twice"),
     (lambda d: d["nodes"][0].update(translation=[0, "x", 0]), r"translation\[1\]: expected a finite number"),
@@ -434,8 +436,21 @@ def test_skins_and_morph_targets_warn_once(tmp_path):
 
 def test_appearance_only_extension_warns(tmp_path):
     document, blob = _document()
-    document["extensionsRequired"] = document["extensionsUsed"] = ["KHR_texture_transform"]
-    with pytest.warns(UserWarning, match="KHR_texture_transform is not implemented"):
+    document["extensionsRequired"] = document["extensionsUsed"] = ["EXT_texture_avif"]
+    with pytest.warns(UserWarning, match="EXT_texture_avif is not implemented"):
+        _load(_write(tmp_path, document, blob))
+
+
+def test_used_extensions_glphong_does_not_apply_warn_and_those_it_applies_do_not(tmp_path):
+    """docs/files.md: an extension the file uses and glphong ignores is named in a warning; KHR_texture_transform,
+    which glphong applies, is neither warned about nor refused, required or not."""
+    document, blob = _document()
+    document["extensionsUsed"] = ["KHR_texture_transform", "VENDOR_sparkle", "KHR_materials_variants"]
+    with pytest.warns(UserWarning, match=r"does not apply VENDOR_sparkle \(extensionsUsed\)"):
+        _load(_write(tmp_path, document, blob))
+    document["extensionsUsed"] = document["extensionsRequired"] = ["KHR_texture_transform", "KHR_mesh_quantization"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
         _load(_write(tmp_path, document, blob))
 
 

@@ -8,17 +8,19 @@ URIs are decoded from base64, and every byte range is checked before it is read.
 
 `read_gltf_primitives` returns every primitive of every node reachable from the file's scene as a
 `glphong.scene.geometry.MeshData` with the file's own arrays: ``POSITION``, ``NORMAL`` (smooth normals where
-absent), ``TEXCOORD_0`` (v flipped once, in float64, from glTF's top-left origin to glphong's
-bottom-left), ``TANGENT``, ``COLOR_0`` (linear; normalised integers scaled to [0, 1]) and the indices.
+absent), the ``TEXCOORD_<n>`` its material's textures read (`glphong.formats.gltf_choices`; v flipped once, in
+float64, from glTF's top-left origin to glphong's bottom-left), ``TANGENT``, ``COLOR_0`` (linear; normalised
+integers scaled to [0, 1]) and the indices, with the material a ``KHR_materials_variants`` variant chooses.
 Nothing is merged or reordered, so a file written by `glphong.save_gltf` reads back the very arrays it
 holds.  Triangle strips and fans are triangulated (strips alternate their winding as the specification
-says); points and lines are skipped with a warning; sparse accessors are applied; Draco-compressed
-primitives (``KHR_draco_mesh_compression``) are decoded by ``DracoPy`` (the ``[draco]`` extra); morph
-targets and skins are drawn in the rest pose, with one warning.
+says); points and lines are skipped with a warning; sparse accessors are applied; Draco-compressed primitives
+and meshopt-compressed buffer views are decoded by optional packages (`glphong.formats.gltf_compressed`); morph
+targets and skins are drawn in the rest pose, with one warning.  Images are PNG, JPEG, WebP (``EXT_texture_webp``)
+or KTX2 (``KHR_texture_basisu``).
 
-Extensions (``extensionsRequired``): `REQUIRED_OK` are read; `APPEARANCE_ONLY` cost appearance only
-and are warned about; any other required extension (``EXT_meshopt_compression`` among them) is refused
-by name.
+Extensions: `REQUIRED_OK` are read; `APPEARANCE_ONLY` cost appearance only and are warned about where required;
+any other required extension is refused by name; one a file uses (``extensionsUsed``) that glphong does not apply
+(`APPLIED`) is named in a warning.
 """
 import base64
 import binascii
@@ -29,30 +31,22 @@ from pathlib import Path
 import numpy as np
 
 from glphong.core.filesafety import LIMITS, SceneFileError, decode_image, parse_json, read_bytes, resolve_reference
+from glphong.formats.gltf_compressed import (OPTIONAL_DECODERS, decode_ktx2, decode_meshopt_view, decoder_available,
+                                             draco_primitive, meshopt_extension)
+from glphong.formats.gltf_choices import (APPEARANCE_ONLY, APPLIED, REQUIRED_OK, check_attribute_type,
+                                          dispersion_matters, material_uv_set, primitive_material, variant_index)
 from glphong.formats.gltf_validate import COMPONENT_BYTES, TYPE_WIDTHS, validate_gltf
 from glphong.scene.geometry import MeshData
 
 __all__ = ["GltfFile", "glb_chunks", "node_matrices", "read_accessor", "read_gltf_primitives", "read_gltf_image",
-           "texture_sampling", "gl_sampling", "REQUIRED_OK", "APPEARANCE_ONLY"]
+           "texture_sampling", "gl_sampling", "REQUIRED_OK", "APPEARANCE_ONLY", "APPLIED"]
 
 _DTYPES = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32, 5126: np.float32}
 _TRIANGLES, _STRIP, _FAN = 4, 5, 6
 _GLB_JSON, _GLB_BIN = 0x4E4F534A, 0x004E4942
 
-#: required extensions glphong reads (Draco needs the ``[draco]`` extra)
-REQUIRED_OK = ("KHR_lights_punctual", "KHR_mesh_quantization", "KHR_draco_mesh_compression",
-               "KHR_materials_emissive_strength")
-#: required extensions whose loss changes appearance only: read without them, with a warning
-APPEARANCE_ONLY = ("KHR_texture_transform", "KHR_texture_basisu", "EXT_texture_webp", "EXT_texture_avif",
-                   "KHR_materials_ior", "KHR_materials_specular", "KHR_materials_transmission", "KHR_materials_volume",
-                   "KHR_materials_clearcoat", "KHR_materials_sheen", "KHR_materials_unlit", "KHR_materials_iridescence",
-                   "KHR_materials_anisotropy", "KHR_materials_dispersion", "KHR_materials_variants",
-                   "KHR_materials_pbrSpecularGlossiness")
 #: what each refused extension does, for the message
-_REFUSED_WHY = {"EXT_meshopt_compression": "meshopt-compressed buffers, which glphong does not decode (decompress the "
-                "file first, for example with gltf-transform or gltfpack)",
-                "KHR_meshopt_compression": "meshopt-compressed buffers, which glphong does not decode",
-                "EXT_mesh_gpu_instancing": "GPU instancing, which glphong does not expand"}
+_REFUSED_WHY = {"EXT_mesh_gpu_instancing": "GPU instancing, which glphong does not expand"}
 
 
 def glb_chunks(path, data):
@@ -87,14 +81,6 @@ def glb_chunks(path, data):
                 raise SceneFileError(path, f"the binary chunk of {size} bytes runs past the end of the file", "chunk 1")
             binary = data[start + 8:start + 8 + size]
     return data[20:start], binary
-
-
-def _draco_available():
-    try:
-        import DracoPy  # noqa: F401 - optional dependency, probed only
-    except ImportError:
-        return False
-    return True
 
 
 class GltfFile:
@@ -132,21 +118,28 @@ class GltfFile:
         self.document = parse_json(self.path, data, "a glTF document")
         validate_gltf(self.path, self.document, self.limits)
         self._check_required()
-        self._buffers, self._accessors, self._images, self._meshes = {}, {}, {}, {}
+        self._buffers, self._accessors, self._images, self._meshes, self._views = {}, {}, {}, {}, {}
         self._warned = set()
         self._decoded = 0
 
     def _check_required(self):
-        for name in self.document.get("extensionsRequired", []):
+        required = self.document.get("extensionsRequired", [])
+        for name in required:
             if name in APPEARANCE_ONLY:
                 warnings.warn(f"{self.path}: required extension {name} is not implemented by glphong; the file is "
                               "drawn without it (its appearance may differ)", stacklevel=4)
-            elif name == "KHR_draco_mesh_compression" and not _draco_available():
-                raise SceneFileError(self.path, "needs KHR_draco_mesh_compression, which glphong decodes with the "
-                                     "optional DracoPy: pip install 'glphong[draco]'", "extensionsRequired")
             elif name not in REQUIRED_OK:
                 why = _REFUSED_WHY.get(name, "an extension glphong does not implement")
                 raise SceneFileError(self.path, f"requires {name}: {why}", "extensionsRequired")
+            elif not decoder_available(name):
+                module, extra = OPTIONAL_DECODERS[name]
+                raise SceneFileError(self.path, f"needs {name}, which glphong decodes with the optional {module}: "
+                                     f"pip install 'glphong[{extra}]'", "extensionsRequired")
+        ignored = [n for n in self.document.get("extensionsUsed", []) if n not in APPLIED and n not in required
+                   and not (n == "KHR_materials_dispersion" and not dispersion_matters(self.document))]
+        if ignored:
+            warnings.warn(f"{self.path}: glphong does not apply {', '.join(sorted(set(ignored)))} (extensionsUsed); "
+                          "the file is drawn without them (its appearance may differ)", stacklevel=4)
 
     def warn_once(self, topic, message):
         """Warn ``message`` once per file and ``topic``."""
@@ -184,8 +177,14 @@ class GltfFile:
         return self._buffers[index]
 
     def view(self, index):
-        """``(bytes, byteStride or None)`` of buffer view ``index`` (its range validated)."""
+        """``(bytes, byteStride or None)`` of buffer view ``index`` (its range validated; a meshopt-compressed view
+        decoded once, `glphong.formats.gltf_compressed.decode_meshopt_view`)."""
         view = self.document["bufferViews"][index]
+        compressed = meshopt_extension(view)
+        if compressed is not None:
+            if index not in self._views:
+                self._views[index] = decode_meshopt_view(self, index, *compressed)
+            return memoryview(self._views[index]), view.get("byteStride")
         start = view.get("byteOffset", 0)
         return memoryview(self.buffer(view["buffer"]))[start:start + view["byteLength"]], view.get("byteStride")
 
@@ -322,54 +321,33 @@ def _triangles(gltf, mode, indices, where):
     return np.stack([np.full_like(k, indices[0]), indices[k + 1], indices[k + 2]], axis=1)  # a fan
 
 
-def _draco_primitive(gltf, extension, where):
-    """``{attribute name: (n, width) array, 'indices': (T*3,) array}`` of a Draco-compressed primitive."""
-    try:
-        import DracoPy
-    except ImportError:
-        raise SceneFileError(gltf.path, "a Draco-compressed primitive: glphong decodes it with the optional DracoPy: "
-                             "pip install 'glphong[draco]'", where) from None
-    view = extension.get("bufferView")
-    if isinstance(view, bool) or not isinstance(view, int) or not 0 <= view < len(gltf.document.get("bufferViews", [])):
-        raise SceneFileError(gltf.path, f"expected a bufferView index, found {view!r:.40}", f"{where}.bufferView")
-    data, _ = gltf.view(view)
-    try:
-        mesh = DracoPy.decode(bytes(data))
-    except Exception as exc:  # noqa: BLE001 - the decoder's own exception types vary by version
-        raise SceneFileError(gltf.path, f"Draco data that cannot be decoded ({type(exc).__name__})", where) from None
-    gltf.charge(8 * (np.asarray(mesh.faces).size + sum(np.asarray(a["data"]).size for a in mesh.attributes)), where)
-    out = {"indices": np.asarray(mesh.faces, dtype=np.int64).reshape(-1)}
-    for name, unique_id in extension.get("attributes", {}).items():
-        attribute = mesh.get_attribute_by_unique_id(unique_id) if isinstance(unique_id, int) else None
-        if attribute is None:
-            raise SceneFileError(gltf.path, f"no Draco attribute with id {unique_id!r:.20}", f"{where}.attributes.{name}")
-        out[name] = np.asarray(attribute["data"]).reshape(len(mesh.points), -1)
-    return out
-
-
-_ATTRIBUTE_TYPES = {"POSITION": ("VEC3",), "NORMAL": ("VEC3",), "TEXCOORD_0": ("VEC2",), "TANGENT": ("VEC4",),
+_ATTRIBUTE_TYPES = {"POSITION": ("VEC3",), "NORMAL": ("VEC3",), "TEXCOORD": ("VEC2",), "TANGENT": ("VEC4",),
                     "COLOR_0": ("VEC3", "VEC4")}
 
 
 def _attribute(gltf, primitive, name, where):
-    """The accessor of attribute ``name`` of a primitive (None where absent), its type checked."""
+    """The accessor of attribute ``name`` of a primitive (None where absent), its type and component type checked
+    (`glphong.formats.gltf_choices.check_attribute_type`)."""
     if name not in primitive["attributes"]:
         return None
     index = primitive["attributes"][name]
-    kind = gltf.document["accessors"][index]["type"]
-    if kind not in _ATTRIBUTE_TYPES[name]:
-        raise SceneFileError(gltf.path, f"{name} must be {' or '.join(_ATTRIBUTE_TYPES[name])}, found {kind}",
+    accessor = gltf.document["accessors"][index]
+    kinds = _ATTRIBUTE_TYPES["TEXCOORD" if name.startswith("TEXCOORD_") else name]
+    if accessor["type"] not in kinds:
+        raise SceneFileError(gltf.path, f"{name} must be {' or '.join(kinds)}, found {accessor['type']}",
                              f"{where}.attributes.{name}")
+    check_attribute_type(gltf.path, accessor, name, f"{where}.attributes.{name}")
     return read_accessor(gltf, index)
 
 
-def _primitive_arrays(gltf, primitive, where):
-    """``(positions, indices or None, other attributes)`` of a primitive, Draco-decoded where it is."""
+def _primitive_arrays(gltf, primitive, where, uv_set):
+    """``(positions, indices or None, other attributes)`` of a primitive, Draco-decoded where it is; its uvs are
+    ``TEXCOORD_<uv_set>`` (under the key ``'uv'``)."""
+    names = {"NORMAL": "NORMAL", "uv": f"TEXCOORD_{uv_set}", "TANGENT": "TANGENT", "COLOR_0": "COLOR_0"}
     draco = primitive.get("extensions", {}).get("KHR_draco_mesh_compression")
     if draco is not None:
-        decoded = _draco_primitive(gltf, draco, f"{where}.extensions.KHR_draco_mesh_compression")
-        get = decoded.get
-        return get("POSITION"), decoded["indices"], {k: get(k) for k in _ATTRIBUTE_TYPES if k != "POSITION"}
+        decoded = draco_primitive(gltf, draco, f"{where}.extensions.KHR_draco_mesh_compression")
+        return decoded.get("POSITION"), decoded["indices"], {k: decoded.get(n) for k, n in names.items()}
     positions = _attribute(gltf, primitive, "POSITION", where)
     indices = None
     if "indices" in primitive:
@@ -378,18 +356,18 @@ def _primitive_arrays(gltf, primitive, where):
             raise SceneFileError(gltf.path, f"indices must be SCALAR unsigned integers, found {accessor['type']} of "
                                  f"componentType {accessor['componentType']}", f"{where}.indices")
         indices = read_accessor(gltf, primitive["indices"]).reshape(-1).astype(np.int64)
-    return positions, indices, {k: _attribute(gltf, primitive, k, where) for k in _ATTRIBUTE_TYPES if k != "POSITION"}
+    return positions, indices, {k: _attribute(gltf, primitive, n, where) for k, n in names.items()}
 
 
-def _primitive_mesh(gltf, primitive, where, key):
+def _primitive_mesh(gltf, primitive, where, key, uv_set):
     """The `MeshData` of one primitive, or None (no triangles); made once per file and ``key`` (mesh index,
-    primitive index), so every node that instances a mesh shares its arrays (and the renderer its buffers)."""
+    primitive index, uv set), so every node that instances a mesh shares its arrays (and the renderer its buffers)."""
     if key not in gltf._meshes:
-        gltf._meshes[key] = _new_primitive_mesh(gltf, primitive, where)
+        gltf._meshes[key] = _new_primitive_mesh(gltf, primitive, where, uv_set)
     return gltf._meshes[key]
 
 
-def _new_primitive_mesh(gltf, primitive, where):
+def _new_primitive_mesh(gltf, primitive, where, uv_set):
 
     mode = primitive.get("mode", _TRIANGLES)
     if mode not in (_TRIANGLES, _STRIP, _FAN):
@@ -397,7 +375,7 @@ def _new_primitive_mesh(gltf, primitive, where):
         return None
     if primitive.get("targets"):
         gltf.warn_once("morph", "morph targets are drawn in the rest pose (the base geometry)")
-    positions, indices, attributes = _primitive_arrays(gltf, primitive, where)
+    positions, indices, attributes = _primitive_arrays(gltf, primitive, where, uv_set)
     if positions is None:
         raise SceneFileError(gltf.path, "a primitive without POSITION", f"{where}.attributes")
     positions = positions.astype(np.float64)
@@ -406,6 +384,7 @@ def _new_primitive_mesh(gltf, primitive, where):
     count = len(positions)
     for name, values in attributes.items():
         if values is not None and len(values) != count:
+            name = f"TEXCOORD_{uv_set}" if name == "uv" else name
             raise SceneFileError(gltf.path, f"{name} has {len(values)} elements, POSITION {count}",
                                  f"{where}.attributes.{name}")
     indices = np.arange(count, dtype=np.int64) if indices is None else indices
@@ -419,7 +398,7 @@ def _new_primitive_mesh(gltf, primitive, where):
         import trimesh
 
         normals = trimesh.Trimesh(positions, triangles, process=False).vertex_normals
-    uvs = attributes["TEXCOORD_0"]
+    uvs = attributes["uv"]
     if uvs is not None:
         uvs = uvs.astype(np.float64)  # a copy: the accessor's array is shared
         uvs[:, 1] = 1.0 - uvs[:, 1]  # glTF's origin is the image's top-left corner
@@ -428,22 +407,33 @@ def _new_primitive_mesh(gltf, primitive, where):
                     colors=None if colors is None else np.clip(colors[:, :3], 0.0, 1.0))
 
 
-def read_gltf_primitives(gltf):
+def read_gltf_primitives(gltf, variant=None):
     """Every primitive with triangles of the nodes of the file's scene.
 
     Parameters
     ----------
     gltf : GltfFile
+    variant : str, optional
+        A ``KHR_materials_variants`` variant's name: each primitive gets the material its mappings give that variant
+        (`glphong.formats.gltf_choices.primitive_material`).
 
     Returns
     -------
     list of (name, MeshData, world (4, 4) ndarray, material index or None)
         ``name`` is the node's (``node<i>`` where it has none), with ``.<k>`` for the k-th primitive of a
-        mesh of several.
+        mesh of several.  The mesh's uvs are the ``TEXCOORD_<n>`` its material's textures read
+        (`glphong.formats.gltf_choices.material_uv_set`; ``TEXCOORD_0`` without a material or textures).
+
+    Raises
+    ------
+    ValueError
+        ``variant`` is not one of the file's variants (the message lists them).
     """
     document = gltf.document
+    chosen = variant_index(document, variant, gltf.path)
     out = []
     worlds = node_matrices(document)
+    materials = document.get("materials", [])
     for index, node in enumerate(document.get("nodes", [])):
         if "mesh" not in node or index not in worlds:
             continue
@@ -453,41 +443,80 @@ def read_gltf_primitives(gltf):
         for k, primitive in enumerate(primitives):
             name = node.get("name") if isinstance(node.get("name"), str) and node.get("name") else f"node{index}"
             name = name if len(primitives) == 1 else f"{name}.{k}"
-            mesh = _primitive_mesh(gltf, primitive, f"meshes[{node['mesh']}].primitives[{k}]", (node["mesh"], k))
+            where = f"meshes[{node['mesh']}].primitives[{k}]"
+            material = primitive_material(primitive, chosen)
+            uv_set = (material_uv_set(materials[material]) or 0) if material is not None else 0
+            mesh = _primitive_mesh(gltf, primitive, where, (node["mesh"], k, uv_set), uv_set)
+            if mesh is not None and uv_set and mesh.uvs is None:
+                gltf.warn_once(("uv set", where), f"{where}: material {material}'s textures read TEXCOORD_{uv_set}, "
+                               "which the primitive lacks: drawn without its textures")
             if mesh is not None:
-                out.append((name, mesh, worlds[index], primitive.get("material")))
+                out.append((name, mesh, worlds[index], material))
     return out
 
 
-_IMAGE_TYPES = {"image/png": "PNG", "image/jpeg": "JPEG"}
+_IMAGE_TYPES = {"image/png": ("PNG",), "image/jpeg": ("JPEG",), "image/webp": ("WEBP",)}
+#: a texture's image sources, most preferred first: the extension's (where glphong decodes it), then ``source``
+_SOURCES = ("KHR_texture_basisu", "EXT_texture_webp")
+
+
+def _webp_available():
+    from PIL import features
+
+    return bool(features.check("webp"))
+
+
+def _texture_source(gltf, index):
+    """``(image index, kind)`` of glTF texture ``index``: its ``KHR_texture_basisu`` (kind ``'ktx2'``) or
+    ``EXT_texture_webp`` (``'webp'``) image where glphong decodes it, else its ``source`` (``'core'``: PNG or JPEG),
+    or None where none of these is there."""
+    texture = gltf.document["textures"][index]
+    for name in _SOURCES:
+        extension = texture.get("extensions", {}).get(name)
+        if extension is None:
+            continue
+        ktx2 = name == "KHR_texture_basisu"
+        if decoder_available(name) if ktx2 else _webp_available():
+            return extension["source"], "ktx2" if ktx2 else "webp"
+        how = f"the optional {OPTIONAL_DECODERS[name][0]}: pip install 'glphong[{OPTIONAL_DECODERS[name][1]}]'" if ktx2 \
+            else "Pillow, which was built without WebP here (Pillow's own wheels include it)"
+        if "source" not in texture:
+            raise SceneFileError(gltf.path, f"a {name} texture without a PNG or JPEG fallback: glphong decodes it with "
+                                 f"{how}", f"textures[{index}]")
+        gltf.warn_once(("fallback", name), f"{name} textures are drawn from their PNG or JPEG fallback (glphong "
+                       f"decodes {name} with {how})")
+    return (texture["source"], "core") if "source" in texture else None
 
 
 def read_gltf_image(gltf, index):
-    """The pixels (H, W, 4) uint8 (rgba) of glTF texture ``index``, or None where the texture has no
-    image glphong decodes (a KTX2 or WebP source only; warned once).
+    """The pixels (H, W, 4) uint8 (rgba) of glTF texture ``index``, or None where the texture names no image (warned
+    once).
 
-    The image comes from a buffer view, a base64 data URI, or a file inside the document's folder; it is
-    decoded as PNG or JPEG only, after its size was checked against ``Limits.image_pixels``, once per file.
+    The image is the texture's ``KHR_texture_basisu`` KTX2 image (transcoded, `glphong.formats.gltf_compressed`) or
+    ``EXT_texture_webp`` WebP image where the file has one, else its ``source`` (PNG or JPEG).  It comes from a buffer
+    view, a base64 data URI, or a file inside the document's folder; its size is checked against
+    ``Limits.image_pixels`` before it is decoded, once per file.
     """
-    texture = gltf.document["textures"][index]
-    if "source" not in texture:
-        gltf.warn_once("texture source", f"texture {index} has no PNG or JPEG source (only an extension's); drawn "
-                       "without it")
+    chosen = _texture_source(gltf, index)
+    if chosen is None:
+        gltf.warn_once("texture source", f"texture {index} names no image glphong decodes; drawn without it")
         return None
-    if texture["source"] not in gltf._images:
-        gltf._images[texture["source"]] = _decode_gltf_image(gltf, texture["source"])
-    return gltf._images[texture["source"]]
+    if chosen not in gltf._images:
+        gltf._images[chosen] = _decode_gltf_image(gltf, *chosen)
+    return gltf._images[chosen]
 
 
-def _decode_gltf_image(gltf, source):
-    """The pixels of image ``source`` (see `read_gltf_image`), counted against ``Limits.decoded_bytes`` at the
-    size of the float64 mip pyramid a texture builds from them (4/3 of the base level)."""
+def _decode_gltf_image(gltf, source, kind):
+    """The pixels of image ``source`` (see `read_gltf_image`) as ``kind`` ('core', 'webp' or 'ktx2'), counted against
+    ``Limits.decoded_bytes`` at the size of the float64 mip pyramid a texture builds from them (4/3 of the base
+    level)."""
     where = f"images[{source}]"
     image = gltf.document["images"][source]
     if "bufferView" in image:
         mime = image.get("mimeType")
-        if mime not in _IMAGE_TYPES:
-            raise SceneFileError(gltf.path, f"mimeType {mime!r:.40}: glphong decodes image/png and image/jpeg",
+        expected = {"core": ("image/png", "image/jpeg"), "webp": ("image/webp",), "ktx2": ("image/ktx2",)}[kind]
+        if mime not in expected:
+            raise SceneFileError(gltf.path, f"mimeType {mime!r:.40}: expected {' or '.join(expected)}",
                                  f"{where}.mimeType")
         payload = bytes(gltf.view(image["bufferView"])[0])
     elif image["uri"].startswith("data:"):
@@ -495,7 +524,11 @@ def _decode_gltf_image(gltf, source):
     else:
         target = resolve_reference(gltf.path, image["uri"], f"{where}.uri", gltf.allow_outside)
         payload = read_bytes(target, gltf.limits, gltf.path, f"{where}.uri")
-    pixels = decode_image(payload, gltf.limits, gltf.path, where, mode="RGBA")  # alpha: an alpha mask's
+    if kind == "ktx2":
+        pixels = decode_ktx2(gltf, payload, where)
+    else:
+        formats = _IMAGE_TYPES["image/webp"] if kind == "webp" else _IMAGE_TYPES["image/png"] + _IMAGE_TYPES["image/jpeg"]
+        pixels = decode_image(payload, gltf.limits, gltf.path, where, formats=formats, mode="RGBA")  # alpha: a mask's
     gltf.charge(pixels.size * 8 * 4 // 3, where)
     pixels.flags.writeable = False  # shared by every texture that names the image
     return pixels

@@ -19,6 +19,9 @@ What is written:
   the asset's ``extras: {"glphong": {"light_units": "radiometric"}}`` together with the ambient light,
   which glTF has no place for.  A kind without a glTF equivalent (`UnattenuatedPointLight`, a user's kind
   without ``to_gltf``) is skipped, with a warning.
+
+Nothing is written compressed: a scene loaded from a Draco- or meshopt-compressed file, or with KTX2 or WebP textures,
+is written with plain buffers and PNG images (its decoded arrays and pixels, so it reads back equal).
 """
 import base64
 import json

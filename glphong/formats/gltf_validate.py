@@ -10,6 +10,11 @@ child of two nodes, twice in one ``children``, or both a child and a scene root)
 naming the node.  Each error is a `glphong.filesafety.SceneFileError` naming the file, the JSON path
 (``accessors[3].byteStride``), what was found and what was expected.
 
+Extensions whose JSON the reader relies on are checked too: ``EXT_``/``KHR_meshopt_compression`` buffer views (the
+extension's rules on ``mode``, ``filter``, ``byteStride`` and ``count``, ``count * byteStride`` equal to the view's
+``byteLength``, the compressed bytes inside their buffer), ``KHR_texture_basisu`` and ``EXT_texture_webp`` image
+indices, ``KHR_materials_variants`` names and mappings.
+
 glTF 1.0 documents are refused as such; the ``extensionsRequired`` list is returned to the reader, which
 refuses the required extensions it cannot honour (`glphong.formats.gltf_data`).
 """
@@ -17,6 +22,7 @@ import math
 import numbers
 
 from glphong.core.filesafety import SceneFileError
+from glphong.formats.gltf_compressed import MESHOPT_FILTERS, meshopt_extension
 
 __all__ = ["validate_gltf", "COMPONENT_BYTES", "TYPE_WIDTHS", "MODES"]
 
@@ -152,6 +158,39 @@ def _check_buffers(c):
             stride = c.integer(view["byteStride"], f"{where}.byteStride", 4, 252)
             if stride % 4:
                 c.fail(f"{where}.byteStride", f"expected a multiple of 4 from 4 to 252, found {stride}")
+        c.obj(view.get("extensions", {}), f"{where}.extensions")
+        compressed = meshopt_extension(view)
+        if compressed is not None:
+            _check_meshopt(c, view, f"{where}.extensions.{compressed[0]}", *compressed)
+
+
+def _check_meshopt(c, view, where, name, extension):
+    """A meshopt-compressed view (``EXT_`` or ``KHR_meshopt_compression``): the extension's validity rules."""
+    c.obj(extension, where)
+    b = c.index(extension.get("buffer"), f"{where}.buffer", "buffers")
+    offset = c.integer(extension.get("byteOffset", 0), f"{where}.byteOffset")
+    length = c.integer(extension.get("byteLength"), f"{where}.byteLength", 1)
+    size = c.document["buffers"][b]["byteLength"]
+    if offset + length > size:
+        c.fail(where, f"compressed bytes {offset} to {offset + length} lie outside buffer {b} of {size} bytes")
+    stride = c.integer(extension.get("byteStride"), f"{where}.byteStride", 1, 256)
+    count = c.integer(extension.get("count"), f"{where}.count", 1)
+    mode = c.enum(extension.get("mode"), f"{where}.mode", ("ATTRIBUTES", "TRIANGLES", "INDICES"))
+    filter_ = c.enum(extension.get("filter", "NONE"), f"{where}.filter", MESHOPT_FILTERS[name])
+    if count * stride != view["byteLength"]:
+        c.fail(where, f"count {count} times byteStride {stride} is {count * stride} bytes; the bufferView's "
+               f"byteLength is {view['byteLength']} (they must be equal)")
+    allowed = {"ATTRIBUTES": stride % 4 == 0, "TRIANGLES": stride in (2, 4) and count % 3 == 0,
+               "INDICES": stride in (2, 4)}
+    if not allowed[mode]:
+        c.fail(where, f"mode {mode} with byteStride {stride} and count {count}: ATTRIBUTES needs a byteStride that is a "
+               "multiple of 4, INDICES a byteStride of 2 or 4, TRIANGLES that and a count divisible by 3")
+    strides = {"NONE": None, "OCTAHEDRAL": (4, 8), "QUATERNION": (8,), "COLOR": (4, 8)}
+    if filter_ != "NONE" and mode != "ATTRIBUTES":
+        c.fail(f"{where}.filter", f"filter {filter_} applies to mode ATTRIBUTES only, found mode {mode}")
+    if strides.get(filter_) and stride not in strides[filter_]:
+        c.fail(f"{where}.byteStride", f"filter {filter_} needs a byteStride of {' or '.join(map(str, strides[filter_]))}, "
+               f"found {stride}")
 
 
 def _element_bytes(component_type, kind):
@@ -229,6 +268,11 @@ def _check_textures(c):
             c.index(texture["source"], f"{where}.source", "images")
         if "sampler" in texture:
             c.index(texture["sampler"], f"{where}.sampler", "samplers")
+        extensions = c.obj(texture.get("extensions", {}), f"{where}.extensions")
+        for name in ("KHR_texture_basisu", "EXT_texture_webp"):
+            if name in extensions:
+                c.index(c.obj(extensions[name], f"{where}.extensions.{name}").get("source"),
+                        f"{where}.extensions.{name}.source", "images")
 
 
 def _check_texture_ref(c, ref, where):
@@ -288,7 +332,31 @@ def _check_meshes(c):
             c.enum(primitive.get("mode", 4), f"{pw}.mode", tuple(MODES))
             for t, target in enumerate(c.array(primitive.get("targets", []), f"{pw}.targets")):
                 c.obj(target, f"{pw}.targets[{t}]")
-            c.obj(primitive.get("extensions", {}), f"{pw}.extensions")
+            variants = c.obj(primitive.get("extensions", {}), f"{pw}.extensions").get("KHR_materials_variants")
+            if variants is not None:
+                _check_variant_mappings(c, variants, f"{pw}.extensions.KHR_materials_variants")
+
+
+def _check_variant_mappings(c, block, where):
+    """A primitive's ``KHR_materials_variants.mappings``: each a material and the variants that choose it."""
+    names = c.document.get("extensions", {}).get("KHR_materials_variants", {}).get("variants", [])
+    for m, mapping in enumerate(c.array(c.obj(block, where).get("mappings"), f"{where}.mappings", 1)):
+        mw = f"{where}.mappings[{m}]"
+        c.index(c.obj(mapping, mw).get("material"), f"{mw}.material", "materials")
+        for v, variant in enumerate(c.array(mapping.get("variants"), f"{mw}.variants", 1)):
+            if not names:
+                c.fail(f"{mw}.variants[{v}]", "refers to a variant, but the document's "
+                       "extensions.KHR_materials_variants.variants is empty or absent")
+            c.integer(variant, f"{mw}.variants[{v}]", 0, len(names) - 1)
+
+
+def _check_variants(c):
+    block = c.document.get("extensions", {}).get("KHR_materials_variants")
+    if block is None:
+        return
+    where = "extensions.KHR_materials_variants"
+    for k, variant in enumerate(c.array(c.obj(block, where).get("variants"), f"{where}.variants", 1)):
+        c.string(c.obj(variant, f"{where}.variants[{k}]").get("name"), f"{where}.variants[{k}].name")
 
 
 def _check_cameras(c):
@@ -406,6 +474,7 @@ def validate_gltf(path, document, limits):
     _check_accessors(c)
     _check_textures(c)
     _check_materials(c)
+    _check_variants(c)
     _check_meshes(c)
     _check_cameras(c)
     _check_lights(c)

@@ -38,7 +38,7 @@ def scene_from_trimesh(trimesh_scene, camera=None, lights=None, ambient=None, ma
 
 
 def load_scene(path, camera=None, lights=None, ambient=None, materials=None, light_units=None, camera_name=None,
-               allow_outside=False, limits=None):
+               allow_outside=False, limits=None, variant=None):
     """Load a scene file as a `glphong.Scene` (see the module for what each format keeps).
 
     Files are untrusted (`glphong.filesafety`): the file and every file it names must be regular files
@@ -66,11 +66,14 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None, lig
         Let the file name files outside its own folder (absolute paths, ``..``): for files you trust.
     limits : glphong.filesafety.Limits, optional
         File-size cap, image pixel budget, entry counts (default `glphong.filesafety.LIMITS`).
+    variant : str, optional
+        glTF: the ``KHR_materials_variants`` variant to draw, by name (default: each primitive's own material).
 
     Raises
     ------
     ValueError
-        A format glphong does not read (naming those it does), a missing file.
+        A format glphong does not read (naming those it does), a missing file; a ``variant`` the file does not have
+        (naming those it has), or one given for an OBJ file.
     glphong.filesafety.SceneFileError
         (a ValueError) Anything wrong with the file's content, naming the file and the line or JSON path.
     """
@@ -81,7 +84,11 @@ def load_scene(path, camera=None, lights=None, ambient=None, materials=None, lig
     if not path.exists():
         raise SceneFileError(path, "no such file")
     if suffix in (".gltf", ".glb"):
-        return load_gltf(path, camera, lights, ambient, materials, light_units, camera_name, allow_outside, limits)
+        return load_gltf(path, camera, lights, ambient, materials, light_units, camera_name, allow_outside, limits,
+                         variant)
+    if variant is not None:
+        raise ValueError(f"{path}: variant={variant!r}: an OBJ file has no material variants (glTF's "
+                         "KHR_materials_variants)")
     return _load_obj(path, camera, lights, ambient, materials, allow_outside, limits)
 
 
