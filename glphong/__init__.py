@@ -24,7 +24,7 @@ from glphong.lights import (AmbientLight, DirectionalLight, ExtendedLight, Light
                             SphereLight, DiskLight, EnvironmentLight,                             SpotLight, UnattenuatedPointLight)
 from glphong.formats.gltf_export import save_gltf
 from glphong.formats.load import load_scene
-from glphong.materials import AlphaMask, Material, MaterialModel, MaterialSum, NormalMap, Param, Texture, VertexColors
+from glphong.materials import AlphaBlend, AlphaMask, Material, MaterialModel, MaterialSum, NormalMap, Param, Texture, VertexColors
 from glphong.materials.ashikhmin_shirley import AshikhminShirley
 from glphong.materials.blinn import BlinnPhong
 from glphong.materials.cook_torrance import CookTorrance
@@ -50,7 +50,7 @@ __all__ = [
     "ExtendedLight", "RectLight", "PolygonLight", "SphereLight", "DiskLight", "EnvironmentLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
     "NormalizedBlinnPhong", "CookTorrance", "GltfPBR", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
-    "DielectricFresnel", "Texture", "VertexColors", "NormalMap", "AlphaMask", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "Frame", "GBuffer",
+    "DielectricFresnel", "Texture", "VertexColors", "NormalMap", "AlphaMask", "AlphaBlend", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
     "datasets", "imaging", "lights", "materials", "primitives", "radiometry", "reference", "filesafety", "__version__",
 ]

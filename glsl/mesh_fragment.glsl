@@ -25,11 +25,26 @@
 //   radiance): the position plane (w = object id + 1) at PLANE_POSITION_LOCATION and, with PLANE_NORMAL,
 //   PLANE_OBJECT, PLANE_UV, the normal, object and uv planes at their PLANE_*_LOCATION, the same in either program.
 // NAIVE_NORMAL: n by plain_normalize where the key proves it safe, common.glsl.
+// ALPHA_BLEND (defined only in a blended surface's layer programs, glphong/gpu/peeling.py, docs/design.md section 16;
+//   per-pixel shading only): with z = gl_FragCoord.z (the window depth, float32) and
+//   z_k = texelFetch(u_blend_depth, pixel).r:
+//   2 (the peel): discard where z <= z_k (the previous layer's depth; -1 before the first); out = vec4(z), which the
+//     renderer MIN-blends, so the target keeps the nearest depth behind the previous layer exactly;
+//   1 (the layer): out = vec4(a L, a), a = u_alpha_blend: premultiplied, composited front to back by the blend unit
+//     (C += (1 - A) c, A += (1 - A) a); discarded at the end where z != z_k (this layer's depth), so textures are
+//     sampled in uniform control flow; 3: the same with a = u_alpha_blend * texture(u_alpha_blend_texture, uv).r.
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, HAS_FACE, HAS_OBJECT, NUM_LOD_TEXTURES,
 // WRITES_PLANES, PLANE_NORMAL, PLANE_OBJECT, PLANE_UV, PLANE_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
-// NAIVE_NORMAL, RUNTIME_SWITCHES, SWITCH(flag).
+// NAIVE_NORMAL, RUNTIME_SWITCHES, SWITCH(flag), ALPHA_BLEND.
 
 invariant in vec3 v_position;
+#ifdef ALPHA_BLEND
+uniform sampler2D u_blend_depth;  // the previous layer's window depth (ALPHA_BLEND 2) or this layer's (1, 3)
+uniform float u_alpha_blend;      // read by the layer (1, 3) alone
+#if ALPHA_BLEND == 3
+uniform sampler2D u_alpha_blend_texture;
+#endif
+#endif
 #if ALPHA_MASK
 uniform float u_alpha_mask_cutoff;
 uniform float u_alpha_mask_scale;
@@ -132,6 +147,16 @@ layout(location = 0) out vec4 out_radiance;
 
 void main()
 {
+#ifdef ALPHA_BLEND
+    float layer_depth = texelFetch(u_blend_depth, ivec2(gl_FragCoord.xy), 0).r;
+#if ALPHA_BLEND == 2
+    if (gl_FragCoord.z <= layer_depth) {
+        discard;
+    }
+    out_radiance = vec4(gl_FragCoord.z);
+    return;
+#endif
+#endif
     vec3 n = vec3(0.0);
     bool n_valid = false;
 #if HAS_NORMAL
@@ -162,6 +187,12 @@ void main()
     if (alpha_masked(uv)) {
         discard;
     }
+#endif
+#ifdef ALPHA_BLEND
+    float blend_alpha = u_alpha_blend;
+#if ALPHA_BLEND == 3
+    blend_alpha *= surface_texture(u_alpha_blend_texture, uv).r;  // in uniform control flow: implicit derivatives
+#endif
 #endif
 #if NORMAL_MAP
     vec3 texel = surface_texture(u_normal_map_texture, uv);  // in uniform control flow: implicit derivatives
@@ -201,6 +232,11 @@ void main()
 #endif
 #if OUTPUT_DISPLAY
     out_radiance = vec4(srgb_encode(u_exposure * shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye)), 1.0);
+#elif defined(ALPHA_BLEND)
+    out_radiance = blend_alpha * vec4(shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye), 1.0);
+    if (gl_FragCoord.z != layer_depth) {  // not this layer's fragment: at the end, after every texture lookup
+        discard;
+    }
 #else
     out_radiance = vec4(shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye), 1.0);
 #endif

@@ -1,4 +1,4 @@
-"""Alpha testing (glphong.AlphaMask; glTF's alphaMode MASK) and the refusal of BLEND.
+"""Alpha testing (glphong.AlphaMask; glTF's alphaMode MASK); BLEND's loading (its rendering: tests/test_blend.py).
 
 Independent check: a plane whose alpha texture is two texels, opaque left and clear right, sampled bilinearly and
 clamped: alpha falls linearly from 1 at u = 0.25 to 0 at u = 0.75, so with cutoff 0.5 exactly the fragments with
@@ -110,8 +110,9 @@ def test_gltf_alpha_modes(tmp_path):
     np.testing.assert_array_equal(mask.alpha.texture.levels[0][..., 0][::-1][:, :2], 1.0)  # the texture's alpha
     np.testing.assert_array_equal(mask.alpha.texture.levels[0][..., 0][::-1][:, 2:], 0.0)
     assert glphong.load_scene(_gltf(tmp_path, "OPAQUE"), lights=[]).objects[0].material.alpha_mask is None
-    with pytest.raises(glphong.filesafety.SceneFileError, match=r"materials\[0\]\.alphaMode.*BLEND"):
-        glphong.load_scene(_gltf(tmp_path, "BLEND"), lights=[])
+    blend = glphong.load_scene(_gltf(tmp_path, "BLEND"), lights=[]).objects[0].material.alpha_blend  # tests/test_blend.py
+    assert blend.textured and blend.alpha.scale == pytest.approx(204 / 255, abs=1e-6)
+    np.testing.assert_array_equal(blend.alpha.texture.levels[0][..., 0][::-1][:, 2:], 0.0)
 
 
 def test_masked_and_normal_mapped_materials_survive_save_gltf(tmp_path):

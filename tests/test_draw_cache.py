@@ -1,5 +1,5 @@
 """A renderer keeps what it derives per object (key, program, packed uniforms) across frames
-(`Renderer._draw_list`); these tests change everything that may change between frames and compare with a
+(`glphong.gpu.drawing.draw_list`); these tests change everything that may change between frames and compare with a
 fresh renderer, image for image (bit-identical), on both backends.
 
 - the camera (reassigned or replaced), lights added, the ambient light replaced, objects added: the same

@@ -160,7 +160,8 @@ def test_values_are_validated_at_instantiation_with_the_parameter_and_its_range(
         Rim(0.3, a=11.0)
     with pytest.raises(ValueError, match=r"k must be finite and in \[0, 3.40282e\+38\] per channel"):
         Rim(-0.1)
-    with pytest.raises(TypeError, match=r"unexpected parameter 'q' \(parameters: k, a, ka, two_sided, normal_map, alpha_mask\)"):
+    with pytest.raises(TypeError, match=r"unexpected parameter 'q' \(parameters: k, a, ka, two_sided, normal_map, alpha_mask, "
+                                          r"alpha_blend\)"):
         Rim(0.3, q=2.0)
     with pytest.raises(TypeError, match=r"at most 2 positional"):
         Rim(0.3, 1.0, 2.0)

@@ -17,7 +17,8 @@ Conventions
   T_MIN`` and its depth along the viewing axis ``(p - c) . f``, ``f = -camera.pose[:3, 2]``, lies in ``[znear,
   zfar]`` (`glphong.checks.raycast`).  The nearest ``t`` wins.  Objects whose material has a constant alpha mask
   below its cutoff are not drawn (`glphong.definitions.surface.alpha_masked`) and are skipped; a textured alpha mask
-  is refused.
+  is refused.  Blended objects (`glphong.AlphaBlend`) are skipped: the passes are the nearest opaque surface's
+  (`glphong.checks.blend_twin` casts their layers).
 - Candidates: each triangle is tested only against the pixels of its screen box, the box of its vertices projected
   by a pinhole model built from ``_image_plane`` (affine in ``(xp, yp)``: evaluated at three points and inverted),
   widened by one pixel; a triangle with a vertex not in front of a perspective camera (``c_z >= 0``) gets the whole
@@ -261,7 +262,8 @@ def _hits(camera, width, height, offsets, corners):
         tri, pixel = _pairs(starts, ends, nx, i0, j0, first, min(first + step, total), width)
         ray_o = o[:, pixel] if per_ray else o
         t, u, v, det = _moller_trumbore(ray_o, d[:, pixel], v0[tri], e1[tri], e2[tri])  # (S, N): samples broadcast
-        ok = (det != 0.0) & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > T_MIN)
+        with np.errstate(invalid="ignore"):  # a ray in a triangle's plane: u + v is inf - inf, and not a hit
+            ok = (det != 0.0) & (u >= 0.0) & (v >= 0.0) & (u + v <= 1.0) & (t > T_MIN)
         sample, pair = np.nonzero(ok)
         t = t[ok]
         depth = dot((ray_o[ok] if per_ray else o) + t[:, None] * d[sample, pixel[pair]] - eye, forward)

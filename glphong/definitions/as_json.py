@@ -17,7 +17,7 @@ found among the defined materials by module and name (a user's module must have 
 
 from glphong.definitions.fresnel import Fresnel
 from glphong.definitions.material import Choice, Material, Param
-from glphong.definitions.surface import AlphaMask, NormalMap, SurfaceInput
+from glphong.definitions.surface import AlphaBlend, AlphaMask, NormalMap, SurfaceInput
 from glphong.definitions.table import Table
 __all__ = ["material_to_json", "material_from_json"]
 
@@ -74,6 +74,8 @@ def material_to_json(material, texture_index=None):
                  "filter": mask.alpha.texture.filter, "scale": mask.alpha.scale, "channel": mask.alpha.channel} \
             if mask.textured else mask.alpha
         out["alpha_mask"] = {"cutoff": mask.cutoff, "alpha": alpha}
+    if material.alpha_blend is not None:
+        out["alpha_blend"] = {"alpha": material.alpha_blend.alpha}
     if material.normal_map is not None:
         if texture_index is None:
             raise ValueError(f"{cls.__name__} has a normal map: give texture_index to store it")
@@ -177,5 +179,11 @@ def material_from_json(data, textures=None):
         if not isinstance(a, dict) or not isinstance(alpha, (int, float, SurfaceInput)) or isinstance(alpha, bool):
             raise ValueError(f"{cls.__name__}: 'alpha_mask' must be an object with a cutoff and an alpha")
         alpha_mask = AlphaMask(a.get("cutoff", 0.5), alpha)
+    alpha_blend = data.get("alpha_blend")
+    if alpha_blend is not None:
+        if not isinstance(alpha_blend, dict) or not isinstance(alpha_blend.get("alpha"), (int, float)) \
+                or isinstance(alpha_blend.get("alpha"), bool):
+            raise ValueError(f"{cls.__name__}: 'alpha_blend' must be an object with a number 'alpha' in [0, 1]")
+        alpha_blend = AlphaBlend(alpha_blend["alpha"])
     return cls(**arguments, ka=tuple(ka) if isinstance(ka, list) else float(ka), two_sided=bool(data.get("two_sided", True)),
-               normal_map=normal_map, alpha_mask=alpha_mask)
+               normal_map=normal_map, alpha_mask=alpha_mask, alpha_blend=alpha_blend)

@@ -182,12 +182,12 @@ class MaterialModel(Material, Definition):
         """How this term reflects an extended light in closed form (`Integral`), or None: sampled (default)."""
         return None
 
-    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, **kwargs):
+    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, alpha_blend=None, **kwargs):
         if type(self).name is None:
             raise TypeError(f"{type(self).__name__} is not a material model (it has no name)")
         for name, value in bind_arguments(type(self), self.arguments(), args, kwargs).items():
             object.__setattr__(self, name, value)
-        self._set_common(ka, two_sided, normal_map, alpha_mask)
+        self._set_common(ka, two_sided, normal_map, alpha_mask, alpha_blend)
 
     @classmethod
     def arguments(cls):
@@ -499,13 +499,13 @@ class MaterialSum(Material):
         slots = [t.fresnel_slot for t in cls.terms if t.fresnel_slot is not None]
         return cls.all_params() + tuple(slots[:1]) + tuple(c for t in cls.terms for c in t.choices)
 
-    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, **kwargs):
+    def __init__(self, *args, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, alpha_blend=None, **kwargs):
         if not type(self).terms:
             raise TypeError(f"{type(self).__name__} has no terms")
         values = bind_arguments(type(self), self.arguments(), args, kwargs)
         parts = tuple(t(**{a.name: values[a.name] for a in t.arguments()}, two_sided=two_sided) for t in self.terms)
         object.__setattr__(self, "_parts", parts)
-        self._set_common(ka, two_sided, normal_map, alpha_mask)
+        self._set_common(ka, two_sided, normal_map, alpha_mask, alpha_blend)
 
     @property
     def components(self):

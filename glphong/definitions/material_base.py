@@ -6,7 +6,7 @@ import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.definitions.params import MATERIAL_KEYWORDS, Param, Properties
-from glphong.definitions.surface import AlphaMask, NormalMap
+from glphong.definitions.surface import AlphaBlend, AlphaMask, NormalMap
 from glphong.definitions.table import Table
 
 __all__ = ["Material", "bind_arguments", "surface_define", "constant_part"]
@@ -27,6 +27,8 @@ class Material:
         A tangent-space normal map: every term shades with the mapped normal.
     alpha_mask : glphong.AlphaMask or None
         Alpha testing: fragments whose alpha is below the cutoff are not drawn.
+    alpha_blend : glphong.AlphaBlend or None
+        Alpha blending: the surface is composited over what lies behind it, per pixel in depth order.
     """
 
     #: display name; a model's name is also its GLSL prefix
@@ -34,7 +36,7 @@ class Material:
     #: declared BRDF properties (for a sum: derived from its terms unless declared)
     properties = Properties()
 
-    def _set_common(self, ka, two_sided, normal_map=None, alpha_mask=None):
+    def _set_common(self, ka, two_sided, normal_map=None, alpha_mask=None, alpha_blend=None):
         object.__setattr__(self, "ka", _validate.rgb("ka", ka))
         if not isinstance(two_sided, (bool, np.bool_)):
             raise TypeError(f"two_sided must be a bool, True or False (got {two_sided!r})")
@@ -45,6 +47,12 @@ class Material:
         if alpha_mask is not None and not isinstance(alpha_mask, AlphaMask):
             raise TypeError(f"alpha_mask must be a glphong.AlphaMask or None (got {type(alpha_mask).__name__})")
         object.__setattr__(self, "alpha_mask", alpha_mask)
+        if alpha_blend is not None and not isinstance(alpha_blend, AlphaBlend):
+            raise TypeError(f"alpha_blend must be a glphong.AlphaBlend or None (got {type(alpha_blend).__name__})")
+        if alpha_blend is not None and alpha_mask is not None:
+            raise ValueError("a material has an alpha mask or alpha blending, not both (glTF's alphaMode is one of "
+                             "OPAQUE, MASK and BLEND)")
+        object.__setattr__(self, "alpha_blend", alpha_blend)
 
     @property
     def components(self):
@@ -56,7 +64,8 @@ class Material:
         out = {}
         for term in self.components:
             out.update({a.name: getattr(term, a.name) for a in term.arguments()})
-        out.update(ka=self.ka, two_sided=self.two_sided, normal_map=self.normal_map, alpha_mask=self.alpha_mask)
+        out.update(ka=self.ka, two_sided=self.two_sided, normal_map=self.normal_map, alpha_mask=self.alpha_mask,
+                   alpha_blend=self.alpha_blend)
         return out
 
     def uniform_values(self, key):
@@ -101,11 +110,17 @@ class Material:
     def surface_uniform_values(self, key):
         """The uniforms of the material's normal map and alpha mask that program ``key`` reads (radiance and
         G-buffer programs alike): ``u_normal_map_texture``, ``u_normal_map_scale``, ``u_alpha_mask_cutoff``,
-        ``u_alpha_mask_scale`` and ``u_alpha_mask_texture``."""
+        ``u_alpha_mask_scale`` and ``u_alpha_mask_texture``; ``u_alpha_blend`` and ``u_alpha_blend_texture`` in the
+        programs that draw a blended layer (`glphong.gpu.peeling`)."""
         values = {}
         if key.normal_map:
             values["u_normal_map_texture"] = self.normal_map.texture
             values["u_normal_map_scale"] = _validate.float32_uniform(self.normal_map.scale)
+        if key.alpha_blend in (1, 3):  # a blended layer: its alpha, constant (1) or textured (3)
+            blend = self.alpha_blend
+            values["u_alpha_blend"] = _validate.float32_uniform(blend.alpha.scale if blend.textured else blend.alpha)
+            if blend.textured:
+                values["u_alpha_blend_texture"] = blend.alpha.texture
         if key.alpha_mask:
             mask = self.alpha_mask
             values["u_alpha_mask_cutoff"] = _validate.float32_uniform(mask.cutoff)
@@ -132,7 +147,7 @@ class Material:
             shown.append(f"ka={_short(values['ka'])}")
         if not values["two_sided"]:
             shown.append("two_sided=False")
-        shown += [f"{k}={values[k]!r}" for k in ("normal_map", "alpha_mask") if values[k] is not None]
+        shown += [f"{k}={values[k]!r}" for k in ("normal_map", "alpha_mask", "alpha_blend") if values[k] is not None]
         return f"{type(self).__name__}({', '.join(shown)})"
 
 

@@ -30,9 +30,10 @@ LIBRARY_CHUNKS = library_chunks("model")
 RESERVED_NAMES = frozenset({
     "material", "shade", "common", "lights", "light", "point", "unattenuated", "directional", "ambient",
     "eye", "model", "normal", "view", "use", "ka", "safe", "lobe", "srgb", "encode", "mesh", "uber", "naive",
-    "frame", "gl", "object", "exposure", "radiance", "fullscreen", "fresnel", "microfacet", "normal_map", "alpha_mask"})
+    "frame", "gl", "object", "exposure", "radiance", "fullscreen", "fresnel", "microfacet", "normal_map", "alpha_mask",
+    "alpha_blend"})
 #: material-level keywords every material takes
-MATERIAL_KEYWORDS = ("ka", "two_sided", "normal_map", "alpha_mask")
+MATERIAL_KEYWORDS = ("ka", "two_sided", "normal_map", "alpha_mask", "alpha_blend")
 _GLSL_KEYWORDS = frozenset("""attribute const uniform varying layout centroid flat smooth noperspective break continue
 do for while switch case default if else in out inout float int void bool true false invariant discard return mat2
 mat3 mat4 vec2 vec3 vec4 ivec2 ivec3 ivec4 bvec2 bvec3 bvec4 uint uvec2 uvec3 uvec4 lowp mediump highp precision

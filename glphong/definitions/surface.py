@@ -41,7 +41,8 @@ from glphong.core.filesafety import LIMITS, decode_image, read_bytes
 from glphong.core.imaging import encode_srgb8, srgb_decode
 from glphong.twin.band import EPS
 
-__all__ = ["SurfaceInput", "Texture", "VertexColors", "TextureImage", "NormalMap", "AlphaMask", "surface_texture", "surface_texture_band",
+__all__ = ["SurfaceInput", "Texture", "VertexColors", "TextureImage", "NormalMap", "AlphaMask", "AlphaBlend",
+           "surface_texture", "surface_texture_band",
            "WRAPS", "FILTERS", "CHANNELS", "MAX_TEXTURE_SIZE"]
 
 #: texture wrap modes: GL_REPEAT, GL_CLAMP_TO_EDGE (moderngl's textures offer no mirrored repeat)
@@ -412,16 +413,7 @@ class AlphaMask(_Frozen):
 
     def __init__(self, cutoff=0.5, alpha=1.0):
         object.__setattr__(self, "cutoff", _validate.scalar("cutoff", cutoff, low=0.0))
-        if isinstance(alpha, SurfaceInput):
-            if alpha.channel != "r" or alpha.vertex_colors or alpha.texture is None:  # mesh_fragment.glsl reads .r
-                raise ValueError("an alpha mask's alpha is one channel of a texture, its red (channel='r', no vertex "
-                                 f"colours; got channel={alpha.channel!r}): move the alpha into the red channel")
-            low, high = alpha.value_range()
-            if low < 0.0 or high > 1.0:
-                raise ValueError(f"alpha must be in [0, 1] everywhere; {alpha!r} spans [{low:g}, {high:g}]")
-        else:
-            alpha = _validate.scalar("alpha", alpha, low=0.0, high=1.0)
-        object.__setattr__(self, "alpha", alpha)
+        object.__setattr__(self, "alpha", _alpha_value(alpha, "an alpha mask"))
 
     @property
     def textured(self):
@@ -430,6 +422,52 @@ class AlphaMask(_Frozen):
 
     def __repr__(self):
         return f"AlphaMask(cutoff={self.cutoff:g}, alpha={self.alpha!r})"
+
+
+def _alpha_value(alpha, what):
+    """An alpha in [0, 1]: a float, or a `SurfaceInput` reading a texture's red channel (mesh_fragment.glsl reads .r)
+    without vertex colours, in [0, 1] everywhere; ValueError naming ``what`` otherwise."""
+    if not isinstance(alpha, SurfaceInput):
+        return _validate.scalar("alpha", alpha, low=0.0, high=1.0)
+    if alpha.channel != "r" or alpha.vertex_colors or alpha.texture is None:
+        raise ValueError(f"{what}'s alpha is one channel of a texture, its red (channel='r', no vertex "
+                         f"colours; got channel={alpha.channel!r}): move the alpha into the red channel")
+    low, high = alpha.value_range()
+    if low < 0.0 or high > 1.0:
+        raise ValueError(f"alpha must be in [0, 1] everywhere; {alpha!r} spans [{low:g}, {high:g}]")
+    return alpha
+
+
+class AlphaBlend(_Frozen):
+    """Alpha blending (glTF's ``alphaMode: BLEND``): the surface covers a fraction ``alpha`` of what lies behind it.
+    Every blended surface is composited over what lies behind it in depth order per pixel, premultiplied, in linear
+    float: ``C = alpha L + (1 - alpha) C_behind`` (the Porter-Duff "over" the glTF specification names), by depth
+    peeling (`glphong.gpu.peeling`, docs/design.md section 16).
+
+    Given to any material as ``alpha_blend=``; not together with ``alpha_mask``.  Alpha is a constant, or one channel
+    of a texture times a constant (glTF: ``baseColorFactor.a`` times the base-colour texture's alpha,
+    ``glphong.Texture(alpha, scale, srgb=False, channel='r')``; the mesh needs uvs).  Shadow maps are drawn without it
+    (a blended surface that casts shadows casts its whole shadow); give the object ``casts_shadow=False`` for none.
+
+    Parameters
+    ----------
+    alpha : float or SurfaceInput
+        The coverage, in [0, 1] (0: the surface is not seen, 1: it hides what lies behind it, still drawn as a
+        blended layer); a `SurfaceInput` reads its texture's red channel (``channel='r'``), without vertex colours.
+    """
+
+    __slots__ = ("alpha",)  # the constructor's order: pickled by them
+
+    def __init__(self, alpha=1.0):
+        object.__setattr__(self, "alpha", _alpha_value(alpha, "a blended material"))
+
+    @property
+    def textured(self):
+        """Whether alpha varies over the surface."""
+        return isinstance(self.alpha, SurfaceInput)
+
+    def __repr__(self):
+        return f"AlphaBlend({self.alpha!r})" if self.textured else f"AlphaBlend({self.alpha:g})"
 
 
 # --------------------------------------------------------------------------- the twin of surface.glsl

@@ -8,10 +8,12 @@ import numpy as np
 
 from glphong.core.filesafety import SceneFileError
 from glphong.core.radiometry import LUMENS_PER_WATT
+from glphong.formats.gltf_choices import check_one_uv_set
 from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, read_gltf_primitives, texture_sampling
-from glphong.materials import AlphaMask, NormalMap, Texture, TextureImage, VertexColors
+from glphong.materials import AlphaBlend, AlphaMask, NormalMap, Texture, TextureImage, VertexColors
 from glphong.materials.cook_torrance import CookTorrance
 from glphong.materials.gltf_pbr import GltfPBR
+from glphong.formats.gltf_material_extensions import extension_arguments, extension_texture_infos
 from glphong.definitions.fresnel import SchlickFresnel
 from glphong.formats.overrides import chosen_material
 from glphong.definitions.as_json import material_from_json
@@ -176,11 +178,6 @@ def gltf_material(entry, base_color_texture=None, vertex_colors=False):
     return CookTorrance(rho_d, max(roughness * roughness, 1e-3), fresnel=SchlickFresnel(tuple(np.clip(f0, 0.0, 1.0))))
 
 
-#: why a glTF material with alphaMode BLEND is refused
-BLEND_REFUSED = ("alphaMode BLEND: glphong draws opaque and alpha-masked surfaces, not blended ones (give this material "
-                 "with load_scene(..., materials=...), or set its alphaMode to MASK or OPAQUE)")
-
-
 def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1.0):
     """A glTF metallic-roughness material (JSON ``materials`` entry) as `glphong.GltfPBR`, the specification's
     Appendix B, with its textures (docs/scenes_from_files.md):
@@ -195,7 +192,8 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
     - ``doubleSided`` as ``two_sided``;
     - ``KHR_materials_ior``'s ``ior`` (the dielectric's ``f0``);
     - ``alphaMode``: OPAQUE; MASK as a `glphong.AlphaMask` of ``alphaCutoff`` and ``baseColorFactor.a`` times the
-      base-colour texture's alpha (COLOR_0's alpha is not read: a warning says so); BLEND is refused (ValueError).
+      base-colour texture's alpha (COLOR_0's alpha is not read: a warning says so); BLEND as a `glphong.AlphaBlend` of
+      the same alpha (composited per pixel in depth order, docs/design.md section 16).
 
     Parameters
     ----------
@@ -245,18 +243,20 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
             occlusion_image = TextureImage(np.repeat((1.0 - weight + weight * red)[..., None], 3, axis=2),
                                            wrap=occlusion_image.wrap, filter=occlusion_image.filter)
         occlusion = Texture(occlusion_image, channel="r")
-    alpha_mask = None
+    alpha_mask = alpha_blend = None
     mode = entry.get("alphaMode", "OPAQUE")
-    if mode == "BLEND":
-        raise ValueError(BLEND_REFUSED)
-    if mode == "MASK":
+    if mode in ("MASK", "BLEND"):
         factor = float(np.clip(pbr.get("baseColorFactor", (1.0, 1.0, 1.0, 1.0))[3], 0.0, 1.0))
         info = pbr.get("baseColorTexture")
         alpha = texture(info, False, True) if info is not None else None
-        alpha_mask = AlphaMask(float(entry.get("alphaCutoff", 0.5)),
-                               Texture(alpha, factor, channel="r") if alpha is not None else factor)
+        alpha = Texture(alpha, factor, channel="r") if alpha is not None else factor
+        if mode == "MASK":
+            alpha_mask = AlphaMask(float(entry.get("alphaCutoff", 0.5)), alpha)
+        else:
+            alpha_blend = AlphaBlend(alpha)
         if vertex_colors:
-            warnings.warn("COLOR_0's alpha is not read: the alpha mask is the base colour's", stacklevel=3)
+            warnings.warn(f"COLOR_0's alpha is not read: the alpha {'mask' if mode == 'MASK' else 'blend'} is the base "
+                          "colour's", stacklevel=3)
     normal_image = image("normalTexture", False)
     normal_map = NormalMap(normal_image, float(entry["normalTexture"].get("scale", 1.0))) \
         if normal_image is not None else None
@@ -264,21 +264,19 @@ def gltf_pbr_material(entry, texture=None, vertex_colors=False, emissive_scale=1
     if not 1.0 <= ior <= 1e4:  # validated >= 0; 0 (a "perfect reflector" in some exporters) is not a dielectric
         warnings.warn(f"KHR_materials_ior {ior!r}: glphong takes an ior in [1, 1e4]; 1.5 is used", stacklevel=3)
         ior = 1.5
-    return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion, ior=float(ior),
-                   two_sided=bool(entry.get("doubleSided", False)), normal_map=normal_map, alpha_mask=alpha_mask)
+    extensions = extension_arguments(entry, texture, lambda message: warnings.warn(message, stacklevel=4))
+    return GltfPBR(base_color, metallic, roughness, emissive=emissive, occlusion=occlusion, ior=float(ior), **extensions,
+                   two_sided=bool(entry.get("doubleSided", False)), normal_map=normal_map, alpha_mask=alpha_mask,
+                   alpha_blend=alpha_blend)
 
 
 def _texture_reader(gltf, where):
     """``texture(info, srgb, alpha=False)`` for `gltf_pbr_material`: the `TextureImage` of a ``textureInfo`` of ``gltf``
     (of its alpha channel alone, as grey, with ``alpha``), or None
-    (with a warning once per file) where it names a second set of texture coordinates or an image glphong does not
-    decode."""
+    (with a warning once per file) where it names no image glphong decodes.  The mesh carries the texture coordinate
+    set the material's textures read (`glphong.formats.gltf_choices.material_uv_set`)."""
 
     def texture(info, srgb, alpha=False):
-        if info.get("texCoord", 0) != 0:
-            gltf.warn_once("texCoord", f"{where}: a texture reads TEXCOORD_{info['texCoord']}; glphong reads "
-                           "TEXCOORD_0 only: drawn without that texture")
-            return None
         pixels = read_gltf_image(gltf, info["index"])
         if pixels is None:
             return None
@@ -293,7 +291,7 @@ def texture_transform(entry, gltf=None, where=""):
     offset, rotation by ``-rotation`` about the origin, scale, as the extension defines it), or None.
 
     glphong's textures share the mesh's coordinates, so the transform is applied to them (`transformed_uvs`): where
-    the material's textures carry different transforms, or one names its own ``texCoord``, none is applied and a
+    the material's textures carry different transforms, none is applied and a
     warning says so (``gltf``: the file that warns once).
 
     Raises
@@ -305,6 +303,7 @@ def texture_transform(entry, gltf=None, where=""):
     infos = [holder[key] for holder, key in ((pbr, "baseColorTexture"), (pbr, "metallicRoughnessTexture"),
                                              (entry, "normalTexture"), (entry, "occlusionTexture"),
                                              (entry, "emissiveTexture")) if isinstance(holder.get(key), dict)]
+    infos += extension_texture_infos(entry)  # KHR_materials_specular's and _clearcoat's (gltf_material_extensions)
     transforms = [info.get("extensions", {}).get("KHR_texture_transform") for info in infos]
     if not any(t is not None for t in transforms):
         return None
@@ -325,16 +324,13 @@ def texture_transform(entry, gltf=None, where=""):
                 raise ValueError(f"{where}: KHR_texture_transform needs finite numbers") from None
             raise SceneFileError(gltf.path, "KHR_texture_transform needs a finite offset [2], scale [2] and rotation",
                                  f"{where}.extensions.KHR_texture_transform") from None
-        if t.get("texCoord", 0) != 0:
-            matrices = None
-            break
         c, s = np.cos(r), np.sin(r)
         matrices.append(np.array([[1, 0, ox], [0, 1, oy], [0, 0, 1.0]]) @ np.array([[c, s, 0], [-s, c, 0], [0, 0, 1.0]])
                         @ np.diag([sx, sy, 1.0]))
     if matrices is None or any(not np.array_equal(m, matrices[0]) for m in matrices[1:]):
         if gltf is not None:
             gltf.warn_once(("KHR_texture_transform", where), f"{where}: its textures carry different "
-                           "KHR_texture_transforms (or their own texCoord): none is applied")
+                           "KHR_texture_transforms: none is applied")
         return None
     return matrices[0]
 
@@ -377,20 +373,19 @@ def _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emi
         stored, transform = material_from_extras(entry, gltf, f"materials[{index}]"), None
         if stored is None:
             where = f"materials[{index}]"
+            check_one_uv_set(gltf.path, entry, where)
             texture = _texture_reader(gltf, where) if mesh.uvs is not None else None
             if approximate:
                 info = entry.get("pbrMetallicRoughness", {}).get("baseColorTexture")
                 stored = gltf_material(entry, texture(info, True) if texture and info else None, mesh.colors is not None)
             else:
-                if entry.get("alphaMode") == "BLEND":
-                    raise SceneFileError(gltf.path, BLEND_REFUSED, f"{where}.alphaMode")
                 stored = gltf_pbr_material(entry, texture, mesh.colors is not None, emissive_scale)
             transform = texture_transform(entry, gltf, where)
         made[key] = stored, transform
     return made[key]
 
 
-def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name, allow_outside, limits):
+def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name, allow_outside, limits, variant=None):
     """A glTF file's scene: its own arrays (`glphong.formats.gltf_data`), nodes in file order, materials from the
     user's ``materials``, else the stored glphong material (``extras``), else `gltf_pbr_material` (`gltf_material`
     with ``materials='cook_torrance'``)."""
@@ -411,7 +406,7 @@ def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name
     scene = empty_scene(Scene, chosen_camera, lights, ambient)
     entries, made = document.get("materials", []), {}
     emissive_scale = 1.0 / LUMENS_PER_WATT if light_units == "photometric" else 1.0
-    for name, mesh, world, index in read_gltf_primitives(gltf):
+    for name, mesh, world, index in read_gltf_primitives(gltf, variant):
         material, transform = _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale)
         scene.add(transformed_uvs(mesh, transform), material, pose=world, name=name)
     if lights is None:  # a file without lights is not drawn black by accident

@@ -24,9 +24,12 @@ class Frame:
         rows flipped by a negative stride; no copy is made): ``numpy.ascontiguousarray`` gives
         C order where a consumer needs it.
     mask : (H, W) bool ndarray
-        Pixels covered by geometry (any sample; the pixel centre where the radiance is left out).
+        Pixels covered by geometry (any sample; the pixel centre where the radiance is left out); with blended
+        surfaces, where ``coverage > 0``.
     coverage : (H, W) float32 ndarray
-        Fraction of the pixel's samples covered by geometry (0 or 1 with one sample, or without the radiance).
+        Fraction of the pixel's samples covered by geometry (0 or 1 with one sample, or without the radiance); with
+        blended surfaces (`glphong.AlphaBlend`) the composite's alpha, ``1 - prod(1 - a_k)`` over the blended layers
+        where no opaque surface lies behind them, 1 where one does.
     depth : (H, W) float32 ndarray or None
         With ``render(scene, depth=True)``: linear depth [m], the distance of the surface point at
         the pixel centre from the camera along its viewing axis (view-space ``-z``; not the distance
@@ -44,6 +47,12 @@ class Frame:
         share descending (ties by id ascending), 0 padding (`glphong.gpu.matte`).
     matte_fractions : (H, W, k) float32 ndarray or None
         Their shares of the pixel's area, descending, 0 padding; a pixel's sum is its covered share.
+    blend_layers : int or None
+        Where the scene has blended materials (`glphong.AlphaBlend`): the most blended layers any pixel composites
+        (`glphong.gpu.peeling`); None without.
+    blend_cut : (H, W) bool ndarray or None
+        The pixels that had more blended layers than the renderer's ``blend_layers``: their farthest ones were left
+        out (a `glphong.gpu.peeling.BlendCapWarning` says how many); None where no pixel was cut.
     passes : tuple of str
         The passes the frame holds, in `glphong.gpu.passes.PASSES` order.
     exposure : float
@@ -69,6 +78,8 @@ class Frame:
     matte_ids: np.ndarray = None
     matte_fractions: np.ndarray = None
     passes: tuple = ("radiance",)
+    blend_layers: int = None
+    blend_cut: np.ndarray = None
 
     def with_exposure(self, exposure):
         """The same frame (arrays shared, not copied) shown at ``exposure`` in a notebook."""

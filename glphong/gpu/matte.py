@@ -50,8 +50,9 @@ def matte_tolerance(samples):
 
 
 def drawn_objects(scene, refusal):
-    """Indices of the objects a pass draws: all but those whose constant alpha lies below their cutoff (they are not
-    seen).
+    """Indices of the opaque objects a pass draws: all but those whose constant alpha lies below their cutoff (they are
+    not seen) and the blended ones (`glphong.AlphaBlend`: the geometry passes, the matte and the G-buffer are those of
+    the nearest opaque or alpha-masked surface, docs/design.md section 16).
 
     Parameters
     ----------
@@ -66,6 +67,8 @@ def drawn_objects(scene, refusal):
     """
     drawn = []
     for index, obj in enumerate(scene.objects):
+        if obj.material.alpha_blend is not None:
+            continue
         mask = obj.material.alpha_mask
         if mask is not None and mask.textured:
             raise ValueError(refusal(obj))

@@ -15,17 +15,20 @@ import numpy as np
 from glphong.core import validate as _validate
 from glphong.gpu.frame import Frame, GBuffer
 from glphong.gpu.passes import check_passes, derive_passes, gbuffer_planes, requested_passes
-from glphong.gpu.resources import (MeshBuffers, ObjectEntry, check_target_size, gl_object_count, make_target, orphan,
+from glphong.gpu.resources import (MeshBuffers, check_target_size, gl_object_count, make_target, orphan,
                                    read_attachment, release_orphans, release_resources, release_targets, target_bytes)
 from glphong.gpu.contexts import check_not_forked, create_context
-from glphong.scene.culling import closed_outward, culling_decision, view_allows_culling, world_sphere
+from glphong.scene.culling import culling_decision
 from glphong.shaders.binding import binding
 from glphong.shaders.keys import EncodeKey
 from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, PASS_PLANES
-from glphong.shaders.numerics import NUMERICS, allowed_pieces, view_decision
+from glphong.shaders.numerics import NUMERICS
 from glphong.gpu.shadows import ShadowMaps
 from glphong.gpu.matte import MATTE_K, MATTE_SAMPLES, MAX_MATTE_K, MAX_MATTE_SAMPLES, TILE, Matte
 from glphong.gpu.programs import ProgramCache
+from glphong.gpu.drawing import draw_objects
+from glphong.gpu.peeling import (BLEND_LAYERS, MAX_BLEND_LAYERS, CompositeKey, Peeling, blend_fields, blended_objects,
+                                 check_blend_options)
 from glphong.gpu.program_keys import renderer_program_key
 from glphong.scene.scene import Scene
 
@@ -105,6 +108,10 @@ class Renderer:
         straight boundary crossing the pixel (docs/design.md section 15).
     matte_k : int
         Objects kept per pixel by the 'matte' pass, 1 to 16 (default 4).
+    blend_layers : int
+        Blended layers (`glphong.AlphaBlend`, glTF alphaMode BLEND) composited per pixel, 1 to 256 (default 16): the
+        nearest ones; a pixel with more has the rest left out, and the frame says where (`Frame.blend_cut`, and a
+        warning with the count; `glphong.gpu.peeling`).
 
     Examples
     --------
@@ -114,9 +121,11 @@ class Renderer:
 
     def __init__(self, width, height, backend="auto", shading="pixel", samples=1, supersample=1,
                  formulation="stable", specialise=True, culling="auto", device=None, shadow_map_size=1024,
-                 shadow_filter_radius=0, numerics="auto", matte_samples=MATTE_SAMPLES, matte_k=MATTE_K):
+                 shadow_filter_radius=0, numerics="auto", matte_samples=MATTE_SAMPLES, matte_k=MATTE_K,
+                 blend_layers=BLEND_LAYERS):
         self.matte_samples = _validate.positive_int("matte_samples", matte_samples, 1, MAX_MATTE_SAMPLES)
         self.matte_k = _validate.positive_int("matte_k", matte_k, 1, MAX_MATTE_K)
+        self.blend_layers = _validate.positive_int("blend_layers", blend_layers, 1, MAX_BLEND_LAYERS)
         self.shadow_map_size = _validate.positive_int("shadow_map_size", shadow_map_size, 16, 8192)
         self.shadow_filter_radius = _validate.positive_int("shadow_filter_radius", shadow_filter_radius, 0, 8)
         self.shading = _validate.choice("shading", shading, ("pixel", "vertex"))
@@ -232,6 +241,9 @@ class Renderer:
         Returns
         -------
         Frame
+            With blended materials (`glphong.AlphaBlend`), the radiance composites their layers per pixel in depth
+            order (`glphong.gpu.peeling`; ``blend_layers`` and ``blend_cut`` say how many and where the cap cut), and
+            the other passes are the nearest opaque surface's.
         """
         self._check_scene(scene)
         for name, flag in (("depth", depth), ("normals", normals)):
@@ -239,6 +251,7 @@ class Renderer:
                 raise TypeError(f"{name} must be a bool, True or False (got {flag!r})")
         names = requested_passes(passes, depth, normals)
         check_passes(scene, names, next_scene, previous_scene)
+        check_blend_options(self, scene)
         geometry = [n for n in names if n not in ("radiance", "matte")]
         extra = self._draw_matte(scene) if "matte" in names else {}
         if geometry and "radiance" in names and self.samples == 1 and self.supersample == 1 \
@@ -254,7 +267,7 @@ class Renderer:
                 mask = extra["matte_fractions"][..., 0] > 0.0
             return Frame(radiance=None, mask=mask, coverage=mask.astype(np.float32), passes=names, **extra)
         with self.context:
-            fbo = self._draw_radiance(scene)
+            fbo, blend = self._draw_radiance(scene)
             rgba = read_attachment(fbo, self._internal_size, components=4)
             self.context.check_error("rendering radiance")
         s = self.supersample
@@ -262,7 +275,8 @@ class Renderer:
             rgba = rgba.reshape(self.height, s, self.width, s, 4).mean(axis=(1, 3), dtype=np.float64).astype(np.float32)
         # views of the one readback (rows flipped by strides): no copy after the driver's
         coverage = rgba[..., 3]
-        return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, passes=names, **extra)
+        return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, passes=names,
+                     **extra, **blend_fields(blend, s))
 
     def _draw_matte(self, scene):
         """The 'matte' pass's arrays (`glphong.gpu.matte.Matte.draw`), dict of frame attribute to array."""
@@ -312,13 +326,13 @@ class Renderer:
         pass_planes = tuple(p for p in PASS_PLANES if p == "position" or (p == "normal" and normal) or p in planes)
         with self.context:
             fbo = self._target(("radiance", *pass_planes))
-            self._draw(scene, "radiance", fbo, planes=pass_planes)
+            blend = self._draw(scene, "radiance", fbo, planes=pass_planes)
             rgba = read_attachment(fbo, self._size, components=4)
             read = {name: read_attachment(fbo, self._size, components=4, attachment=1 + i)
                     for i, name in enumerate(pass_planes)}
             self.context.check_error("rendering radiance and the frame passes' planes")
         gbuffer = GBuffer.from_planes(read.pop("position"), read.pop("normal", None), read, copy=False)
-        extra = extra | derive_passes(scene, gbuffer, geometry, next_scene, previous_scene)
+        extra = extra | derive_passes(scene, gbuffer, geometry, next_scene, previous_scene) | blend_fields(blend)
         coverage = rgba[..., 3]
         return Frame(radiance=rgba[..., :3], mask=coverage > 0.0, coverage=coverage, passes=names, **extra)
 
@@ -340,8 +354,8 @@ class Renderer:
             (encode.glsl).  Interior pixels are the same either way; silhouette pixels of a
             multisampled image differ (the average of encoded values against the encoded average).
             'display' needs per-pixel shading, no supersampling and specialised programs; with any
-            other option the linear path runs.  Measured: 'display' saves the float target's clear,
-            resolve and readback (see README).
+            other option, or blended materials (composited in linear float), the linear path runs.
+            Measured: 'display' saves the float target's clear, resolve and readback (see README).
 
         Returns
         -------
@@ -349,10 +363,12 @@ class Renderer:
             Row 0 at the top.
         """
         self._check_scene(scene)
+        check_blend_options(self, scene)
         exposure = _validate.scalar("exposure", exposure, low=0.0, low_inclusive=False)
         resolve = _validate.choice("resolve", resolve, ("display", "linear"))
         with self.context:
-            if resolve == "display" and self.supersample == 1 and self.shading == "pixel" and self.specialise:
+            if resolve == "display" and self.supersample == 1 and self.shading == "pixel" and self.specialise \
+                    and not blended_objects(scene):  # blended layers are composited in linear float
                 target = self._target("display")
                 self._draw(scene, "display", target, {"u_exposure": exposure})
                 if self.samples > 1:
@@ -362,7 +378,9 @@ class Renderer:
                 rgb = read_attachment(target, self._size, components=3, dtype="f1")
                 self.context.check_error("rendering display values")
                 return rgb
-            texture = self._draw_radiance(scene).color_attachments[0]
+            fbo, blend = self._draw_radiance(scene)
+            texture = fbo.color_attachments[0]
+            blend_fields(blend, self.supersample)  # the warning where the cap cut pixels' layers
             out = self._target("srgb8")
             out.use()
             program = self.programs.get(EncodeKey(self.supersample))
@@ -376,7 +394,8 @@ class Renderer:
 
     @_one_call_at_a_time
     def gbuffer(self, scene, planes=()):
-        """Render the per-pixel shading inputs of the scene (one sample per pixel, output size).
+        """Render the per-pixel shading inputs of the scene (one sample per pixel, output size): of its opaque and
+        alpha-masked objects (blended ones are left out: the nearest opaque surface, docs/design.md section 16).
 
         Parameters
         ----------
@@ -416,14 +435,15 @@ class Renderer:
             raise RuntimeError("this Renderer has been released")
 
     def _draw_radiance(self, scene):
-        """Draw the radiance; returns the single-sample framebuffer whose color is a texture."""
+        """Draw the radiance; returns the single-sample framebuffer whose color is a texture, and the peel's
+        ``(layers, cut)`` (`_draw`)."""
         target = self._target("radiance")
-        self._draw(scene, "radiance", target)
+        blend = self._draw(scene, "radiance", target)
         if self.samples == 1:
-            return target
+            return target, blend
         resolved = self._target("resolve")
         self._mgl.copy_framebuffer(resolved, target)
-        return resolved
+        return resolved, blend
 
     @property
     def shadow_settings(self):
@@ -442,89 +462,21 @@ class Renderer:
                                       self._vertex_array)
 
     def _draw(self, scene, output, fbo, frame_values=None, planes=frozenset()):
-        aspect = self.width / self.height
+        """Draw ``scene``'s objects into ``fbo`` (`glphong.gpu.drawing`); its radiance with blended objects then peels
+        and composites their layers (`glphong.gpu.peeling`): returns ``(layers, cut)`` then, else None."""
         self._purge_dead_meshes()
         shadow_values = self._shadow_values(scene, output)
         fbo.use()
         fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
         self._mgl.enable(moderngl.DEPTH_TEST)
         self._mgl.disable(moderngl.CULL_FACE)
-        camera = scene.camera
-        eye = tuple(camera.pose[:3, 3])
-        forward = tuple(-camera.pose[:3, 2])
-        near, far = camera.znear, camera.zfar
-        mirrored = culled = False
-        for program, frame_pack, entry in self._draw_list(scene, output, aspect, frame_values, shadow_values, planes):
-            program.write(frame_pack)
-            program.write(entry.pack)
-            if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
-                mirrored = entry.mirrored
-                self._mgl.front_face = "cw" if mirrored else "ccw"
-            cull = entry.sphere is not None and view_allows_culling(*entry.sphere, eye, forward, near, far)
-            if cull != culled:
-                culled = cull
-                (self._mgl.enable if cull else self._mgl.disable)(moderngl.CULL_FACE)
-            entry.vertex_array.render(moderngl.TRIANGLES)
-        self._mgl.front_face = "ccw"
-        self._mgl.disable(moderngl.CULL_FACE)
-
-    def _draw_list(self, scene, output, aspect, frame_values=None, shadow_values=None, planes=frozenset()):
-        """``(program, frame pack, object entry)`` per object, in order.
-
-        Per frame, the uniforms every object shares (camera, lights) are packed once per program key;
-        per object, its key, program, vertex array and packed uniforms (pose, normal matrix, material)
-        are made once and kept (`ObjectEntry`) while the scene's lights, ambient light and the object's
-        index are what they were: objects, materials and poses are immutable.  The uber-shader's key is
-        the scene's, the same for every object (made once per frame).  ``frame_values`` are uniforms the
-        call adds to every program's frame pack (the display programs' ``u_exposure``), ``shadow_values`` the
-        shadow maps, added to the programs that read them; ``planes`` a G-buffer's planes beyond the scene's (kept apart
-        from the plain G-buffer's entries)."""
-        drop = self.formulation == "naive"
-        bound = binding(scene)
-        state = (output, bound.light_keys(), scene.ambient_radiance, self.formulation,
-                 self.shading, self.specialise, self.culling, self.numerics, planes)
-        camera = scene.camera
-        shared = self.program_key(scene, None, output) if output == "radiance" and not self.specialise else None
-        frame_packs = {}
-        entries = self._entries
-        for index, obj in enumerate(scene.objects):
-            per_object = entries.get(obj)
-            if per_object is None:
-                per_object = entries[obj] = {}
-            entry = per_object.get((output, planes) if planes else output)
-            if entry is not None and entry.camera is not camera and not self._same_view_piece(entry, obj, camera):
-                entry = None
-            if shared is not None or entry is None or entry.state != state or entry.index != index:
-                key = shared or self.program_key(scene, obj, output, planes)
-                program = self.programs.get(key)
-                values = bound.uniform_values(index, key, aspect) if shared is not None else \
-                    bound.object_uniform_values(index, key)
-                vao = self._vertex_array(obj.mesh, program)
-                sphere = world_sphere(obj.mesh, obj.pose) if self.culling == "auto" and closed_outward(obj.mesh)[0] else None
-                entry = ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
-                                     None if sphere is None else (tuple(sphere[0]), sphere[1]), camera=camera)
-                if shared is None:
-                    per_object[(output, planes) if planes else output] = entry
-            frame = frame_packs.get(entry.program)
-            if frame is None:
-                values = {} if shared is not None else bound.frame_uniform_values(entry.key, aspect)
-                shadows = (shadow_values or {}) if entry.key.shadow_slots else {}
-                pack = entry.program.pack(values | (frame_values or {}) | shadows, drop)
-                frame = frame_packs[entry.program] = (pack, tuple(name for name, _, _ in pack))
-            if entry.checked != frame[1]:  # strict: every active uniform set, checked once per entry
-                entry.program.check_complete(frame[0], entry.pack)
-                entry.checked = frame[1]
-            yield entry.program, frame[0], entry
-
-    def _same_view_piece(self, entry, obj, camera):
-        """True where ``entry``'s key needs no change for ``camera``: its 'view' piece (the only piece that depends on
-        the camera, `glphong.shaders.numerics`) is decided the same way; the entry then remembers ``camera``."""
-        key = entry.key
-        if self.numerics == "auto" and "view" in allowed_pieces(key) \
-                and view_decision(obj, camera)[0] != ("view" in key.numerics):
-            return False
-        entry.camera = camera
-        return True
+        draw_objects(self, scene, output, frame_values, shadow_values, planes)
+        if output != "radiance" or not blended_objects(scene):
+            return None
+        peeling = self._targets.get(("peeling",)) or self._targets.setdefault(("peeling",), Peeling(self._mgl))
+        return peeling.draw(fbo, fbo.size, lambda kind, depth: draw_objects(
+            self, scene, output, {"u_blend_depth": depth}, shadow_values, blend=kind), self.blend_layers,
+            self.programs.get(CompositeKey()), self._fullscreen)
 
     def _fullscreen(self, program):
         vao = self._targets.get(("fullscreen", program.key))

@@ -58,7 +58,7 @@ def read_attachment(fbo, size, components, attachment=0, dtype="f4"):
 
 @dataclass(eq=False)
 class ObjectEntry:
-    """What a renderer draws one scene object with (see `Renderer._draw_list`)."""
+    """What a renderer draws one scene object with (see `glphong.gpu.drawing.draw_list`)."""
 
     state: tuple
     index: int
@@ -169,7 +169,7 @@ ORPHANS_LOCK = threading.Lock()
 def release_targets(context, targets):
     """Release a renderer's framebuffers and full-screen vertex arrays (context entered)."""
     for name, obj in targets.items():
-        if name[0] == "fullscreen":  # a full-screen vertex array
+        if name[0] in ("fullscreen", "peeling"):  # a full-screen vertex array; the peel's targets (`glphong.gpu.peeling`)
             obj.release()
         else:
             context.release_framebuffer(obj)
@@ -197,8 +197,8 @@ def gl_object_count(programs, meshes, targets):
     """Number of GL objects a renderer holds: its programs (a `glphong.gpu.programs.ProgramCache`) and their textures,
     its meshes' buffers and vertex arrays (dict of `MeshBuffers`), its targets' framebuffers and attachments."""
     mesh_objects = sum(1 + len(e.buffers) + len(e.vertex_arrays) for e in meshes.values())
-    target_objects = sum(1 if name[0] == "fullscreen" else 1 + len(f.color_attachments) + (f.depth_attachment is not None)
-                         for name, f in targets.items())
+    target_objects = sum(1 if name[0] == "fullscreen" else f.gl_object_count() if name[0] == "peeling" else
+                         1 + len(f.color_attachments) + (f.depth_attachment is not None) for name, f in targets.items())
     return len(programs) + len(programs.textures) + mesh_objects + target_objects
 
 

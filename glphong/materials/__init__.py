@@ -31,7 +31,7 @@ and `FresnelSlot` (see README, "Write your own material").
 """
 from glphong.definitions.discovery import import_definitions
 from glphong.definitions.material import Choice, GlslFile, Material, MaterialDefinitionError, MaterialModel, MaterialSum, Param, ParamValues, Properties, ShadingFrame, model_named, registered_models
-from glphong.definitions.surface import AlphaMask, NormalMap, SurfaceInput, Texture, TextureImage, VertexColors
+from glphong.definitions.surface import AlphaBlend, AlphaMask, NormalMap, SurfaceInput, Texture, TextureImage, VertexColors
 from glphong.definitions.table import Table, TableData
 from glphong.definitions.cases import Case
 from glphong.definitions.fresnel import DielectricFresnel, Fresnel, FresnelSlot, SchlickFresnel
@@ -39,7 +39,7 @@ from glphong.definitions.params import DefinitionError
 
 __all__ = ["Material", "MaterialModel", "MaterialSum", "Param", "Choice", "Table", "TableData", "ParamValues",
            "Properties", "ShadingFrame", "MaterialDefinitionError", "GlslFile", "registered_models", "model_named",
-           "SurfaceInput", "Texture", "TextureImage", "VertexColors", "NormalMap", "AlphaMask", "Fresnel",
+           "SurfaceInput", "Texture", "TextureImage", "VertexColors", "NormalMap", "AlphaMask", "AlphaBlend", "Fresnel",
            "SchlickFresnel", "DielectricFresnel", "FresnelSlot", "Case", "DefinitionError"]
 
 # every module of this package is one model (the mechanism is glphong.definitions): importing it registers the

@@ -138,7 +138,8 @@ def _resolve_lobes(owner, lobes, per_lobe):
     unknown = sorted(set(per_lobe) - set(_LOBE_NAMES))
     if unknown:
         raise TypeError(f"{owner}() got an unexpected parameter {unknown[0]!r} (parameters: lobes, or "
-                        f"lobe<k>_rho, lobe<k>_c, lobe<k>_n for k = 1..{LAFORTUNE_MAX_LOBES}; ka, two_sided, normal_map, alpha_mask)")
+                        f"lobe<k>_rho, lobe<k>_c, lobe<k>_n for k = 1..{LAFORTUNE_MAX_LOBES}; ka, two_sided, normal_map, alpha_mask, "
+                        "alpha_blend)")
     if lobes is not None and per_lobe:
         raise TypeError(f"{owner}() takes lobes= or the per-lobe parameters ({', '.join(sorted(per_lobe))}), not both")
     if lobes is None:
@@ -316,9 +317,11 @@ class LafortuneLobes(MaterialModel):
                             condition="not in general (|C o l|^n is unbounded); with C = (-1, -1, 1) and "
                                       "rho_i = rho_s,i (n_i + 2)/(2 pi): where rho_d + sum_i rho_s,i <= 1")
 
-    def __init__(self, lobes=None, *, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, **per_lobe):
+    def __init__(self, lobes=None, *, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, alpha_blend=None,
+                 **per_lobe):
         count, values = _resolve_lobes(type(self).__name__, lobes, per_lobe)
-        super().__init__(**values, ka=ka, two_sided=two_sided, normal_map=normal_map, alpha_mask=alpha_mask)
+        super().__init__(**values, ka=ka, two_sided=two_sided, normal_map=normal_map, alpha_mask=alpha_mask,
+                         alpha_blend=alpha_blend)
         object.__setattr__(self, "lobe_count", count)
 
     @property
@@ -448,12 +451,13 @@ class Lafortune(MaterialSum):
                             condition="not in general; with C = (-1, -1, 1) and rho_i = rho_s,i (n_i + 2)/(2 pi) "
                                       "for every lobe: where rho_d + sum_i rho_s,i <= 1 per channel")
 
-    def __init__(self, rho_d, lobes=None, *, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, **per_lobe):
+    def __init__(self, rho_d, lobes=None, *, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None, alpha_blend=None,
+                 **per_lobe):
         count, values = _resolve_lobes(type(self).__name__, lobes, per_lobe)
         used = {k: v for k, v in values.items() if _lobe_index(k) <= count}
         parts = (Diffuse(rho_d, two_sided=two_sided), LafortuneLobes(**used, two_sided=two_sided))
         object.__setattr__(self, "_parts", parts)
-        self._set_common(ka, two_sided, normal_map, alpha_mask)
+        self._set_common(ka, two_sided, normal_map, alpha_mask, alpha_blend)
 
     @property
     def lobe_count(self):

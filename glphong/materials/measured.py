@@ -195,9 +195,11 @@ class MeasuredBRDF(MaterialModel):
     properties = Properties(reciprocal=True, isotropic=True, energy_conserving=None, non_negative=True,
                             condition="depends on the data (glphong.analysis measures it)")
 
-    def __init__(self, table, lookup="nearest", *, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None):
+    def __init__(self, table, lookup="nearest", *, ka=0.0, two_sided=True, normal_map=None, alpha_mask=None,
+                 alpha_blend=None):
         data, unmeasured = _read_table(table)
-        super().__init__(table=data, lookup=lookup, ka=ka, two_sided=two_sided, normal_map=normal_map, alpha_mask=alpha_mask)
+        super().__init__(table=data, lookup=lookup, ka=ka, two_sided=two_sided, normal_map=normal_map, alpha_mask=alpha_mask,
+                         alpha_blend=alpha_blend)
         object.__setattr__(self, "unmeasured", unmeasured)
 
     @classmethod

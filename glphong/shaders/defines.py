@@ -37,6 +37,7 @@ def program_defines(key):
         ("HAS_OBJECT", b(key.has_object)),
         ("NORMAL_MAP", b(key.normal_map)),
         ("ALPHA_MASK", str(key.alpha_mask)),
+        *((("ALPHA_BLEND", str(key.alpha_blend)),) if key.alpha_blend else ()),  # only in a blended layer's programs
         *((f"{name.upper()}_LOCATION", str(where)) for name, where in
           ({"tangent": 2, "uv": 3, "color": 5} | dict(key.attribute_locations)).items()),
         ("NUM_LOD_TEXTURES", str(key.lod_textures)),

@@ -190,6 +190,11 @@ class ProgramKey:
     alpha_mask : int
         0: no alpha test; 1: a constant alpha; 2: alpha from a texture (glsl/mesh_fragment.glsl discards the fragments
         below the cutoff, in the radiance and the G-buffer programs alike).
+    alpha_blend : int
+        0: an opaque or alpha-masked surface; a blended one's layer programs (`glphong.gpu.peeling`, docs/design.md
+        section 16): 1 shades the fragment at the layer's depth, premultiplied by the material's alpha (3: a textured
+        alpha); 2 writes the window depth of the fragments behind the previous layer (the peel).  Set by the renderer,
+        never by a scene.
     normal_map : bool
         The material's tangent-space normal map perturbs the shading normal in the fragment stage
         (glsl/normal_map.glsl); for a G-buffer program: the normal it writes is the mapped one.
@@ -231,6 +236,7 @@ class ProgramKey:
     lod_textures: int = 0
     normal_map: bool = False
     alpha_mask: int = 0
+    alpha_blend: int = 0
     has_face: bool = False
     has_object: bool = False
     pass_planes: tuple = ()

@@ -31,8 +31,8 @@ class Slot:
 
 
 def _reads_surface(key):
-    """surface.glsl: a textured input, a normal map or a textured alpha mask."""
-    return bool(key.textured_inputs) or key.normal_map or key.alpha_mask == 2
+    """surface.glsl: a textured input, a normal map, a textured alpha mask or a blended layer's textured alpha."""
+    return bool(key.textured_inputs) or key.normal_map or key.alpha_mask == 2 or key.alpha_blend == 3
 
 
 def _normal_map(key):

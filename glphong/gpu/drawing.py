@@ -1,0 +1,111 @@
+"""A renderer's draw of a scene's objects: the per-object program, uniforms and vertex array, kept from frame to frame
+(`draw_list`), and the draw with the winding and culling each object needs (`draw_objects`).
+
+``blend`` selects what is drawn: 0 the opaque and alpha-masked objects (every object of a scene without a blended
+material), 1 and 2 the blended objects with their layer and peel programs (`glphong.gpu.peeling.blend_key`).
+"""
+import moderngl
+
+from glphong.gpu.peeling import blend_key, blended
+from glphong.gpu.resources import ObjectEntry
+from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
+from glphong.shaders.binding import binding
+from glphong.shaders.numerics import allowed_pieces, view_decision
+
+__all__ = ["draw_objects", "draw_list"]
+
+
+def draw_objects(renderer, scene, output, frame_values=None, shadow_values=None, planes=frozenset(), blend=0):
+    """Draw the objects ``blend`` selects into the bound framebuffer (depth test and blending as the caller set them).
+
+    Opaque objects (``blend=0``): back faces culled where they cannot be seen (`glphong.scene.culling`).  Blended
+    ones: back faces culled where the material is one-sided (glTF's ``doubleSided: false``), drawn where it is
+    two-sided (a transparent closed mesh shows its far side through its near one)."""
+    mgl = renderer._mgl
+    camera = scene.camera
+    eye = tuple(camera.pose[:3, 3])
+    forward = tuple(-camera.pose[:3, 2])
+    near, far = camera.znear, camera.zfar
+    mirrored = culled = False
+    for program, frame_pack, entry in draw_list(renderer, scene, output, renderer.width / renderer.height,
+                                                frame_values, shadow_values, planes, blend):
+        program.write(frame_pack)
+        program.write(entry.pack)
+        if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
+            mirrored = entry.mirrored
+            mgl.front_face = "cw" if mirrored else "ccw"
+        if blend:
+            cull = not scene.objects[entry.index].material.two_sided
+        else:
+            cull = entry.sphere is not None and view_allows_culling(*entry.sphere, eye, forward, near, far)
+        if cull != culled:
+            culled = cull
+            (mgl.enable if cull else mgl.disable)(moderngl.CULL_FACE)
+        entry.vertex_array.render(moderngl.TRIANGLES)
+    mgl.front_face = "ccw"
+    mgl.disable(moderngl.CULL_FACE)
+
+
+def draw_list(renderer, scene, output, aspect, frame_values=None, shadow_values=None, planes=frozenset(), blend=0):
+    """``(program, frame pack, object entry)`` per object ``blend`` selects, in order.
+
+    Per frame, the uniforms every object shares (camera, lights) are packed once per program key;
+    per object, its key, program, vertex array and packed uniforms (pose, normal matrix, material)
+    are made once and kept (`ObjectEntry`) while the scene's lights, ambient light and the object's
+    index are what they were: objects, materials and poses are immutable.  The uber-shader's key is
+    the scene's, the same for every object (made once per frame).  ``frame_values`` are uniforms the
+    call adds to every program's frame pack (the display programs' ``u_exposure``, a blended layer's
+    ``u_blend_depth``), ``shadow_values`` the shadow maps, added to the programs that read them; ``planes`` a
+    G-buffer's planes beyond the scene's (kept apart from the plain G-buffer's entries)."""
+    drop = renderer.formulation == "naive"
+    bound = binding(scene)
+    state = (output, bound.light_keys(), scene.ambient_radiance, renderer.formulation,
+             renderer.shading, renderer.specialise, renderer.culling, renderer.numerics, planes)
+    camera = scene.camera
+    shared = renderer.program_key(scene, None, output) if output == "radiance" and not renderer.specialise else None
+    frame_packs = {}
+    entries = renderer._entries
+    slot = (output, planes, blend) if planes or blend else output
+    for index, obj in enumerate(scene.objects):
+        if blended(obj) != bool(blend):
+            continue
+        per_object = entries.get(obj)
+        if per_object is None:
+            per_object = entries[obj] = {}
+        entry = per_object.get(slot)
+        if entry is not None and entry.camera is not camera and not _same_view_piece(renderer, entry, obj, camera):
+            entry = None
+        if shared is not None or entry is None or entry.state != state or entry.index != index:
+            key = shared or renderer.program_key(scene, obj, output, planes)
+            key = blend_key(key, blend, obj.material.alpha_blend.textured) if blend else key
+            program = renderer.programs.get(key)
+            values = bound.uniform_values(index, key, aspect) if shared is not None else \
+                bound.object_uniform_values(index, key)
+            vao = renderer._vertex_array(obj.mesh, program)
+            sphere = world_sphere(obj.mesh, obj.pose) if renderer.culling == "auto" and closed_outward(obj.mesh)[0] \
+                else None
+            entry = ObjectEntry(state, index, key, program, program.pack(values, drop), vao, obj.mirrored,
+                                None if sphere is None else (tuple(sphere[0]), sphere[1]), camera=camera)
+            if shared is None:
+                per_object[slot] = entry
+        frame = frame_packs.get(entry.program)
+        if frame is None:
+            values = {} if shared is not None else bound.frame_uniform_values(entry.key, aspect)
+            shadows = (shadow_values or {}) if entry.key.shadow_slots else {}
+            pack = entry.program.pack(values | (frame_values or {}) | shadows, drop)
+            frame = frame_packs[entry.program] = (pack, tuple(name for name, _, _ in pack))
+        if entry.checked != frame[1]:  # strict: every active uniform set, checked once per entry
+            entry.program.check_complete(frame[0], entry.pack)
+            entry.checked = frame[1]
+        yield entry.program, frame[0], entry
+
+
+def _same_view_piece(renderer, entry, obj, camera):
+    """True where ``entry``'s key needs no change for ``camera``: its 'view' piece (the only piece that depends on
+    the camera, `glphong.shaders.numerics`) is decided the same way; the entry then remembers ``camera``."""
+    key = entry.key
+    if renderer.numerics == "auto" and "view" in allowed_pieces(key) \
+            and view_decision(obj, camera)[0] != ("view" in key.numerics):
+        return False
+    entry.camera = camera
+    return True
