@@ -123,6 +123,11 @@ def main(platform):
     poses = np.stack([translation(0, 0, 0), translation(1, 0, 0)])
     result["instanced"] = _refusal(renderer, pyrender.Mesh.from_trimesh(
         trimesh.creation.box(), material=GlphongMaterial(glphong.Lambert(0.5)), poses=poses))
+    try:  # a blended material: pyrender's passes would draw it opaque
+        GlphongMaterial(glphong.Lambert(0.5, alpha_blend=glphong.AlphaBlend(0.5)))
+        result["blended"] = "accepted"
+    except ValueError as exc:
+        result["blended"] = str(exc)
     renderer.delete()
     # a GlphongMaterial drawn by a renderer glphong was not enabled on: an error, not a black image
     # (after the first renderer is deleted: on EGL deleting one OffscreenRenderer ends the shared display)

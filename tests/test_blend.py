@@ -300,8 +300,13 @@ def test_materials_keep_their_blending_in_json_and_files(tmp_path):
     assert material_from_json(json.loads(json.dumps(material_to_json(material)))) == material
     assert "AlphaBlend(0.25)" in repr(material)
     scene = _quad_scene(range(1), background=False)
-    glphong.save_gltf(scene, tmp_path / "blend.glb")
-    assert glphong.load_scene(tmp_path / "blend.glb").objects[0].material == scene.objects[0].material
+    glphong.save_gltf(scene, tmp_path / "blend.gltf")
+    assert glphong.load_scene(tmp_path / "blend.gltf").objects[0].material == scene.objects[0].material
+    entry = json.loads((tmp_path / "blend.gltf").read_text())["materials"][0]  # what other viewers read
+    alpha = scene.objects[0].material.alpha_blend.alpha
+    assert entry["alphaMode"] == "BLEND" and entry["pbrMetallicRoughness"]["baseColorFactor"][3] == alpha
+    del entry["extras"]  # without glphong's own record, the file's glTF fields alone give the blend back
+    assert glphong.formats.gltf_scene.gltf_pbr_material(entry).alpha_blend == glphong.AlphaBlend(alpha)
 
 
 def test_gltf_blend_loads_and_renders(tmp_path, glphong_make_renderer):

@@ -69,6 +69,7 @@ def test_refusals_name_the_problem(measured):
     _, m = measured
     assert "cannot be instanced" in m["instanced"]
     assert "not enabled on" in m["not_enabled"] and "enable(renderer)" in m["not_enabled"]
+    assert "blends (alpha_blend)" in m["blended"] and "glphong.Renderer" in m["blended"]
 
 
 def test_metallic_roughness_material_converts_to_gltf_pbr(measured):

@@ -8,8 +8,8 @@ What is written:
   diffuse albedo ``rho_d``/``rho``, or ``pi kd`` clipped to 1, its texture as ``baseColorTexture``;
   metallic 0, roughness 1: an approximation; a `GltfPBR` as itself: its base colour, metallic and roughness
   factors, a metallic-roughness texture that both read (blue, green), its emissive with
-  ``KHR_materials_emissive_strength``; any material's normal map as ``normalTexture`` and alpha mask as
-  ``alphaMode`` MASK) and, exactly, in the material's
+  ``KHR_materials_emissive_strength``; any material's normal map as ``normalTexture``, alpha mask as
+  ``alphaMode`` MASK and alpha blend as ``alphaMode`` BLEND) and, exactly, in the material's
   ``extras: {"glphong": ...}`` (`glphong.definitions.as_json`), which `load_scene` prefers;
 - textures as PNG images (8-bit sources, re-encoded losslessly) with their samplers;
 - the camera (perspective: ``yfov``, ``znear``, ``zfar``; orthographic: ``ymag``; an `IntrinsicsCamera`'s
@@ -139,8 +139,11 @@ def _material(builder, material, cache):
                                 "scale": float(material.normal_map.scale)}
     if material.alpha_mask is not None:
         out.update(alphaMode="MASK", alphaCutoff=float(material.alpha_mask.cutoff))
-        if not material.alpha_mask.textured:
-            pbr["baseColorFactor"][3] = float(material.alpha_mask.alpha)
+    elif material.alpha_blend is not None:
+        out.update(alphaMode="BLEND")
+    alpha = material.alpha_mask or material.alpha_blend
+    if alpha is not None and not alpha.textured:
+        pbr["baseColorFactor"][3] = float(alpha.alpha)
     name = f"{type(material).__name__}{len(builder.doc.get('materials', []))}"  # unique: readers key materials by name
     return {"name": name, "pbrMetallicRoughness": pbr, **out, "extras": {"glphong": stored},
             "doubleSided": bool(material.two_sided)}

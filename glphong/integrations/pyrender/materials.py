@@ -18,7 +18,8 @@ class GlphongMaterial(pyrender.Material):
     Parameters
     ----------
     material : glphong.Material
-        Any glphong material: `Lambert`, `Phong`, `BlinnPhong` or a user's `MaterialModel`/`MaterialSum`.
+        Any glphong material: `Lambert`, `Phong`, `BlinnPhong` or a user's `MaterialModel`/`MaterialSum`; not a blended
+        one (``alpha_blend``: ValueError).
     exposure : float
         Linear scale before the sRGB encoding into pyrender's 8-bit framebuffer, > 0.
     name : str, optional
@@ -27,6 +28,10 @@ class GlphongMaterial(pyrender.Material):
     def __init__(self, material, exposure=1.0, name=None):
         if not isinstance(material, Material):
             raise TypeError(f"material must be a glphong material such as glphong.Phong (got {type(material).__name__})")
+        if material.alpha_blend is not None:
+            raise ValueError(f"{material!r} blends (alpha_blend): pyrender's passes draw glphong's materials opaque, so "
+                             "the embedding refuses it rather than draw it wrong; composite it with glphong.Renderer "
+                             "(depth peeling, docs/design.md section 16), or give the material alpha_mask= instead")
         super().__init__(name=name, doubleSided=material.two_sided)
         self.glphong = material
         self.exposure = scalar("exposure", exposure, low=0.0, low_inclusive=False)
