@@ -567,3 +567,19 @@ def test_obj_mtllib_is_read_once_and_named_by_its_line(tmp_path, monkeypatch):
     (tmp_path / "late.obj").write_text("# a comment\n\n  mtllib a.mtl ../b.mtl\n" + quad)
     error = _refused(tmp_path / "late.obj", "leaves the scene file's folder")
     assert error.where == "line 3"
+
+
+@pytest.mark.parametrize("suffix", [".glb", ".obj"])
+def test_a_scene_too_large_for_a_default_view_names_the_file(tmp_path, suffix):
+    """Finite positions of 1e30 m (a legal file, or a damaged compressed stream): float32 holds the vertices but no
+    default camera and light 5 radii away (the light's power 4 pi d^2 overflows); the error names the file and what to
+    give, and a given camera and lights load it."""
+    import trimesh
+    path = tmp_path / f"huge{suffix}"
+    trimesh.Trimesh([[0, 0, 0], [1e30, 0, 0], [0, 1e30, 0]], [[0, 1, 2]], process=False).export(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(SceneFileError, match=r"huge.*beyond 1e\+18 m.*give camera= and lights="):
+            glphong.load_scene(path)
+        camera = glphong.PerspectiveCamera.look_at((0.0, 0.0, 1e31), (0.0, 0.0, 0.0), znear=1e29, zfar=1e32)
+        assert len(glphong.load_scene(path, camera=camera, lights=[]).objects) == 1

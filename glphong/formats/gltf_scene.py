@@ -410,7 +410,7 @@ def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name
         material, transform = _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale)
         scene.add(transformed_uvs(mesh, transform), material, pose=world, name=name)
     if lights is None:  # a file without lights is not drawn black by accident
-        _, view_lights, view_ambient = default_view(scene)
+        _, view_lights, view_ambient = default_view(scene, path)
         warnings.warn(f"{path} has no lights: glphong adds its default point light and ambient light (give "
                       "lights=[] to keep the scene dark)", stacklevel=3)
         for light in view_lights:
@@ -418,4 +418,4 @@ def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name
         if ambient is None:
             scene.ambient = view_ambient
         lights = list(view_lights)
-    return with_default_view(scene, chosen_camera, lights, ambient)
+    return with_default_view(scene, chosen_camera, lights, ambient, path)

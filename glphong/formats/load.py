@@ -128,6 +128,6 @@ def _load_obj(path, camera, lights, ambient, materials, allow_outside, limits):
                 made[name] = material_from_mtl(mtl.get(name, {}), name, str(path), limits)
             material = made[name]
         scene.add(mesh, material, name=name or path.stem)
-    return with_default_view(scene, camera, lights, ambient)
+    return with_default_view(scene, camera, lights, ambient, path)
 
 

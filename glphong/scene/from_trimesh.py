@@ -17,6 +17,7 @@ import math
 
 import numpy as np
 
+from glphong.core.filesafety import SceneFileError
 from glphong.materials import Material, Texture
 from glphong.materials.lambert import Lambert
 from glphong.materials.mtl import MtlPhong
@@ -25,7 +26,7 @@ from glphong.scene.culling import points_sphere
 from glphong.scene.geometry import MeshData
 from glphong.lights import AmbientLight, PointLight
 
-__all__ = ["build_from_trimesh", "default_view", "scene_bounds", "empty_scene", "with_default_view"]
+__all__ = ["build_from_trimesh", "default_view", "DEFAULT_VIEW_EXTENT", "scene_bounds", "empty_scene", "with_default_view"]
 
 
 def empty_scene(scene_class, camera, lights, ambient):
@@ -43,11 +44,28 @@ def scene_bounds(scene):
     return centre, max(radius, 1e-6)
 
 
-def default_view(scene):
+#: the largest scene extent [m] (bounding sphere's radius and centre) that gets a default view: its light, some 5 radii
+#: away, has the power 4 pi d^2 that float32 still holds (a light's limit, 4.3e39 W, is reached near d = 1.8e19 m)
+DEFAULT_VIEW_EXTENT = 1e18
+
+
+def default_view(scene, source=None):
     """A camera, a point light and an ambient light for a scene that has none (see the module):
-    ``(camera, [light], ambient)``."""
+    ``(camera, [light], ambient)``.
+
+    Raises
+    ------
+    ValueError
+        (`glphong.filesafety.SceneFileError` naming ``source``, the file the scene came from, where given) The
+        scene's extent is beyond `DEFAULT_VIEW_EXTENT` or not finite: no default camera and light exist in float32.
+    """
 
     centre, radius = scene_bounds(scene)
+    if not (np.all(np.isfinite(centre)) and np.isfinite(radius)) or max(radius, *np.abs(centre)) > DEFAULT_VIEW_EXTENT:
+        message = (f"the scene's bounding sphere (centre {np.array2string(np.asarray(centre), precision=3)}, radius "
+                   f"{radius:.3g} m) lies beyond {DEFAULT_VIEW_EXTENT:g} m, where no default camera and light can be "
+                   "placed in float32: give camera= and lights=")
+        raise SceneFileError(source, message) if source is not None else ValueError(message)
     direction = np.array([0.3, 0.4, 1.0]) / np.linalg.norm([0.3, 0.4, 1.0])
     distance = 3.0 * radius  # the bounding sphere fills 87% of a 45-degree view
     camera = PerspectiveCamera.look_at(centre + distance * direction, centre, yfov=math.radians(45.0),
@@ -57,11 +75,11 @@ def default_view(scene):
     return camera, [PointLight(tuple(light), 4 * math.pi * d * d)], AmbientLight(0.1)
 
 
-def with_default_view(scene, camera, lights, ambient):
+def with_default_view(scene, camera, lights, ambient, source=None):
     """``scene`` with `default_view`'s camera where none was given, and its lights and ambient light where
-    no lights were given either."""
+    no lights were given either (``source``: the file the scene came from, named in `default_view`'s error)."""
     if camera is None:
-        view_camera, view_lights, view_ambient = default_view(scene)
+        view_camera, view_lights, view_ambient = default_view(scene, source)
         scene.camera = view_camera
         if lights is None:
             for light in view_lights:
