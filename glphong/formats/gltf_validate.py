@@ -23,6 +23,7 @@ import numbers
 
 from glphong.core.filesafety import SceneFileError
 from glphong.formats.gltf_compressed import MESHOPT_FILTERS, meshopt_extension
+from glphong.formats.gltf_material_extensions import check_material_extensions
 
 __all__ = ["validate_gltf", "COMPONENT_BYTES", "TYPE_WIDTHS", "MODES"]
 
@@ -310,6 +311,7 @@ def _check_materials(c):
         if ior is not None:
             c.obj(ior, f"{where}.extensions.KHR_materials_ior")
             c.number(ior.get("ior", 1.5), f"{where}.extensions.KHR_materials_ior.ior", 0.0)
+        check_material_extensions(c, extensions, where, _check_texture_ref)  # specular, clearcoat
         strength = extensions.get("KHR_materials_emissive_strength")
         if strength is not None:
             c.obj(strength, f"{where}.extensions.KHR_materials_emissive_strength")

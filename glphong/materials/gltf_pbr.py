@@ -45,15 +45,19 @@ import numpy as np
 
 from glphong.definitions.cases import Case, _mirror_eye, _unit, generic_cases
 from glphong.materials.cook_torrance import oracle_half_vector
+from glphong.materials.gltf_extensions import (EXTENSION_PARAMS, ExtensionProperties, GltfExtensionFeatures,  # noqa: F401
+                                               extension_cases, extension_gltf_fields, gltf_clearcoat_fresnel,
+                                               gltf_clearcoat_mix, gltf_extensions_oracle, gltf_specular_fresnel,
+                                               gltf_specular_parts)
 from glphong.definitions.material import MaterialModel, Param, Properties, constant_part
 from glphong.definitions.params import GlslFile
 from glphong.definitions.surface import SurfaceInput
-from glphong.twin.band import EPS
-from glphong.twin.functions import microfacet_geometry, microfacet_ggx
+from glphong.twin.band import EPS, FLT_MAX, FLT_MIN
+from glphong.twin.functions import dot as _dot, microfacet_geometry, microfacet_ggx
 
-__all__ = ["GltfPBR", "gltf_pbr_ggx", "gltf_pbr_visibility_cos"]
+__all__ = ["GltfPBR", "gltf_pbr_band", "gltf_pbr_ggx", "gltf_pbr_visibility_cos"]
 
-_FLT_MAX = float(np.finfo(np.float32).max)
+_INV_PI = 1.0 / np.pi
 _BASE_COLOR = Param("base_color", "rgb", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
                     doc="baseColorFactor: a dielectric's diffuse colour, a metal's f0")
 _METALLIC = Param("metallic", "scalar", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
@@ -84,7 +88,115 @@ def gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2):
         return (n_dot_l / (dtype.type(2) * (n_dot_v * r_l + n_dot_l * r_v))).astype(dtype)
 
 
-class GltfPBR(MaterialModel):
+#: the parameters `gltf_pbr_band` bounds (emissive and occlusion: outside the response)
+_CORE_PARAMS = ("base_color", "metallic", "roughness", "emissive", "occlusion", "ior")
+#: KHR_materials_specular's and KHR_materials_clearcoat's defaults, at which the response is the core formula
+_CORE_AT = {"specular": 1.0, "specular_color": 1.0, "clearcoat": 0.0}
+
+
+def _interval(value, rel):
+    """``value (1 -+ rel)``: the float32 rounding of a chain of operations on non-negative factors."""
+    return value * (1.0 - rel), value * (1.0 + rel)
+
+
+def _float32(value):
+    """A parameter as the GPU holds it: rounded to float32 (a float32 uniform is itself), as float64."""
+    return np.asarray(value, dtype=np.float64).astype(np.float32).astype(np.float64)
+
+
+def gltf_pbr_band(n, wi, wo, n_dot_l, p, constants):
+    """Interval ``(low, high)``, each (N, 3), of the float32 ``gltf_pbr_response``: the formula of gltf_pbr.glsl over
+    the box of its float32 inputs, one evaluation, each factor bounded by its monotonicity (docs/speed.md, "Verify
+    against the render").
+
+    The inputs: ``n.l`` and ``n.v`` to ``D eps`` (`glphong.twin.band.BandConstants`), ``v.h = |l + v|/2`` to ``D eps``
+    (l and v each to ``D eps``) and ``2 eps`` of its length; the half vector's angle from n, ``theta_h``, to
+    ``2 D eps / (v.h)`` (the direction of ``l + v``, and n's) plus ``2 C eps (1 + c)`` (its chord ``c = |h - n|``
+    formed in float32, `glphong.twin.band.lobe_band`'s rule); the parameters as the float32 uniforms hold them
+    (a textured value's own interval is `glphong.checks.tolerances`'s), ``a2 = roughness^4`` to ``4 eps`` (two
+    products), ``1 - metallic`` and ``1 - base_color`` to ``eps``.  Then, all factors non-negative: ``tan2 =
+    sin^2(theta_h) / (n.h)^2`` with ``n.h = (n.l + n.v)/|l + v|`` at its ends; GGX ``D`` falls with ``tan2`` (``a2 <=
+    1``) and moves by at most the relative change of ``a2`` (``|d ln D / d ln a2| = |tan2 - a2|/(tan2 + a2) <= 1``);
+    ``V (n.l)`` rises with ``n.l`` and falls with ``n.v`` and ``a2``; ``x = (1 - v.h)^5`` falls with ``v.h``; the
+    products and sums of non-negative intervals bound the rest.  Each chain of float32 operations (D, V, x, f0, fd,
+    the two parts, the sum) is widened by ``A eps`` relative, at least twice its operations' rounding.  Where the
+    GPU's gate ``n.v > 0``, ``n.l > 0`` is uncertain the low end is 0; where ``n.v <= -D eps`` the GPU returns 0.
+    Checked against the formula run in float32 and on both GPUs (tests/materials/test_gltf_pbr.py).
+
+    Parameters
+    ----------
+    n, wi, wo : (N, 3) float64 ndarray
+        Unit normal, directions toward the light and the viewer.
+    n_dot_l : (N,) float64 ndarray
+        As the caller's gate computed it; the band covers ``(0, n.l + D eps]``.
+    p : ParamValues
+        ``base_color`` (3,) or (N, 3), ``metallic``, ``roughness``, ``ior`` scalars or (N,).
+    constants : glphong.twin.band.BandConstants
+
+    Returns
+    -------
+    low, high : (N, 3) float64 ndarray
+    """
+    de, rel = constants.D * EPS, constants.A * EPS
+    nl = np.asarray(n_dot_l, dtype=np.float64)
+    nv = _dot(n, wo)
+    s = wi + wo
+    length = np.sqrt(_dot(s, s))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        e = s / length[:, None] - n
+        chord = np.sqrt(_dot(e, e))
+        theta = 2.0 * np.arcsin(np.minimum(0.5 * chord, 1.0))
+        spread = 4.0 * de / length + 2.0 * constants.C * EPS * (1.0 + chord)
+        nl_lo, nl_hi = np.maximum(nl - de, 0.0), nl + de
+        nv_lo, nv_hi = np.maximum(nv - de, np.finfo(np.float64).tiny), nv + de
+        # tan^2(theta_h) = sin^2 / (n.h)^2, n.h = (n.l + n.v)/|l + v| with |l + v| to 2 D eps and 2 eps of itself
+        sin2_lo = np.sin(np.maximum(theta - spread, 0.0)) ** 2
+        sin2_hi = np.where(theta + spread < 0.5 * np.pi, np.sin(theta + spread) ** 2, 1.0)
+        nh_lo = (nl_lo + nv_lo) / ((length + 2.0 * de) * (1.0 + 2.0 * EPS))
+        nh_hi = (nl_hi + nv_hi) / np.maximum((length - 2.0 * de) * (1.0 - 2.0 * EPS), 0.0)
+        tan2_lo = sin2_lo / (nh_hi * nh_hi) * (1.0 - rel)
+        tan2_hi = sin2_hi / (nh_lo * nh_lo) * (1.0 + rel)
+        a2 = _float32(p.roughness) ** 4
+        a2_lo, a2_hi = _interval(a2, 4.0 * EPS)  # two float32 products of the float32 roughness
+        a2_lo = np.where(a2_lo < 2.0 * FLT_MIN, 0.0, a2_lo)  # float32 may flush alpha^2
+        # D (its rounding and a2's within 2 A eps) times V (n.l) (its rounding within A eps), and their product
+        d_lo = microfacet_ggx(tan2_hi, a2_lo)
+        d_hi = microfacet_ggx(tan2_lo, a2)
+        spec_lo = np.minimum(d_lo * gltf_pbr_visibility_cos(nl_lo, nv_hi, a2_hi)
+                             * ((1.0 - 2.0 * rel) * (1.0 - rel) * (1.0 - EPS)), FLT_MAX)
+        spec_hi = np.where(d_hi > 0, np.minimum(d_hi * gltf_pbr_visibility_cos(nl_hi, nv_lo, a2_lo)
+                                                * ((1.0 + 2.0 * rel) * (1.0 + rel) * (1.0 + EPS)), FLT_MAX), 0.0)
+        # v.h = |l + v|/2 to D eps (and 2 eps of |l + v|, 1 of 1 - v.h); x = max(1 - v.h, 0)^5
+        x1_lo = np.maximum(1.0 - 0.5 * length - (de + 3.0 * EPS), 0.0)
+        x1_hi = np.maximum(1.0 - 0.5 * length + (de + 3.0 * EPS), 0.0)
+        x_lo, x_hi = x1_lo ** 5 * (1.0 - rel), x1_hi ** 5 * (1.0 + rel)
+        ior = _float32(p.ior)
+        f0_lo, f0_hi = _interval(((ior - 1.0) / (ior + 1.0)) ** 2, rel)
+        fd_lo = (f0_lo + np.maximum(1.0 - f0_hi, 0.0) * x_lo) * (1.0 - rel)
+        fd_hi = np.minimum((f0_hi + (1.0 - f0_lo) * x_hi) * (1.0 + rel), 1.0 + rel)
+        m = _float32(p.metallic)
+        om_lo, om_hi = _interval(1.0 - m, EPS)  # one float32 difference (exact for m >= 1/2)
+        c = _float32(p.base_color)
+        # the two parts, each a chain widened by A eps, and their sum by A eps more; the diffuse part c times
+        # (n.l/pi)(1 - fd)(1 - m), the specular part the Fresnel factor fd (1 - m) + (c + (1 - c) x) m times spec
+        shrink, grow = (1.0 - rel) ** 2, (1.0 + rel) ** 2
+        diffuse_lo = (_INV_PI * shrink) * nl_lo * np.maximum(1.0 - fd_hi, 0.0) * om_lo
+        diffuse_hi = (_INV_PI * grow) * nl_hi * (1.0 - fd_lo) * om_hi
+        # diffuse c + [fd (1 - m) + (c + (1 - c) x) m] spec = c (diffuse + m spec) + (1 - c) m (x spec) + fd (1 - m) spec
+        spec_lo, spec_hi = spec_lo * shrink, spec_hi * grow
+        m3 = m[..., None]
+        low = c * (diffuse_lo + m * spec_lo)[..., None] + ((1.0 - c) * (1.0 - EPS) * m3) * (x_lo * spec_lo)[..., None] \
+            + (fd_lo * om_lo * spec_lo)[..., None]
+        high = c * (diffuse_hi + m * spec_hi)[..., None] + ((1.0 - c) * (1.0 + EPS) * m3) * (x_hi * spec_hi)[..., None] \
+            + (fd_hi * om_hi * spec_hi)[..., None]
+    np.nan_to_num(low, copy=False, nan=0.0)
+    np.nan_to_num(high, copy=False, nan=np.inf)
+    low[~((nl - de > 0) & (nv - de > 0))] = 0.0  # the GPU's gate n.l > 0, n.v > 0 uncertain: it may return 0
+    high[~(nv + de > 0)] = 0.0  # n.v <= -D eps: the GPU returns 0
+    return low, high
+
+
+class GltfPBR(GltfExtensionFeatures, MaterialModel):
     """glTF 2.0's metallic-roughness material, as the specification's Appendix B writes it:
     ``f_r = mix(dielectric, metal, metallic)`` [1/sr].
 
@@ -119,10 +231,17 @@ class GltfPBR(MaterialModel):
     ior : float
         ``KHR_materials_ior``, in [1, 1e4]: the dielectric's Fresnel ``f0 = ((ior - 1)/(ior + 1))^2`` (the core
         specification's 1.5 gives 0.04).
+    specular, specular_color : float or SurfaceInput, float or (3,) array_like or SurfaceInput
+        ``KHR_materials_specular`` (default 1 and 1: the core): the dielectric's Fresnel ``F_d = mix(min(f0
+        specular_color, 1) specular, specular, x)`` and its diffuse weight ``1 - max(F_d)``
+        (`glphong.materials.gltf_extensions`, docs/gltf_extensions.md).
+    clearcoat, clearcoat_roughness : float or SurfaceInput
+        ``KHR_materials_clearcoat`` (default 0: no coat): ``mix(f_r, V_c D_c, clearcoat F_c(n.v))``, ``alpha_c =
+        clearcoat_roughness^2``; the coat takes the shading normal.
     """
 
     name = "gltf_pbr"
-    params = (_BASE_COLOR, _METALLIC, _ROUGHNESS, _EMISSIVE, _OCCLUSION, _IOR)
+    params = (_BASE_COLOR, _METALLIC, _ROUGHNESS, _EMISSIVE, _OCCLUSION, _IOR) + EXTENSION_PARAMS  # gltf_extensions
     needs = ("view",)
     ambient = "base_color"
     ambient_scale = 1.0 / np.pi
@@ -131,9 +250,10 @@ class GltfPBR(MaterialModel):
     glsl = GlslFile("materials/gltf_pbr.glsl")
     uses = ("microfacet",)
     vanishes_with = ()
-    properties = Properties(reciprocal=True, isotropic=True, energy_conserving=False, non_negative=True,
-                            condition="never in general: the Fresnel mix of a light dielectric exceeds 1 at oblique "
-                                      "incidence (module docstring)")
+    properties = ExtensionProperties(Properties(  # a coat is not reciprocal (gltf_extensions)
+        reciprocal=True, isotropic=True, energy_conserving=False, non_negative=True,
+        condition="never in general: the Fresnel mix of a light dielectric exceeds 1 at oblique incidence (module "
+                  "docstring)"))
 
     def gltf_fields(self, texture_index):
         """glTF's fields as the file writes them: the factors as they are, the metallic-roughness texture where
@@ -155,6 +275,9 @@ class GltfPBR(MaterialModel):
                 out["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": float(emissive.max())}}
             if isinstance(self.emissive, SurfaceInput) and self.emissive.texture is not None:
                 out["emissiveTexture"] = {"index": texture_index(self.emissive.texture)}
+        extensions = extension_gltf_fields(self, texture_index)  # KHR_materials_specular, _clearcoat (gltf_extensions)
+        if extensions:
+            out["extensions"] = out.get("extensions", {}) | extensions
         return pbr, out
 
     def _parts(self, f, wi, wo, n_dot_l, p):
@@ -168,7 +291,7 @@ class GltfPBR(MaterialModel):
         a2 = alpha * alpha
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
             specular = np.minimum(gltf_pbr_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2),
-                                  dtype.type(_FLT_MAX)).astype(dtype)
+                                  dtype.type(FLT_MAX)).astype(dtype)
             x1 = np.maximum(dtype.type(1) - v_dot_h, dtype.type(0))
             x = ((x1 * x1) * (x1 * x1) * x1).astype(dtype)
             c = np.asarray(p.base_color, dtype)
@@ -180,6 +303,8 @@ class GltfPBR(MaterialModel):
             diffuse = (c * (dtype.type(1 / np.pi) * n_dot_l)[..., None]) * (dtype.type(1) - fd)[..., None] \
                 * (dtype.type(1) - m)
             fresnel = fd[..., None] * (dtype.type(1) - m) + (c + (dtype.type(1) - c) * x[..., None]) * m
+            if "specular" in getattr(p, "extensions", ()):  # KHR_materials_specular: an rgb F_d (gltf_extensions)
+                diffuse, fresnel = gltf_specular_parts(c, m, n_dot_l, x, f0, p)
         return valid, diffuse, fresnel, specular, tan2, a2, v_dot_h
 
     def response(self, f, wi, wo, n_dot_l, p):
@@ -187,31 +312,20 @@ class GltfPBR(MaterialModel):
         dtype = specular.dtype
         with np.errstate(over="ignore", invalid="ignore"):
             value = diffuse + fresnel * specular[..., None]
+        if "clearcoat" in getattr(p, "extensions", ()):  # KHR_materials_clearcoat (gltf_extensions)
+            value = gltf_clearcoat_mix(value, f, wi, wo, n_dot_l, p, gltf_pbr_visibility_cos)
         return np.where(valid[..., None], value, dtype.type(0)).astype(dtype)
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
-        """The generic band, widened by D over the half vector's angular uncertainty: ``theta_h`` is known to
-        ``delta = 2 D eps / (v.h)`` (l, v and n rounded to float32, h from their sum), and D falls monotonically
-        with ``theta_h``, so the specular part lies between its values at ``theta_h + delta`` and at
-        ``max(theta_h - delta, 0)``.  What matters where the lobe (``alpha = roughness^2`` rad wide) is narrower
-        than float32 resolves directions: roughness below about 3e-4, off the exact peak."""
-        low, high = super().band(f, wi, wo, n_dot_l, p, constants)
-        valid, _, fresnel, specular, tan2, a2, v_dot_h = self._parts(f, wi, wo, n_dot_l, p)
-        theta = np.arctan(np.sqrt(tan2))
-        delta = 2 * constants.D * EPS / np.maximum(v_dot_h, 1e-30)
-
-        def ggx(t):
-            with np.errstate(over="ignore"):
-                return gltf_pbr_ggx(np.tan(np.clip(t, 0.0, np.pi / 2)) ** 2, a2)
-
-        d = gltf_pbr_ggx(tan2, a2)
-        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            ratio_high = np.where(d > 0, ggx(theta - delta) / d, 1.0)
-            ratio_low = np.where(d > 0, ggx(theta + delta) / d, 1.0)
-            part = np.where(valid, specular, 0.0)[..., None] * fresnel
-            high = high + np.nan_to_num(part * np.maximum(ratio_high - 1, 0.0)[..., None], posinf=_FLT_MAX)
-            low = low - np.nan_to_num(part * np.maximum(1 - ratio_low, 0.0)[..., None])
-        return low, high
+        """The derived band (`gltf_pbr_band`): the response over the box of float32 inputs, factor by factor; the
+        generic band (`MaterialModel.band`) where a parameter the derived band does not know is present, unless it is
+        at the value where the core formula holds (`_CORE_AT`: glTF's extensions at their defaults)."""
+        for name, value in p.__dict__.items():
+            if name in _CORE_PARAMS or (name in _CORE_AT and np.all(np.asarray(value) == _CORE_AT[name])) or \
+                    (name in ("extensions", "clearcoat_roughness") and not getattr(p, "extensions", ())):
+                continue
+            return super().band(f, wi, wo, n_dot_l, p, constants)
+        return gltf_pbr_band(f.n, wi, wo, n_dot_l, p, constants)
 
     def oracle(self, f, wi, wo, n_dot_l, p):
         """Appendix B in mpmath, as the specification writes it: ``h`` from ``l + v``, ``D`` with the denominator
@@ -223,6 +337,9 @@ class GltfPBR(MaterialModel):
         if h is None:
             return [mpmath.mpf(0)] * 3
         n_dot_h, v_dot_h = dot(f.n, h), abs(dot(wo, h))
+        if getattr(p, "extensions", ()):  # the extensions' own formulas (gltf_extensions)
+            return gltf_extensions_oracle(p.base_color, p.metallic, p.roughness, p.ior, p.extensions, p, n_dot_l,
+                                          n_dot_v, n_dot_h, v_dot_h)
         alpha = p.roughness * p.roughness
         a2 = alpha * alpha
         denominator = n_dot_h * n_dot_h * (a2 - 1) + 1
@@ -247,7 +364,7 @@ class GltfPBR(MaterialModel):
 
     @classmethod
     def stability_cases(cls):
-        return _stability_cases()
+        return _stability_cases() + extension_cases(cls)
 
 
 def _stability_cases():
