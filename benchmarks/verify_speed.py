@@ -15,12 +15,26 @@ warm-up; printed: both medians and their ratio.
 ``--compare DIR`` checks the arrays against such a directory with ``np.array_equal`` (bit for bit) and prints the
 verdict per scene; ``--profile SCENE`` runs cProfile over one verify of that scene at the first size instead.
 
+``--against BEFORE`` compares two versions of glphong interleaved: BEFORE (the root of a checkout or an export of
+another commit, e.g. ``git archive <commit> | tar -x -C /tmp/before``) and ``--tree`` (default: this checkout), each
+imported in a worker process of its own (``PYTHONPATH`` and ``GLPHONG_GLSL_DIR`` set to its root) that runs this
+script's scenes on request.  Per scene and size, after a warm-up, ``--rounds`` rounds alternate the workers (before,
+after, before, after, ...); each round times ``--repeats`` renders (their median) and one verify in each worker.
+Printed per version: the medians over the rounds of the render, the verify and their ratio, with the ratio's spread
+(25th to 75th percentile), and whether the two versions' verify arrays are equal bit for bit.
+
 Run:  python benchmarks/verify_speed.py [--backend egl] [--sizes 64 256] [--repeats 7] [--verify-repeats 3]
       [--scenes ...] [--save DIR | --compare DIR] [--profile SCENE]
+      python benchmarks/verify_speed.py --against /tmp/before [--tree DIR] [--rounds 5] [--sizes ...] [--scenes ...]
 """
 import argparse
 import cProfile
+import os
 import pstats
+import subprocess
+import sys
+import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -64,6 +78,84 @@ def _arrays(report):
     return {name: getattr(report, name) for name in ARRAYS if getattr(report, name) is not None}
 
 
+def _worker(backend):
+    """Serve ``render|verify|save <scene> <size> [path]`` lines from stdin: seconds (or 'ok') on stdout."""
+    renderers, scenes = {}, {}
+    print(Path(glphong.__file__).parent.parent, flush=True)  # the version this worker imported
+    for line in sys.stdin:
+        command, name, size, *rest = line.split()
+        size = int(size)
+        if size not in renderers:
+            renderers[size] = glphong.Renderer(size, size, backend=backend)
+        scene = scenes.setdefault(name, SCENES[name]())
+        start = time.perf_counter()
+        if command == "render":
+            renderers[size].render(scene)
+        else:
+            report = glphong.verify(scene, renderers[size])
+            if command == "save":
+                np.savez(rest[0], **_arrays(report))
+        print(time.perf_counter() - start, flush=True)
+
+
+class _Version:
+    """A worker process importing glphong from ``root``."""
+
+    def __init__(self, root, backend):
+        env = dict(os.environ, PYTHONPATH=str(root), GLPHONG_GLSL_DIR=str(Path(root) / "glsl"))
+        self.process = subprocess.Popen([sys.executable, __file__, "--worker", "--backend", backend], cwd=root,
+                                        env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+        self.root = self.process.stdout.readline().strip()
+
+    def ask(self, *words):
+        self.process.stdin.write(" ".join(str(w) for w in words) + "\n")
+        self.process.stdin.flush()
+        answer = self.process.stdout.readline()
+        if not answer:
+            raise RuntimeError(f"the worker of {self.process.args} stopped")
+        return float(answer)
+
+    def close(self):
+        self.process.stdin.close()
+        self.process.wait()
+
+
+def _against(args):
+    """``--against``: the two versions interleaved, one worker each."""
+    versions = {"before": _Version(args.against, args.backend), "after": _Version(args.tree, args.backend)}
+    print(f"before: glphong from {versions['before'].root}; after: from {versions['after'].root}; {args.rounds} rounds, "
+          f"render: median of {args.repeats}\n")
+    print("| scene | size | render before [ms] | verify before [ms] | before / render | render after [ms] | "
+          "verify after [ms] | after / render | same arrays |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    with tempfile.TemporaryDirectory() as folder:
+        for size in args.sizes:
+            for name in args.scenes:
+                times = {v: {"render": [], "verify": [], "ratio": []} for v in versions}
+                for v, worker in versions.items():  # warm-up, and the arrays
+                    worker.ask("render", name, size)
+                    worker.ask("save", name, size, f"{folder}/{v}.npz")
+                for _ in range(args.rounds):
+                    for v, worker in versions.items():
+                        render = float(np.median([worker.ask("render", name, size) for _ in range(args.repeats)]))
+                        check = worker.ask("verify", name, size)
+                        times[v]["render"].append(render)
+                        times[v]["verify"].append(check)
+                        times[v]["ratio"].append(check / render)
+                before, after = (np.load(f"{folder}/{v}.npz") for v in versions)
+                differ = [k for k in set(before.files) | set(after.files) if k not in before.files
+                          or k not in after.files or not np.array_equal(before[k], after[k], equal_nan=True)]
+                cells = []
+                for v in versions:
+                    ratio = times[v]["ratio"]
+                    cells.append(f"{1000 * np.median(times[v]['render']):.1f} | {1000 * np.median(times[v]['verify']):.0f} | "
+                                 f"{np.median(ratio):.0f}x ({np.percentile(ratio, 25):.0f}-{np.percentile(ratio, 75):.0f})")
+                same = "yes" if not differ else f"no: {', '.join(sorted(differ))}"
+                print(f"| {name} | {size} | {' | '.join(cells)} | {same} |", flush=True)
+    for worker in versions.values():
+        worker.close()
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--backend", default="egl")
@@ -74,7 +166,18 @@ def main():
     parser.add_argument("--save", type=Path)
     parser.add_argument("--compare", type=Path)
     parser.add_argument("--profile", choices=list(SCENES))
+    parser.add_argument("--against", type=Path, help="root of the version to compare with (before)")
+    parser.add_argument("--tree", type=Path, default=Path(__file__).resolve().parent.parent,
+                        help="root of the version compared (after; default: this checkout)")
+    parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
+    if args.worker:
+        _worker(args.backend)
+        return
+    if args.against:
+        _against(args)
+        return
     if args.profile:
         size = args.sizes[0]
         with glphong.Renderer(size, size, backend=args.backend) as renderer:

@@ -369,20 +369,64 @@ def exact_reflection(position, f, wo, lit, key, uniforms, material, lights=None,
         exact = [t for t in closed if twin.closed_form_is_exact(
             t.integral.form, _exponent(t, terms[t.name].values_from_uniforms(uniforms, dtype=np.float64))
             if t.integral.form != "irradiance" else None)]
-        if closed_forms and len(exact) == len(key.lit_terms):  # all in closed form (else all by quadrature: its rtol is of the sum)
+        if closed_forms and hasattr(twin, "exact_lobe"):  # the mixed-material split: each term by its cheapest exact way
+            value, err = _split_reflection(position, f, wo, lit, key, exact, twin, p, light_key, uniforms, terms)
+            error = error + np.where(lit, err, 0.0)
+        elif closed_forms and len(exact) == len(key.lit_terms):  # all in closed form (else all by quadrature: its rtol is of the sum)
             with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
                 value = closed_reflection(position, f, wo, exact, twin, p, light_key, uniforms, terms, np.float64)
         else:
-            def integrand(index, w):
-                g = f.select(index)
-                with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-                    return terms_response(g, w, wo[index], _dot(g.n, w), key.lit_terms, uniforms, terms,
-                                          light_key.occludable)
-
-            value, err, _ = twin.exact(position, f.n, p, integrand)
+            value, err = _quadrature(position, f, wo, key.lit_terms, twin, p, light_key, uniforms, terms)
             error = error + np.where(lit, err, 0.0)
         out = out + np.where(lit[:, None], value, 0.0)
     return out, error
+
+
+def _quadrature(position, f, wo, term_keys, twin, p, light_key, uniforms, terms):
+    """The kind's float64 quadrature (``exact``) of the sum of ``term_keys``' responses: ``(value (N, 3), error
+    (N,))``."""
+    def integrand(index, w):
+        g = f.select(index)
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            return terms_response(g, w, wo[index], _dot(g.n, w), term_keys, uniforms, terms, light_key.occludable)
+
+    value, error, _ = twin.exact(position, f.n, p, integrand)
+    return value, error
+
+
+def _split_reflection(position, f, wo, lit, key, exact, twin, p, light_key, uniforms, terms, rtol=1e-9):
+    """The mixed-material split of `exact_reflection` (issue 40), ``(value (N, 3), error (N,))``: the terms of
+    irradiance form by the twin's exact irradiance (as when every term has one), the lecture's lobes by its
+    ``exact_lobe`` to ``rtol`` of the rest of the pixel (`glphong.twin.environment_lobe`), and only the other terms by
+    the quadrature of their sum (``exact``, its rtol of their sum)."""
+    irradiance_terms = [t for t in exact if t.integral.form == "irradiance"]
+    # q = 0: the twin's lobe is 1 even where r.w <= 0 (lobe_from_delta), which the quadrature integrates as it is
+    lobes = [t for t in exact if t.integral.form != "irradiance"
+             and _exponent(t, terms[t.name].values_from_uniforms(uniforms, dtype=np.float64)) > 0]
+    rest = [t for t in key.lit_terms if t not in irradiance_terms and t not in lobes]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
+        value = closed_reflection(position, f, wo, irradiance_terms, twin, p, light_key, uniforms, terms, np.float64)
+    error = np.zeros(len(position))
+    if rest:
+        more, error = _quadrature(position, f, wo, rest, twin, p, light_key, uniforms, terms)
+        value = value + more
+    if lobes:
+        r = view_reflected(f.n, wo)
+        ok = lit & np.all(np.isfinite(r), axis=1) & np.all(np.isfinite(f.n), axis=1)
+        for t in lobes:
+            values = terms[t.name].values_from_uniforms(uniforms, dtype=np.float64, inputs=f.inputs)
+            k = np.broadcast_to(getattr(values, t.integral.scale) * occlusion_factor(t, values, light_key.occludable),
+                                position.shape)
+            size = np.max(np.abs(k), axis=1)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                floor = np.where(size > 0, np.max(np.abs(value), axis=1) / size, 0.0)
+            lobe = np.zeros(position.shape)
+            spread = np.zeros(len(position))
+            q = _exponent(t, terms[t.name].values_from_uniforms(uniforms, dtype=np.float64))
+            lobe[ok], spread[ok], _ = twin.exact_lobe(f.n[ok], r[ok], q, rtol, floor[ok])
+            value = value + k * lobe
+            error = error + size * spread
+    return value, error
 
 
 def terms_response(f, wi, wo, n_dot_l, term_keys, uniforms, terms, occluded=False):
@@ -462,12 +506,13 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None):
         if key.shadow_slots:
             _, face, _ = safe_normalize(gbuffer.face[selection].astype(np.float64))  # the triangles' own normals
             f = replace(f, visibility=_visibility(scene, key, gbuffer.position[selection].astype(np.float64), face,
-                                                  shadows[1]))
+                                                  shadows[1], obj))
         yield selection, obj, key, uniforms, position, f, n_valid
 
 
-def _visibility(scene, key, position, normal, filter_radius):
-    """Per light of ``key`` in loop order: None, or its ray-cast visibility ``(exact, low, high)``."""
+def _visibility(scene, key, position, normal, filter_radius, receiver=None):
+    """Per light of ``key`` in loop order: None, or its ray-cast visibility ``(exact, low, high)`` at the points of
+    ``receiver``."""
     setups = {(s.kind, s.index): s for s in binding(scene).shadow_setups(key.lights, key.shadow_size)}
     out = []
     for light in key.lights:
@@ -476,7 +521,8 @@ def _visibility(scene, key, position, normal, filter_radius):
         for j in range(light.count):
             setup = setups.get((light.name, j))
             out.append(None if setup is None else
-                       shadow_visibility(scene, setup, position, np.asarray(normal, dtype=np.float64), filter_radius))
+                       shadow_visibility(scene, setup, position, np.asarray(normal, dtype=np.float64), filter_radius,
+                                         receiver))
     return tuple(out)
 
 

@@ -94,13 +94,35 @@ def _intersector(mesh):
 
 
 def _first_hits(intersector, origins, directions):
-    """Distance along each ray to its first hit (inf where none), float64 (N,)."""
+    """Distance along each ray to its first hit (inf where none), float64 (N,).
+
+    With Embree, trimesh's ``intersects_id`` first-hit path, step by step and bit for bit (the directions unitized by
+    trimesh, one query of its Embree scene, the hit's float64 point on the triangle's plane by
+    ``trimesh.intersections.planes_lines``), without its copies of every ray (a ray-offset array, the live rays'
+    gather, the stuck-ray bookkeeping) that a single first hit does not use, and without gathering the rays where
+    every one hit (each ray a shadow test casts ends on a caster, nearly always)."""
     out = np.full(len(origins), np.inf)
     if intersector is None or not len(origins):
         return out
-    _, ray, location = intersector.intersects_id(origins, directions, multiple_hits=False, return_locations=True)
+    origins = np.asarray(origins, dtype=np.float64)
+    if not type(intersector).__module__.endswith("ray_pyembree"):  # trimesh's float64 intersector
+        _, ray, location = intersector.intersects_id(origins, directions, multiple_hits=False, return_locations=True)
+        start, toward = origins[ray], directions[ray]
+    else:
+        unit = trimesh.util.unitize(np.asarray(directions, dtype=np.float64))
+        triangle = intersector._scene.run(origins, unit)
+        every = bool(np.all(triangle != -1))
+        ray = np.arange(len(origins)) if every else np.nonzero(triangle != -1)[0]
+        start, unit = (origins, unit) if every else (origins[ray], unit[ray])
+        mesh = intersector.mesh
+        hit = triangle if every else triangle[ray]
+        location, valid = trimesh.intersections.planes_lines(mesh.triangles[hit, 0, :], mesh.face_normals[hit],
+                                                             start, unit)
+        toward = directions if every else directions[ray]
+        if not valid.all():
+            ray, start, toward = ray[valid], start[valid], toward[valid]
     if len(ray):
-        t = np.einsum("ij,ij->i", location - origins[ray], directions[ray])
+        t = np.einsum("ij,ij->i", location - start, toward)
         keep = t > 0.0
         rays = ray[keep]
         if np.all(rays[1:] > rays[:-1]):  # each ray once, in order (Embree's first hits): a plain assignment
@@ -125,7 +147,70 @@ def _plane_distance(n, point, origins, directions):
     return np.where(np.isfinite(t) & (t > 0.0), t, np.inf)
 
 
-def shadow_visibility(scene, setup, position, normal, filter_radius):
+def _world_vertices(obj):
+    """An object's vertices in world space (N, 3) float64, as `_caster_mesh` places them."""
+    return obj.mesh.positions @ obj.pose[:3, :3].T + obj.pose[:3, 3]
+
+
+def _flat(obj):
+    """``(n, c, slack)`` where every triangle of ``obj`` lies in the slab ``|n.y - c| <= slack`` and every triangle's
+    own plane stays in it to within ``slack`` of the triangle (Embree's float32 may report a hit just outside one);
+    None where the object is not flat to ``1e-7`` of its size."""
+    v = _world_vertices(obj)
+    tri = v[obj.mesh.indices.reshape(-1, 3)]
+    g = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    area = np.linalg.norm(g, axis=1)
+    if not len(area) or not area.max() > 0.0:
+        return None
+    n = g[np.argmax(area)] / area.max()
+    height = v @ n
+    size = float(np.max(np.abs(v))) + float(np.max(np.ptp(v, axis=0)))
+    thickness = 0.5 * float(height.max() - height.min())
+    tilt = float(np.max(np.linalg.norm(g[area > 0] / area[area > 0, None] - n, axis=1)))
+    if not thickness <= 1e-7 * size:
+        return None
+    return n, 0.5 * float(height.max() + height.min()), thickness + tilt * 1e-5 * size + 1e-12 * size
+
+
+def _clear_without_a_cast(scene, receiver, origins, directions, threshold):
+    """Rays that provably meet no caster nearer than ``threshold`` (their first hit, whichever triangle Embree
+    reports, no nearer), so that casting them would find them clear: (RING + 1, N) bool.
+
+    Where the receiver casts shadows it must be flat (`_flat`): a ray meets it only in its slab, at ``t_r +-
+    slack / |n.u|`` from ``t_r``, the distance to its plane, which must lie beyond the threshold (the receiver's own
+    plane at ``x`` is the tangent plane the threshold is measured from, less ``p + q``).  Every other caster must
+    keep its bounding sphere off the segment from the ray's origin to the threshold, the sphere widened by 5 % of the
+    scene's size: the distance trimesh reports is to the plane of the triangle Embree's float32 says the ray hits,
+    which a ray down to ``|u.n| = 1e-5`` (trimesh's cut) meets up to ``1e5`` float32 errors (``3e-7`` of the size)
+    away from the triangle.  At most 8 other casters are tested (beyond, nothing is proven)."""
+    others = [obj for obj in scene.objects if obj.casts_shadow and obj is not receiver]
+    flat = _flat(receiver) if receiver is not None and receiver.casts_shadow else None
+    if receiver is None or len(others) > 8 or (receiver.casts_shadow and flat is None):
+        return np.zeros(threshold.shape, bool)
+    proven = np.isfinite(threshold) & (threshold > 0.0)
+    limit = threshold * (1.0 + 1e-9)
+    vertices = [_world_vertices(obj) for obj in others]
+    one = origins.ndim == 1 or not any(origins.strides[:-1])  # the light's position for every ray (a cube map)
+    size = max([float(np.max(np.abs(v))) for v in vertices]
+               + [float(np.max(np.abs(origins[(0,) * (origins.ndim - 1)] if one else origins)))])
+    origins = np.broadcast_to(origins, threshold.shape + (3,))
+    directions = np.broadcast_to(directions, threshold.shape + (3,))
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        if flat is not None:
+            n, c, slack = flat
+            cos = np.abs(dot(directions, n))
+            t = (c - dot(origins, n)) / dot(directions, n)
+            proven &= (cos > 1e-6) & (t - slack / cos >= limit)
+        for v in vertices:
+            centre = 0.5 * (v.max(axis=0) + v.min(axis=0))
+            radius = float(np.max(np.linalg.norm(v - centre, axis=1))) * (1.0 + 1e-9) + 0.05 * size
+            w = centre - origins
+            along = np.clip(dot(w, directions), 0.0, limit)
+            proven &= dot(w - along[..., None] * directions, w - along[..., None] * directions) > radius * radius
+    return proven & np.isfinite(limit)
+
+
+def shadow_visibility(scene, setup, position, normal, filter_radius, receiver=None):
     """A shadowing light's visibility at given points: the exact value and its interval.
 
     Parameters
@@ -138,6 +223,9 @@ def shadow_visibility(scene, setup, position, normal, filter_radius):
         Their unit normals (either orientation).
     filter_radius : int
         The renderer's ``shadow_filter_radius``.
+    receiver : glphong.scene.SceneObject, optional
+        The object the points lie on: rays that provably meet nothing before their threshold are then not cast
+        (`_clear_without_a_cast`; the same visibility and band as casting them).
 
     Returns
     -------
@@ -177,10 +265,18 @@ def shadow_visibility(scene, setup, position, normal, filter_radius):
         directions = np.broadcast_to(axis, (RING + 1, n_points, 3))
     q = SHADOW_QUANTUM * (np.abs(d) + scale_x)
     bias = shadow_bias(plane, np.abs(d) + scale_x)
-    hits = _first_hits(intersector, origins.reshape(-1, 3), np.ascontiguousarray(directions).reshape(-1, 3))
-    hits = hits.reshape(RING + 1, n_points)
     planes = _plane_distance(normal[None], position[None], origins, directions)
     planes[0] = d
+    threshold = np.concatenate([(d - q)[None], planes[1:] - plane - q])  # clear where the first hit is no nearer
+    cast = ~_clear_without_a_cast(scene, receiver, origins, directions, threshold).reshape(-1)
+    rays = np.ascontiguousarray(directions).reshape(-1, 3)
+    starts = np.broadcast_to(setup.origin, rays.shape) if setup.map == "cube" else origins.reshape(-1, 3)
+    if cast.all():
+        hits = _first_hits(intersector, starts, rays)
+    else:  # a ray proven clear: as if it met nothing
+        hits = np.full(len(rays), np.inf)
+        hits[cast] = _first_hits(intersector, starts[cast], rays[cast])
+    hits = hits.reshape(RING + 1, n_points)
     # the centre ray reaches x unless something is nearer than d - q, and is blocked for the map by what is nearer
     # than d - B; a ring ray reaches the receiver where nothing comes nearer than its distance to x's tangent plane
     # less p + q (the neighbouring triangles' share of B: with x's own plane's p, the map cannot fall short of

@@ -18,10 +18,11 @@ import numpy as np
 
 from glphong.core import validate as _validate
 from glphong.lights.extended import CENTER, RADIANCE, SAMPLES, ExtendedLight, extended_cases
-from glphong.definitions.light import GlslFile, Param
+from glphong.definitions.light import GlslFile, Param, sensitivity_band
 from glphong.materials.lambert import Lambert
-from glphong.twin.area import (area_clip, area_clip_rounding, area_clipped_cosine, area_clipped_lobe,
-                               area_cosine_rounding, area_lobe_rounding, area_triangle_sample, polygon_arrays)
+from glphong.twin.area import (area_clip, area_clip_rounding, area_clipped_cosine, area_clipped_cosine_of,
+                               area_clipped_lobe, area_cosine_rounding, area_lobe_rounding, area_triangle_sample,
+                               polygon_arrays)
 from glphong.twin.functions import dot as _dot, safe_normalize
 from glphong.twin.quadrature import polygon_integral
 
@@ -36,7 +37,11 @@ class _Polygonal:
     """What the polygon kinds share, given ``polygon_of(x, p)`` (their GLSL's ``<kind>_polygon``): the closed forms'
     twins (rect.glsl's and polygon.glsl's ``_irradiance`` and ``_lobe``) and their bands, the generic sensitivity band
     (inputs moved by a few ulps) plus the float32 rounding of the edge formulas and the clips themselves
-    (`area_cosine_rounding`, `area_lobe_rounding`, `area_clip_rounding`), which no input perturbation shows."""
+    (`area_cosine_rounding`, `area_lobe_rounding`, `area_clip_rounding`), which no input perturbation shows.  The
+    sensitivity band takes the shortcuts the closed forms allow (`sensitivity_band`): the radiance a factor, the
+    rect's centre moved with ``x`` (``offset_uniform``), each move one way (``one_sided``: the closed forms are
+    continuous, and smooth where not 0); the irradiance's moves of the normal reuse the polygon of ``x`` and its
+    edges (`area_clipped_cosine_of`)."""
 
     def irradiance(self, x, n, p):
         return p.radiance * area_clipped_cosine(*self.polygon_of(x, p), n)[:, None]
@@ -44,9 +49,20 @@ class _Polygonal:
     def lobe(self, x, n, r, q, p):
         return p.radiance * area_clipped_lobe(*self.polygon_of(x, p), n, r, q)[:, None]
 
+    #: the 'vec3' uniform the twin reads only through ``uniform - x`` (`sensitivity_band`'s ``offset``), or None
+    offset_uniform = None
+
     def irradiance_band(self, x, n, p, constants):
-        low, high = super().irradiance_band(x, n, p, constants)
         polygon = self.polygon_of(x, p)
+        cosine = area_clipped_cosine_of(*polygon)  # the moves of n see the polygon of x
+
+        def evaluate(x_, p_, n_):
+            if p_ is p and x_.shape == x.shape and np.array_equal(x_, x):
+                return p.radiance * cosine(n_)[:, None]
+            return self.irradiance(x_, n_, p_)
+
+        low, high = sensitivity_band(evaluate, x, p, self.perturbed_uniforms(), constants, (n,), factors=("radiance",),
+                                     offset=self.offset_uniform, one_sided=True)
         clipped = area_clip(*polygon, n)
         slack = p.radiance * (area_cosine_rounding(*clipped, n) + area_clip_rounding(*polygon, n))[:, None]
         return np.maximum(low - slack, 0.0), high + slack
@@ -54,7 +70,9 @@ class _Polygonal:
     def lobe_band(self, x, n, r, q, p, constants):
         """Also the clips' slide: by the horizon, where the lobe is not 0 (`area_clip_rounding` with ``lobe``), and by
         the lobe's own plane, where it is."""
-        low, high = super().lobe_band(x, n, r, q, p, constants)
+        low, high = sensitivity_band(lambda x_, p_, n_, r_: self.lobe(x_, n_, r_, q, p_), x, p,
+                                     self.perturbed_uniforms(), constants, (n, r), factors=("radiance",),
+                                     offset=self.offset_uniform, one_sided=True)
         polygon = self.polygon_of(x, p)
         by_n = area_clip(*polygon, n)
         clipped = area_clip(*by_n, r)
@@ -127,13 +145,15 @@ class RectLight(_Polygonal, ExtendedLight):
         u, v = p.u, p.v
         a = (p.center - x) - 0.5 * u - 0.5 * v
         points = np.zeros((len(x), 10, 3), x.dtype)
-        edges = np.zeros_like(points)
-        points[:, :4] = np.stack([a, a + u, a + u + v, a + v], axis=1)
+        edges = np.zeros((len(x), 10, 3), x.dtype)
+        b = a + u
+        points[:, 0], points[:, 1], points[:, 2], points[:, 3] = a, b, b + v, a + v
         edges[:, :4] = np.stack(np.broadcast_arrays(u, v, -u, -v), axis=0)[None]
         count = np.where(_dot(x - p.center, np.cross(u, v)) > 0, 4, 0)
         return points, edges, count
 
     polygon_of = rect_polygon
+    offset_uniform = "center"  # rect_polygon reads the centre only through center - x
 
     def sample(self, x, n, k, p):
         m = int(p.samples)

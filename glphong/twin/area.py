@@ -17,7 +17,7 @@ from glphong.twin.band import EPS
 from glphong.twin.functions import atan2_first_quadrant, dot as _dot
 
 __all__ = ["AREA_MAX_VERTICES", "area_angle", "area_clip", "area_polygon_cosine", "area_solid_angle",
-           "area_edge_powers", "area_polygon_lobe", "area_clipped_cosine", "area_clipped_lobe", "area_cosine_rounding", "area_lobe_rounding", "area_clip_rounding", "area_triangle_sample", "polygon_arrays"]
+           "area_edge_powers", "area_polygon_lobe", "area_clipped_cosine", "area_clipped_cosine_of", "area_clipped_lobe", "area_cosine_rounding", "area_lobe_rounding", "area_clip_rounding", "area_triangle_sample", "polygon_arrays"]
 
 #: vertices a polygon may have after two clips (a light has at most 8)
 AREA_MAX_VERTICES = 10
@@ -91,7 +91,7 @@ def area_clip(p, e, count, c):
     and edge where it is inside, and none where it is outside."""
     n, size = p.shape[:2]
     width = _live_width(count, size)  # beyond every polygon's count nothing is put
-    q, f = np.zeros_like(p), np.zeros_like(e)
+    q, f = np.zeros(p.shape, p.dtype), np.zeros(e.shape, e.dtype)  # (calloc'd pages: no fill of the 10 slots)
     if not width:
         return q, f, np.zeros(n, int)
     index = np.arange(width)[None, :]
@@ -162,17 +162,29 @@ def _edge_frames(p, e):
     return g, s
 
 
-def area_polygon_cosine(p, e, count, n):
-    """``integral over the polygon of (n.w) dw`` [sr], (N,): ``max(-(1/2) sum_i Theta_i (n . m_i), 0)``."""
+def _cosine_edges(p, e, count):
+    """What `area_polygon_cosine` takes from the polygon alone: ``(theta, g, s, live, count, size)``, each edge's
+    angle ``Theta_i``, its plane's normal ``g = p x e`` and ``|g|``, (N, W), (N, W, 3), (N, W)."""
     size = p.shape[1]
     width = _live_width(count, size)
     p, e = p[:, :width], e[:, :width]
     g, s = _edge_frames(p, e)
     theta = area_angle(s, _dot(p, p + e))
     live = (np.arange(width)[None, :] < count[:, None]) & (s > 0)
+    return theta, g, s, live, count, size
+
+
+def _cosine_sum(edges, n):
+    """`area_polygon_cosine` from `_cosine_edges` and the normal ``n`` (N, 3)."""
+    theta, g, s, live, count, size = edges
     with np.errstate(divide="ignore", invalid="ignore"):
         terms = np.where(live, theta * (_dot(n[:, None, :], g) / s), 0.0)
     return np.where(count >= 3, np.maximum(-0.5 * _vertex_sum(terms, size), 0.0), 0.0)
+
+
+def area_polygon_cosine(p, e, count, n):
+    """``integral over the polygon of (n.w) dw`` [sr], (N,): ``max(-(1/2) sum_i Theta_i (n . m_i), 0)``."""
+    return _cosine_sum(_cosine_edges(p, e, count), n)
 
 
 def area_solid_angle(p, e, count):
@@ -236,9 +248,9 @@ def area_edge_powers(a, e, w, q, rounding=False):
     ek = da - db if even else theta
     pa = sa * sa if even else sa
     pb = sb * sb if even else sb
-    total = np.zeros_like(theta)
+    total = np.zeros(theta.shape, theta.dtype)
     err = 4 * (np.abs(da) + np.abs(db)) if even else 4 * theta   # E_0, E_1: the angle's, or the difference's
-    bound = np.zeros_like(theta)
+    bound = np.zeros(theta.shape, theta.dtype)
     rk = np.sqrt(r2) if even else np.ones_like(r2)
     with np.errstate(divide="ignore", invalid="ignore"):
         tail = theta / np.maximum(1 - r2, 1e-30)
@@ -348,6 +360,29 @@ def area_polygon_lobe(p, e, count, w, q):
 def area_clipped_cosine(p, e, count, n):
     """`area_polygon_cosine` of the polygon clipped by ``n`` (area.glsl), (N,)."""
     return area_polygon_cosine(*area_clip(p, e, count, n), n)
+
+
+def area_clipped_cosine_of(p, e, count):
+    """``n -> area_clipped_cosine(p, e, count, n)`` for one polygon and many normals (a band's moves of ``n``), bit
+    for bit: where every vertex lies on or above ``n``'s horizon the clip keeps the polygon as it is (`area_clip`), so
+    its edges' angles and planes, computed once, serve every ``n``; elsewhere the clip and the formula run anew."""
+    edges = None
+    size = p.shape[1]
+
+    def cosine(n):
+        nonlocal edges
+        width = _live_width(count, size)
+        active = np.arange(width)[None, :] < count[:, None]
+        whole = np.all(~active | (_dot(n[:, None, :], p[:, :width]) >= 0), axis=1) & (count < size)
+        if edges is None:
+            edges = _cosine_edges(p, e, count)
+        out = _cosine_sum(edges, n)
+        rest = np.nonzero(~whole)[0]
+        if len(rest):
+            out[rest] = area_clipped_cosine(p[rest], e[rest], count[rest], n[rest])
+        return out
+
+    return cosine
 
 
 def area_clipped_lobe(p, e, count, n, r, q):

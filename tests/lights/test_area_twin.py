@@ -101,3 +101,55 @@ def test_a_sum_over_the_live_vertices_is_the_whole_widths():
     for width in range(area.AREA_MAX_VERTICES + 1):
         padded = np.where(np.arange(area.AREA_MAX_VERTICES) < width, terms, 0.0)
         assert _same(area._vertex_sum(terms[:, :width], area.AREA_MAX_VERTICES), padded.sum(axis=1))
+
+
+@pytest.mark.parametrize("dtype", [np.float64, np.float32])
+def test_the_cosine_of_one_polygon_for_many_normals_is_the_clipped_cosine_to_the_bit(dtype):
+    """`area_clipped_cosine_of` reuses the polygon's edges where no vertex is below the horizon: the same bits as the
+    clip and the formula run anew, for normals that keep every vertex, that cut the polygon, and that clip it all."""
+    rng = np.random.default_rng(11)
+    p, e, count, c = _polygons(rng, 3000, dtype, False)
+    cosine = area.area_clipped_cosine_of(p, e, count)
+    centre = np.sum(p, axis=1) / np.maximum(count, 1)[:, None]
+    toward = -centre / np.maximum(np.linalg.norm(centre, axis=1, keepdims=True), 1e-300)  # most keep every vertex
+    whole = 0
+    with np.errstate(all="ignore"):
+        for n in (c, toward.astype(dtype), -toward.astype(dtype), (toward + 0.3 * c).astype(dtype)):
+            got, want = cosine(n), area.area_clipped_cosine(p, e, count, n)
+            assert _same(got, want)
+            active = np.arange(area.AREA_MAX_VERTICES)[None, :] < count[:, None]
+            whole += np.all(~active | (np.sum(n[:, None, :] * p, -1) >= 0), axis=1).sum()
+    assert whole > 3000  # the shortcut was taken
+
+
+@pytest.mark.parametrize("integral", ["irradiance", "lobe"])
+def test_the_area_bands_shortcuts_hold_the_generic_band(integral):
+    """The rect's band takes `sensitivity_band`'s shortcuts (the radiance a factor, the centre moved with x, each move
+    one way): it holds the generic band (every move both ways, each uniform's own) to 1e-3 of each deviation (its
+    second order) and 1e-12 of the largest value, at points around the light, below its plane and in it beside it
+    (seen edge-on: held at 0 on one side), with normals that cut the polygon and that clip it all."""
+    import glphong
+    from glphong.definitions.light import sensitivity_band
+    from glphong.twin.band import BAND
+
+    light = glphong.RectLight((0.3, -0.5, 1.6), (0.0, 0.6, 0.3), (1.0, 0.0, 0.0), (5.0, 2.0, 0.5))
+    p = light.values()
+    rng = np.random.default_rng(13)
+    x = rng.normal(size=(4000, 3)) * (1.5, 1.5, 1.0)
+    a, b = rng.uniform(0.6, 2.0, (2, 400)) * rng.choice([-1.0, 1.0], (2, 400))
+    x[:400] = p.center + a[:, None] * p.u + b[:, None] * p.v  # in the light's plane, off the light (there E jumps)
+    n, r = rng.normal(size=(2, 4000, 3))
+    n /= np.linalg.norm(n, axis=1, keepdims=True)
+    r /= np.linalg.norm(r, axis=1, keepdims=True)
+    if integral == "irradiance":
+        evaluate, directions = (lambda x_, p_, n_: light.irradiance(x_, n_, p_)), (n,)
+    else:
+        evaluate, directions = (lambda x_, p_, n_, r_: light.lobe(x_, n_, r_, 20, p_)), (n, r)
+    base = evaluate(x, p, *directions)
+    low, high = sensitivity_band(evaluate, x, p, light.perturbed_uniforms(), BAND, directions, factors=("radiance",),
+                                 offset="center", one_sided=True)
+    g_low, g_high = sensitivity_band(evaluate, x, p, light.perturbed_uniforms(), BAND, directions)
+    floor = 1e-12 * base.max()
+    assert (base > 0).mean() > 0.2 and (base == 0).mean() > 0.2 and (g_high[:400] > 0).mean() > 0.3
+    assert np.all(high >= g_high - 1e-3 * (g_high - base) - floor)
+    assert np.all(low <= g_low + 1e-3 * (base - g_low) + floor)

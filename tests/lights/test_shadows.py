@@ -252,3 +252,36 @@ def test_without_embree_the_float64_intersector_gives_the_same_answer():
 def test_without_an_intersector_the_error_names_the_extra():
     out = _blocked_run(("embreex", "rtree"), TWIN_RUN)
     assert out.returncode != 0 and "pip install 'glphong[shadows]'" in out.stderr, out.stderr[-1500:]
+
+
+@pytest.mark.parametrize("name, kind", [("sphere over plane", k) for k in ("point", "spot", "directional")]
+                         + [("grazing", "point"), ("grazing", "directional")])
+def test_rays_not_cast_are_clear_and_change_nothing(name, kind, monkeypatch, glphong_make_renderer):
+    """Rays to a flat receiver that provably meet nothing before their threshold are not cast
+    (`_clear_without_a_cast`): cast anyway, each is clear (its first hit no nearer than the threshold), and verify's
+    arrays are those of casting every ray, bit for bit."""
+    from glphong.checks import shadows
+
+    proofs = []
+    original = shadows._clear_without_a_cast
+
+    def record(scene, receiver, origins, directions, threshold):
+        proven = original(scene, receiver, origins, directions, threshold)
+        shape = threshold.shape + (3,)
+        proofs.append((np.broadcast_to(origins, shape)[proven], np.broadcast_to(directions, shape)[proven],
+                       threshold[proven]))
+        return proven
+
+    monkeypatch.setattr(shadows, "_clear_without_a_cast", record)
+    renderer = glphong_make_renderer(64, 48, "egl")
+    culled = glphong.verify(SCENES[name](kind), renderer)
+    assert sum(len(t) for _, _, t in proofs) > 1000  # rays not cast
+    scene = SCENES[name](kind)
+    intersector = shadows._caster_mesh(scene)
+    for origins, directions, threshold in proofs:
+        assert np.all(shadows._first_hits(intersector, origins, np.ascontiguousarray(directions)) >= threshold)
+    monkeypatch.setattr(shadows, "_clear_without_a_cast",
+                        lambda scene, receiver, o, d, threshold: np.zeros(threshold.shape, bool))
+    every = glphong.verify(scene, renderer)
+    for field in ("reference", "low", "high", "outside", "shadow_band"):
+        assert np.array_equal(getattr(culled, field), getattr(every, field)), field

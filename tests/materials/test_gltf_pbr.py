@@ -235,3 +235,93 @@ def test_occlusion_darkens_the_environment_light(glphong_backend, glphong_make_r
     assert report.covered_pixels > 2000 and report.passed, report.summary()
     assert program_key(glphong.GltfPBR(0.5, 0.0, 0.5, occlusion=0.5), [environment], None).terms[0].occlusion == "occlusion"
     assert program_key(glphong.GltfPBR(0.5, 0.0, 0.5, occlusion=0.5), [rect], None).terms[0].occlusion is None
+
+
+# --------------------------------------------------------------------------- the derived band (gltf_pbr_band)
+def _float32_twin(term, n, l, v):
+    """The twin run in float32 on the directions rounded to float32 and normalised in float32: the GLSL's formula
+    with a float32 rounding at every step, its inputs a few ulps off the float64 ones, as the GPU's are."""
+    from glphong.definitions.params import ParamValues
+
+    n32, l32, v32 = (np.asarray(a, np.float32) for a in (n, l, v))
+    l32 = l32 / np.sqrt(np.sum(l32 * l32, -1, keepdims=True))
+    v32 = v32 / np.sqrt(np.sum(v32 * v32, -1, keepdims=True))
+    values = term.values()
+    p32 = ParamValues({k: np.float32(x) if isinstance(x, (float, np.floating, np.ndarray)) else x
+                       for k, x in values.__dict__.items()})
+    return term.response(ShadingFrame(n32), l32, v32, np.sum(n32 * l32, -1), p32).astype(np.float64)
+
+
+@pytest.mark.parametrize("metallic", [0.0, 0.5, 1.0])
+@pytest.mark.parametrize("roughness", [1e-3, 0.05, 0.3, 1.0])
+def test_the_derived_band_holds_the_formula_in_float32(metallic, roughness):
+    """`gltf_pbr_band` holds every value of the float32 formula (`_float32_twin`), grazing light and view included,
+    and is narrow: a relative 1e-4 off the twin lies outside it at nearly every pair off the lobe's sharpest part."""
+    from glphong.materials.gltf_pbr import gltf_pbr_band
+    from glphong.twin.band import BAND, EPS
+
+    term = glphong.GltfPBR((0.9, 0.5, 0.1), metallic, roughness, ior=1.4).components[0]
+    l, v = _pairs(20000, seed=int(1000 * roughness) + int(10 * metallic), max_angle=1.5707)
+    n = np.broadcast_to(Z, l.shape).astype(np.float64)
+    p = term.values()
+    n_dot_l = np.sum(n * l, -1)
+    low, high = gltf_pbr_band(n, l, v, n_dot_l, p, BAND)
+    gpu_like = _float32_twin(term, n, l, v)
+    decided = (n_dot_l > BAND.D * EPS)[:, None] & (gpu_like > 0)
+    assert decided.sum() > 30000
+    assert np.all((low <= gpu_like)[decided]) and np.all((gpu_like <= high)[decided])
+    twin = term.response(ShadingFrame(n), l, v, n_dot_l, p)
+    caught = ((twin * (1 + 1e-4) > high) & (twin * (1 - 1e-4) < low))[decided]
+    assert caught.mean() > (0.97 if roughness >= 0.05 else 0.5), caught.mean()
+
+
+def _spot_scene(material):
+    from glphong import primitives
+
+    camera = glphong.PerspectiveCamera.look_at((0.0, -1.2, 1.5), (0.0, 0.0, 0.45), up=(0.0, 0.0, 1.0))
+    pose = np.eye(4)
+    pose[2, 3] = 0.5
+    scene = glphong.Scene(camera, [glphong.SpotLight((1.2, -0.2, 1.2), (-1.2, 0.2, -0.7), 20.0, 0.5, 0.9)])
+    scene.add(primitives.sphere(4, radius=0.5), material, pose=pose)
+    return scene
+
+
+PLANTED = {  # (chunk, text, planted text): each a relative 1e-4 or a wrong power, in the GLSL only
+    "GGX D 1e-4 too large": ("microfacet", "(min(r, FLT_MAX) * MICROFACET_INV_PI)",
+                             "(min(r, FLT_MAX) * (1.0001 * MICROFACET_INV_PI))"),
+    "V (n.l) 1e-4 too large": ("model", "return n_dot_l / (2.0", "return 1.0001 * n_dot_l / (2.0"),
+    "Schlick's x to the fourth": ("model", "float x = (x1 * x1) * (x1 * x1) * x1;", "float x = (x1 * x1) * (x1 * x1);"),
+    "the diffuse part 1e-4 too large": ("model", "(c * (GLTF_PBR_INV_PI * n_dot_l))",
+                                        "(c * (1.0001 * GLTF_PBR_INV_PI * n_dot_l))"),
+}
+
+
+@pytest.mark.parametrize("planted", sorted(PLANTED))
+def test_planted_errors_fail(planted, monkeypatch, glphong_make_renderer):
+    """A GltfPBR sphere under a spot light (the scene passes unplanted on both backends:
+    test_the_spot_lit_sphere_verifies)."""
+    from glphong.shaders import assembly
+
+    chunk, old, new = PLANTED[planted]
+    if chunk == "model":
+        original = assembly.model_source
+        source = original(glphong.materials.gltf_pbr.GltfPBR)
+        assert old in source[0]
+        monkeypatch.setattr(assembly, "model_source", lambda cls: (source[0].replace(old, new),) + tuple(source[1:])
+                            if cls is glphong.materials.gltf_pbr.GltfPBR else original(cls))
+    else:
+        original = assembly.chunk_source
+        source = original(chunk)
+        assert old in source
+        monkeypatch.setattr(assembly, "chunk_source", lambda name: source.replace(old, new) if name == chunk
+                            else original(name))
+    report = glphong.verify(_spot_scene(glphong.GltfPBR((0.8, 0.5, 0.2), 0.5, 0.4)),
+                            glphong_make_renderer(64, 64, "egl"))
+    assert not report.passed and report.outside_count > 0, report.summary()
+
+
+@pytest.mark.parametrize("roughness", [0.02, 0.4, 1.0])
+def test_the_spot_lit_sphere_verifies(roughness, glphong_backend, glphong_make_renderer):
+    report = glphong.verify(_spot_scene(glphong.GltfPBR((0.8, 0.5, 0.2), 0.5, roughness)),
+                            glphong_make_renderer(64, 64, glphong_backend))
+    assert report.covered_pixels > 900 and report.passed, report.summary()
