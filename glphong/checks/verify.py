@@ -4,9 +4,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from glphong.checks import reference
+from glphong.checks.blend_twin import blend_twin
+from glphong.checks.method_sample import method_figures, sample_mask
 from glphong.checks.tolerances import BAND, point_band
 from glphong.checks.verify_passes import verify_passes
 from glphong.gpu.passes import requested_passes
+from glphong.gpu.peeling import blended_objects
 from glphong.gpu.renderer import Renderer
 
 __all__ = ["VerifyReport", "verify", "compare", "relative_error"]
@@ -43,8 +46,16 @@ class VerifyReport:
         twin against the GPU, under the band).
     exact_error : (H, W) float64 ndarray or None
         The quadrature's absolute error estimate per pixel.
+    exact_sample : (H, W) bool ndarray or None
+        Where ``verify(..., exact_sample=N)`` computed the exact image at a random sample of covered pixels only: the
+        sample (`exact`, `exact_error` and `method_error` are NaN elsewhere; `method_error_figures` states the sample
+        and its confidence, `glphong.checks.method_sample`); None where every covered pixel was computed.
     passes : dict of str to glphong.checks.verify_passes.PassReport
         Each frame pass ``verify(..., passes=...)`` asked for against its twin (empty without).
+    blend : glphong.checks.blend_twin.BlendTwin or None
+        Where the scene has blended materials: the twin of the composite (``reference``, ``low`` and ``high`` are
+        its), the pixels it leaves unchecked, those the layer cap cut (``cut``, against the frame's ``blend_cut``:
+        `blend_cut_mismatch`) and the cut composite's error against the whole one (``cap_error``).
     """
 
     gpu: np.ndarray
@@ -58,24 +69,29 @@ class VerifyReport:
     shadow_band: np.ndarray = None
     exact: np.ndarray = None
     exact_error: np.ndarray = None
+    exact_sample: np.ndarray = None
     passes: dict = field(default_factory=dict)
+    blend: object = None
+    blend_cut_mismatch: int = 0
 
     @property
     def method_error(self):
         """``|twin - exact| / |exact|`` (H, W, 3): the extended lights' methods against their exact integrals (NaN
-        outside the mask; None without extended lights)."""
+        outside the mask and outside `exact_sample`; None without extended lights)."""
         if self.exact is None:
             return None
-        return np.where(self.mask[..., None], relative_error(self.reference, self.exact), np.nan)
+        where = self.mask if self.exact_sample is None else self.mask & self.exact_sample
+        with np.errstate(invalid="ignore"):
+            return np.where(where[..., None], relative_error(self.reference, self.exact), np.nan)
 
     def method_error_figures(self):
         """``(mean, max)`` of the finite `method_error` over covered channels (0 where twin and exact are both 0; the
-        channels where only the exact value is 0 left out), or None without extended lights."""
+        channels where only the exact value is 0 left out), or None without extended lights: a
+        `glphong.checks.method_sample.MethodErrorFigures`, which where `exact_sample` is set also says the sample's
+        size and the 95 % statements of its mean and its max."""
         if self.exact is None:
             return None
-        e = self.method_error[self.mask]
-        e = e[np.isfinite(e)]
-        return (float(e.mean()), float(e.max())) if e.size else (0.0, 0.0)
+        return method_figures(self.method_error, self.mask, self.exact_sample)
 
     @property
     def covered_pixels(self):
@@ -109,7 +125,8 @@ class VerifyReport:
     @property
     def passed(self):
         """True when every covered pixel lies in the band, the coverage masks agree and every pass checked passes."""
-        return self.outside_count == 0 and self.mask_mismatch == 0 and all(p.passed for p in self.passes.values())
+        return self.outside_count == 0 and self.mask_mismatch == 0 and self.blend_cut_mismatch == 0 and \
+            all(p.passed for p in self.passes.values())
 
     @property
     def shadow_band_count(self):
@@ -127,14 +144,25 @@ class VerifyReport:
         figures = self.method_error_figures()
         if figures is not None:
             out["method_mean_error"], out["method_max_error"] = figures
+            if figures.sample is not None:  # the exact image of a random sample of pixels, said so
+                out |= {"method_sample": figures.sample, "method_mean_ci95": figures.mean_ci95,
+                        "method_above_max95": figures.above_max95}
         if self.passes:
             out["passes"] = {name: report.summary() for name, report in self.passes.items()}
+        if self.blend is not None:
+            cut = self.blend.cut
+            out["blend"] = {"unchecked": int((self.blend.unchecked & self.mask).sum()), "cut": int(cut.sum()),
+                            "cut_mismatch": self.blend_cut_mismatch, "layers": int(self.blend.layers.max(initial=0)),
+                            "cap_max_error": float(np.nanmax(self.blend.cap_error[cut], initial=0.0))}
         return out
 
     def __str__(self):
         s = self.summary()
         method = (f"; method against exact: mean rel err {s['method_mean_error']:.3g}, max {s['method_max_error']:.3g}"
                   if "method_max_error" in s else "")
+        if "method_sample" in s:
+            method += (f" (a random sample of {s['method_sample']} px: mean +- {s['method_mean_ci95']:.2g}, at most "
+                       f"{s['method_above_max95']:.2g} of the pixels above max, 95 %)")
         passes = "".join(f"; {name} {'pass' if p['passed'] else 'FAIL'} (max err {p['max_error']:.3g}, outside "
                          f"{p['outside']})" for name, p in s.get("passes", {}).items())
         return (f"{'PASS' if s['passed'] else 'FAIL'}: {s['covered_pixels']} px, max rel err {s['max_relative_error']:.3g}, "
@@ -181,7 +209,8 @@ def compare(gpu, reference_radiance, low, high, mask):
     return rel, outside
 
 
-def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None, previous_scene=None):
+def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None, previous_scene=None, exact_sample=None,
+           seed=0):
     """Render ``scene``, shade its G-buffer with the float64 twin, compare under the band; where the scene has
     extended lights, also the twin against their exact integrals (the method error map); and each frame pass asked
     for against its own twin (`glphong.checks.verify_passes`).
@@ -197,6 +226,11 @@ def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None,
         Frame passes to check besides the radiance (`glphong.Renderer.render`'s names; 'radiance' is always checked).
     next_scene, previous_scene : Scene, optional
         What 'flow' and 'backward_flow' read (as in `glphong.Renderer.render`).
+    exact_sample : int, optional
+        Compute the exact integrals at this many covered pixels only, drawn uniformly without replacement with
+        ``np.random.default_rng(seed)`` (`VerifyReport.exact_sample`; the figures say so and how sure they are); default
+        every covered pixel.  For large environment maps (docs/speed.md, "Verify with an environment light").
+    seed : int, optional
 
     Returns
     -------
@@ -222,25 +256,52 @@ def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None,
         gbuffer = renderer.gbuffer(scene)
     ref, low, high, shadow_band = twin_and_band(scene, gbuffer, band, renderer.shadow_settings)
     mask = frame.mask & gbuffer.mask
+    mismatch = int((frame.mask != gbuffer.mask).sum())
+    blend, cut_mismatch = None, 0
+    if blended_objects(scene):  # the layers over the opaque twin (glphong.checks.blend_twin)
+        if exact:
+            raise ValueError("exact integrals of extended lights are not computed for scenes with blended materials")
+        exact = False
+        blend = blend_twin(scene, renderer._size, renderer.blend_layers, (ref, low, high, gbuffer.mask),
+                           lambda g: twin_and_band(scene, g, band, renderer.shadow_settings), band)
+        ref, low, high, shadow_band = blend.reference, blend.low, blend.high, shadow_band | blend.shadow_band
+        covered = blend.coverage > 0.0
+        mask = frame.mask & covered
+        mismatch = int(((frame.mask != covered) & ~blend.unchecked).sum())
+        gpu_cut = np.zeros_like(blend.cut) if frame.blend_cut is None else frame.blend_cut
+        cut_mismatch = int(((gpu_cut != blend.cut) & ~blend.unchecked).sum())
     rel, outside = compare(frame.radiance, ref, low, high, mask)
     if exact is None:
         exact = any(light.extent == "extended" for light in scene.lights)
-    exact_radiance, exact_error = exact_image(scene, gbuffer, renderer.shadow_settings) if exact else (None, None)
+    sample = sample_mask(mask, exact_sample, seed) if exact else None
+    exact_radiance, exact_error = exact_image(scene, gbuffer, renderer.shadow_settings, sample=sample) if exact else \
+        (None, None)
     geometry = tuple(n for n in names if n != "radiance")
     return VerifyReport(gpu=frame.radiance, reference=ref, low=low, high=high, relative_error=rel,
-                        outside=outside, mask=mask, mask_mismatch=int((frame.mask != gbuffer.mask).sum()),
-                        shadow_band=shadow_band, exact=exact_radiance, exact_error=exact_error,
+                        outside=outside, mask=mask, mask_mismatch=mismatch, blend=blend,
+                        blend_cut_mismatch=cut_mismatch,
+                        shadow_band=shadow_band, exact=exact_radiance, exact_error=exact_error, exact_sample=sample,
                         passes=verify_passes(scene, frame, geometry, next_scene, previous_scene,
                                              renderer.matte_samples) if geometry else {})
 
 
-def exact_image(scene, gbuffer, shadows=None, closed_forms=True):
+def exact_image(scene, gbuffer, shadows=None, closed_forms=True, sample=None):
     """The radiance of a G-buffer with every extended light's exact integral (float64 quadrature, or the closed forms
     where they are exact, `glphong.checks.reference.exact_reflection`) in place of the shader's method (docs/design.md
-    section 13): ``(radiance (H, W, 3), error estimate (H, W))``; ``closed_forms=False``: the quadrature throughout."""
+    section 13): ``(radiance (H, W, 3), error estimate (H, W))``; ``closed_forms=False``: the quadrature throughout;
+    ``sample`` (H, W) bool: at those pixels only (NaN elsewhere)."""
     out = np.zeros(gbuffer.position.shape)
     error = np.zeros(gbuffer.mask.shape)
+    if sample is not None:
+        out[~sample], error[~sample] = np.nan, np.nan
     for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, shadows=shadows):
+        if sample is not None:  # the sampled pixels of this object only
+            pick = sample[selection]
+            selection = selection & sample
+            position, f, n_valid = position[pick], f.select(pick), n_valid[pick]
+            if not pick.any():
+                continue
+
         def exact(*arguments):  # the exact integrals in place of the shader's methods, keeping the error estimate
             value, error[selection] = reference.exact_reflection(*arguments, lights=scene.lights,
                                                                  closed_forms=closed_forms)

@@ -39,18 +39,26 @@ _NODES, _WEIGHTS = 0.5 * (_NODES + 1.0), 0.5 * _WEIGHTS
 _CHUNK = 400_000              # integrand evaluations per call
 
 
-def _rule(rects, planes, integrand, radiance, rotation):
-    """The tensor rule on rectangles ``rects`` = (owner, texel, t0, t1, p0, p1): (K, 3) values."""
+def _rule(rects, planes, integrand, radiance, rotation, order=_ORDER, zonal=None):
+    """The tensor rule of ``order`` Gauss-Legendre points a side on rectangles ``rects`` = (owner, texel, t0, t1, p0,
+    p1): (K, C) values (``C`` the radiance's channels).  ``zonal = (axes (N, 3), q)``: the integrand is
+    ``max(a.w, 0)^q`` about each owner's axis ``a`` in the map's frame, evaluated at every node at once (``integrand``
+    and ``rotation`` unused; `glphong.twin.environment_lobe`)."""
     owner, texel, t0, t1, p0, p1 = rects
     K = len(owner)
-    out = np.zeros((K, 3))
+    out = np.zeros((K, radiance.shape[-1]))
     if K == 0:
         return out
-    step = max(1, _CHUNK // (_ORDER * _ORDER))
+    if order == _ORDER:
+        nodes, weights = _NODES, _WEIGHTS
+    else:
+        nodes, weights = np.polynomial.legendre.leggauss(order)
+        nodes, weights = 0.5 * (nodes + 1.0), 0.5 * weights
+    step = max(1, _CHUNK // (order * order))
     for a in range(0, K, step):
         sl = slice(a, a + step)
         o = owner[sl]
-        phi = p0[sl, None] + (p1 - p0)[sl, None] * _NODES[None, :]                         # (k, G)
+        phi = p0[sl, None] + (p1 - p0)[sl, None] * nodes[None, :]                          # (k, G)
         lo = np.broadcast_to(t0[sl, None], phi.shape).copy()
         hi = np.broadcast_to(t1[sl, None], phi.shape).copy()
         cp, sp = np.cos(phi), np.sin(phi)
@@ -65,14 +73,22 @@ def _rule(rects, planes, integrand, radiance, rotation):
             lo = np.maximum(lo, np.where(none, np.inf, low))
             hi = np.minimum(hi, high)
         width = np.maximum(hi - lo, 0.0)                                                    # (k, G)
-        theta = lo[:, :, None] + width[:, :, None] * _NODES[None, None, :]                  # (k, G, G)
+        theta = lo[:, :, None] + width[:, :, None] * nodes[None, None, :]                   # (k, G, G)
         st = np.sin(theta)
-        w = np.stack([st * cp[:, :, None], st * sp[:, :, None], np.broadcast_to(np.cos(theta), st.shape)], axis=-1)
-        weight = ((p1 - p0)[sl, None, None] * _WEIGHTS[None, :, None] * width[:, :, None] * _WEIGHTS[None, None, :]
+        weight = ((p1 - p0)[sl, None, None] * weights[None, :, None] * width[:, :, None] * weights[None, None, :]
                   * st)                                                                      # (k, G, G)
+        if zonal is not None:  # the radiance is one texel's over each rectangle
+            axis = zonal[0][o]
+            dot = axis[:, 2, None, None] * np.cos(theta) + st * (axis[:, 0, None, None] * cp[:, :, None]
+                                                                 + axis[:, 1, None, None] * sp[:, :, None])
+            with np.errstate(divide="ignore"):
+                g = np.where(dot > 0.0, np.exp(zonal[1] * np.log(np.where(dot > 0.0, dot, 1.0))), 0.0)
+            out[sl] = np.sum(g * weight, axis=(1, 2))[:, None] * radiance[texel[sl]]
+            continue
+        w = np.stack([st * cp[:, :, None], st * sp[:, :, None], np.broadcast_to(np.cos(theta), st.shape)], axis=-1)
         live = weight > 0.0
         k_index = np.broadcast_to(np.arange(len(o))[:, None, None], live.shape)[live]
-        values = np.zeros(live.shape + (3,))
+        values = np.zeros(live.shape + (radiance.shape[-1],))
         if k_index.size:
             g = np.asarray(integrand(o[k_index], w[live] @ rotation.T), dtype=np.float64)
             g = g if g.ndim == 2 else g[:, None]

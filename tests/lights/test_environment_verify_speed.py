@@ -82,4 +82,6 @@ def test_exact_irradiance_against_the_quadrature():
     exact = light.exact_twin().irradiance(None, n, None)
     value, _, converged = environment_integral(n, sky, lambda i, w: np.sum(n[i] * w, axis=1), rotation=rotation)
     assert converged.all() and np.max(np.abs(exact - value) / value) < 1e-9
-    assert light.exact_twin().closed_form_is_exact("irradiance") and not light.exact_twin().closed_form_is_exact("lobe", 20)
+    twin = light.exact_twin()
+    assert twin.closed_form_is_exact("irradiance") and twin.closed_form_is_exact("lobe", 20)
+    assert not twin.closed_form_is_exact("sampled")
