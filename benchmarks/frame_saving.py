@@ -1,6 +1,6 @@
 """What saving a frame as PNG costs against rendering it (issue 29, part 2).
 
-Usage: python benchmarks/frame_saving.py [--size WxH] [--repeats N] [--frames N] [--backend egl|osmesa]
+Usage: python benchmarks/frame_saving.py [--size WxH] [--repeats N] [--frames N] [--backend egl|osmesa] [--floor]
 
 One process, interleaved rounds, medians:
 
@@ -9,6 +9,10 @@ One process, interleaved rounds, medians:
   parts;
 - the same image through Pillow at the same zlib level (1), for the PNG writer's comparison
   (these four: `glphong.bench.png_cost`, which ``glphong bench --speed`` reports too);
+- with ``--floor`` (instead of the turntables), the floor under a save, interleaved with the render and the save:
+  the contiguous copy of the radiance (a strided view of the RGBA read-back), that copy and one table lookup per value (``np.take``
+  of a byte table by the values' top 20 bits: the least an exact per-value encode does), and zlib at level 1 of
+  the encoded image's bytes in one call (the deflate's share, one thread);
 - a turntable of ``--frames`` frames through `glphong.batch.render_many` (worker processes, each rendering the next frame
   while its writer thread encodes and writes the last) as PNG and as ``.npy`` (a raw copy: the render's own cost).
 """
@@ -34,12 +38,38 @@ def scene(angle=0.0):
     return out
 
 
+def floor(width, height, repeats, backend):
+    """Print the floor under `Frame.save_png` against the render and the save (see the module), medians [ms]."""
+    import statistics
+    import zlib
+
+    from glphong.core.imaging import encode_srgb8
+    from glphong.core.timing import alternating_times
+
+    table = np.zeros(1 << 20, np.uint8)
+    with tempfile.TemporaryDirectory() as folder, glphong.Renderer(width, height, backend=backend) as renderer:
+        shown = scene()
+        frame = renderer.render(shown)
+        codes = encode_srgb8(frame.radiance).tobytes()
+        times = alternating_times({
+            "render": lambda: renderer.render(shown), "save_png": lambda: frame.save_png(Path(folder) / "f.png"),
+            "contiguous copy": lambda: np.ascontiguousarray(frame.radiance),
+            "copy and one table lookup": lambda: np.take(table, np.ascontiguousarray(frame.radiance).view(np.uint32) >> 12),
+            "zlib level 1": lambda: zlib.compress(codes, 1)}, repeats, warmup=2)
+    ms = {k: 1e3 * statistics.median(t) for k, t in times.items()}
+    print("| floor step | ms | / render |")
+    print("|---|---|---|")
+    for name, value in ms.items():
+        print(f"| {name} | {value:.2f} | {value / ms['render']:.2f} |")
+
+
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--size", default="640x480")
     parser.add_argument("--repeats", type=int, default=20)
     parser.add_argument("--frames", type=int, default=48)
     parser.add_argument("--backend", default="egl")
+    parser.add_argument("--floor", action="store_true", help="the floor under a save (see the module)")
     args = parser.parse_args()
     width, height = (int(v) for v in args.size.split("x"))
     cost = png_cost(width, height, args.repeats, scene=scene(), backend=args.backend)
@@ -50,6 +80,9 @@ def main():
                       ("encode_png", "write_ms"), ("pillow_png", "deflate_ms")):
         print(f"| {name} | {cost[key]:.2f} | {cost[key] / cost['render_ms']:.2f} |")
     print(f"PNG size: glphong {cost['png_bytes']} bytes, Pillow {cost['pillow_bytes']} bytes (zlib level 1 both)")
+    if args.floor:
+        floor(width, height, args.repeats, args.backend)
+        return
 
     # one process, one renderer: frames per second rendering alone, saving each PNG after its render, and saving on a
     # writer thread while the next frame renders (what render_many's workers do)

@@ -1,13 +1,16 @@
 """A renderer's draw of a scene's objects: the per-object program, uniforms and vertex array, kept from frame to frame
-(`draw_list`), and the draw with the winding and culling each object needs (`draw_objects`).
+(`draw_list`), and the draw with the winding and culling each object needs (`draw_objects`); of a large mesh that
+reaches out of the view, only the triangles that may meet it (`glphong.gpu.view_cull`, kept per object and camera).
 
 ``blend`` selects what is drawn: 0 the opaque and alpha-masked objects (every object of a scene without a blended
 material), 1 and 2 the blended objects with their layer and peel programs (`glphong.gpu.peeling.blend_key`).
 """
 import moderngl
+import numpy as np
 
 from glphong.gpu.peeling import blend_key, blended
 from glphong.gpu.resources import ObjectEntry
+from glphong.gpu.view_cull import MIN_TRIANGLES, box_inside, visible_triangles
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
 from glphong.shaders.numerics import allowed_pieces, view_decision
@@ -26,9 +29,10 @@ def draw_objects(renderer, scene, output, frame_values=None, shadow_values=None,
     eye = tuple(camera.pose[:3, 3])
     forward = tuple(-camera.pose[:3, 2])
     near, far = camera.znear, camera.zfar
+    aspect = renderer.width / renderer.height
+    view_projection = None
     mirrored = culled = False
-    for program, frame_pack, entry in draw_list(renderer, scene, output, renderer.width / renderer.height,
-                                                frame_values, shadow_values, planes, blend):
+    for program, frame_pack, entry in draw_list(renderer, scene, output, aspect, frame_values, shadow_values, planes, blend):
         program.write(frame_pack)
         program.write(entry.pack)
         if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
@@ -41,9 +45,37 @@ def draw_objects(renderer, scene, output, frame_values=None, shadow_values=None,
         if cull != culled:
             culled = cull
             (mgl.enable if cull else mgl.disable)(moderngl.CULL_FACE)
-        entry.vertex_array.render(moderngl.TRIANGLES)
+        vao = entry.vertex_array
+        if scene.objects[entry.index].mesh.indices.size >= 3 * MIN_TRIANGLES:  # a large mesh: what may meet the view
+            if view_projection is None:
+                view_projection = camera.projection_matrix(aspect) @ camera.view_matrix()
+            vao = _view_vertex_array(renderer, scene.objects[entry.index], entry, camera, aspect, view_projection)
+        if vao is not None:
+            vao.render(moderngl.TRIANGLES)
     mgl.front_face = "ccw"
     mgl.disable(moderngl.CULL_FACE)
+
+
+def _view_vertex_array(renderer, obj, entry, camera, aspect, view_projection):
+    """The vertex array drawing what of ``obj``'s mesh may meet the view (`glphong.gpu.view_cull`): the entry's own
+    where the mesh's bounding box lies inside the view or every triangle may meet it, else one of the kept triangles,
+    made once per camera and aspect; None where no triangle may meet it."""
+    buffers = renderer._mesh_buffers(obj.mesh)
+    token = (entry.program.key, entry.index, id(obj))
+    if entry.view is not None and entry.view[0] is camera and entry.view[1] == aspect:
+        record = entry.view[2]
+        if record is None or record == "whole" or buffers.subsets.get(token) is record:
+            return entry.vertex_array if record == "whole" else record and record[0]
+    if entry.bounds is None:
+        centre, radius = world_sphere(obj.mesh, obj.pose)
+        entry.bounds = (tuple(centre), radius)
+    record = "whole"
+    if not box_inside(*entry.bounds, view_projection):
+        kept = visible_triangles(obj.mesh.positions, obj.mesh.indices, view_projection @ np.asarray(obj.pose))
+        if kept is not None:
+            record = buffers.subset(renderer._mgl, entry.program, token, kept) if len(kept) else None
+    entry.view = (camera, aspect, record)
+    return entry.vertex_array if record == "whole" else record and record[0]
 
 
 def draw_list(renderer, scene, output, aspect, frame_values=None, shadow_values=None, planes=frozenset(), blend=0):

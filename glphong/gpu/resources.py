@@ -70,6 +70,8 @@ class ObjectEntry:
     sphere: tuple = None  # ((x, y, z), radius) in the world where the mesh's back faces may be culled
     checked: object = None
     camera: object = None  # the camera the key's 'view' piece was decided for (numerics='auto')
+    view: tuple = None  # (camera, aspect, record or None): the triangles drawn for that view (`glphong.gpu.drawing`)
+    bounds: tuple = None  # ((x, y, z), radius): the mesh's bounding sphere in the world, once it is asked for
 
 
 def target_bytes(size, supersample, samples):
@@ -129,6 +131,7 @@ class MeshBuffers:
         self.buffers = {}
         self.index_buffer = mgl.buffer(mesh.indices.tobytes())
         self.vertex_arrays = {}
+        self.subsets = {}  # token -> (vertex array, index buffer) of the triangles in a view (`glphong.gpu.view_cull`)
 
     #: what a mesh without tangents or UVs supplies to a program that reads them for another object's
     #: sake (the G-buffer, the uber-shader): tangent 0 (the shader then uses the basis around n), uv 0
@@ -153,9 +156,27 @@ class MeshBuffers:
                 program.gl_program, content, self.index_buffer, index_element_size=4)
         return vao
 
+    def subset(self, mgl, program, token, indices):
+        """A vertex array of ``program`` drawing the triangles ``indices`` ((3 K,) uint32, K > 0) of this mesh, kept
+        under ``token`` (replacing, and releasing, what the token held); returns the record ``(vao, index buffer)``,
+        which its user compares by identity with ``subsets.get(token)`` before drawing with it."""
+        old = self.subsets.pop(token, None)
+        if old is not None:
+            for obj in old:
+                obj.release()
+        ibo = mgl.buffer(np.ascontiguousarray(indices, np.uint32).tobytes())
+        content = [(self.buffer(mgl, name), self._SOURCES[name][1], name) for name in program.key.attributes()
+                   if name in program.gl_program]
+        record = self.subsets[token] = (mgl.vertex_array(program.gl_program, content, ibo, index_element_size=4), ibo)
+        return record
+
     def release(self):
         for vao in self.vertex_arrays.values():
             vao.release()
+        for vao, ibo in self.subsets.values():
+            vao.release()
+            ibo.release()
+        self.subsets.clear()
         for buf in (*self.buffers.values(), self.index_buffer):
             buf.release()
 
@@ -196,7 +217,7 @@ def release_resources(context, meshes, targets, programs):
 def gl_object_count(programs, meshes, targets):
     """Number of GL objects a renderer holds: its programs (a `glphong.gpu.programs.ProgramCache`) and their textures,
     its meshes' buffers and vertex arrays (dict of `MeshBuffers`), its targets' framebuffers and attachments."""
-    mesh_objects = sum(1 + len(e.buffers) + len(e.vertex_arrays) for e in meshes.values())
+    mesh_objects = sum(1 + len(e.buffers) + len(e.vertex_arrays) + 2 * len(e.subsets) for e in meshes.values())
     target_objects = sum(1 if name[0] == "fullscreen" else f.gl_object_count() if name[0] == "peeling" else
                          1 + len(f.color_attachments) + (f.depth_attachment is not None) for name, f in targets.items())
     return len(programs) + len(programs.textures) + mesh_objects + target_objects
