@@ -9,27 +9,35 @@ of the coarse sky's and of the sun-only map's (whose zero texels the quadrature 
 integral, a quadrature over every texel above the horizon, is then affordable (``--check-split`` checks the split
 against the quadrature over the whole map at a few pixels).
 
-Measured, per knob setting of `glphong.EnvironmentLight`:
+Measured, per knob setting of `glphong.EnvironmentLight`, each with the bright blocks (``bright`` = K, the default)
+and without (K = 0, the whole map by the cube map and the harmonics, the way before them), and at the default knob
+every K of ``--brights`` and every threshold T of ``--thresholds`` (besides the automatic one):
 
 - Lambert (``Lambert(0.8)``) against ``resolution`` R of the irradiance cube map: the error of the GPU render against
   the exact integral (`glphong.checks.verify.exact_image`: the map's closed forms) at ``--score`` x ``--score`` pixels;
 - the Phong lobe alone (``Phong(0, 1, q)``, q = 10, 50, 100) against ``order`` of the harmonics: the error against
   the exact integral (the quadrature, split as above) at ``--lobe-score`` x ``--lobe-score`` pixels;
-- frame time: median of ``--repeats`` frames (after 2 warm-up) at ``--size`` x ``--size``, EGL, readback included,
-  for the Lambert sphere, the lobe sphere and a Phong sphere with both terms (``Phong(0.5, 0.3, q)``);
-- the light's one-time host cost: the cube map's exact irradiances (R) and the harmonics' projection (order).
+- frame time: median and quartiles of ``--repeats`` frames (after 2 warm-up) at ``--size`` x ``--size``, EGL,
+  readback included, every setting once in each round (interleaved: the machine's load drifts alike for all), for
+  the Lambert sphere, the lobe sphere and a Phong sphere with both terms (``Phong(0.5, 0.3, q)``);
+- the light's one-time host cost, measured once: the bright blocks, and the cube map's exact irradiances (R) or the
+  harmonics' projection (order).
+
+The exact images do not depend on the knobs: ``--cache DIR`` keeps them between runs (the lobe's take minutes).
 
 Errors (`errors`): the bench's relative RMS ``sqrt(sum |err|^2 / sum |exact|^2)`` over the covered pixels
 (`glphong.bench.continuous`), and per pixel ``|err| / |exact|`` over the covered pixels whose exact radiance is above
 1e-2 of the image's largest (the bench's rule; RMS, p99, worst) and above ``--threshold`` (default 1e-3: the dim
 side and the sky's reflection in the lobe included).
 
-    python benchmarks/environment_defaults.py [--resolutions 5,7,9,11,13,15,17,21,24] [--orders 8,12,16,20,24]
-        [--sh-orders 8,16,24] [--qs 10,50,100] [--size 256] [--score 128] [--lobe-score 48] [--repeats 15]
-        [--backend egl] [--json out.json] [--error-maps out.png]
+    python benchmarks/environment_defaults.py [--resolutions 5,7,9,13,24] [--orders 2,4,8,16,24]
+        [--sh-orders 4,8] [--qs 10,50,100] [--brights 0,8,16,32,64,128] [--thresholds 0.6,2.4,9.6] [--size 256]
+        [--score 128] [--lobe-score 48] [--repeats 15] [--backend egl] [--cache DIR] [--json out.json]
+        [--error-maps out.png]
 
-``--error-maps`` draws the signed relative error (render / exact - 1) at the defaults (R = 9, order 8) and the finest
-settings run, Lambert and the lobe at the largest q, pixels below ``--threshold`` blank (matplotlib).
+``--error-maps`` draws the signed relative error (render / exact - 1) of Lambert and of the lobe at the largest q:
+the old defaults (R = 9, order 8, no blocks, `OLD`), the finest settings run without blocks, and the new defaults,
+pixels below ``--threshold`` blank (matplotlib).
 """
 import argparse
 import dataclasses
@@ -43,6 +51,8 @@ SUN_ELEVATION = np.radians(35.0)
 SUN_AZIMUTH = np.radians(-30.0)
 SUN_DIAMETER = np.radians(5.0)
 BLOCK = 8
+#: the defaults before the bright blocks (R = 9, order 8, no blocks), kept in the table and the figure
+OLD = {"resolution": 9, "order": 8}
 
 
 def sun_direction():
@@ -110,75 +120,128 @@ def save_error_maps(path, maps_):
     fig.savefig(path, dpi=110)
 
 
-def frame_ms(renderer, sc, repeats):
-    from glphong.core.timing import median_seconds
-    return 1e3 * median_seconds(lambda: renderer.render(sc), repeats)
+def alternating_times(runs, repeats):
+    from glphong.core.timing import alternating_times as times  # noqa: PLC0415
+    return times(runs, repeats)
+
+
+def exact_lambert(sc, renderer, cache):
+    """The exact Lambert image (the map's closed forms), from ``cache`` (an .npz path or None) where it is there."""
+    from glphong.checks.verify import exact_image
+    return _cached(cache, "lambert", lambda: exact_image(sc, renderer.gbuffer(sc))[0])
+
+
+def exact_lobe(lobe, sc, renderer, cache, q):
+    """The exact Phong lobe image, split as the module docstring says (coarse sky + sun only), cached likewise."""
+    import glphong
+    from glphong.checks.verify import exact_image
+    _, coarse, sun, _ = maps()
+
+    def compute():
+        gb = renderer.gbuffer(sc)
+        return (exact_image(scene(lobe, glphong.EnvironmentLight(coarse, order=2, bright=0)), gb)[0]
+                + exact_image(scene(lobe, glphong.EnvironmentLight(sun, order=2, bright=0)), gb)[0])
+    return _cached(cache, f"lobe_q{q:g}", compute)
+
+
+def _cached(cache, name, compute):
+    import os  # noqa: PLC0415
+    path = None if cache is None else os.path.join(cache, f"{name}.npy")
+    if path is not None and os.path.exists(path):
+        return np.load(path)
+    start = time.perf_counter()
+    value = compute()
+    print(json.dumps({f"{name}_exact_s": time.perf_counter() - start}), flush=True)
+    if path is not None:
+        os.makedirs(cache, exist_ok=True)
+        np.save(path, value)
+    return value
+
+
+def settings(args, knob, values):
+    """``(knob value, bright K, threshold)`` rows: each ``values`` with the old way (K = 0) and the default K, and at
+    the default knob every K of ``--brights`` and every threshold of ``--thresholds``."""
+    import glphong
+    default = dict(zip(("resolution", "order"), (glphong.lights.environment.RESOLUTION.default,
+                                                  glphong.lights.environment.ORDER.default)))[knob]
+    k0 = int(glphong.lights.environment.BRIGHT.default)
+    rows = [(v, k, None) for v in values for k in (0, k0)] + [(OLD[knob], 0, None)]
+    rows += [(default, k, None) for k in args.brights if k not in (0, k0)]
+    rows += [(default, k0, t) for t in args.thresholds]
+    return list(dict.fromkeys(rows))
 
 
 def run(args):
     import glphong
-    from glphong.checks.verify import exact_image
     whole, coarse, sun, info = maps()
     print(json.dumps({"map": info}), flush=True)
     rows, error_maps = [], []
-    light = lambda **kw: glphong.EnvironmentLight(whole, **kw)  # noqa: E731
+
+    def light(**kw):
+        return glphong.EnvironmentLight(whole, **kw)
+
     big = glphong.Renderer(args.size, args.size, backend=args.backend)
     small = glphong.Renderer(args.score, args.score, backend=args.backend)
     lobe_small = glphong.Renderer(args.lobe_score, args.lobe_score, backend=args.backend)
+    default_r = int(glphong.lights.environment.RESOLUTION.default)
+    default_order = int(glphong.lights.environment.ORDER.default)
+    default_k = int(glphong.lights.environment.BRIGHT.default)
 
-    # ---- Lambert against R
+    timed = {}                          # (row index, column) -> the scene whose frame time that column holds
+
+    def measure(term, knob, value, k, t, lt, build, frame, exact, scenes):
+        row = {"term": term, "knob": knob, "value": value, "bright": k, "threshold": t,
+               "blocks": lt.bright_count(), "T": lt.bright_threshold(), "build_s": build,
+               **errors(frame.radiance.astype(np.float64), exact, frame.mask, args.threshold)}
+        print(json.dumps(row), flush=True)
+        timed.update({(len(rows), column): sc for column, sc in scenes.items()})
+        rows.append(row)
+
+    # ---- Lambert against R, with and without the bright blocks
     lambert = glphong.Lambert(0.8)
     exact = None
-    for R in args.resolutions:
-        lt, build = built(light(resolution=R), "irradiance")
+    for R, k, t in settings(args, "resolution", args.resolutions):
+        lt, build = built(light(resolution=R, bright=k, threshold=t), "irradiance")
         sc = scene(lambert, lt)
         frame = small.render(sc)
-        if exact is None:
-            start = time.perf_counter()
-            exact, _ = exact_image(sc, small.gbuffer(sc))
-            print(json.dumps({"lambert_exact_s": time.perf_counter() - start}), flush=True)
-        row = {"term": "lambert", "knob": "resolution", "value": R, "build_s": build,
-               "frame_ms": frame_ms(big, sc, args.repeats),
-               **errors(frame.radiance.astype(np.float64), exact, frame.mask, args.threshold)}
-        print(json.dumps(row), flush=True)
-        rows.append(row)
-        if R in (9, max(args.resolutions)):  # the default and the finest
-            error_maps.append((f"Lambert, R = {R}", signed_error(frame.radiance, exact, frame.mask, args.threshold)))
+        exact = exact_lambert(sc, small, args.cache) if exact is None else exact
+        measure("lambert", "resolution", R, k, t, lt, build, frame, exact, {"frame_ms": sc})
+        if t is None and (R, k) in ((OLD["resolution"], 0), (max(args.resolutions), 0), (default_r, default_k)):
+            error_maps.append((f"Lambert, R = {R}, K = {k}",
+                               signed_error(frame.radiance, exact, frame.mask, args.threshold)))
     for order in args.sh_orders:  # Lambert by the harmonics (irradiance='sh')
-        lt, build = built(light(order=order, irradiance="sh"), "sh")
-        sc = scene(lambert, lt)
-        frame = small.render(sc)
-        row = {"term": "lambert sh", "knob": "order", "value": order, "build_s": build,
-               "frame_ms": frame_ms(big, sc, args.repeats),
-               **errors(frame.radiance.astype(np.float64), exact, frame.mask, args.threshold)}
-        print(json.dumps(row), flush=True)
-        rows.append(row)
+        for k in (0, default_k):
+            lt, build = built(light(order=order, irradiance="sh", bright=k), "sh")
+            sc = scene(lambert, lt)
+            measure("lambert sh", "order", order, k, None, lt, build, small.render(sc), exact, {"frame_ms": sc})
 
-    # ---- the Phong lobe against order
+    # ---- the Phong lobe against order, with and without the bright blocks
     for q in args.qs:
         lobe = glphong.Phong(0.0, 1.0, q)
         exact = None
-        for order in args.orders:
-            lt, build = built(light(order=order), "sh")
+        for order, k, t in settings(args, "order", args.orders):
+            lt, build = built(light(order=order, bright=k, threshold=t), "sh")
             sc = scene(lobe, lt)
             frame = lobe_small.render(sc)
-            if exact is None:
-                start = time.perf_counter()
-                gb = lobe_small.gbuffer(sc)
-                exact = (exact_image(scene(lobe, glphong.EnvironmentLight(coarse, order=2)), gb)[0]
-                         + exact_image(scene(lobe, glphong.EnvironmentLight(sun, order=2)), gb)[0])
-                print(json.dumps({"lobe_exact_s": time.perf_counter() - start, "q": q}), flush=True)
-            row = {"term": f"lobe q={q:g}", "knob": "order", "value": order, "build_s": build,
-                   "frame_ms": frame_ms(big, sc, args.repeats),
-                   "phong_frame_ms": frame_ms(big, scene(glphong.Phong(0.5, 0.3, q), lt), args.repeats),
-                   **errors(frame.radiance.astype(np.float64), exact, frame.mask, args.threshold)}
-            print(json.dumps(row), flush=True)
-            rows.append(row)
-            if q == args.qs[-1] and order in (8, max(args.orders)):
-                error_maps.append((f"lobe q = {q:g}, order {order}",
+            exact = exact_lobe(lobe, sc, lobe_small, args.cache, q) if exact is None else exact
+            measure(f"lobe q={q:g}", "order", order, k, t, lt, build, frame, exact,
+                    {"frame_ms": sc, "phong_frame_ms": scene(glphong.Phong(0.5, 0.3, q), lt)})
+            if q == args.qs[-1] and t is None and (order, k) in ((OLD["order"], 0), (max(args.orders), 0),
+                                                                  (default_order, default_k)):
+                error_maps.append((f"lobe q = {q:g}, order {order}, K = {k}",
                                    signed_error(frame.radiance, exact, frame.mask, args.threshold)))
-    if args.error_maps:
-        save_error_maps(args.error_maps, error_maps)
+    if args.error_maps:  # per term: the old defaults, the new, the finest without blocks
+        old = (f"R = {OLD['resolution']}, K = 0", f"order {OLD['order']}, K = 0")
+        rank = [(title.startswith("lobe"), 0 if title.endswith(old) else 2 if title.endswith(", K = 0") else 1)
+                for title, _ in error_maps]
+        save_error_maps(args.error_maps, [m for _, m in sorted(zip(rank, error_maps), key=lambda x: x[0])])
+    # frame times last, every setting in each round (interleaved, so the load's drift hits all alike)
+    times = alternating_times({key: (lambda sc=sc: big.render(sc)) for key, sc in timed.items()}, args.repeats)
+    for (i, column), t in times.items():
+        rows[i][column] = 1e3 * float(np.median(t))
+        rows[i][column + "_spread"] = [1e3 * float(np.percentile(t, 25)), 1e3 * float(np.percentile(t, 75))]
+    for row in rows:
+        print(json.dumps(row), flush=True)
     return rows
 
 
@@ -207,7 +270,8 @@ def check_split(args):
 
 
 def built(light_, uniform):
-    """``(light, seconds)``: the light with its host-side table ``uniform`` built (the one-time cost, timed)."""
+    """``(light, seconds)``: the light with its host-side tables built (the bright blocks and ``uniform``: the
+    one-time cost, timed)."""
     start = time.perf_counter()
     light_.uniform_value(uniform)
     return light_, time.perf_counter() - start
@@ -216,9 +280,9 @@ def built(light_, uniform):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ints = lambda s: [int(v) for v in s.split(",")]  # noqa: E731
-    parser.add_argument("--resolutions", type=ints, default=[5, 7, 9, 11, 13, 15, 17, 21, 24])
-    parser.add_argument("--orders", type=ints, default=[8, 12, 16, 20, 24])
-    parser.add_argument("--sh-orders", type=ints, default=[8, 16, 24], help="Lambert by the harmonics")
+    parser.add_argument("--resolutions", type=ints, default=[5, 7, 9, 13, 24])
+    parser.add_argument("--orders", type=ints, default=[2, 4, 8, 16, 24])
+    parser.add_argument("--sh-orders", type=ints, default=[4, 8], help="Lambert by the harmonics")
     parser.add_argument("--qs", type=lambda s: [float(v) for v in s.split(",")], default=[10.0, 50.0, 100.0])
     parser.add_argument("--size", type=int, default=256)
     parser.add_argument("--score", type=int, default=128)
@@ -226,6 +290,10 @@ def main():
     parser.add_argument("--repeats", type=int, default=15)
     parser.add_argument("--threshold", type=float, default=1e-3)
     parser.add_argument("--backend", default="egl")
+    parser.add_argument("--brights", type=ints, default=[0, 8, 16, 32, 64, 128], help="K, at the default R and order")
+    parser.add_argument("--thresholds", type=lambda s: [float(v) for v in s.split(",")] if s else [],
+                        default=[0.6, 2.4, 9.6], help="T [W/(m^2 sr)] besides the automatic one, at the defaults")
+    parser.add_argument("--cache", help="a folder keeping the exact images between runs")
     parser.add_argument("--json")
     parser.add_argument("--error-maps")
     parser.add_argument("--check-split", action="store_true")

@@ -17,6 +17,13 @@ The lecture's continuous version for it, three ways:
 - Every other term: the map averaged onto ``samples x 2 samples`` texels, each a direction (its moment's) and an
   irradiance.
 
+A small bright source (a sun) is taken out first (`glphong.twin.environment_bright`): the map is split exactly as
+``min(L, T) + max(L - T, 0)`` at a ``threshold`` ``T`` (default automatic: 8 times the median radiance, raised so that
+the texels above it cover at most 0.25 sr); the residual takes the ways above, the excess is cut into at most
+``bright`` blocks, each integrated apart: Lambert by its exact moment where it is wholly above the horizon (a disc of
+its solid angle where the horizon crosses it), the Phong lobe by the midpoint rule over the blocks.  A map with no
+texel above ``T`` renders as before, and its programs carry no block.
+
 `glphong.verify` shows each method's error against the exact integral (`exact`: adaptive quadrature over the map's
 texels, `glphong.twin.environment_quadrature`) apart from the float32 band of the GPU against the twin.
 """
@@ -31,8 +38,10 @@ from glphong.lights.extended import ExtendedLight, extended_cases
 from glphong.definitions.light import GlslFile, Param
 from glphong.materials.lambert import Lambert
 from glphong.twin import environment as env
+from glphong.twin import environment_bright as bright_blocks
 from glphong.twin.band import EPS
 from glphong.twin.environment_quadrature import environment_integral
+from glphong.twin.environment_lobe import lobe_integral
 
 __all__ = ["EnvironmentLight", "read_radiance_map", "Y_UP"]
 
@@ -44,10 +53,16 @@ MAX_SAMPLE_ROWS = 16
 RESOLUTION = Param("resolution", "scalar", low=2.0, high=24.0, default=9.0,
                    doc="texels per side of each face of the irradiance cube map (an integer; odd puts a texel centre on "
                        "each axis)")
-ORDER = Param("order", "scalar", low=0.0, high=24.0, default=8.0,
+ORDER = Param("order", "scalar", low=0.0, high=24.0, default=4.0,
               doc="order of the spherical harmonics of the Phong lobe (and of the irradiance with irradiance='sh')")
 ENV_SAMPLES = Param("samples", "scalar", low=1.0, high=float(MAX_SAMPLE_ROWS), default=4.0,
                     doc="rows of the averaged map whose 2 samples^2 texels carry the terms without a closed form")
+#: the largest ``bright`` (seven vec4 uniform slots a block)
+MAX_BRIGHT = 128
+BRIGHT = Param("bright", "scalar", low=0.0, high=float(MAX_BRIGHT), default=32.0,
+               doc="the most blocks the map's excess over threshold is cut into, integrated apart (0: none)")
+THRESHOLD = Param("threshold", "scalar", low=0.0, optional=True, unit="W/(m^2 sr)",
+                  doc="radiance above which a texel's excess is integrated apart (None: automatic)")
 
 _UNIFORMS = (
     Param("irradiance", "rgb", low=0.0, unit="W/m^2", doc="the irradiance cube map, 6 R^2 texels"),
@@ -57,6 +72,15 @@ _UNIFORMS = (
     Param("samples", "scalar", low=1.0, doc="rows s of the averaged map"),
     Param("sample_direction", "vec3", low=-float("inf"), doc="each averaged texel's direction (world)"),
     Param("sample_irradiance", "rgb", low=0.0, unit="W/m^2", doc="each averaged texel's Lbar |M|"),
+    Param("bright_count", "scalar", low=0.0, doc="the light's bright blocks"),
+    Param("bright_direction", "vec3", low=-float("inf"), doc="each block's centroid (world)"),
+    Param("bright_radius", "scalar", low=0.0, unit="rad", doc="each block's disc radius sqrt(Omega/pi)"),
+    Param("bright_moment", "vec3", low=-float("inf"), unit="W/m^2", doc="each block's moment per channel (3 a block)"),
+    Param("bright_length", "rgb", low=0.0, unit="W/m^2", doc="each block's |moment| per channel"),
+    Param("bright_power", "rgb", low=0.0, unit="W/m^2", doc="each block's power per channel"),
+    Param("bright_total", "vec3", low=-float("inf"), unit="W/m^2", doc="the blocks' moments summed, per channel"),
+    Param("bright_center", "vec3", low=-float("inf"), doc="the centre of the blocks' cap (world)"),
+    Param("bright_cap", "vec3", low=-float("inf"), doc="(cos rho, sin rho, rho) of the blocks' cap"),
 )
 
 
@@ -134,35 +158,50 @@ class EnvironmentLight(ExtendedLight):
     resolution : int
         Texels per side of the irradiance cube map's faces, 2 to 24 (default 9).
     order : int
-        Order of the spherical harmonics, 0 to 24 (default 8).
+        Order of the spherical harmonics, 0 to 24 (default 4).
     samples : int
         Rows of the averaged map for the other terms, 1 to 16 (default 4: 32 directions).
     irradiance : {'map', 'sh'}
         Lambert by the irradiance cube map (default) or by the spherical harmonics.
     method : {'auto', 'sampled'}
         As every extended light (`glphong.lights.ExtendedLight`).
+    bright : int
+        The most blocks the map's excess over ``threshold`` is cut into and integrated apart, 0 to 128 (default 32;
+        0: none, the whole map by the ways above).
+    threshold : float or None
+        ``T`` [W/(m^2 sr)] (after ``scale``); None (default): `glphong.twin.environment_bright.bright_threshold`.
     """
 
     name = "environment"
     loop_order = 8
-    params = (RESOLUTION, ORDER, ENV_SAMPLES)
+    params = (RESOLUTION, ORDER, ENV_SAMPLES, BRIGHT, THRESHOLD)
     uniforms = _UNIFORMS
     glsl = GlslFile("lights/environment.glsl")
     uses = ("angle",)
     integrals = ("irradiance", "lobe", "lobe_real")
     occludable = True
     uniform_lengths = {"irradiance": "MAP_TEXELS", "sh": "SH_COEFFICIENTS", "frame": 3,
-                       "sample_direction": "SAMPLE_TEXELS", "sample_irradiance": "SAMPLE_TEXELS"}
+                       "sample_direction": "SAMPLE_TEXELS", "sample_irradiance": "SAMPLE_TEXELS",
+                       "bright_direction": "BRIGHT_BLOCKS", "bright_radius": "BRIGHT_BLOCKS",
+                       "bright_moment": "BRIGHT_MOMENTS", "bright_length": "BRIGHT_BLOCKS",
+                       "bright_power": "BRIGHT_BLOCKS", "bright_total": 3}
     conditional_uniforms = {"irradiance": "IRRADIANCE_MAP", "resolution": "IRRADIANCE_MAP", "sh": "SH", "frame": "SH",
                             "samples": "USES_SAMPLE", "sample_direction": "USES_SAMPLE",
-                            "sample_irradiance": "USES_SAMPLE"}
+                            "sample_irradiance": "USES_SAMPLE", "bright_count": "BRIGHT",
+                            "bright_direction": "BRIGHT", "bright_radius": "BRIGHT",
+                            "bright_moment": "BRIGHT_IRRADIANCE", "bright_length": "BRIGHT_IRRADIANCE",
+                            "bright_power": "BRIGHT_LOBE", "bright_total": "BRIGHT_IRRADIANCE",
+                            "bright_center": "BRIGHT", "bright_cap": "BRIGHT"}
     exact_uniforms = tuple(p.name for p in _UNIFORMS)
     optional_code = (("IRRADIANCE_MAP", "the irradiance cube map and its uniforms"),
                      ("SH", "the spherical harmonics and their uniforms"),
-                     ("USES_SAMPLE", "the averaged map's directions and their uniforms"))
+                     ("USES_SAMPLE", "the averaged map's directions and their uniforms"),
+                     ("BRIGHT", "the bright blocks' directions and sizes (a map with texels above its threshold)"),
+                     ("BRIGHT_IRRADIANCE", "the bright blocks' moments, for Lambert"),
+                     ("BRIGHT_LOBE", "the bright blocks' powers, for the Phong lobe"))
 
-    def __init__(self, image, rotation=None, scale=1.0, resolution=9, order=8, samples=4, irradiance="map",
-                 method="auto"):
+    def __init__(self, image, rotation=None, scale=1.0, resolution=9, order=4, samples=4, irradiance="map",
+                 method="auto", bright=32, threshold=None):
         if isinstance(image, (str, Path)):
             image = read_radiance_map(image)
         radiance = np.array(image, dtype=np.float64)
@@ -192,7 +231,7 @@ class EnvironmentLight(ExtendedLight):
         object.__setattr__(self, "irradiance_method", irradiance)
         object.__setattr__(self, "_digest", hashlib.sha256(radiance.tobytes() + rotation.tobytes()).hexdigest()[:16])
         object.__setattr__(self, "_cache", {})
-        super().__init__(resolution, order, samples, method=method)
+        super().__init__(resolution, order, samples, bright, threshold, method=method)
 
     def __setstate__(self, state):
         """Unpickled (a batch worker's copy): the map and the rotation read-only again, as constructed."""
@@ -202,7 +241,7 @@ class EnvironmentLight(ExtendedLight):
 
     def check(self):
         super().check()
-        for name in ("resolution", "order"):
+        for name in ("resolution", "order", "bright"):
             if not float(getattr(self, name)).is_integer():
                 raise ValueError(f"{name} must be a whole number (got {getattr(self, name)!r})")
 
@@ -217,6 +256,7 @@ class EnvironmentLight(ExtendedLight):
     @classmethod
     def structural_defines(cls, lights):
         modes = {light.irradiance_method for light in lights}
+        blocks = max(light.bright_count() for light in lights)
         if len(modes) > 1:
             raise ValueError("a scene's environment lights must agree on irradiance= ('map' or 'sh')")
         return (("MAP_TEXELS", str(6 * max(int(light.resolution) for light in lights) ** 2)),
@@ -224,14 +264,21 @@ class EnvironmentLight(ExtendedLight):
                 ("SH_COEFFICIENTS", str(max(env.sh_count(light.order) for light in lights))),
                 ("SAMPLE_TEXELS", str(max(light.sample_count() for light in lights))),
                 ("MAX_SAMPLES", str(max(light.sample_count() for light in lights)))) \
-            + ((("IRRADIANCE_BY_SH", "1"),) if modes == {"sh"} else ())
+            + ((("IRRADIANCE_BY_SH", "1"),) if modes == {"sh"} else ()) \
+            + ((("BRIGHT_BLOCKS", str(blocks)), ("BRIGHT_MOMENTS", str(3 * blocks))) if blocks else ())
 
     @classmethod
     def usage_defines(cls, defines, uses):
         """Declare and upload only what the program's terms read: the irradiance cube map (or the harmonics) for
-        Lambert, the harmonics for the Phong lobe, the averaged texels for the other terms."""
+        Lambert, the harmonics for the Phong lobe, the averaged texels for the other terms; the bright blocks'
+        moments for Lambert and their powers for the lobe, where the scene's maps have any."""
         by_sh = "IRRADIANCE_BY_SH" in dict(defines)
         out = []
+        if "BRIGHT_BLOCKS" in dict(defines):
+            lobe = "lobe" in uses or "lobe_real" in uses
+            out += ([("BRIGHT", "1")] if "irradiance" in uses or lobe else []) \
+                + ([("BRIGHT_IRRADIANCE", "1")] if "irradiance" in uses else []) \
+                + ([("BRIGHT_LOBE", "1")] if lobe else [])
         if "irradiance" in uses:
             out.append(("IRRADIANCE_SH", "1") if by_sh else ("IRRADIANCE_MAP", "1"))
         if "lobe" in uses or "lobe_real" in uses or ("irradiance" in uses and by_sh):
@@ -244,11 +291,18 @@ class EnvironmentLight(ExtendedLight):
     def _data(self, what):
         cache = self._cache
         if what not in cache:
-            if what == "irradiance":
+            if what == "bright":
+                threshold = bright_blocks.bright_threshold(self.radiance) if self.threshold is None else self.threshold
+                residual, blocks = bright_blocks.bright_blocks(self.radiance, float(threshold), int(self.bright))
+                blocks["direction"] = blocks["direction"] @ self.rotation.T
+                for name in ("moment", "total", "center"):
+                    blocks[name] = blocks[name] @ self.rotation.T
+                cache[what] = (residual, blocks, float(threshold))
+            elif what == "irradiance":
                 directions = env.cube_texel_directions(int(self.resolution))
-                cache[what] = env.irradiance(self.radiance, directions @ self.rotation)
+                cache[what] = env.irradiance(self._data("bright")[0], directions @ self.rotation)
             elif what == "sh":
-                cache[what] = env.sh_project(self.radiance, int(self.order))
+                cache[what] = env.sh_project(self._data("bright")[0], int(self.order))
             else:
                 rows = int(self.samples)
                 mean = env.downsample(self.radiance, rows).reshape(-1, 3)
@@ -268,7 +322,20 @@ class EnvironmentLight(ExtendedLight):
             return self._data("samples")[0]
         if name == "sample_irradiance":
             return self._data("samples")[1]
+        if name == "bright_count":
+            return float(self.bright_count())
+        if name.startswith("bright_"):
+            value = self._data("bright")[1][name[len("bright_"):]]
+            return value.reshape(-1, 3) if name in ("bright_moment", "bright_total") else value
         return getattr(self, name)
+
+    def bright_count(self):
+        """How many bright blocks the map's excess is cut into (0: no texel above the threshold, or ``bright=0``)."""
+        return len(self._data("bright")[1]["radius"])
+
+    def bright_threshold(self):
+        """The threshold ``T`` in use [W/(m^2 sr)]: ``threshold``, or the automatic one."""
+        return self._data("bright")[2]
 
     def irradiance_map_bound(self):
         """The largest bound on the irradiance cube map's texels' own quadrature error [W/m^2] (texels the
@@ -278,12 +345,30 @@ class EnvironmentLight(ExtendedLight):
     # ---- the twin (environment.glsl, function by function)
     def irradiance(self, x, n, p):
         if "IRRADIANCE_MAP" in p.defines:
-            return env.environment_cube(n, p.irradiance, p.resolution)[0]
-        return env.environment_sh(n, 1.0, p.sh, p.frame, int(p.defines["SH_ORDER"]))[0]
+            smooth = env.environment_cube(n, p.irradiance, p.resolution)[0]
+        else:
+            smooth = env.environment_sh(n, 1.0, p.sh, p.frame, int(p.defines["SH_ORDER"]))[0]
+        return smooth + self._bright_irradiance(n, p)[0] if "BRIGHT_IRRADIANCE" in p.defines else smooth
 
     def lobe(self, x, n, r, q, p):
         horizon = env.environment_horizon(q, np.clip(np.sum(n * r, axis=-1), -1.0, 1.0))
-        return env.environment_sh(r, q, p.sh, p.frame, int(p.defines["SH_ORDER"]))[0] * horizon[:, None]
+        smooth = env.environment_sh(r, q, p.sh, p.frame, int(p.defines["SH_ORDER"]))[0] * horizon[:, None]
+        return smooth + self._bright_lobe(n, r, q, p)[0] if "BRIGHT_LOBE" in p.defines else smooth
+
+    @staticmethod
+    def _blocks(p):
+        """The bright blocks' uniforms (float32 values, as the GPU reads them) by `bright_blocks`' names."""
+        names = ("count", "direction", "radius", "moment", "length", "power", "total", "center", "cap")
+        out = {name: getattr(p, "bright_" + name) for name in names if hasattr(p, "bright_" + name)}
+        if "moment" in out:
+            out["moment"] = out["moment"].reshape(-1, 3, 3)
+        return out
+
+    def _bright_irradiance(self, n, p):
+        return bright_blocks.environment_bright_irradiance(n, self._blocks(p))
+
+    def _bright_lobe(self, n, r, q, p):
+        return bright_blocks.environment_bright_lobe(n, r, q, self._blocks(p))
 
     def sample(self, x, n, k, p):
         count = 2 * int(p.samples) ** 2
@@ -297,7 +382,8 @@ class EnvironmentLight(ExtendedLight):
         """The sensitivity to the normal's rounding (a face or texel boundary crossed moves to the other side) plus
         the blend's float32 rounding: ``8 eps`` of the largest texel and the four texels' spread times ``4 (R + 2)
         eps`` (the texel coordinate's error in texels), or for the harmonics ``(16 + 8 L) eps`` of the sum of
-        ``|terms|``."""
+        ``|terms|``; plus ``32 eps`` of the bright blocks' terms' sizes
+        (`glphong.twin.environment_bright.environment_bright_irradiance`)."""
         low, high = super().irradiance_band(x, n, p, constants)
         if "IRRADIANCE_MAP" in p.defines:
             value, spread = env.environment_cube(n, p.irradiance, p.resolution)
@@ -306,13 +392,16 @@ class EnvironmentLight(ExtendedLight):
         else:
             order = int(p.defines["SH_ORDER"])
             slack = (16 + 8 * order) * EPS * env.environment_sh(n, 1.0, p.sh, p.frame, order)[1]
-        return low - slack[:, None], high + slack[:, None]
+        slack = slack[:, None] + (32 * EPS * self._bright_irradiance(n, p)[1] if "BRIGHT_IRRADIANCE" in p.defines
+                                  else 0.0)
+        return low - slack, high + slack
 
     def lobe_band(self, x, n, r, q, p, constants):
         """The sensitivity to the rounding of ``n`` and ``r``, plus ``(16 + 12 L) eps`` of the sum of the harmonics'
         ``|terms|`` (the recurrences' rounding, the lobe weights' ``c_l(q)`` included) times the horizon factor
         ``h``, plus the harmonics' value times ``h``'s own rounding, ``eps (64 + 2 (q + 1) |log s|) (1 - h)`` (the
-        exponent of its weights is off by that many ulps of its size)."""
+        exponent of its weights is off by that many ulps of its size); plus ``16 eps`` of each bright block's term
+        times ``1 + q (1 + |log x|)`` (`glphong.twin.environment_bright.environment_bright_lobe`)."""
         low, high = super().lobe_band(x, n, r, q, p, constants)
         order = int(p.defines["SH_ORDER"])
         value, magnitude = env.environment_sh(r, q, p.sh, p.frame, order)
@@ -321,7 +410,8 @@ class EnvironmentLight(ExtendedLight):
         s = np.maximum(np.sqrt(np.maximum(1.0 - c * c, 0.0)), 1e-30)
         slack = (16 + 12 * order) * EPS * magnitude * np.abs(h) + np.max(np.abs(value), axis=1) * EPS * (
             64 + 2 * (q + 1) * np.abs(np.log(s))) * np.where(c < 0.0, h, 1.0 - h)
-        return low - slack[:, None], high + slack[:, None]
+        slack = slack[:, None] + (16 * EPS * self._bright_lobe(n, r, q, p)[1] if "BRIGHT_LOBE" in p.defines else 0.0)
+        return low - slack, high + slack
 
     def sample_band(self, x, n, k, p, constants):
         """A uniform: exact."""
@@ -382,13 +472,25 @@ class _ExactEnvironment:
     irradiance ``E(n)`` of the map at the world normals, each texel wholly above the horizon ``L_k (n . M_k)`` and each
     one the horizon crosses in closed form (`glphong.twin.environment.irradiance` with ``crossed='closed'``: about
     1e-12 relative, against the quadrature's 1e-9), so a term of irradiance form is reflected exactly at the cost of
-    the map's rows and crossed texels a normal, not its texels; every other term by `EnvironmentLight.exact`."""
+    the map's rows and crossed texels a normal, not its texels; the lecture's Phong lobe by `exact_lobe`
+    (`glphong.twin.environment_lobe`: shared-node stencils, 1e-9 of the pixel); every other term by
+    `EnvironmentLight.exact` (`glphong.checks.reference.exact_reflection` splits a material so)."""
 
     def __init__(self, light):
         self.light = light
 
     def closed_form_is_exact(self, form, q=None):
-        return form == "irradiance"
+        return form in ("irradiance", "lobe", "lobe_real")
+
+    def exact_lobe(self, n, r, q, rtol=1e-9, floor=None):
+        """``integral max(r.w, 0)^q L(w) [n.w > 0] dw`` at world normals ``n`` and lobe axes ``r`` (N, 3):
+        ``(value (N, 3), error estimate (N,), converged (N,))`` (`glphong.twin.environment_lobe.lobe_integral`;
+        ``floor`` (N,) the scale under which an error does not matter)."""
+        radiance = np.asarray(self.light.radiance, np.float64)
+        radiance = np.repeat(radiance[..., None], 3, axis=-1) if radiance.ndim == 2 else radiance
+        rotation = self.light.rotation
+        return lobe_integral(radiance, np.asarray(r, np.float64) @ rotation, np.asarray(n, np.float64) @ rotation,
+                             q, rtol, floor)
 
     def irradiance(self, x, n, p):
         return env.irradiance(self.light.radiance, np.asarray(n, np.float64) @ self.light.rotation,

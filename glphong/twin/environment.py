@@ -334,11 +334,12 @@ def _crossed_closed(n, t0, t1, p0, p1, guard=1e-6):
 # --------------------------------------------------------------------------- what EnvironmentLight's GLSL reads
 # (glsl/lights/environment.glsl mirrors these function by function; docs/design.md section 13)
 def cube_texel_directions(resolution):
-    """The unit directions of a cube map's texel centres, (6 R^2, 3) float64, in the order ``face * R^2 + t * R + s``:
+    """The unit directions of a cube map's texels, (6 R^2, 3) float64, in the order ``face * R^2 + t * R + s``:
     face ``2 a + (major < 0)`` about axis ``a`` (x, y, z), ``s`` along axis ``(a + 1) % 3`` and ``t`` along
-    ``(a + 2) % 3``, texel centres at ``-1 + (2 i + 1)/R`` of the face's square ``[-1, 1]^2``."""
+    ``(a + 2) % 3``, at ``-1 + 2 i/(R - 1)`` of the face's square ``[-1, 1]^2``: its edges included, so that two
+    faces hold the same values along the edge they share and the blend is continuous across it."""
     R = int(resolution)
-    centres = -1.0 + (2.0 * np.arange(R) + 1.0) / R
+    centres = -1.0 + 2.0 * np.arange(R) / (R - 1.0)
     t, s = np.meshgrid(centres, centres, indexing="ij")
     out = []
     for face in range(6):
@@ -354,8 +355,8 @@ def cube_texel_directions(resolution):
 
 def environment_cube(n, table, resolution):
     """The cube map ``table`` (6 R^2, 3) at unit directions ``n`` (N, 3): the face of ``n``'s largest component
-    (ties to x, then y), its texel coordinates ``u = (s + 1) R/2 - 1/2`` clamped to the face's texel centres, and
-    the bilinear blend of the four texels about ``u``.  Returns ``(value (N, 3), spread (N,))``: spread is the
+    (ties to x, then y), its texel coordinates ``u = (s + 1)(R - 1)/2`` (clamped to ``[0, R - 1]`` against
+    rounding), and the bilinear blend of the four texels about ``u``.  Returns ``(value (N, 3), spread (N,))``: spread is the
     largest difference among the four texels (what a shift of ``u`` can change), for the band."""
     R = int(resolution)
     a = np.abs(n)
@@ -365,7 +366,7 @@ def environment_cube(n, table, resolution):
     s = n[rows, (axis + 1) % 3] / np.abs(major)
     t = n[rows, (axis + 2) % 3] / np.abs(major)
     face = 2 * axis + (major < 0.0)
-    u = np.clip((np.stack([s, t], axis=1) + 1.0) * (0.5 * R) - 0.5, 0.0, R - 1.0)
+    u = np.clip((np.stack([s, t], axis=1) + 1.0) * (0.5 * (R - 1.0)), 0.0, R - 1.0)
     i0 = np.minimum(np.floor(u).astype(np.int64), R - 2)
     fr = u - i0
     base = face * R * R

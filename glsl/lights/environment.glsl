@@ -2,8 +2,9 @@
 // glphong/lights/environment.py; the twin's functions have the same names in glphong/twin/environment.py).
 //
 // environment_irradiance(x, n, j) = E(n) = integral L(w) (n.w)^+ dw [W/m^2], one of:
-//   ENVIRONMENT_IRRADIANCE_MAP: environment_cube, the bilinear blend of a cube map of E at its texel centres
-//     (6 R^2 texels, R = u_environment_resolution[j]), each computed from the map's exact per-texel integrals;
+//   ENVIRONMENT_IRRADIANCE_MAP: environment_cube, the bilinear blend of a cube map of E at its texels
+//     (6 R^2 texels, R = u_environment_resolution[j], at -1 + 2 i/(R - 1) of each face, its edges included: the
+//     blend is continuous across the faces), each computed from the map's exact per-texel integrals;
 //   ENVIRONMENT_IRRADIANCE_SH: environment_sh(n, 1, j), the spherical harmonics up to ENVIRONMENT_SH_ORDER convolved
 //     with the clamped cosine (order 2: Ramamoorthi and Hanrahan 2001).
 // environment_lobe(x, n, r, q, j) = environment_sh(r, q, j) environment_horizon(q, n.r): the lobe max(r.w, 0)^q
@@ -14,9 +15,25 @@
 // environment_sample(x, n, j, k, wi, E): texel k of the map averaged onto s x 2s lat-long texels
 //   (s = u_environment_samples[j]): wi its moment's direction M_k/|M_k| (world), E = Lbar_k |M_k|, so that
 //   (n.wi) E = Lbar_k n.M_k, the texel's exact irradiance where it is wholly above the horizon.
+// ENVIRONMENT_BRIGHT (a map with texels above its threshold T): the map's excess max(L - T, 0) is integrated apart, as
+//   u_environment_bright_count[j] blocks (glphong/twin/environment_bright.py), the cube map and the harmonics holding
+//   the residual min(L, T); each block b: direction w_b (its centroid), radius a_b (the flat disc of its solid angle):
+//   environment_segment(c, a, f, e): the part of a disc of radius a above a chord at signed distance c from its
+//     centre, t = clamp(c/a, -1, 1), u = sqrt(1 - t^2), f = (acos(-t) + t u)/pi (area), e = c f + (2/3) a u^3/pi
+//     (cosine-weighted: c wholly above, 0 wholly below);
+//   environment_bright_irradiance(n, j) = sum_b max(n.M_bc + |M_bc| (e - c), 0), c = n.w_b, M_bc (c = r, g, b) the
+//     exact moments of its excess: n.M_b exactly where its disc is wholly above the horizon;
+//   environment_bright_lobe(n, r, q, j) = sum_b P_b max(r.w_b, 0)^q f (the midpoint rule), P_b its power [W/m^2],
+//     each block's environment_bright_peak(r, q, i) = P_b max(r.w_b, 0)^q (exp(max(q log x, -104)), 0 for x <= 0).
+//   A cap about u_environment_bright_center[j] of angle rho holds every block's disc (u_environment_bright_cap[j] =
+//   (cos rho, sin rho, rho), sin rho stored as 2 where rho > pi/2: no horizon leaves such a cap on one side): where the horizon does not cross it Lambert is n.(sum_b M_b) (u_environment_bright_total,
+//   3 a light) or 0 and the lobe needs no f; where r is further than rho from it and cos(angle - rho)^q < 1e-8 the
+//   lobe is left out (by at most 1e-8 sum_b P_b); each loop runs over the blocks only where it is needed (its bound
+//   the light's count, not the define: a constant bound of 8 or less was unrolled, every pixel paying every block).
 // Key defines read here: ENVIRONMENT_IRRADIANCE_MAP, ENVIRONMENT_IRRADIANCE_SH, ENVIRONMENT_SH, ENVIRONMENT_SH_ORDER,
-//   ENVIRONMENT_USES_SAMPLE, and the array sizes ENVIRONMENT_MAP_TEXELS, ENVIRONMENT_SH_COEFFICIENTS,
-//   ENVIRONMENT_SAMPLE_TEXELS (a program declares only what its terms read).
+//   ENVIRONMENT_USES_SAMPLE, ENVIRONMENT_BRIGHT, ENVIRONMENT_BRIGHT_IRRADIANCE, ENVIRONMENT_BRIGHT_LOBE, and the array
+//   sizes ENVIRONMENT_MAP_TEXELS, ENVIRONMENT_SH_COEFFICIENTS, ENVIRONMENT_SAMPLE_TEXELS, ENVIRONMENT_BRIGHT_BLOCKS,
+//   ENVIRONMENT_BRIGHT_MOMENTS (a program declares only what its terms read).
 
 #if defined(ENVIRONMENT_IRRADIANCE_MAP)
 vec3 environment_cube(vec3 n, int j)
@@ -28,7 +45,7 @@ vec3 environment_cube(vec3 n, int j)
     int face = 2 * axis + (major < 0.0 ? 1 : 0);
     int size = int(u_environment_resolution[j]);
     float R = float(size);
-    vec2 u = clamp((st + 1.0) * (0.5 * R) - 0.5, 0.0, R - 1.0);
+    vec2 u = clamp((st + 1.0) * (0.5 * (R - 1.0)), 0.0, R - 1.0);
     ivec2 i0 = min(ivec2(floor(u)), ivec2(size - 2));
     vec2 fr = u - vec2(i0);
     int base = j * ENVIRONMENT_MAP_TEXELS + face * size * size + i0.y * size + i0.x;
@@ -132,23 +149,100 @@ float environment_horizon(float q, float c)
 }
 #endif
 
+#if defined(ENVIRONMENT_BRIGHT)
+void environment_segment(float c, float a, out float f, out float e)
+{
+    float t = clamp(c / a, -1.0, 1.0);
+    float u = sqrt(max(1.0 - t * t, 0.0));
+    float angle = atan2_first_quadrant(u, abs(t));                  // acos(|t|)
+    float above = t >= 0.0 ? 3.14159265358979 - angle : angle;      // acos(-t)
+    f = (above + t * u) * 0.318309886183791;
+    e = c * f + 0.212206590789194 * a * u * u * u;                  // (2/3)/pi
+}
+#endif
+
+#if defined(ENVIRONMENT_BRIGHT_IRRADIANCE)
+vec3 environment_bright_irradiance(vec3 n, int j)
+{
+    float c_all = dot(n, u_environment_bright_center[j]);
+    float reach = u_environment_bright_cap[j].y;
+    bool above = c_all >= reach;                        // every block's disc above the horizon: n.(sum_b M_b)
+    int count = above || c_all <= -reach ? 0 : min(int(u_environment_bright_count[j]), ENVIRONMENT_BRIGHT_BLOCKS);
+    vec3 sum = above ? vec3(dot(n, u_environment_bright_total[3 * j]), dot(n, u_environment_bright_total[3 * j + 1]),
+                            dot(n, u_environment_bright_total[3 * j + 2])) : vec3(0.0);
+    for (int k = 0; k < count; ++k) {                   // the horizon crosses the blocks' cap: each block
+        int i = j * ENVIRONMENT_BRIGHT_BLOCKS + k;
+        float c = dot(n, u_environment_bright_direction[i]);
+        float f;
+        float e;
+        environment_segment(c, u_environment_bright_radius[i], f, e);
+        vec3 direct = vec3(dot(n, u_environment_bright_moment[3 * i]), dot(n, u_environment_bright_moment[3 * i + 1]),
+                           dot(n, u_environment_bright_moment[3 * i + 2]));
+        sum += max(direct + u_environment_bright_length[i] * (e - c), 0.0);
+    }
+    return sum;
+}
+#endif
+
+#if defined(ENVIRONMENT_BRIGHT_LOBE)
+vec3 environment_bright_peak(vec3 r, float q, int i)                        // P_b max(r.w_b, 0)^q, block i
+{
+    float x = dot(r, u_environment_bright_direction[i]);
+    return u_environment_bright_power[i] * (x > 0.0 ? exp(max(q * log(x), -104.0)) : 0.0);
+}
+
+vec3 environment_bright_lobe(vec3 n, vec3 r, float q, int j)
+{
+    vec3 cap = u_environment_bright_cap[j];
+    float c_all = dot(n, u_environment_bright_center[j]);
+    float cr = dot(r, u_environment_bright_center[j]);
+    float nearest = cr * cap.x + sqrt(max(1.0 - cr * cr, 0.0)) * cap.y;     // cos(angle(r, centre) - rho)
+    bool reached = cr >= cap.x || (nearest > 0.0 && q * log(nearest) > -18.420680743952367);   // above 1e-8
+    int count = min(int(u_environment_bright_count[j]), ENVIRONMENT_BRIGHT_BLOCKS);
+    int plain = reached && c_all >= cap.y ? count : 0;                      // every disc above the horizon: f = 1
+    int clipped = reached && c_all < cap.y && c_all > -cap.y ? count : 0;
+    vec3 sum = vec3(0.0);
+    for (int k = 0; k < plain; ++k) {
+        sum += environment_bright_peak(r, q, j * ENVIRONMENT_BRIGHT_BLOCKS + k);
+    }
+    for (int k = 0; k < clipped; ++k) {
+        int i = j * ENVIRONMENT_BRIGHT_BLOCKS + k;
+        float f;
+        float e;
+        environment_segment(dot(n, u_environment_bright_direction[i]), u_environment_bright_radius[i], f, e);
+        sum += environment_bright_peak(r, q, i) * f;
+    }
+    return sum;
+}
+#endif
+
 vec3 environment_irradiance(vec3 x, vec3 n, int j)
 {
 #if defined(ENVIRONMENT_IRRADIANCE_MAP)
-    return environment_cube(n, j);
+    vec3 smooth_part = environment_cube(n, j);
 #elif defined(ENVIRONMENT_IRRADIANCE_SH)
-    return environment_sh(n, 1.0, j);
+    vec3 smooth_part = environment_sh(n, 1.0, j);
 #else
-    return vec3(0.0);
+    vec3 smooth_part = vec3(0.0);
+#endif
+#if defined(ENVIRONMENT_BRIGHT_IRRADIANCE)
+    return smooth_part + environment_bright_irradiance(n, j);
+#else
+    return smooth_part;
 #endif
 }
 
 vec3 environment_lobe(vec3 x, vec3 n, vec3 r, float q, int j)
 {
 #if defined(ENVIRONMENT_SH)
-    return environment_sh(r, q, j) * environment_horizon(q, clamp(dot(n, r), -1.0, 1.0));
+    vec3 smooth_part = environment_sh(r, q, j) * environment_horizon(q, clamp(dot(n, r), -1.0, 1.0));
 #else
-    return vec3(0.0);
+    vec3 smooth_part = vec3(0.0);
+#endif
+#if defined(ENVIRONMENT_BRIGHT_LOBE)
+    return smooth_part + environment_bright_lobe(n, r, q, j);
+#else
+    return smooth_part;
 #endif
 }
 
