@@ -468,7 +468,7 @@ def test_constructors_and_round_trips():
     diffuse, lobes = m.components
     assert type(diffuse) is Diffuse and type(lobes) is LafortuneLobes and lobes.defines() == (("COUNT", "2"),)
     values = m.parameter_values()
-    assert set(values) == {"rho_d", "ka", "two_sided", "normal_map", "alpha_mask"} | {f"lobe{k}_{p}" for k in (1, 2) for p in ("rho", "c", "n")}
+    assert set(values) == {"rho_d", "ka", "two_sided", "normal_map", "alpha_mask", "alpha_blend"} | {f"lobe{k}_{p}" for k in (1, 2) for p in ("rho", "c", "n")}
     assert type(m)(**values) == m and hash(type(m)(**values)) == hash(m)
     assert eval(repr(m), {"Lafortune": Lafortune}) == m
     assert Lafortune(0.2, m.lobes, ka=0.01) == m
