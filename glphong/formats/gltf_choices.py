@@ -21,9 +21,10 @@ __all__ = ["REQUIRED_OK", "APPEARANCE_ONLY", "APPLIED", "ATTRIBUTE_COMPONENTS", 
 REQUIRED_OK = ("KHR_lights_punctual", "KHR_mesh_quantization", "KHR_draco_mesh_compression",
                "KHR_materials_emissive_strength", "KHR_texture_transform", "KHR_materials_ior",
                "EXT_meshopt_compression", "KHR_meshopt_compression", "KHR_texture_basisu", "EXT_texture_webp",
-               "KHR_materials_variants", "KHR_materials_specular", "KHR_materials_clearcoat")
+               "KHR_materials_variants", "KHR_materials_specular", "KHR_materials_clearcoat",
+               "KHR_materials_sheen")
 #: required extensions whose loss changes appearance only: read without them, with a warning
-APPEARANCE_ONLY = ("EXT_texture_avif", "KHR_materials_transmission", "KHR_materials_volume", "KHR_materials_sheen",
+APPEARANCE_ONLY = ("EXT_texture_avif", "KHR_materials_transmission", "KHR_materials_volume",
                    "KHR_materials_unlit", "KHR_materials_iridescence", "KHR_materials_anisotropy", "KHR_materials_dispersion", "KHR_materials_pbrSpecularGlossiness",
                    "KHR_materials_diffuse_transmission")
 #: extensions glphong applies where a file uses them (`extensionsUsed`); any other is warned about, by name

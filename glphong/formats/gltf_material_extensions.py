@@ -1,13 +1,15 @@
 """The KHR_materials extensions glphong applies to a glTF material, read from a file's JSON (`extension_arguments`) and
-validated with their JSON paths (`check_material_extensions`): ``KHR_materials_specular`` and
-``KHR_materials_clearcoat`` as `glphong.GltfPBR`'s parameters (`glphong.materials.gltf_extensions`,
-docs/gltf_extensions.md).
+validated with their JSON paths (`check_material_extensions`): ``KHR_materials_specular``,
+``KHR_materials_clearcoat`` and ``KHR_materials_sheen`` as `glphong.GltfPBR`'s parameters
+(`glphong.materials.gltf_extensions`, `glphong.materials.gltf_sheen`, docs/gltf_extensions.md).
 
 - ``specular = specularFactor * specularTexture.a`` (linear), ``specular_color = specularColorFactor *
   specularColorTexture.rgb`` (sRGB);
 - ``clearcoat = clearcoatFactor * clearcoatTexture.r``, ``clearcoat_roughness = clearcoatRoughnessFactor *
   clearcoatRoughnessTexture.g`` (linear); ``clearcoatNormalTexture``: glphong's coat takes the material's shading
-  normal, so a coat normal other than the base's normal texture is named in a warning.
+  normal, so a coat normal other than the base's normal texture is named in a warning;
+- ``sheen_color = sheenColorFactor * sheenColorTexture.rgb`` (sRGB), ``sheen_roughness = sheenRoughnessFactor *
+  sheenRoughnessTexture.a`` (linear); ``sheenColorFactor`` 0 (the default) disables the layer.
 """
 import numpy as np
 
@@ -20,9 +22,11 @@ MATERIAL_EXTENSIONS = {
     "KHR_materials_specular": (("specularTexture", "alpha"), ("specularColorTexture", "srgb")),
     "KHR_materials_clearcoat": (("clearcoatTexture", "r"), ("clearcoatRoughnessTexture", "g"),
                                 ("clearcoatNormalTexture", "normal")),
+    "KHR_materials_sheen": (("sheenColorTexture", "srgb"), ("sheenRoughnessTexture", "alpha")),
 }
 _FACTORS = {"KHR_materials_specular": (("specularFactor", 1, 0.0, 1.0), ("specularColorFactor", 3, 0.0, np.inf)),
-            "KHR_materials_clearcoat": (("clearcoatFactor", 1, 0.0, 1.0), ("clearcoatRoughnessFactor", 1, 0.0, 1.0))}
+            "KHR_materials_clearcoat": (("clearcoatFactor", 1, 0.0, 1.0), ("clearcoatRoughnessFactor", 1, 0.0, 1.0)),
+            "KHR_materials_sheen": (("sheenColorFactor", 3, 0.0, 1.0), ("sheenRoughnessFactor", 1, 0.0, 1.0))}
 
 
 def check_material_extensions(c, extensions, where, texture_ref):
@@ -92,4 +96,12 @@ def extension_arguments(entry, texture, warn):
             warn("KHR_materials_clearcoat: glphong's coat takes the material's shading normal ("
                  + ("its normalTexture" if base_normal is not None else "the unperturbed normal") + "), the file's coat "
                  + (f"normal is texture {coat_normal}" if coat_normal is not None else "the unperturbed normal"))
+    sheen = extensions.get("KHR_materials_sheen")
+    if sheen is not None and any(float(c) > 0 for c in sheen.get("sheenColorFactor", (0.0, 0.0, 0.0))):
+        color = tuple(float(c) for c in sheen["sheenColorFactor"])  # all 0 (the default): the layer is disabled
+        factor = float(sheen.get("sheenRoughnessFactor", 0.0))
+        image = texture(sheen["sheenColorTexture"], True) if "sheenColorTexture" in sheen else None
+        out["sheen_color"] = Texture(image, color) if image is not None else color
+        image = texture(sheen["sheenRoughnessTexture"], False, True) if "sheenRoughnessTexture" in sheen else None
+        out["sheen_roughness"] = Texture(image, factor, channel="r") if image is not None else factor
     return out

@@ -311,7 +311,7 @@ def _check_materials(c):
         if ior is not None:
             c.obj(ior, f"{where}.extensions.KHR_materials_ior")
             c.number(ior.get("ior", 1.5), f"{where}.extensions.KHR_materials_ior.ior", 0.0)
-        check_material_extensions(c, extensions, where, _check_texture_ref)  # specular, clearcoat
+        check_material_extensions(c, extensions, where, _check_texture_ref)  # specular, clearcoat, sheen
         strength = extensions.get("KHR_materials_emissive_strength")
         if strength is not None:
             c.obj(strength, f"{where}.extensions.KHR_materials_emissive_strength")

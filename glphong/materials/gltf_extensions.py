@@ -3,14 +3,17 @@
 
 Each is a set of `GltfPBR` parameters; a material uses an extension where a parameter differs from the value at which
 the extension changes nothing (or is textured), and only then is its code in the program (``#define
-GLTF_PBR_SPECULAR``, ``GLTF_PBR_CLEARCOAT``; `GltfExtensionFeatures.extensions`).  With ``x = (1 - |v.h|)^5``,
-``f0 = ((ior - 1)/(ior + 1))^2``, ``c`` the base colour, ``m`` metallic, ``D``/``V`` Appendix B's GGX and visibility::
+GLTF_PBR_SPECULAR``, ``GLTF_PBR_CLEARCOAT``, ``GLTF_PBR_SHEEN``; `GltfExtensionFeatures.extensions`).
+With ``x = (1 - |v.h|)^5``, ``f0 = ((ior - 1)/(ior + 1))^2``, ``c`` the base colour, ``m`` metallic, ``D``/``V``
+Appendix B's GGX and visibility::
 
     KHR_materials_specular   F_d = mix(min(f0 specular_color, 1) specular, specular, x)                  rgb
                              dielectric = F_d V D + (1 - max(F_d.r, F_d.g, F_d.b)) c / pi
                              f_r = mix(dielectric, (c + (1 - c) x) V D, m)     (the metal is unchanged)
     KHR_materials_clearcoat  F_c = 0.04 + 0.96 (1 - |n.v|)^5                   fresnel_coat, ior 1.5, on n.v
                              f_r' = mix(f_r, V_c D_c, clearcoat F_c),  alpha_c = clearcoat_roughness^2
+    KHR_materials_sheen      f_r' = sheen_color D_s V_s + f_r max(min(1 - max3(sheen_color) E(n.v), ...(n.l)), 0)
+                             under the coat (`glphong.materials.gltf_sheen`)
 
 =================== ====== ========= ======= ==========================================================================
 parameter           kind   range     neutral meaning
@@ -21,6 +24,8 @@ specular_color      rgb    [0, inf)  1       ``specularColorFactor`` times ``spe
                                              colour (the product ``f0 specular_color`` is clamped at 1)
 clearcoat           scalar [0, 1]    0       ``clearcoatFactor`` times ``clearcoatTexture.r``: the coat's weight
 clearcoat_roughness scalar [0, 1]    0       ``clearcoatRoughnessFactor`` times ``clearcoatRoughnessTexture.g``
+sheen_color         rgb    [0, 1]    0       ``sheenColorFactor`` times ``sheenColorTexture`` (sRGB)
+sheen_roughness     scalar [0, 1]    0       ``sheenRoughnessFactor`` times ``sheenRoughnessTexture.a``
 =================== ====== ========= ======= ==========================================================================
 
 Exact as the extensions write them, with two limits of glphong's (docs/gltf_extensions.md): the coat's normal is the
@@ -38,6 +43,7 @@ from glphong.definitions.cases import Case, _mirror_eye, _unit
 from glphong.definitions.material_base import constant_part
 from glphong.definitions.params import Param
 from glphong.definitions.surface import SurfaceInput
+from glphong.materials.gltf_sheen import SHEEN_PARAMS, gltf_sheen_oracle, sheen_cases
 from glphong.twin.band import FLT_MAX
 from glphong.twin.functions import microfacet_geometry, microfacet_ggx
 
@@ -57,10 +63,11 @@ _CLEARCOAT_ROUGHNESS = Param("clearcoat_roughness", "scalar", low=0.0, high=1.0,
                                  "alpha_c = clearcoat_roughness^2")
 
 #: the extensions' parameters, appended to `GltfPBR`'s
-EXTENSION_PARAMS = (_SPECULAR, _SPECULAR_COLOR, _CLEARCOAT, _CLEARCOAT_ROUGHNESS)
+EXTENSION_PARAMS = (_SPECULAR, _SPECULAR_COLOR, _CLEARCOAT, _CLEARCOAT_ROUGHNESS) + SHEEN_PARAMS  # gltf_sheen
 #: each extension glphong applies: its short name (the define GLTF_PBR_<NAME>), its glTF name and its parameters
 EXTENSIONS = {"specular": ("KHR_materials_specular", ("specular", "specular_color")),
-              "clearcoat": ("KHR_materials_clearcoat", ("clearcoat", "clearcoat_roughness"))}
+              "clearcoat": ("KHR_materials_clearcoat", ("clearcoat", "clearcoat_roughness")),
+              "sheen": ("KHR_materials_sheen", ("sheen_color", "sheen_roughness"))}
 #: the coat's f0: ((1 - 1.5)/(1 + 1.5))^2, fresnel_coat's fixed ior 1.5
 CLEARCOAT_F0 = 0.04
 
@@ -143,7 +150,8 @@ class GltfExtensionFeatures:
 
     def extensions(self):
         """The extensions this material uses, by short name (`EXTENSIONS`): specular where ``specular`` or
-        ``specular_color`` is not 1 or is textured, clearcoat where ``clearcoat`` is not 0 (tuple of str)."""
+        ``specular_color`` is not 1 or is textured, clearcoat where ``clearcoat`` is not 0, sheen where
+        ``sheen_color`` is not 0 (tuple of str)."""
         def differs(name, neutral):
             value = getattr(self, name)
             return isinstance(value, SurfaceInput) and value.texture is not None or \
@@ -154,6 +162,8 @@ class GltfExtensionFeatures:
             out.append("specular")
         if np.any(constant_part(self.clearcoat)):
             out.append("clearcoat")
+        if np.any(constant_part(self.sheen_color)):  # sheenColorFactor 0 disables the layer, textured or not
+            out.append("sheen")
         return tuple(out)
 
     def defines(self):
@@ -195,6 +205,8 @@ def gltf_extensions_oracle(base_color, metallic, roughness, ior, extensions, p, 
         dielectric = (1 - weight * max(fr)) * c / mpmath.pi + weight * f * layer
         metal = (c + (1 - c) * x) * layer
         out.append((1 - metallic) * dielectric + metallic * metal)
+    if "sheen" in extensions:  # KHR_materials_sheen, under the coat (gltf_sheen)
+        out = gltf_sheen_oracle(out, p, n_dot_l, n_dot_v, n_dot_h)
     if "clearcoat" in extensions:
         w = p.clearcoat * (mpmath.mpf("0.04") + (1 - mpmath.mpf("0.04")) * (1 - n_dot_v) ** 5)
         coat = d_and_v(p.clearcoat_roughness ** 2)
@@ -224,7 +236,7 @@ def extension_cases(cls):
                           cls(0.5, 0.5, 0.3, clearcoat=1.0, clearcoat_roughness=0.1, specular=0.5),
                           eye=(-float(np.sqrt(1.0 - nv * nv)), 0.0, nv), lights=(("point", _unit(40.0), e_one),),
                           note="F_c -> 1: the coat alone"))
-    return cases
+    return cases + sheen_cases(cls)
 
 
 def extension_gltf_fields(material, texture_index):
@@ -250,4 +262,9 @@ def extension_gltf_fields(material, texture_index):
         textured("clearcoat", "clearcoatTexture", fields, "r")
         textured("clearcoat_roughness", "clearcoatRoughnessTexture", fields, "g")
         out["KHR_materials_clearcoat"] = fields
+    if "sheen" in used:
+        fields = {"sheenColorFactor": [float(c) for c in np.broadcast_to(constant_part(material.sheen_color), 3)],
+                  "sheenRoughnessFactor": float(constant_part(material.sheen_roughness))}
+        textured("sheen_color", "sheenColorTexture", fields)
+        out["KHR_materials_sheen"] = fields
     return out

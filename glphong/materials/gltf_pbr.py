@@ -49,6 +49,8 @@ from glphong.materials.gltf_extensions import (EXTENSION_PARAMS, ExtensionProper
                                                extension_cases, extension_gltf_fields, gltf_clearcoat_fresnel,
                                                gltf_clearcoat_mix, gltf_extensions_oracle, gltf_specular_fresnel,
                                                gltf_specular_parts)
+from glphong.materials.gltf_sheen import (gltf_sheen_albedo, gltf_sheen_distribution, gltf_sheen_l,  # noqa: F401
+                                          gltf_sheen_lambda, gltf_sheen_mix)  # the GLSL chunk's twins, by its name
 from glphong.definitions.material import MaterialModel, Param, Properties, constant_part
 from glphong.definitions.params import GlslFile
 from glphong.definitions.surface import SurfaceInput
@@ -90,8 +92,8 @@ def gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2):
 
 #: the parameters `gltf_pbr_band` bounds (emissive and occlusion: outside the response)
 _CORE_PARAMS = ("base_color", "metallic", "roughness", "emissive", "occlusion", "ior")
-#: KHR_materials_specular's and KHR_materials_clearcoat's defaults, at which the response is the core formula
-_CORE_AT = {"specular": 1.0, "specular_color": 1.0, "clearcoat": 0.0}
+#: KHR_materials_specular's, _clearcoat's and _sheen's defaults, at which the response is the core formula
+_CORE_AT = {"specular": 1.0, "specular_color": 1.0, "clearcoat": 0.0, "sheen_color": 0.0}
 
 
 def _interval(value, rel):
@@ -238,6 +240,10 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
     clearcoat, clearcoat_roughness : float or SurfaceInput
         ``KHR_materials_clearcoat`` (default 0: no coat): ``mix(f_r, V_c D_c, clearcoat F_c(n.v))``, ``alpha_c =
         clearcoat_roughness^2``; the coat takes the shading normal.
+    sheen_color, sheen_roughness : float or (3,) array_like or SurfaceInput, float or SurfaceInput
+        ``KHR_materials_sheen`` (default 0: no sheen), under the coat: ``sheen_color D_s V_s + f_r max(min(1 -
+        max3(sheen_color) E(n.v), 1 - max3(sheen_color) E(n.l)), 0)``, Charlie ``D_s`` with ``alpha_g =
+        sheen_roughness^2`` (`glphong.materials.gltf_sheen`).
     """
 
     name = "gltf_pbr"
@@ -312,6 +318,8 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         dtype = specular.dtype
         with np.errstate(over="ignore", invalid="ignore"):
             value = diffuse + fresnel * specular[..., None]
+        if "sheen" in getattr(p, "extensions", ()):  # KHR_materials_sheen, under the coat (gltf_sheen)
+            value = gltf_sheen_mix(value, f, wi, wo, n_dot_l, p)
         if "clearcoat" in getattr(p, "extensions", ()):  # KHR_materials_clearcoat (gltf_extensions)
             value = gltf_clearcoat_mix(value, f, wi, wo, n_dot_l, p, gltf_pbr_visibility_cos)
         return np.where(valid[..., None], value, dtype.type(0)).astype(dtype)
@@ -322,7 +330,7 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         at the value where the core formula holds (`_CORE_AT`: glTF's extensions at their defaults)."""
         for name, value in p.__dict__.items():
             if name in _CORE_PARAMS or (name in _CORE_AT and np.all(np.asarray(value) == _CORE_AT[name])) or \
-                    (name in ("extensions", "clearcoat_roughness") and not getattr(p, "extensions", ())):
+                    (name in ("extensions", "clearcoat_roughness", "sheen_roughness") and not getattr(p, "extensions", ())):
                 continue
             return super().band(f, wi, wo, n_dot_l, p, constants)
         return gltf_pbr_band(f.n, wi, wo, n_dot_l, p, constants)

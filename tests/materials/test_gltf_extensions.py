@@ -209,20 +209,24 @@ PLANTED = {  # text of gltf_pbr.glsl, planted text: each in the extensions' code
 }
 
 
-@pytest.mark.parametrize("planted", sorted(PLANTED))
-def test_planted_errors_fail(planted, monkeypatch, glphong_make_renderer):
-    """The sphere of test_renders_verify_under_every_light_kind (point light), with one error planted in the GLSL."""
+def assert_planted_error_fails(old, new, material, monkeypatch, make_renderer):
+    """The sphere of test_renders_verify_under_every_light_kind (point light) with ``old`` replaced by ``new`` in
+    gltf_pbr.glsl: ``verify`` fails (also used by test_gltf_sheen.py)."""
     from glphong.shaders import assembly
 
-    old, new = PLANTED[planted]
     original = assembly.model_source
     source = original(glphong.materials.gltf_pbr.GltfPBR)
     assert old in source[0]
     monkeypatch.setattr(assembly, "model_source", lambda cls: (source[0].replace(old, new),) + tuple(source[1:])
                         if cls is glphong.materials.gltf_pbr.GltfPBR else original(cls))
-    material = glphong.GltfPBR(**{**MATERIALS["both"], "specular_color": (3.0, 1.0, 0.5), "clearcoat": 1.0})
-    report = glphong.verify(_sphere_scene(material, LIGHTS["point"]()), glphong_make_renderer(64, 64, "egl"))
+    report = glphong.verify(_sphere_scene(material, LIGHTS["point"]()), make_renderer(64, 64, "egl"))
     assert not report.passed and report.outside_count > 0, report.summary()
+
+
+@pytest.mark.parametrize("planted", sorted(PLANTED))
+def test_planted_errors_fail(planted, monkeypatch, glphong_make_renderer):
+    material = glphong.GltfPBR(**{**MATERIALS["both"], "specular_color": (3.0, 1.0, 0.5), "clearcoat": 1.0})
+    assert_planted_error_fails(*PLANTED[planted], material, monkeypatch, glphong_make_renderer)
 
 
 def test_stability_cases_pass(session_gl):
