@@ -208,6 +208,8 @@ def broken(monkeypatch):
 
     monkeypatch.setattr(contexts, "_osmesa_library", no_osmesa)
     monkeypatch.setattr(moderngl, "create_context", no_egl)
+    # nor a context an earlier test's released Renderer recycled (it would be reused instead of created)
+    monkeypatch.setattr(contexts, "_reuse", lambda *args: None)
     monkeypatch.delenv("GLPHONG_BACKEND", raising=False)
 
 

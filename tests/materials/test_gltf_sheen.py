@@ -140,7 +140,9 @@ def test_neutral_sheen_is_the_core_material_and_its_program():
 def test_the_glsl_table_is_the_shipped_table():
     from glphong.materials.gltf_sheen_table import SHEEN_ALBEDO
 
-    text = (pathlib.Path(glphong.__file__).parents[1] / "glsl/materials/gltf_pbr.glsl").read_text()
+    from glphong.core.glsl_files import glsl_root
+
+    text = (glsl_root() / "materials" / "gltf_pbr.glsl").read_text()  # the chunk the programs read, where installed
     body = re.search(r"const float GLTF_SHEEN_E\[561\] = float\[\]\((.*?)\);", text, re.S).group(1)
     glsl = np.array([float(x) for x in body.replace("\n", " ").split(",")], np.float32)
     np.testing.assert_array_equal(glsl, np.asarray(SHEEN_ALBEDO, np.float32).ravel())
