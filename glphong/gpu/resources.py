@@ -79,7 +79,9 @@ def target_bytes(size, supersample, samples):
 
     Radiance target RGBA32F plus depth at the internal (supersampled) size, times the samples, a resolve target when
     multisampling, the 8-bit display target and depth times the samples and its resolve, the G-buffer (up to four
-    RGBA32F planes and depth) at the output size, and the float32 readback of the internal size.
+    RGBA32F planes and depth) at the output size, and the float32 readback of the internal size.  Not counted: the
+    depth peel's targets (`glphong.gpu.peeling`: two float depth planes, an RGBA32F accumulator, a depth buffer and two
+    4-byte scratch planes, 36 bytes a pixel), made on a scene's first blended frame and released with the targets.
     """
     w, h = size
     internal = w * h * supersample ** 2
