@@ -361,3 +361,29 @@ def test_a_textured_alpha_blends_as_its_bilinear_filter_reads(glphong_backend, g
 def test_example_transparency(tmp_path, load_example):
     report = load_example("transparency").main(tmp_path / "transparency.png", 160, 120)
     assert report.passed and report.summary()["blend"]["layers"] == 2 and (tmp_path / "transparency.png").is_file()
+
+
+def test_blended_frames_hold_no_growing_gl_objects_across_renders_and_sizes(glphong_make_renderer):
+    """The peel's targets are made once a size and target and dropped with the renderer's targets on resize: many
+    blended frames, float and 8-bit, in both drawing orders and across two sizes, leave the renderer's GL object count
+    where the first round put it (programs included), and a frame after resizing back is bit for bit the first."""
+    renderer = glphong_make_renderer(SIZE, SIZE, "egl")
+    scenes = [_quad_scene(order) for order in ((0, 1, 2), (2, 1, 0))]
+
+    def one_round():
+        for scene in scenes:
+            renderer.render(scene)
+            renderer.render_srgb8(scene)
+
+    first = renderer.render(scenes[0]).radiance.copy()
+    one_round()
+    baseline = renderer.gl_object_count()
+    for _ in range(6):
+        one_round()
+    assert renderer.gl_object_count() == baseline
+    renderer.resize(SIZE + 8, SIZE)
+    assert renderer.render(scenes[0]).radiance.shape == (SIZE, SIZE + 8, 3)
+    renderer.resize(SIZE, SIZE)
+    np.testing.assert_array_equal(renderer.render(scenes[0]).radiance, first)
+    one_round()
+    assert renderer.gl_object_count() == baseline
