@@ -5,7 +5,7 @@ import numpy as np
 
 from glphong.checks import reference
 from glphong.checks.blend_twin import blend_twin
-from glphong.checks.method_sample import method_figures, sample_mask
+from glphong.checks.method_sample import auto_sample_size, method_figures, sample_mask
 from glphong.checks.tolerances import BAND, point_band
 from glphong.checks.verify_passes import verify_passes
 from glphong.gpu.passes import requested_passes
@@ -209,7 +209,7 @@ def compare(gpu, reference_radiance, low, high, mask):
     return rel, outside
 
 
-def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None, previous_scene=None, exact_sample=None,
+def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None, previous_scene=None, exact_sample="auto",
            seed=0):
     """Render ``scene``, shade its G-buffer with the float64 twin, compare under the band; where the scene has
     extended lights, also the twin against their exact integrals (the method error map); and each frame pass asked
@@ -226,10 +226,13 @@ def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None,
         Frame passes to check besides the radiance (`glphong.Renderer.render`'s names; 'radiance' is always checked).
     next_scene, previous_scene : Scene, optional
         What 'flow' and 'backward_flow' read (as in `glphong.Renderer.render`).
-    exact_sample : int, optional
+    exact_sample : int, None or 'auto'
         Compute the exact integrals at this many covered pixels only, drawn uniformly without replacement with
-        ``np.random.default_rng(seed)`` (`VerifyReport.exact_sample`; the figures say so and how sure they are); default
-        every covered pixel.  For large environment maps (docs/speed.md, "Verify with an environment light").
+        ``np.random.default_rng(seed)`` (`VerifyReport.exact_sample`; the figures say so and how sure they are); None:
+        every covered pixel; 'auto' (default): every covered pixel, except under an environment map whose exact lobe
+        would cost more than `glphong.checks.method_sample.AUTO_PIXEL_TEXELS` pixel-texels, where a sample of
+        `~glphong.checks.method_sample.AUTO_SAMPLE` pixels is taken and reported (`auto_sample_size`; docs/speed.md,
+        "Verify with an environment light").
     seed : int, optional
 
     Returns
@@ -273,6 +276,10 @@ def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None,
     rel, outside = compare(frame.radiance, ref, low, high, mask)
     if exact is None:
         exact = any(light.extent == "extended" for light in scene.lights)
+    if isinstance(exact_sample, str) and exact_sample != "auto":
+        raise ValueError(f"exact_sample must be a positive whole number of pixels, None or 'auto' (got {exact_sample!r})")
+    if exact and isinstance(exact_sample, str):
+        exact_sample = auto_sample_size(scene, int(mask.sum()))
     sample = sample_mask(mask, exact_sample, seed) if exact else None
     exact_radiance, exact_error = exact_image(scene, gbuffer, renderer.shadow_settings, sample=sample) if exact else \
         (None, None)

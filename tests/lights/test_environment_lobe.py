@@ -112,3 +112,28 @@ def test_verify_on_a_random_sample_says_so(glphong_backend, glphong_make_rendere
     np.testing.assert_array_equal(report.exact[picked], full.exact[picked])
     with pytest.raises(ValueError, match="exact_sample"):
         glphong.verify(scene, renderer, exact_sample=2.5)
+
+
+def test_verify_samples_by_itself_where_the_exact_lobe_would_cost_too_much(glphong_make_renderer, monkeypatch):
+    """The default rule, with its bounds lowered to this small scene (16 x 16 px, an 8 x 16 map): a Phong material is
+    sampled and says so; the same scene with a Lambert material (the map's closed forms) and ``exact_sample=None``
+    compute every covered pixel; under the bounds nothing is sampled."""
+    import glphong.checks.method_sample as method_sample
+
+    scene = _scene(8, 16)
+    renderer = glphong_make_renderer(16, 16, "egl")
+    assert glphong.verify(scene, renderer).exact_sample is None  # 8 x 16 texels x ~100 px: far under the bound
+    covered = int(renderer.gbuffer(scene).mask.sum())
+    monkeypatch.setattr(method_sample, "AUTO_PIXEL_TEXELS", covered * 8 * 16 - 1)
+    monkeypatch.setattr(method_sample, "AUTO_SAMPLE", 10)
+    report = glphong.verify(scene, renderer)
+    assert report.exact_sample.sum() == 10 and "random sample of 10 px" in str(report) and report.passed
+    assert glphong.verify(scene, renderer, exact_sample=None).exact_sample is None
+    lambert = glphong.Scene(scene.camera, list(scene.lights))
+    for obj in scene.objects:
+        lambert.add(obj.mesh, glphong.Lambert(0.5), pose=obj.pose)
+    assert glphong.verify(lambert, renderer).exact_sample is None
+    monkeypatch.setattr(method_sample, "AUTO_PIXEL_TEXELS", covered * 8 * 16)
+    assert glphong.verify(scene, renderer).exact_sample is None
+    with pytest.raises(ValueError, match="exact_sample"):
+        glphong.verify(scene, renderer, exact_sample="some")
