@@ -94,26 +94,26 @@ def steps(size, scene):
                                 np.ascontiguousarray((view_projection @ obj.pose).T, np.float32).tobytes()))
             posed[renderer] = (program, objects)
 
-    def constant_draw(renderer):
+    def on_cleared_display(renderer, draw):
+        """``draw()`` into the renderer's display target, cleared, depth test on, in its context."""
         def run():
             fbo = renderer._target("display")
             fbo.use()
             fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
             renderer._mgl.enable(moderngl.DEPTH_TEST)
+            draw()
+        return in_context(run, renderer)
+
+    def constant_draw(renderer):
+        def draw():
             program, objects = posed[renderer]
             for vao, clip in objects:
                 program["u_clip"].write(clip)
                 vao.render(moderngl.TRIANGLES)
-        return in_context(run, renderer)
+        return on_cleared_display(renderer, draw)
 
     def fill(renderer):
-        def run():
-            fbo = renderer._target("display")
-            fbo.use()
-            fbo.clear(0.0, 0.0, 0.0, 0.0, depth=1.0)
-            renderer._mgl.enable(moderngl.DEPTH_TEST)
-            constant[renderer].render(moderngl.TRIANGLES, vertices=3)
-        return in_context(run, renderer)
+        return on_cleared_display(renderer, lambda: constant[renderer].render(moderngl.TRIANGLES, vertices=3))
 
     def by_shader():
         out.use()
