@@ -161,7 +161,35 @@ def _ktx2_header(gltf, payload, where):
     if scheme not in (0, 1, 2):
         raise SceneFileError(gltf.path, f"KTX2 supercompression scheme {scheme}: expected 0 (none), 1 (BasisLZ) or "
                              "2 (Zstandard)", where)
+    _ktx2_levels(gltf, payload, width, height, levels, model, scheme, where)
     return width, height, model
+
+
+def _ktx2_levels(gltf, payload, width, height, levels, model, scheme, where):
+    """Check the KTX2 level index (24 bytes a level after the 80-byte header: byteOffset, byteLength,
+    uncompressedByteLength, uint64 each) before the transcoder reads it: no more levels than the size has, every level
+    inside the file and after the index, and level 0's uncompressed size what a UASTC 4x4 image of this size holds
+    (16 bytes a block: the size a Zstandard stream may ask to be inflated to), BasisLZ's 0 as the specification says."""
+    count = max(levels, 1)
+    if count > max(width, height).bit_length():
+        raise SceneFileError(gltf.path, f"{levels} levels for a {width} x {height} KTX2 image (at most "
+                             f"{max(width, height).bit_length()})", where)
+    end_of_index = 80 + 24 * count
+    if end_of_index > len(payload):
+        raise SceneFileError(gltf.path, f"its level index ({count} levels, to byte {end_of_index}) lies outside the "
+                             f"{len(payload)}-byte file", where)
+    for level in range(count):
+        offset, length, uncompressed = struct.unpack_from("<3Q", payload, 80 + 24 * level)
+        if offset < end_of_index or offset + length > len(payload):
+            raise SceneFileError(gltf.path, f"KTX2 level {level} (bytes {offset} to {offset + length}) lies outside "
+                                 f"the {len(payload)}-byte file's data after its index", where)
+    blocks = -(-width // 4) * -(-height // 4)
+    expected = 0 if scheme == 1 else blocks * 16 if model == 166 else None
+    _, length, uncompressed = struct.unpack_from("<3Q", payload, 80)
+    if expected is not None and uncompressed != expected or scheme == 0 and uncompressed != length:
+        raise SceneFileError(gltf.path, f"KTX2 level 0 declares {uncompressed} uncompressed bytes; a "
+                             f"{_BASIS_MODELS[model]} {width} x {height} image with supercompression {scheme} has "
+                             f"{expected if expected is not None else length}", where)
 
 
 def decode_ktx2(gltf, payload, where):
@@ -183,6 +211,7 @@ def decode_ktx2(gltf, payload, where):
     """
     basisu = _module(gltf, "KHR_texture_basisu", where)
     width, height, model = _ktx2_header(gltf, payload, where)
+    gltf.charge(width * height * 4 + -(-width // 4) * -(-height // 4) * 16, where)  # the rgba8 image, level 0 inflated
     try:
         texture = basisu.open(bytes(payload))
         if (texture.width, texture.height) != (width, height) or texture.is_video:

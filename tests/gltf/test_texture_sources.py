@@ -51,6 +51,13 @@ def _ktx2(blocks, vk_format=0, faces=1, size=None, cut=None):
     return out[:cut] if cut else out
 
 
+def _with(payload, offset, fmt, value):
+    """``payload`` with ``value`` packed as ``fmt`` at byte ``offset`` (a header or level-index field changed)."""
+    out = bytearray(payload)
+    struct.pack_into(fmt, out, offset, value)
+    return bytes(out)
+
+
 def _expected(blocks):
     return np.kron(np.asarray(blocks, np.uint8), np.ones((4, 4, 1), np.uint8))  # each colour over 4 x 4 pixels
 
@@ -116,7 +123,10 @@ def test_a_planted_block_layout_error_is_caught(tmp_path, builder):
     (_ktx2(COLOURS, vk_format=37), r"images\[0\]: a KTX2 image of vkFormat 37"),
     (_ktx2([[(1, 2, 3, 4), b"\x45" + bytes(15)]]), r"images\[0\]: a UASTC LDR 4x4 KTX2 image of 8 x 4 pixels that "
      r"cannot be transcoded"),
-    (_ktx2(COLOURS)[:-20], r"images\[0\]: .*cannot be transcoded"),
+    (_ktx2(COLOURS)[:-20], r"images\[0\]: KTX2 level 0 \(bytes \d+ to \d+\) lies outside"),
+    (_with(_ktx2(COLOURS), 96, "<Q", 1 << 40), r"images\[0\]: KTX2 level 0 declares 1099511627776 uncompressed bytes"),
+    (_with(_ktx2(COLOURS), 80, "<Q", 1 << 40), r"images\[0\]: KTX2 level 0 \(bytes 1099511627776 to"),
+    (_with(_ktx2(COLOURS), 40, "<I", 10), r"images\[0\]: 10 levels for a 12 x 8 KTX2 image \(at most 4\)"),
 ])
 def test_hostile_ktx2_images_are_clear_errors(tmp_path, builder, payload, pattern):
     pytest.importorskip("opengl_basisu", reason="the [ktx2] extra (opengl_basisu) is not installed")
