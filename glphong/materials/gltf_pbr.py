@@ -296,8 +296,9 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         alpha = roughness * roughness
         a2 = alpha * alpha
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-            specular = np.minimum(gltf_pbr_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2),
-                                  dtype.type(FLT_MAX)).astype(dtype)
+            # roughness 0: D is a delta (0 for a point light); V's r_x would underflow to 0/0 for grazing l and v
+            specular = np.where(a2 > 0, np.minimum(gltf_pbr_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2),
+                                                   dtype.type(FLT_MAX)), dtype.type(0)).astype(dtype)
             x1 = np.maximum(dtype.type(1) - v_dot_h, dtype.type(0))
             x = ((x1 * x1) * (x1 * x1) * x1).astype(dtype)
             c = np.asarray(p.base_color, dtype)

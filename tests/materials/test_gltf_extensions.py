@@ -381,3 +381,10 @@ def test_roughness_zero_at_grazing_light_and_view(glphong_backend):
         gpu = evaluate(material, wi, wo, backend=glphong_backend).astype(np.float64)
         twin = evaluate(material, wi, wo, twin=True)
         assert np.all(twin < 1e-20) and np.all(np.abs(gpu - twin) <= 1e-6 * np.abs(twin) + 1e-37), (gpu, twin)
+        # the twin in float32, as the band evaluates it: the same rule, so 0 or tiny, never the NaN of 0 * inf
+        l, v = (np.asarray(d, np.float64) / np.linalg.norm(d, axis=1, keepdims=True) for d in (wi, wo))
+        l32, v32 = l.astype(np.float32), v.astype(np.float32)
+        (term,) = material.components
+        single = term.response(ShadingFrame(np.tile(np.float32([0, 0, 1]), (2, 1))), l32, v32, l32[:, 2].copy(),
+                               term.values())
+        assert np.all(np.isfinite(single)) and np.all(np.abs(single) <= 1e-20), single
