@@ -46,7 +46,8 @@ def draw_objects(renderer, scene, output, frame_values=None, shadow_values=None,
             culled = cull
             (mgl.enable if cull else mgl.disable)(moderngl.CULL_FACE)
         vao = entry.vertex_array
-        if scene.objects[entry.index].mesh.indices.size >= 3 * MIN_TRIANGLES:  # a large mesh: what may meet the view
+        # a large mesh: what may meet the view (not for the uber-shader's entries, made anew each frame and never kept)
+        if renderer.specialise and scene.objects[entry.index].mesh.indices.size >= 3 * MIN_TRIANGLES:
             if view_projection is None:
                 view_projection = camera.projection_matrix(aspect) @ camera.view_matrix()
             vao = _view_vertex_array(renderer, scene.objects[entry.index], entry, camera, aspect, view_projection)
