@@ -14,8 +14,6 @@ from collections import namedtuple
 
 import numpy as np
 
-from glphong.lights.environment import EnvironmentLight
-
 __all__ = ["MethodErrorFigures", "sample_mask", "method_figures", "auto_sample_size", "AUTO_PIXEL_TEXELS",
            "AUTO_SAMPLE"]
 
@@ -79,12 +77,12 @@ def method_figures(error, mask, sample=None):
 
 
 def auto_sample_size(scene, covered):
-    """The sample `verify`'s default (``exact_sample='auto'``) takes: `AUTO_SAMPLE` pixels where the scene has an
-    `EnvironmentLight`, a material term whose exact integral is not the map's closed-form irradiance (a lobe, or a term
-    the quadrature integrates), and ``covered`` (pixels) times the maps' texels beyond `AUTO_PIXEL_TEXELS`; else None
-    (every covered pixel: a Lambert-only scene's closed forms take 24.7 s at 256 x 256 under 256 x 512)."""
-    texels = sum(light.radiance.shape[0] * light.radiance.shape[1] for light in scene.lights
-                 if isinstance(light, EnvironmentLight))
+    """The sample `verify`'s default (``exact_sample='auto'``) takes: `AUTO_SAMPLE` pixels where the scene has a
+    light whose exact integral visits texels (`LightModel.exact_texels`: an `EnvironmentLight`'s map), a material term
+    whose exact integral is not the map's closed-form irradiance (a lobe, or a term the quadrature integrates), and
+    ``covered`` (pixels) times those texels beyond `AUTO_PIXEL_TEXELS`; else None (every covered pixel: a Lambert-only
+    scene's closed forms take 24.7 s at 256 x 256 under 256 x 512)."""
+    texels = sum(light.exact_texels() for light in scene.lights)
     if not texels or covered * texels <= AUTO_PIXEL_TEXELS:
         return None
 

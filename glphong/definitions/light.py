@@ -209,6 +209,12 @@ class LightModel(Definition):
     def check(self):
         """Checks across parameters (default none); raise ValueError naming them."""
 
+    def exact_texels(self):
+        """Directions the exact integral of a term without a closed form visits per pixel, where they grow with the
+        light's data (`verify`'s sampling rule, `glphong.checks.method_sample.auto_sample_size`): 0 (default) where
+        the cost is bounded; an environment light's texels."""
+        return 0
+
     @classmethod
     def contract(cls):
         """The functions the kind defines in GLSL and as its twin (tuple of `ContractFunction`): a punctual kind's

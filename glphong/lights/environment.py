@@ -249,6 +249,10 @@ class EnvironmentLight(ExtendedLight):
         return super().parameter_values() | {"image": f"{self.radiance.shape[0]}x{self.radiance.shape[1]} "
                                                       f"sha256:{self._digest}", "irradiance": self.irradiance_method}
 
+    def exact_texels(self):
+        """The map's texels: its exact lobe and quadrature visit those within reach of each pixel."""
+        return self.radiance.shape[0] * self.radiance.shape[1]
+
     def sample_count(self):
         """``2 samples^2`` averaged texels."""
         return 2 * int(self.samples) ** 2
