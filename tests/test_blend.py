@@ -387,3 +387,15 @@ def test_blended_frames_hold_no_growing_gl_objects_across_renders_and_sizes(glph
     np.testing.assert_array_equal(renderer.render(scenes[0]).radiance, first)
     one_round()
     assert renderer.gl_object_count() == baseline
+
+
+def test_a_textured_alpha_saved_for_other_viewers_is_warned_about(tmp_path):
+    """glTF's alpha is baseColorFactor.a times the base-colour texture's alpha; glphong writes its own alpha texture
+    in its extras only, so other viewers would see alpha 1: the save says so, and glphong reads it back exactly."""
+    alpha = glphong.Texture(np.array([[255, 0]], np.uint8), 0.8, srgb=False, channel="r")
+    scene = glphong.Scene(_camera())
+    scene.add(primitives.plane(size=1.0), glphong.Lambert(0.5, alpha_blend=glphong.AlphaBlend(alpha)))
+    with pytest.warns(UserWarning, match="textured alpha is written in glphong's extras only"):
+        glphong.save_gltf(scene, tmp_path / "textured.gltf")
+    assert json.loads((tmp_path / "textured.gltf").read_text())["materials"][0]["alphaMode"] == "BLEND"
+    assert glphong.load_scene(tmp_path / "textured.gltf").objects[0].material == scene.objects[0].material

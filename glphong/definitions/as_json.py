@@ -29,6 +29,31 @@ def _plain(value):
     return [float(c) for c in value] if isinstance(value, tuple) else float(value)
 
 
+def _alpha_to_json(owner, texture_index, cls, what):
+    """An `AlphaMask`'s or `AlphaBlend`'s alpha as JSON: the number, or its texture (by ``texture_index``)."""
+    if not owner.textured:
+        return owner.alpha
+    if texture_index is None:
+        raise ValueError(f"{cls.__name__} has a textured {what}: give texture_index to store it")
+    return {"texture": int(texture_index(owner.alpha.texture)), "wrap": owner.alpha.texture.wrap,
+            "filter": owner.alpha.texture.filter, "scale": owner.alpha.scale, "channel": owner.alpha.channel}
+
+
+def _alpha_from_json(entry, textures, cls, name, expected):
+    """The alpha of a stored ``alpha_mask`` or ``alpha_blend`` object ``entry``: a number, or a `SurfaceInput` of
+    one of ``textures``; ValueError naming ``name`` and what was ``expected``."""
+    alpha = entry.get("alpha", 1.0) if isinstance(entry, dict) else None
+    if isinstance(alpha, dict):
+        if textures is None:
+            raise ValueError(f"{cls.__name__}: its {name} is textured, but no textures were given")
+        alpha = SurfaceInput(alpha.get("scale", 1.0), textures(alpha["texture"], alpha.get("wrap", "repeat"),
+                                                               alpha.get("filter", "trilinear"), False),
+                             channel=alpha.get("channel", "r"))
+    if not isinstance(alpha, (int, float, SurfaceInput)) or isinstance(alpha, bool):
+        raise ValueError(f"{cls.__name__}: '{name}' must be {expected}")
+    return alpha
+
+
 def material_to_json(material, texture_index=None):
     """The JSON-ready dict of ``material`` (see the module).
 
@@ -66,16 +91,11 @@ def material_to_json(material, texture_index=None):
             arguments[argument.name] = value if isinstance(value, str) or value is None else _plain(value)
     out = {"version": VERSION, "class": cls.__name__, "module": cls.__module__, "arguments": arguments,
            "ka": _plain(material.ka), "two_sided": bool(material.two_sided)}
-    mask = material.alpha_mask
-    if mask is not None:
-        if mask.textured and texture_index is None:
-            raise ValueError(f"{cls.__name__} has a textured alpha mask: give texture_index to store it")
-        alpha = {"texture": int(texture_index(mask.alpha.texture)), "wrap": mask.alpha.texture.wrap,
-                 "filter": mask.alpha.texture.filter, "scale": mask.alpha.scale, "channel": mask.alpha.channel} \
-            if mask.textured else mask.alpha
-        out["alpha_mask"] = {"cutoff": mask.cutoff, "alpha": alpha}
+    if material.alpha_mask is not None:
+        out["alpha_mask"] = {"cutoff": material.alpha_mask.cutoff,
+                             "alpha": _alpha_to_json(material.alpha_mask, texture_index, cls, "alpha mask")}
     if material.alpha_blend is not None:
-        out["alpha_blend"] = {"alpha": material.alpha_blend.alpha}
+        out["alpha_blend"] = {"alpha": _alpha_to_json(material.alpha_blend, texture_index, cls, "alpha blend")}
     if material.normal_map is not None:
         if texture_index is None:
             raise ValueError(f"{cls.__name__} has a normal map: give texture_index to store it")
@@ -166,24 +186,13 @@ def material_from_json(data, textures=None):
             raise ValueError(f"{cls.__name__}: 'normal_map' must be an object naming a texture, and textures must be given")
         normal_map = NormalMap(textures(n["texture"], n.get("wrap", "repeat"), n.get("filter", "trilinear"), False),
                                n.get("scale", 1.0))
-    alpha_mask = None
+    alpha_mask = alpha_blend = None
     if data.get("alpha_mask") is not None:
         a = data["alpha_mask"]
-        alpha = a.get("alpha", 1.0) if isinstance(a, dict) else None
-        if isinstance(alpha, dict):
-            if textures is None:
-                raise ValueError(f"{cls.__name__}: its alpha mask is textured, but no textures were given")
-            alpha = SurfaceInput(alpha.get("scale", 1.0), textures(alpha["texture"], alpha.get("wrap", "repeat"),
-                                                                   alpha.get("filter", "trilinear"), False),
-                                 channel=alpha.get("channel", "r"))
-        if not isinstance(a, dict) or not isinstance(alpha, (int, float, SurfaceInput)) or isinstance(alpha, bool):
-            raise ValueError(f"{cls.__name__}: 'alpha_mask' must be an object with a cutoff and an alpha")
+        alpha = _alpha_from_json(a, textures, cls, "alpha_mask", "an object with a cutoff and an alpha")
         alpha_mask = AlphaMask(a.get("cutoff", 0.5), alpha)
-    alpha_blend = data.get("alpha_blend")
-    if alpha_blend is not None:
-        if not isinstance(alpha_blend, dict) or not isinstance(alpha_blend.get("alpha"), (int, float)) \
-                or isinstance(alpha_blend.get("alpha"), bool):
-            raise ValueError(f"{cls.__name__}: 'alpha_blend' must be an object with a number 'alpha' in [0, 1]")
-        alpha_blend = AlphaBlend(alpha_blend["alpha"])
+    if data.get("alpha_blend") is not None:
+        alpha_blend = AlphaBlend(_alpha_from_json(data["alpha_blend"], textures, cls, "alpha_blend",
+                                                  "an object with an alpha: a number in [0, 1] or a texture"))
     return cls(**arguments, ka=tuple(ka) if isinstance(ka, list) else float(ka), two_sided=bool(data.get("two_sided", True)),
                normal_map=normal_map, alpha_mask=alpha_mask, alpha_blend=alpha_blend)

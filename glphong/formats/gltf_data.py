@@ -24,11 +24,13 @@ any other required extension is refused by name; one a file uses (``extensionsUs
 """
 import base64
 import binascii
+import functools
 import struct
 import warnings
 from pathlib import Path
 
 import numpy as np
+import PIL.features
 
 from glphong.core.filesafety import LIMITS, SceneFileError, decode_image, parse_json, read_bytes, resolve_reference
 from glphong.formats.gltf_compressed import (OPTIONAL_DECODERS, decode_ktx2, decode_meshopt_view, decoder_available,
@@ -460,10 +462,10 @@ _IMAGE_TYPES = {"image/png": ("PNG",), "image/jpeg": ("JPEG",), "image/webp": ("
 _SOURCES = ("KHR_texture_basisu", "EXT_texture_webp")
 
 
+@functools.lru_cache(maxsize=None)
 def _webp_available():
-    from PIL import features
-
-    return bool(features.check("webp"))
+    """Whether this Pillow decodes WebP (asked once a process)."""
+    return bool(PIL.features.check("webp"))
 
 
 def _texture_source(gltf, index):

@@ -144,6 +144,10 @@ def _material(builder, material, cache):
     alpha = material.alpha_mask or material.alpha_blend
     if alpha is not None and not alpha.textured:
         pbr["baseColorFactor"][3] = float(alpha.alpha)
+    elif alpha is not None:
+        warnings.warn(f"{type(material).__name__}'s textured alpha is written in glphong's extras only: other viewers "
+                      "read the glTF alpha, baseColorFactor.a (1) times the base-colour texture's, which does not "
+                      "carry it", stacklevel=4)
     name = f"{type(material).__name__}{len(builder.doc.get('materials', []))}"  # unique: readers key materials by name
     return {"name": name, "pbrMetallicRoughness": pbr, **out, "extras": {"glphong": stored},
             "doubleSided": bool(material.two_sided)}
