@@ -50,7 +50,7 @@ def check_attribute_type(path, accessor, name, where):
     if key not in ATTRIBUTE_COMPONENTS:
         return
     found = (accessor["componentType"], bool(accessor.get("normalized", False)))
-    if found not in ATTRIBUTE_COMPONENTS[key] and not (found[0] == _FLOAT and found[1]):
+    if found not in ATTRIBUTE_COMPONENTS[key]:
         allowed = sorted({("normalized " if n else "") + _TYPE_NAMES[t] for t, n in ATTRIBUTE_COMPONENTS[key]})
         raise SceneFileError(path, f"{name} of {'normalized ' if found[1] else ''}{_TYPE_NAMES[found[0]]} components: "
                              f"the glTF specification and KHR_mesh_quantization allow {', '.join(allowed)}", where)

@@ -33,8 +33,8 @@ import numpy as np
 import PIL.features
 
 from glphong.core.filesafety import LIMITS, SceneFileError, decode_image, parse_json, read_bytes, resolve_reference
-from glphong.formats.gltf_compressed import (OPTIONAL_DECODERS, decode_ktx2, decode_meshopt_view, decoder_available,
-                                             draco_primitive, meshopt_extension)
+from glphong.formats.gltf_compressed import (MESHOPT, OPTIONAL_DECODERS, decode_ktx2, decode_meshopt_view,
+                                             decoder_available, draco_primitive, meshopt_extension)
 from glphong.formats.gltf_choices import (APPEARANCE_ONLY, APPLIED, REQUIRED_OK, check_attribute_type,
                                           dispersion_matters, material_uv_set, primitive_material, variant_index)
 from glphong.formats.gltf_validate import COMPONENT_BYTES, TYPE_WIDTHS, validate_gltf
@@ -178,11 +178,20 @@ class GltfFile:
             self._buffers[index] = blob
         return self._buffers[index]
 
+    def _meshopt_fallback(self, view):
+        """Whether a meshopt-compressed view's parent buffer holds plain data a reader without the decoder may read
+        (the extension's rule: a buffer marked ``fallback: true`` holds none)."""
+        parent = self.document["buffers"][view["buffer"]]
+        marks = parent.get("extensions", {})
+        return not any(isinstance(marks.get(name), dict) and marks[name].get("fallback") is True for name in MESHOPT)
+
     def view(self, index):
         """``(bytes, byteStride or None)`` of buffer view ``index`` (its range validated; a meshopt-compressed view
         decoded once, `glphong.formats.gltf_compressed.decode_meshopt_view`)."""
         view = self.document["bufferViews"][index]
         compressed = meshopt_extension(view)
+        if compressed is not None and not decoder_available(compressed[0]) and self._meshopt_fallback(view):
+            compressed = None  # the parent view's plain data, which a reader without the decoder may read
         if compressed is not None:
             if index not in self._views:
                 self._views[index] = decode_meshopt_view(self, index, *compressed)

@@ -225,6 +225,9 @@ def _check_accessors(c):
         offset = c.integer(accessor.get("byteOffset", 0), f"{where}.byteOffset")
         if not isinstance(accessor.get("normalized", False), bool):
             c.fail(f"{where}.normalized", f"expected a boolean, found {_kind(accessor['normalized'])}")
+        elif accessor.get("normalized") and component in (5125, 5126):
+            c.fail(f"{where}.normalized", "true for FLOAT or UNSIGNED_INT components, which the glTF specification "
+                   "forbids (only 8- and 16-bit integers are normalized)")
         element = _element_bytes(component, kind)
         if "bufferView" in accessor:
             view = c.index(accessor["bufferView"], f"{where}.bufferView", "bufferViews")

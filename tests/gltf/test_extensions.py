@@ -61,6 +61,8 @@ def test_quantized_attributes_read_as_the_extension_says(tmp_path, builder):
      r"float, normalized byte, normalized short"),
     ("POSITION", np.array([[0, 0, 0]] * 3, np.uint32), False, r"attributes\.POSITION: POSITION of unsigned int"),
     ("TANGENT", np.array([[0, 0, 1, 1]] * 3, np.int16), False, r"TANGENT of short components"),
+    ("NORMAL", np.array([[0, 0, 1]] * 3, np.float32), True, r"accessors\[1\]\.normalized: true for FLOAT"),
+    ("TEXCOORD_0", np.array([[0, 1]] * 3, np.uint32), True, r"accessors\[1\]\.normalized: true for FLOAT or UNSIGNED_INT"),
 ])
 def test_attribute_types_outside_the_table_are_refused(tmp_path, builder, name, values, normalized, pattern):
     if name != "POSITION":

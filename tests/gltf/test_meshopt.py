@@ -192,6 +192,27 @@ def test_without_the_package_the_error_names_the_extra(tmp_path, builder, monkey
         _load(path)
 
 
+def test_without_the_package_a_parent_view_with_plain_data_is_read(tmp_path, builder, monkeypatch):
+    """The extension's fallback: where the parent buffer is not marked ``fallback`` it holds the plain data, which a
+    reader without the decoder reads (and a reader with it decodes to the same arrays)."""
+    positions, _, _, _, indices = _compressed_sphere(builder)
+    builder.document.pop("extensionsRequired")
+    for view in builder.document["bufferViews"]:  # the plain rows, over the placeholder's data
+        stream = view["extensions"]["EXT_meshopt_compression"]
+        rows = meshopt.decode_gltf_buffer(bytes(builder.blob[stream["byteOffset"]:][:stream["byteLength"]]),
+                                          stream["count"], stream["byteStride"], stream["mode"], stream["filter"])
+        view.update(buffer=0, byteOffset=builder._append(np.ascontiguousarray(rows).tobytes()))
+    del builder.document["buffers"][builder.placeholder]["extensions"]
+    builder.document["buffers"].pop(builder.placeholder)
+    path = builder.write(tmp_path)
+    decoded = _load(path).objects[0].mesh
+    monkeypatch.setitem(sys.modules, "meshopt", None)
+    plain = _load(path).objects[0].mesh
+    np.testing.assert_array_equal(plain.positions, decoded.positions)
+    np.testing.assert_array_equal(plain.positions, positions)
+    np.testing.assert_array_equal(plain.indices, decoded.indices)
+
+
 def test_a_compressed_sphere_renders_and_verifies(tmp_path, builder, glphong_backend, glphong_make_renderer):
     _compressed_sphere(builder)
     scene = _load(builder.write(tmp_path))  # the default view: a camera and a point light
