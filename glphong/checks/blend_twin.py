@@ -133,7 +133,8 @@ def front_of(det, mirrored):
 def _layer_gbuffer(scene, hits, face, s):
     """Sample ``s`` of one layer's hits as the `GBuffer` the shading twin reads (float64 planes)."""
     mask = hits.object_index[s] >= 0
-    keys = {i: binding(scene).program_key(scene.objects[i]) for i in np.unique(hits.object_index[s][mask])}
+    bound = binding(scene)
+    keys = {i: bound.program_key(scene.objects[i]) for i in np.unique(hits.object_index[s][mask])}
     for i, key in keys.items():
         obj = scene.objects[i]
         unsupported = [name for name, wrong in (("textured parameters", bool(key.textured_inputs)),

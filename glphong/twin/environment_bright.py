@@ -94,9 +94,11 @@ def bright_blocks(radiance, threshold, count):
         t0, t1, p0, p1 = (x.reshape(-1) for x in (t0, t1, p0, p1))
     else:                               # merge them into the map's tiles of 2^m x 2^m texels
         m = 1
-        while len(np.unique((rows >> m) * W + (cols >> m))) > count:
+        while True:
+            tiles, owner = np.unique((rows >> m) * W + (cols >> m), return_inverse=True)
+            if len(tiles) <= count:
+                break
             m += 1
-        _, owner = np.unique((rows >> m) * W + (cols >> m), return_inverse=True)
         owner = owner.reshape(-1)
         source = np.arange(len(rows))
         t0, t1, p0, p1 = theta[rows], theta[rows + 1], phi[cols], phi[cols + 1]
