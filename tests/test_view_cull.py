@@ -93,3 +93,6 @@ def test_the_test_runs_and_its_buffers_are_replaced(glphong_backend, glphong_mak
     scene.camera = PerspectiveCamera.look_at((0.2, 0.0, 1.0), (0.2, 0.0, 0.0), yfov=math.radians(60.0))
     renderer.render(scene)  # another camera: tested again, the old buffers replaced
     assert len(calls) == 2 and renderer.gl_object_count() == before > whole
+    renderer.render_srgb8(scene)  # another program (the display's), the same view: the kept triangles are shared
+    renderer.render(scene, passes=("depth", "instance", "object_coordinates"))
+    assert len(calls) == 2

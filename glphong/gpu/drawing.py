@@ -72,7 +72,13 @@ def _view_vertex_array(renderer, obj, entry, camera, aspect, view_projection):
         entry.bounds = (tuple(centre), radius)
     record = "whole"
     if not box_inside(*entry.bounds, view_projection):
-        kept = visible_triangles(obj.mesh.positions, obj.mesh.indices, view_projection @ np.asarray(obj.pose))
+        clip = view_projection @ np.asarray(obj.pose, np.float64)
+        view = clip.tobytes()
+        if view not in buffers.kept:  # once per pose and view, whichever programs draw the mesh
+            if len(buffers.kept) >= 8:
+                buffers.kept.clear()
+            buffers.kept[view] = visible_triangles(obj.mesh.positions, obj.mesh.indices, clip)
+        kept = buffers.kept[view]
         if kept is not None:
             record = buffers.subset(renderer._mgl, entry.program, token, kept) if len(kept) else None
     entry.view = (camera, aspect, record)

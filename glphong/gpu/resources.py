@@ -134,6 +134,7 @@ class MeshBuffers:
         self.index_buffer = mgl.buffer(mesh.indices.tobytes())
         self.vertex_arrays = {}
         self.subsets = {}  # token -> (vertex array, index buffer) of the triangles in a view (`glphong.gpu.view_cull`)
+        self.kept = {}  # (pose, view) bytes -> the triangles in that view, shared by every program that draws it
 
     #: what a mesh without tangents or UVs supplies to a program that reads them for another object's
     #: sake (the G-buffer, the uber-shader): tangent 0 (the shader then uses the basis around n), uv 0
