@@ -452,13 +452,14 @@ def occlusion_factor(term_key, p, occluded):
 
 
 # --------------------------------------------------------------------------- mesh_fragment.glsl
-def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None):
+def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None, only=None):
     """Per object, the fragments it covers and the inputs its program shaded them with.
 
     ``band`` (`glphong.checks.tolerances.BandConstants`): also the intervals of the surface inputs
     (``f.input_bounds``), for the tolerance band.  ``shadows``: the renderer's ``(shadow_map_size,
     shadow_filter_radius)`` (`glphong.Renderer.shadow_settings`), needed where a light has ``shadows=True``: each
-    shadowing light's visibility is then ray-cast (``f.visibility``, `glphong.checks.shadows`).
+    shadowing light's visibility is then ray-cast (``f.visibility``, `glphong.checks.shadows`).  ``only`` (H, W)
+    bool: those pixels alone (a sample of the frame).
 
     Yields
     ------
@@ -479,6 +480,8 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None):
     height, width = gbuffer.mask.shape
     for index, obj in enumerate(scene.objects):
         selection = gbuffer.object_index == index
+        if only is not None:
+            selection &= only
         if not selection.any():
             continue
         key = binding(scene).program_key(obj)

@@ -301,14 +301,8 @@ def exact_image(scene, gbuffer, shadows=None, closed_forms=True, sample=None):
     error = np.zeros(gbuffer.mask.shape)
     if sample is not None:
         out[~sample], error[~sample] = np.nan, np.nan
-    for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, shadows=shadows):
-        if sample is not None:  # the sampled pixels of this object only
-            pick = sample[selection]
-            selection = selection & sample
-            position, f, n_valid = position[pick], f.select(pick), n_valid[pick]
-            if not pick.any():
-                continue
-
+    for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, shadows=shadows,
+                                                                                only=sample):
         def exact(*arguments):  # the exact integrals in place of the shader's methods, keeping the error estimate
             value, error[selection] = reference.exact_reflection(*arguments, lights=scene.lights,
                                                                  closed_forms=closed_forms)
