@@ -203,11 +203,11 @@ def broken(monkeypatch):
     def no_osmesa():
         raise OSError("simulated: libOSMesa.so not found")
 
-    def no_egl(**kwargs):
+    def no_egl(*args):
         raise Exception("simulated: eglQueryDevicesEXT failed (0x3001)")
 
     monkeypatch.setattr(contexts, "_osmesa_library", no_osmesa)
-    monkeypatch.setattr(moderngl, "create_context", no_egl)
+    monkeypatch.setattr(contexts, "create_egl_loader", no_egl)
     # nor a context an earlier test's released Renderer recycled (it would be reused instead of created)
     monkeypatch.setattr(contexts, "_reuse", lambda *args: None)
     monkeypatch.delenv("GLPHONG_BACKEND", raising=False)
@@ -285,8 +285,9 @@ print("EVALUATE", np.array_equal(evaluate(glphong.Lambert(0.3), [[0, 0, 1.0]], [
 
 
 def test_a_terminated_egl_display_is_named_not_rendered_through(make_context):
-    """pyrender's OffscreenRenderer.delete() on EGL terminates the display glphong's EGL contexts share:
-    rendering with one of them raises EGLDisplayTerminatedError naming what happened (it returned NaN
+    """With the display every library shares (GLPHONG_EGL_DISPLAY=shared; glphong's own display is the default,
+    tests/test_coexistence.py), pyrender's OffscreenRenderer.delete() on EGL terminates it: rendering with a
+    glphong EGL context raises EGLDisplayTerminatedError naming what happened and the library (it returned NaN
     images before), releasing it does not raise, a new Renderer draws the same image as before, and
     glphong.testing's pooled context is replaced."""
     import importlib.util
@@ -296,24 +297,27 @@ def test_a_terminated_egl_display_is_named_not_rendered_through(make_context):
     if importlib.util.find_spec("pyrender") is None:
         pytest.skip("pyrender is not installed (pip install 'glphong[pyrender]')")
     make_context("egl")  # skips (or fails where required) without EGL
-    out = subprocess.run([sys.executable, "-c", _TERMINATE_SCRIPT], capture_output=True, text=True, timeout=120)
+    import os
+
+    out = subprocess.run([sys.executable, "-c", _TERMINATE_SCRIPT], capture_output=True, text=True, timeout=120,
+                         env=dict(os.environ, GLPHONG_EGL_DISPLAY="shared"))
     assert out.returncode == 0, out.stderr[-3000:]
     assert out.stdout.split() == ["REFUSED", "True", "FRESH", "True", "EVALUATE", "True"], out.stdout
 
 
 def test_egl_device_selection(make_context):
-    """``device`` selects an EGL device; an index this machine does not have is refused with how many it
-    has (it suggested installing packages before), and a non-EGL backend with a device is refused."""
+    """``device`` selects an EGL device; an index this machine does not have is refused with the list of those
+    it has (it suggested installing packages before), and a non-EGL backend with a device is refused."""
     import glphong
-    from glphong.gpu.contexts import egl_device_count
+    from glphong.gpu.egl_devices import devices
 
     make_context("egl")  # skips (or fails where required) without EGL
-    count = egl_device_count()
-    assert count is not None and count >= 1
+    listed = devices()
+    assert len(listed) >= 1
     with glphong.Renderer(8, 8, backend="egl", device=0) as renderer:
         assert renderer.context.device == 0
-    with pytest.raises(ValueError, match=rf"device must be an EGL device index from 0 to {count - 1} "
-                                         rf"\(this machine has {count} EGL device"):
-        glphong.Renderer(8, 8, device=count)
+    with pytest.raises(ValueError, match=rf"no EGL device {len(listed)} here: the EGL devices this process may "
+                                         rf"use are: 0: "):
+        glphong.Renderer(8, 8, device=len(listed))
     with pytest.raises(ValueError, match="needs backend 'egl' or 'auto'"):
         glphong.Renderer(8, 8, backend="osmesa", device=0)

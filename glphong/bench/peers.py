@@ -11,9 +11,9 @@ clipped to [0, 1], as for pyrender (the shading differs: these are speed peers, 
 
 Both are optional (the extra ``bench``): imported only inside these classes, with an ImportError naming the extra;
 each is meant to run in a process of its own with glphong (their GL contexts live beside glphong's there). Making a
-PyVista plotter on EGL (VTK 9.7) terminates the EGL display every context of the process shares, as pyrender's
-``delete()`` does: glphong's renderers made before it draw nothing after (`glphong.gpu.contexts` says so with
-``EGLDisplayTerminatedError``); prepare the peers first, then make glphong's renderers, and release glphong's first.
+PyVista plotter on EGL (VTK 9.7) terminates the device's shared EGL display, as pyrender's ``delete()`` does;
+glphong's contexts live on a display of their own where the driver allows it (`glphong.gpu.egl_devices`), and
+otherwise raise ``EGLDisplayTerminatedError``: there, prepare the peers first, then make glphong's renderers.
 Open3D 0.20 renders through Vulkan only, which Mesa's llvmpipe lacks: use 0.19 (EGL) there.
 """
 import numpy as np

@@ -10,6 +10,10 @@ Several contexts, of either backend, may live in one process.  Make a context
 current with ``with ctx:`` before issuing GL calls on it; ``with`` blocks nest,
 and leaving an inner block makes the enclosing block's context current again.
 
+EGL contexts live on a display of glphong's own where the driver allows it, so that another library's
+``eglTerminate`` (pyrender, VTK/PyVista, Open3D) does not end them; `glphong.gpu.egl_devices` opens it and
+chooses the device.
+
 The two backends share one context pool (recycling), one fork guard and one notion of "current",
 whose invariants hold only if a single module owns them: this one.  The drivers' C libraries
 (:mod:`ctypes` bindings of libEGL and libOSMesa) are `glphong.gpu.drivers`'s, and contexts another
@@ -24,15 +28,17 @@ import threading
 
 import moderngl
 
+from glphong.gpu.egl_devices import create_egl_loader, resolve_device, terminating_libraries
 from glphong.gpu.drivers import (  # noqa: F401 - egl_device_count stays importable from here
     _OSMESA_CONTEXT_MAJOR_VERSION, _OSMESA_CONTEXT_MINOR_VERSION, _OSMESA_CORE_PROFILE,
-    _OSMESA_DEPTH_BITS, _OSMESA_FORMAT, _OSMESA_PROFILE, _OSMESA_RGBA, _OSMESA_VERSIONS, _egl_current_context,
+    _OSMESA_DEPTH_BITS, _OSMESA_FORMAT, _OSMESA_PROFILE, _OSMESA_RGBA, _OSMESA_VERSIONS,
     _osmesa_library, _OSMesaLoader, egl_device_count)
 from glphong.gpu.foreign import attach_current, release_offscreen  # noqa: F401 - public names of this module
 
 __all__ = [
     "BACKENDS",
     "SYSTEM_PACKAGES",
+    "PACKAGES",
     "BackendUnavailableError",
     "EGLDisplayTerminatedError",
     "release_offscreen",
@@ -49,7 +55,21 @@ SYSTEM_PACKAGES = {
     "egl": "libegl1 libegl-mesa0 libgl1-mesa-dri",
     "osmesa": "libosmesa6",
 }
-"""Debian/Ubuntu packages providing each backend."""
+"""Debian/Ubuntu packages providing each backend (``libosmesa6`` exists only up to Mesa 25.0: Debian 12 and 13,
+Ubuntu up to 25.04)."""
+
+PACKAGES = {
+    "egl": {"Debian/Ubuntu": "apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri",
+            "Fedora": "dnf install libglvnd-egl mesa-libEGL mesa-dri-drivers",
+            "conda-forge": "conda install -c conda-forge libegl (libglvnd's libEGL; Mesa's EGL vendor and drivers "
+                           "come from the system packages above; not tried by this project)"},
+    "osmesa": {"Debian/Ubuntu": "apt-get install libosmesa6 (Mesa before 25.1 only: Debian 12 and 13, Ubuntu "
+                                "22.04 to 25.04)",
+               "Fedora": "dnf install mesa-libOSMesa (Fedora 42 and older: Mesa 25.1 removed OSMesa)",
+               "conda-forge": "conda install -c conda-forge mesalib (its builds of Mesa before 25.1; not tried by "
+                              "this project)"},
+}
+"""The install command of each backend's libraries on each family of systems (`glphong doctor` prints them)."""
 
 _ENV_BACKEND = "GLPHONG_BACKEND"
 
@@ -68,14 +88,22 @@ class EGLDisplayTerminatedError(RuntimeError):
     """An EGL context can no longer be made current: its display was terminated (``eglTerminate``)."""
 
 
-_EGL_TERMINATED = (
-    "this EGL context can no longer be made current: the EGL display it lives on was terminated "
-    "(eglTerminate). Mesa gives every EGL context on a device one display, and pyrender's "
-    "OffscreenRenderer.delete() on EGL (also when the garbage collector drops one) terminates it, "
-    "taking the contexts of every other library in the process with it; glphong's drew nothing from "
-    "then on (moderngl says 'cannot create texture' or returns garbage). Make a new glphong.Renderer "
-    "(a fresh context re-initialises the display), keep pyrender's renderer alive while glphong's are "
-    "in use, or release it with glphong.integrations.pyrender.release(renderer), which does not terminate it")
+def _terminated_message(how):
+    """The message of `EGLDisplayTerminatedError` for a context on a display opened as ``how``."""
+    suspects = terminating_libraries()
+    named = ("; loaded in this process and known to terminate the display they share with glphong: " +
+             "; ".join(suspects)) if suspects else ""
+    if how == "shared":
+        why = ("the one every library in the process gets for this device (GLPHONG_EGL_DISPLAY=shared, or a driver "
+               "with neither EGL_KHR_display_reference nor, for Mesa's software device, the surfaceless platform), "
+               "so another library's eglTerminate ends glphong's contexts too")
+    else:
+        why = "its own, which another library in the process got the same way and terminated"
+    return ("this EGL context can no longer be made current: the EGL display it lives on was terminated "
+            f"(eglTerminate). glphong's display here is {how}: {why}{named}. glphong drew nothing from then on. Make a new glphong.Renderer "
+            "(a fresh context re-initialises the display), keep the other library's renderer alive while "
+            "glphong's are in use, or (pyrender) release it with glphong.integrations.pyrender.release(renderer), "
+            "which does not terminate it")
 
 
 #: the process that first tried to make a context (llvmpipe starts its rasterizer threads then)
@@ -98,8 +126,9 @@ def _destroy_pool():
             pass
 
 
-def _reuse(backend, require, device=0):
-    """A recycled context of ``backend`` (on EGL ``device``) at least as new as ``require``, or None."""
+def _reuse(backend, require, device=None):
+    """A recycled context of ``backend`` (on the EGL device of index ``device``) at least as new as ``require``,
+    or None."""
     with _POOL_LOCK:
         waiting = _POOL.get(backend, [])
         for i, ctx in enumerate(waiting):
@@ -158,6 +187,10 @@ class GLContext:
     on_release : callable, optional
         Called without arguments once, after ``mgl`` is released, to free
         native resources that moderngl does not own.
+    device : int, optional
+        The EGL device's index in `glphong.gpu.egl_devices.devices` (None for OSMesa, or a surfaceless display).
+    loader : glphong.gpu.egl_devices.EGLLoader, optional
+        The EGL context's loader (EGL only).
 
     Attributes
     ----------
@@ -171,10 +204,11 @@ class GLContext:
         OpenGL version as reported by moderngl, e.g. ``450`` for 4.5.
     """
 
-    def __init__(self, backend, mgl, on_release=None, device=0):
+    def __init__(self, backend, mgl, on_release=None, device=None, loader=None):
         self.backend = backend
         self.device = device
         self.mgl = mgl
+        self._loader = loader
         self.renderer_name = mgl.info["GL_RENDERER"]
         self.version_code = mgl.version_code
         self._on_release = on_release
@@ -204,14 +238,19 @@ class GLContext:
         self.mgl.__exit__(None, None, None)
         self.mgl.__enter__()
         if self.backend == "egl" and self.alive is False:
-            raise EGLDisplayTerminatedError(_EGL_TERMINATED)
+            raise EGLDisplayTerminatedError(_terminated_message(self.display))
 
     @property
     def alive(self):
         """For an EGL context just made current: whether EGL made it current (False once its display was
-        terminated, `EGLDisplayTerminatedError`); None where that cannot be asked (OSMesa, no libEGL)."""
-        current = _egl_current_context() if self.backend == "egl" else None
-        return None if current is None else bool(current())
+        terminated, `EGLDisplayTerminatedError`); None for OSMesa, where that cannot be asked."""
+        return self._loader.is_current() if self.backend == "egl" else None
+
+    @property
+    def display(self):
+        """How the EGL display was opened (`glphong.gpu.egl_devices.open_display`): ``'own (...)'`` or ``'shared'``
+        (other libraries' ``eglTerminate`` ends this context too); None for OSMesa."""
+        return self._loader.how if self.backend == "egl" else None
 
     def detach(self):
         """Leave the context current on no thread, so that any thread may enter it next (EGL allows a
@@ -307,10 +346,20 @@ class GLContext:
         )
 
 
-def _create_egl(require, device=0):
-    # moderngl itself rejects a context older than ``require``.
-    mgl = moderngl.create_context(standalone=True, backend="egl", require=require, device_index=device)
-    return GLContext("egl", mgl, device=device)
+def _create_egl(require, device=None):
+    """A context on the `glphong.gpu.egl_devices.EGLDevice` ``device`` (None: a surfaceless display)."""
+    loader = create_egl_loader(device, require)
+    try:
+        moderngl.init_context(loader)
+        mgl = moderngl.get_context()
+    except BaseException:
+        loader.destroy()
+        raise
+    ctx = GLContext("egl", mgl, on_release=loader.destroy, device=None if device is None else device.index, loader=loader)
+    if ctx.version_code < require:
+        ctx.release()
+        raise RuntimeError(f"got OpenGL {ctx.version_code}, need {require}")
+    return ctx
 
 
 def _create_osmesa(require):
@@ -348,23 +397,25 @@ def _create_osmesa(require):
 _CREATORS = {"egl": _create_egl, "osmesa": _create_osmesa}
 
 
-def _try_create(backend, require, device=0):
+def _try_create(backend, require, device=None):
     """Return ``(context, None)``, or ``(None, reason)`` if creation failed.
 
-    The context current before the call stays current if it was entered.
+    ``device`` is, for EGL, a `glphong.gpu.egl_devices.EGLDevice` (None: a surfaceless display).  The context
+    current before the call stays current if it was entered.
     """
     check_not_forked()
     stack = _entered_stack()
     if stack:  # the entered context's queued work completes before another context takes the GL dispatch, which
         stack[-1].mgl.finish()  # EGL and OSMesa share through libglapi (a clear was once lost: test_contexts)
-    reused = _reuse(backend, require, device)
+    index = None if device is None else device.index
+    reused = _reuse(backend, require, index)
     while reused is not None:
         try:
             reused._make_current()  # as a new context is: current (unless a with block restores another below)
             return reused, None
         except EGLDisplayTerminatedError:  # a recycled context whose display was terminated since: drop it
             reused._released = True
-            reused = _reuse(backend, require, device)
+            reused = _reuse(backend, require, index)
     try:
         context = _create_egl(require, device) if backend == "egl" else _CREATORS[backend](require)
         _note_gl_use()
@@ -378,7 +429,10 @@ def _try_create(backend, require, device=0):
 
 
 def _install_hint(backend):
-    return f"Debian/Ubuntu: apt-get install {SYSTEM_PACKAGES[backend]}"
+    hint = f"Debian/Ubuntu: apt-get install {SYSTEM_PACKAGES[backend]}"
+    if backend == "osmesa":
+        hint += " (Mesa 25.1 and newer have no OSMesa: use EGL there)"
+    return hint + "; other systems and what is missing here: glphong doctor"
 
 
 def create_context(backend="auto", require=330, device=None):
@@ -398,8 +452,11 @@ def create_context(backend="auto", require=330, device=None):
         empty, otherwise the first of `BACKENDS` that works.
     require : int, optional
         Minimum OpenGL version, as ``major * 100 + minor * 10``.
-    device : int, optional
-        The EGL device (GPU) index, as ``eglQueryDevicesEXT`` lists them (default 0); EGL only.
+    device : int or {"gpu", "software"}, optional
+        The EGL device: an index of `glphong.gpu.egl_devices.devices`'s list, or the first device of a kind; EGL
+        only.  None: ``GLPHONG_EGL_DEVICE`` where set, else the first GPU device, else Mesa's software device
+        (`glphong.gpu.egl_devices.resolve_device`; ``EGL_VISIBLE_DEVICES`` and ``CUDA_VISIBLE_DEVICES`` hide
+        devices).
 
     Returns
     -------
@@ -409,8 +466,8 @@ def create_context(backend="auto", require=330, device=None):
     Raises
     ------
     ValueError
-        If ``backend`` or ``GLPHONG_BACKEND`` names no known backend, or ``device`` is not an index of
-        this machine's EGL devices (the message gives their number).
+        If ``backend`` or ``GLPHONG_BACKEND`` names no known backend, or ``device`` (or
+        ``GLPHONG_EGL_DEVICE``) names no EGL device here (the message lists those there are).
     BackendUnavailableError
         If no context could be created; the message gives the reason for
         each backend tried and the system packages that provide it.
@@ -433,14 +490,9 @@ def create_context(backend="auto", require=330, device=None):
             backend = "egl"
         if backend != "egl":
             raise ValueError(f"device selects an EGL device: it needs backend 'egl' or 'auto' (got {backend!r})")
-        count = egl_device_count()
-        if isinstance(device, bool) or not isinstance(device, int) or device < 0 or (count is not None and device >= count):
-            raise ValueError(f"device must be an EGL device index from 0 to {'?' if count is None else count - 1} "
-                             f"(this machine has {'an unknown number of' if count is None else count} EGL device(s); "
-                             f"got {device!r})")
-    device = device or 0
     if backend != "auto":
-        ctx, reason = _try_create(backend, require, device)
+        egl_device = resolve_device(device) if backend == "egl" else None
+        ctx, reason = _try_create(backend, require, egl_device)
         if ctx is None:
             raise BackendUnavailableError(
                 f"OpenGL backend {backend!r}{origin} is unavailable: {reason}. "
@@ -449,7 +501,7 @@ def create_context(backend="auto", require=330, device=None):
         return ctx
     failures = []
     for name in BACKENDS:
-        ctx, reason = _try_create(name, require)
+        ctx, reason = _try_create(name, require, resolve_device() if name == "egl" else None)
         if ctx is not None:
             return ctx
         failures.append(f"  {name}: {reason} ({_install_hint(name)})")
@@ -471,7 +523,12 @@ def available_backends():
     """
     report = {}
     for name in BACKENDS:
-        ctx, report[name] = _try_create(name, 330)
+        try:
+            device = resolve_device() if name == "egl" else None
+        except ValueError as exc:  # GLPHONG_EGL_DEVICE names no device here
+            report[name] = str(exc)
+            continue
+        ctx, report[name] = _try_create(name, 330, device)
         if ctx is not None:
             ctx.release()
     return report

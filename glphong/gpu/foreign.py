@@ -4,12 +4,9 @@ them (`attach_current`), and ends them without ending the EGL display the proces
 glphong's own contexts are `glphong.gpu.contexts`'s.
 """
 
-import ctypes
-import ctypes.util
-
 import moderngl
 
-from glphong.gpu.drivers import _osmesa_library
+from glphong.gpu.drivers import _egl_library, _osmesa_library
 
 
 class _CurrentContextLoader:
@@ -49,10 +46,7 @@ def attach_current(platform):
         Valid while the owner keeps that context current; releasing it is the owner's job.
     """
     if platform == "egl":
-        name = ctypes.util.find_library("EGL") or "libEGL.so.1"
-        get_proc_address = ctypes.CDLL(name).eglGetProcAddress
-        get_proc_address.restype = ctypes.c_void_p
-        get_proc_address.argtypes = [ctypes.c_char_p]
+        get_proc_address = _egl_library().eglGetProcAddress
     elif platform == "osmesa":
         get_proc_address = _osmesa_library().OSMesaGetProcAddress
     else:

@@ -30,6 +30,7 @@ from glphong.lights import registered_lights
 from glphong.materials import registered_models
 from glphong.materials.blinn import BlinnPhong
 from glphong.materials.phong import Phong
+from glphong.tools.doctor import run_doctor
 from glphong.tools.expressions import ExpressionError, parse_material
 
 __all__ = ["main", "print_error", "EXIT_BAD_INPUT", "EXIT_INTERRUPTED"]
@@ -211,6 +212,10 @@ def _describe(args):
     print(f"the default scene ('Phong Examples', {len(scenes)} tiles) compiles:")
     print(format_descriptions(describe(scenes, gbuffer=args.gbuffer), source=args.source))
     return 0
+
+
+def _doctor(args):
+    return run_doctor(args.tile)
 
 
 def _bench(args):
@@ -397,7 +402,7 @@ def _tile_size(text):
 
 
 def build_parser():
-    """The argument parser (subcommands: render, stability, gallery, describe, bench, brdf)."""
+    """The argument parser (subcommands: render, stability, gallery, describe, bench, brdf, plot, doctor)."""
 
     parser = argparse.ArgumentParser(
         prog="glphong", description="Classic local-illumination shading (Lambert, Phong, Blinn-Torrance and your "
@@ -497,6 +502,10 @@ def build_parser():
     plot.add_argument("--theta-i", type=_incident_angle, default=45.0, help="incident angle [deg], 0 to 90 (default 45)")
     plot.add_argument("--out", default="plot.png", type=_png_path, help="PNG path (default: plot.png)")
     plot.set_defaults(func=_plot)
+    doctor = sub.add_parser("doctor", help="why it does (not) render here: libraries, EGL devices, each backend "
+                            "checked with a verified render, and what to install (exit 0 where one renders)")
+    doctor.add_argument("--tile", type=_tile_size, default=32, help="verification render size in pixels (default 32)")
+    doctor.set_defaults(func=_doctor)
     return parser
 
 

@@ -1,0 +1,92 @@
+"""``glphong doctor`` in a subprocess: on this machine, and with a driver library made unloadable."""
+import os
+import subprocess
+import sys
+
+import pytest
+
+
+def _doctor(**env):
+    out = subprocess.run([sys.executable, "-m", "glphong", "doctor", "--tile", "16"], capture_output=True, text=True,
+                         timeout=300, env={**os.environ, **env})
+    return out.returncode, out.stdout + out.stderr
+
+
+def test_doctor_here(make_context):
+    """Exit 0, each backend this machine has listed with its GL facts and a passed verification render."""
+    backends = []
+    for name in ("egl", "osmesa"):
+        try:
+            make_context(name)
+            backends.append(name)
+        except pytest.skip.Exception:
+            pass
+    if not backends:
+        pytest.skip("no OpenGL backend here")
+    status, text = _doctor()
+    assert status == 0, text[-3000:]
+    for name in backends:
+        assert f"\n  {name}: OpenGL " in text
+    assert text.count("passed, max relative error") == len(backends)
+    assert text.count("GL_MAX_SAMPLES ") == len(backends)
+    assert text.count("subnormal float32: operands ") == len(backends)
+    for part in ("packages: glphong ", "moderngl ", "glcontext ", "numpy ", "EGL devices:", "environment:",
+                 "GLPHONG_BACKEND", "__EGL_VENDOR_LIBRARY_FILENAMES", "DISPLAY"):
+        assert part in text
+    assert f"glphong renders and verifies here on: {', '.join(backends)}" in text
+    if "egl" in backends:
+        assert "libEGL: /" in text and "EGL vendor: /" in text  # where they were loaded from
+    if "osmesa" in backends:
+        assert "libOSMesa: /" in text
+
+
+def test_doctor_without_any_backend(tmp_path, make_context):
+    """No EGL vendor (libglvnd pointed at a bogus vendor file) and no libOSMesa (glphong's override pointed at a
+    missing file): exit 1, and the report names each missing piece and the packages that provide it."""
+    make_context("egl")  # the EGL part of this test needs libglvnd's libEGL
+    bogus = tmp_path / "bogus.json"
+    bogus.write_text('{"file_format_version": "1.0.0", "ICD": {"library_path": "libEGL_nowhere.so.0"}}')
+    status, text = _doctor(__EGL_VENDOR_LIBRARY_FILENAMES=str(bogus), GLPHONG_LIBOSMESA="/nonexistent/libOSMesa.so.8")
+    assert status == 1, text[-3000:]
+    missing = text[text.index("missing or broken:"):]
+    for part in ("libOSMesa not found (GLPHONG_LIBOSMESA='/nonexistent/libOSMesa.so.8')",
+                 "apt-get install libosmesa6", "dnf install mesa-libOSMesa", "conda install -c conda-forge mesalib",
+                 "no EGL vendor library (Mesa's libEGL_mesa.so.0) did", "apt-get install libegl-mesa0 libgl1-mesa-dri",
+                 "dnf install mesa-libEGL mesa-dri-drivers", "Mesa 25.1 removed it"):
+        assert part in missing, part
+    assert f"{bogus}: libEGL_nowhere.so.0" in text
+    assert "glphong cannot render here" in text
+
+
+def test_doctor_without_libegl(make_context):
+    """libEGL itself unloadable (GLPHONG_LIBEGL): the EGL packages are named; OSMesa, where present, still
+    renders, so the exit status is 0 there."""
+    try:
+        make_context("osmesa")
+        has_osmesa = True
+    except pytest.skip.Exception:
+        has_osmesa = False
+    status, text = _doctor(GLPHONG_LIBEGL="libEGL_nowhere.so.1")
+    assert status == (0 if has_osmesa else 1), text[-3000:]
+    missing = text[text.index("missing or broken:"):]
+    for part in ("libEGL not found (GLPHONG_LIBEGL='libEGL_nowhere.so.1')", "apt-get install libegl1 libegl-mesa0",
+                 "dnf install libglvnd-egl mesa-libEGL", "conda install -c conda-forge libegl"):
+        assert part in missing, part
+
+
+def test_readme_driver_lines_survive_without_osmesa():
+    """The README's and docs/install.md's driver blocks: the required line installs EGL only, and every line that
+    installs libosmesa6 goes on where the package does not exist (Mesa 25.1 and newer); .ci/run still installs
+    libosmesa6 and requires both backends."""
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    for page in (root / "README.md", root / "docs" / "install.md"):
+        text = page.read_text(encoding="utf-8")
+        lines = [line for line in text.splitlines() if line.startswith("sudo apt-get install")]
+        assert lines, page
+        assert "libosmesa6" not in lines[0] and "libegl1 libegl-mesa0 libgl1-mesa-dri" in lines[0]
+        for line in lines:
+            assert "libosmesa6" not in line or "|| " in line, (page, line)
+    ci = (root / ".ci" / "run").read_text(encoding="utf-8")
+    assert "libosmesa6" in ci and "GLPHONG_REQUIRE_BACKENDS=egl,osmesa" in ci
