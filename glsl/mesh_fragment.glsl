@@ -35,7 +35,9 @@
 //     sampled in uniform control flow; 3: the same with a = u_alpha_blend * texture(u_alpha_blend_texture, uv).r.
 // Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, HAS_FACE, HAS_OBJECT, NUM_LOD_TEXTURES,
 // WRITES_PLANES, PLANE_NORMAL, PLANE_OBJECT, PLANE_UV, PLANE_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
-// NAIVE_NORMAL, RUNTIME_SWITCHES, SWITCH(flag), ALPHA_BLEND.
+// GLTF_PBR_TRANSMISSION (a radiance program of a transmissive gltf_pbr, glphong/gpu/transmission.py): after shading,
+//   out += gltf_transmission_radiance(...) (transmission_thin.glsl), what lies behind the surface seen through it.
+// NAIVE_NORMAL, RUNTIME_SWITCHES, SWITCH(flag), ALPHA_BLEND, GLTF_PBR_TRANSMISSION.
 
 invariant in vec3 v_position;
 #ifdef ALPHA_BLEND
@@ -239,6 +241,9 @@ void main()
     }
 #else
     out_radiance = vec4(shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye), 1.0);
+#if defined(GLTF_PBR_TRANSMISSION) && !defined(ALPHA_BLEND) && !SHADE_PER_VERTEX  // transmission_thin.glsl
+    out_radiance.rgb += gltf_transmission_radiance(n, n_valid, v_position, u_eye);
+#endif
 #endif
 #endif
 #if WRITES_PLANES

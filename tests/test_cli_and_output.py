@@ -48,7 +48,9 @@ def test_glsl_sources_ship_with_the_package():
     for model in builtin:  # one file per model under glsl/materials/, opening with its formula header
         path = f"materials/{model.name}.glsl"
         assert (glsl_root() / path).is_file(), path
-        assert model.source().startswith(f"// {path} -- the model '{model.name}'"), path
+        text = (glsl_root() / path).read_text(encoding="utf-8")
+        assert text.startswith(f"// {path} -- the model '{model.name}'"), path
+        assert model.source().rstrip().endswith(text.rstrip()), path  # after the chunks it reads first (GlslFile(before=...)), if any
 
 
 def test_main_job_from_outside_the_checkout(tmp_path):

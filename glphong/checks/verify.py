@@ -7,9 +7,11 @@ from glphong.checks import reference
 from glphong.checks.blend_twin import blend_twin
 from glphong.checks.method_sample import auto_sample_size, method_figures, sample_mask
 from glphong.checks.tolerances import BAND, point_band
+from glphong.checks.transmission_twin import transmission_check
 from glphong.checks.verify_passes import verify_passes
 from glphong.gpu.passes import requested_passes
 from glphong.gpu.peeling import blended_objects
+from glphong.gpu.transmission import transmissive_objects
 from glphong.gpu.renderer import Renderer
 
 __all__ = ["VerifyReport", "verify", "compare", "relative_error"]
@@ -56,6 +58,9 @@ class VerifyReport:
         Where the scene has blended materials: the twin of the composite (``reference``, ``low`` and ``high`` are
         its), the pixels it leaves unchecked, those the layer cap cut (``cut``, against the frame's ``blend_cut``:
         `blend_cut_mismatch`) and the cut composite's error against the whole one (``cap_error``).
+    transmission : glphong.checks.transmission_twin.TransmissionTwin or None
+        Where the scene has transmissive materials: what their thin walls transmit (added to ``reference``, ``low``
+        and ``high``), their pixels and those seen through the filtered lookup (``rough``, docs/transmission.md).
     """
 
     gpu: np.ndarray
@@ -73,6 +78,7 @@ class VerifyReport:
     passes: dict = field(default_factory=dict)
     blend: object = None
     blend_cut_mismatch: int = 0
+    transmission: object = None
 
     @property
     def method_error(self):
@@ -273,6 +279,12 @@ def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None,
         mismatch = int(((frame.mask != covered) & ~blend.unchecked).sum())
         gpu_cut = np.zeros_like(blend.cut) if frame.blend_cut is None else frame.blend_cut
         cut_mismatch = int(((gpu_cut != blend.cut) & ~blend.unchecked).sum())
+    transmission = None
+    if transmissive_objects(scene):  # what the thin walls transmit (glphong.checks.transmission_twin)
+        transmission = transmission_check(scene, renderer, gbuffer, lambda s, g: twin_and_band(
+            s, g, band, renderer.shadow_settings), band, exact)
+        exact = False
+        ref, low, high = ref + transmission.transmitted, low + transmission.low, high + transmission.high
     rel, outside = compare(frame.radiance, ref, low, high, mask)
     if exact is None:
         exact = any(light.extent == "extended" for light in scene.lights)
@@ -286,7 +298,7 @@ def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None,
     geometry = tuple(n for n in names if n != "radiance")
     return VerifyReport(gpu=frame.radiance, reference=ref, low=low, high=high, relative_error=rel,
                         outside=outside, mask=mask, mask_mismatch=mismatch, blend=blend,
-                        blend_cut_mismatch=cut_mismatch,
+                        blend_cut_mismatch=cut_mismatch, transmission=transmission,
                         shadow_band=shadow_band, exact=exact_radiance, exact_error=exact_error, exact_sample=sample,
                         passes=verify_passes(scene, frame, geometry, next_scene, previous_scene,
                                              renderer.matte_samples) if geometry else {})

@@ -79,16 +79,42 @@ def _function_body(code, name):
     return [p.split()[-1] for p in m.group(1).split(",")], code[m.end():i]
 
 
+def _outside_define(body, define):
+    """``body`` less the lines under ``#if defined(define)`` (up to its ``#else``, ``#elif`` or ``#endif``)."""
+    out, depth, inside = [], 0, False
+    for line in body.splitlines():
+        directive = line.strip()
+        if not inside and re.match(rf"#\s*if\s+defined\s*\(\s*{define}\s*\)\s*$", directive):
+            inside, depth = True, 1
+            continue
+        if inside:
+            depth += 1 if re.match(r"#\s*if", directive) else -1 if re.match(r"#\s*endif", directive) else 0
+            inside = depth > 0 and not (depth == 1 and re.match(r"#\s*(else|elif)\b", directive))
+            continue
+        out.append(line)
+    return "\n".join(out)
+
+
 def _check_needs(cls, code):
     """The response must not read what `needs` does not declare: ``wo`` without 'view', ``f.t``/``f.b``
-    without 'tangent', ``f.uv`` without 'uv' (they would be 0, or set by another term's needs)."""
-    (frame, _, wo, _), body = _function_body(code, f"{cls.name}_response")
+    without 'tangent', ``f.uv`` without 'uv' (they would be 0, or set by another term's needs); except under a
+    structural define whose ``structural_needs`` declare it (an instance with that define needs it: `GltfPBR`'s
+    anisotropy reads the tangent frame)."""
+    (frame, _, wo, _), full = _function_body(code, f"{cls.name}_response")
+    structural = getattr(cls, "structural_needs", {})
+
+    def body(need):
+        text = full
+        for define, needs in structural.items():
+            text = _outside_define(text, define) if need in needs else text
+        return text
+
     missing = []
-    if "view" not in cls.needs and re.search(rf"\b{wo}\b", body):
+    if "view" not in cls.needs and re.search(rf"\b{wo}\b", body("view")):
         missing.append(f"'view' (it reads {wo})")
-    if "tangent" not in cls.needs and re.search(rf"\b{frame}\s*\.\s*[tb]\b", body):
+    if "tangent" not in cls.needs and re.search(rf"\b{frame}\s*\.\s*[tb]\b", body("tangent")):
         missing.append(f"'tangent' (it reads {frame}.t or {frame}.b)")
-    if "uv" not in cls.needs and re.search(rf"\b{frame}\s*\.\s*uv\b", body):
+    if "uv" not in cls.needs and re.search(rf"\b{frame}\s*\.\s*uv\b", body("uv")):
         missing.append(f"'uv' (it reads {frame}.uv)")
     if missing:
         raise MaterialDefinitionError(f"{cls.__qualname__}.needs must include {' and '.join(missing)}: what a model "

@@ -291,8 +291,13 @@ class GlslFile:
     shaders) applies to model chunks too.  A model's GLSL is read when its class is defined (the
     definition is checked then), library chunks when first used: set ``GLPHONG_GLSL_DIR`` before
     importing glphong.
+
+    ``before``: further files of the shader folder whose text precedes the file's in the model's chunk, in order
+    (`GltfPBR`'s extensions kept in their own files, each under its structural define); a compile error's line
+    counts from the first of them.
     """
 
     path: str
+    before: tuple = ()
 
 

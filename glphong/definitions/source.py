@@ -7,6 +7,7 @@ checks compare (`glphong.definitions.checks`).
 """
 import functools
 import inspect
+import itertools
 import re
 import sys
 from pathlib import Path
@@ -30,9 +31,14 @@ def resolve_source(cls):
     error = getattr(cls, "definition_error", DefinitionError)
     glsl = cls.__dict__.get("glsl", cls.glsl)
     if isinstance(glsl, GlslFile):
-        path = glsl_root().joinpath(*glsl.path.split("/"))  # a Traversable: one part at a time
-        try:
-            return path.read_text(encoding="utf-8"), glsl.path, 1
+        try:  # a Traversable: one part at a time; the files ``before`` it first, in order
+            names = tuple(glsl.before) + (glsl.path,)
+            texts = [glsl_root().joinpath(*name.split("/")).read_text(encoding="utf-8") for name in names]
+            if not glsl.before:
+                return texts[0], glsl.path, 1
+            texts = [text.rstrip("\n") for text in texts]
+            starts = itertools.accumulate([1] + [text.count("\n") + 1 for text in texts[:-1]])
+            return "\n".join(texts), " + ".join(f"{name} (from line {s})" for name, s in zip(names, starts)), 1
         except OSError as exc:
             raise error(
                 f"{cls.__qualname__}: cannot read its GLSL {glsl.path!r} from the shader folder {glsl_root()} "

@@ -15,17 +15,18 @@
 from glphong.core.filesafety import SceneFileError
 
 __all__ = ["REQUIRED_OK", "APPEARANCE_ONLY", "APPLIED", "ATTRIBUTE_COMPONENTS", "variant_index", "primitive_material",
-           "texture_infos", "material_uv_set", "check_one_uv_set", "check_attribute_type", "dispersion_matters"]
+           "texture_infos", "material_uv_set", "check_one_uv_set", "check_attribute_type"]
 
 #: required extensions glphong reads (the compressed ones need their extra: `OPTIONAL_DECODERS`)
 REQUIRED_OK = ("KHR_lights_punctual", "KHR_mesh_quantization", "KHR_draco_mesh_compression",
                "KHR_materials_emissive_strength", "KHR_texture_transform", "KHR_materials_ior",
                "EXT_meshopt_compression", "KHR_meshopt_compression", "KHR_texture_basisu", "EXT_texture_webp",
                "KHR_materials_variants", "KHR_materials_specular", "KHR_materials_clearcoat",
-               "KHR_materials_sheen")
+               "KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_iridescence", "KHR_materials_transmission",
+               "KHR_materials_volume", "KHR_materials_dispersion")
 #: required extensions whose loss changes appearance only: read without them, with a warning
-APPEARANCE_ONLY = ("EXT_texture_avif", "KHR_materials_transmission", "KHR_materials_volume",
-                   "KHR_materials_unlit", "KHR_materials_iridescence", "KHR_materials_anisotropy", "KHR_materials_dispersion", "KHR_materials_pbrSpecularGlossiness",
+APPEARANCE_ONLY = ("EXT_texture_avif",
+                   "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness",
                    "KHR_materials_diffuse_transmission")
 #: extensions glphong applies where a file uses them (`extensionsUsed`); any other is warned about, by name
 APPLIED = REQUIRED_OK
@@ -122,20 +123,3 @@ def check_one_uv_set(path, entry, where):
         raise SceneFileError(path, f"its textures read different texture coordinate sets ({listed}): glphong draws "
                              "one set per material; give this material with load_scene(..., materials={name: ...})",
                              where)
-
-
-def dispersion_matters(document):
-    """Whether a material has ``KHR_materials_dispersion`` with an effect: a ``dispersion`` above 0 in a volume
-    (``KHR_materials_volume`` of ``thicknessFactor`` above 0); the extension changes nothing elsewhere."""
-    for entry in document.get("materials", []):
-        extensions = entry.get("extensions", {}) if isinstance(entry, dict) else {}
-        dispersion = extensions.get("KHR_materials_dispersion", {})
-        volume = extensions.get("KHR_materials_volume", {})
-        if isinstance(dispersion, dict) and isinstance(volume, dict) and _positive(dispersion.get("dispersion", 0.0)) \
-                and _positive(volume.get("thicknessFactor", 0.0)):
-            return True
-    return False
-
-
-def _positive(value):
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0

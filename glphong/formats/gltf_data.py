@@ -36,7 +36,7 @@ from glphong.core.filesafety import LIMITS, SceneFileError, decode_image, parse_
 from glphong.formats.gltf_compressed import (MESHOPT, OPTIONAL_DECODERS, decode_ktx2, decode_meshopt_view,
                                              decoder_available, draco_primitive, meshopt_extension)
 from glphong.formats.gltf_choices import (APPEARANCE_ONLY, APPLIED, REQUIRED_OK, check_attribute_type,
-                                          dispersion_matters, material_uv_set, primitive_material, variant_index)
+                                          material_uv_set, primitive_material, variant_index)
 from glphong.formats.gltf_validate import COMPONENT_BYTES, TYPE_WIDTHS, validate_gltf
 from glphong.scene.geometry import MeshData
 
@@ -137,8 +137,7 @@ class GltfFile:
                 module, extra = OPTIONAL_DECODERS[name]
                 raise SceneFileError(self.path, f"needs {name}, which glphong decodes with the optional {module}: "
                                      f"pip install 'glphong[{extra}]'", "extensionsRequired")
-        ignored = [n for n in self.document.get("extensionsUsed", []) if n not in APPLIED and n not in required
-                   and not (n == "KHR_materials_dispersion" and not dispersion_matters(self.document))]
+        ignored = [n for n in self.document.get("extensionsUsed", []) if n not in APPLIED and n not in required]
         if ignored:
             warnings.warn(f"{self.path}: glphong does not apply {', '.join(sorted(set(ignored)))} (extensionsUsed); "
                           "the file is drawn without them (its appearance may differ)", stacklevel=4)

@@ -219,8 +219,10 @@ def save_gltf(scene, path):
         nodes.append(_light_node(builder, light, index))
     if "extensions" in doc:
         doc["extensionsUsed"] = ["KHR_lights_punctual"]
-    if any("KHR_materials_emissive_strength" in m.get("extensions", {}) for m in doc.get("materials", [])):
-        doc["extensionsUsed"] = doc.get("extensionsUsed", []) + ["KHR_materials_emissive_strength"]
+    # every material extension written (emissive strength, specular, clearcoat, sheen, anisotropy...), as glTF asks
+    used = sorted({name for m in doc.get("materials", []) for name in m.get("extensions", {})})
+    if used:
+        doc["extensionsUsed"] = doc.get("extensionsUsed", []) + used
     doc["nodes"] = nodes
     doc["scenes"] = [{"nodes": list(range(len(nodes)))}]
     doc["scene"] = 0

@@ -6,16 +6,30 @@ validated with their JSON paths (`check_material_extensions`): ``KHR_materials_s
 - ``specular = specularFactor * specularTexture.a`` (linear), ``specular_color = specularColorFactor *
   specularColorTexture.rgb`` (sRGB);
 - ``clearcoat = clearcoatFactor * clearcoatTexture.r``, ``clearcoat_roughness = clearcoatRoughnessFactor *
-  clearcoatRoughnessTexture.g`` (linear); ``clearcoatNormalTexture``: glphong's coat takes the material's shading
-  normal, so a coat normal other than the base's normal texture is named in a warning;
+  clearcoatRoughnessTexture.g`` (linear); ``clearcoatNormalTexture`` (linear, its ``scale``) is the coat's own normal
+  where the material has no ``normalTexture`` (`glphong.materials.gltf_coat_normal`); over a normal-mapped base the
+  coat takes the base's normal, and a coat normal other than it is named in a warning;
 - ``sheen_color = sheenColorFactor * sheenColorTexture.rgb`` (sRGB), ``sheen_roughness = sheenRoughnessFactor *
-  sheenRoughnessTexture.a`` (linear); ``sheenColorFactor`` 0 (the default) disables the layer.
+  sheenRoughnessTexture.a`` (linear); ``sheenColorFactor`` 0 (the default) disables the layer;
+- ``iridescence = iridescenceFactor * iridescenceTexture.r``, ``iridescence_thickness_mix = iridescenceThicknessTexture.g``
+  (linear; `glphong.materials.gltf_iridescence`); ``iridescenceFactor`` 0 (the default) disables the film;
+- ``anisotropy_strength = anisotropyStrength * anisotropyTexture.b``, ``anisotropy_direction = anisotropyTexture.rgb``
+  (linear; the material maps rg to [-1, 1]), ``anisotropy_rotation = anisotropyRotation`` (reduced to [-pi, pi];
+  `glphong.materials.gltf_anisotropy`); ``anisotropyStrength`` 0 (the default) is isotropic.  The mesh's tangent frame
+  is its ``TANGENT``, or computed from its UVs where it has none (as the specification asks of the normal texture's).
 """
+import math
+
 import numpy as np
 
+from glphong.formats.gltf_transmission import TRANSMISSION_FACTORS, TRANSMISSION_TEXTURES, transmission_arguments
+from glphong.core.filesafety import SceneFileError
 from glphong.materials import Texture
+from glphong.materials.gltf_coat_normal import COAT_NORMAL_PARAMS
+from glphong.materials.gltf_extensions import EXTENSIONS
 
-__all__ = ["MATERIAL_EXTENSIONS", "extension_arguments", "check_material_extensions", "extension_texture_infos"]
+__all__ = ["MATERIAL_EXTENSIONS", "extension_arguments", "check_material_extensions", "extension_texture_infos",
+           "tangent_frame_error"]
 
 #: the material extensions read here, each with its textures (key, what glphong reads of it)
 MATERIAL_EXTENSIONS = {
@@ -23,10 +37,18 @@ MATERIAL_EXTENSIONS = {
     "KHR_materials_clearcoat": (("clearcoatTexture", "r"), ("clearcoatRoughnessTexture", "g"),
                                 ("clearcoatNormalTexture", "normal")),
     "KHR_materials_sheen": (("sheenColorTexture", "srgb"), ("sheenRoughnessTexture", "alpha")),
-}
+    "KHR_materials_anisotropy": (("anisotropyTexture", "rgb"),),
+    "KHR_materials_iridescence": (("iridescenceTexture", "r"), ("iridescenceThicknessTexture", "g")),
+} | TRANSMISSION_TEXTURES  # KHR_materials_transmission, _volume, _dispersion: glphong.formats.gltf_transmission
 _FACTORS = {"KHR_materials_specular": (("specularFactor", 1, 0.0, 1.0), ("specularColorFactor", 3, 0.0, np.inf)),
             "KHR_materials_clearcoat": (("clearcoatFactor", 1, 0.0, 1.0), ("clearcoatRoughnessFactor", 1, 0.0, 1.0)),
-            "KHR_materials_sheen": (("sheenColorFactor", 3, 0.0, 1.0), ("sheenRoughnessFactor", 1, 0.0, 1.0))}
+            "KHR_materials_sheen": (("sheenColorFactor", 3, 0.0, 1.0), ("sheenRoughnessFactor", 1, 0.0, 1.0)),
+            "KHR_materials_anisotropy": (("anisotropyStrength", 1, 0.0, 1.0), ("anisotropyRotation", 1, -np.inf, np.inf)),
+            "KHR_materials_iridescence": (("iridescenceFactor", 1, 0.0, 1.0), ("iridescenceIor", 1, 1.0, 1e4),
+                                          ("iridescenceThicknessMinimum", 1, 0.0, 1e5),
+                                          ("iridescenceThicknessMaximum", 1, 0.0, 1e5)),
+} | TRANSMISSION_FACTORS
+_COAT_NORMAL_SCALE = next(p for p in COAT_NORMAL_PARAMS if p.name == "clearcoat_normal_strength")
 
 
 def check_material_extensions(c, extensions, where, texture_ref):
@@ -48,8 +70,9 @@ def check_material_extensions(c, extensions, where, texture_ref):
         for key, _ in textures:
             if key in entry:
                 texture_ref(c, entry[key], f"{path}.{key}")
-        if "scale" in entry.get("clearcoatNormalTexture", {}):
-            c.number(entry["clearcoatNormalTexture"]["scale"], f"{path}.clearcoatNormalTexture.scale")
+        if "scale" in entry.get("clearcoatNormalTexture", {}):  # the bounds of glphong's clearcoat_normal_strength
+            c.number(entry["clearcoatNormalTexture"]["scale"], f"{path}.clearcoatNormalTexture.scale",
+                     _COAT_NORMAL_SCALE.low, _COAT_NORMAL_SCALE.high)
 
 
 def extension_texture_infos(entry):
@@ -58,6 +81,40 @@ def extension_texture_infos(entry):
     extensions = entry.get("extensions", {})
     return [extensions[name][key] for name, textures in MATERIAL_EXTENSIONS.items() if name in extensions
             for key, _ in textures if isinstance(extensions[name].get(key), dict)]
+
+
+def tangent_frame_error(path, error, material, mesh, name, index):
+    """The `SceneFileError` for the scene's refusal ``error`` (ValueError: `glphong.Scene.add`'s check of what the
+    mesh serves) of primitive ``name`` where the mesh has no tangent frame (neither ``TANGENT`` nor texture coordinates
+    to compute it from) and the material's extensions need it (KHR_materials_anisotropy, KHR_materials_clearcoat's
+    ``clearcoatNormalTexture``: those whose structural define reads 'tangent'): it names them, with their JSON paths
+    under ``materials[index]``.  ``error`` itself otherwise (its refusal is not an extension's)."""
+    needing = [f"materials[{index}].extensions.{EXTENSIONS[short][0]}"
+               + (".clearcoatNormalTexture" if short == "clearcoat_normal" else "")
+               for term in material.components if hasattr(term, "structural_needs")
+               for short in term.extensions()
+               if "tangent" in term.structural_needs.get(f"{term.name.upper()}_{short.upper()}", ())]
+    if mesh.has_tangents or not needing:
+        return error
+    return SceneFileError(path, f"primitive {name!r} uses {', '.join('.'.join(p.split('.')[2:]) for p in needing)} "
+                          f"(materials[{index}]), which needs the mesh's tangent frame, but the mesh has neither "
+                          "TANGENT nor TEXCOORD to compute it from (the extensions ask for TANGENT, or a normal texture "
+                          f"and its texture coordinates): {error}", ", ".join(needing))
+
+
+def _anisotropy_arguments(entry, texture):
+    """KHR_materials_anisotropy's `glphong.GltfPBR` arguments (dict; none where ``anisotropyStrength`` is 0, the
+    default: isotropic): the strength times the texture's blue channel, the texture's texel as the direction (its rg
+    mapped to [-1, 1] by the material), the rotation reduced to [-pi, pi] (the same angle)."""
+    if entry is None or float(entry.get("anisotropyStrength", 0.0)) == 0.0:
+        return {}
+    strength = float(entry["anisotropyStrength"])
+    out = {"anisotropy_rotation": math.remainder(float(entry.get("anisotropyRotation", 0.0)), 2.0 * math.pi)}
+    image = texture(entry["anisotropyTexture"], False) if "anisotropyTexture" in entry else None
+    out["anisotropy_strength"] = Texture(image, strength, channel="b") if image is not None else strength
+    if image is not None:
+        out["anisotropy_direction"] = Texture(image, 1.0)
+    return out
 
 
 def extension_arguments(entry, texture, warn):
@@ -92,10 +149,15 @@ def extension_arguments(entry, texture, warn):
             out[name] = Texture(image, factor, channel=channel) if image is not None else factor
         base_normal = entry.get("normalTexture", {}).get("index")
         coat_normal = coat.get("clearcoatNormalTexture", {}).get("index")
-        if base_normal != coat_normal:
+        image = texture(coat["clearcoatNormalTexture"], False) if coat_normal is not None else None
+        if base_normal is None and image is not None:  # the coat's own normal on the unperturbed frame: exact
+            out["clearcoat_normal"] = Texture(image, 1.0)
+            out["clearcoat_normal_strength"] = float(coat["clearcoatNormalTexture"].get("scale", 1.0))
+        elif base_normal != coat_normal:  # a coat normal over a normal-mapped base: the base's (gltf_coat_normal)
             warn("KHR_materials_clearcoat: glphong's coat takes the material's shading normal ("
                  + ("its normalTexture" if base_normal is not None else "the unperturbed normal") + "), the file's coat "
-                 + (f"normal is texture {coat_normal}" if coat_normal is not None else "the unperturbed normal"))
+                 + (f"normal is texture {coat_normal}" if coat_normal is not None else "the unperturbed normal")
+                 + ("" if base_normal is None else ": a coat normal over a normal-mapped base is not drawn exactly"))
     sheen = extensions.get("KHR_materials_sheen")
     if sheen is not None and any(float(c) > 0 for c in sheen.get("sheenColorFactor", (0.0, 0.0, 0.0))):
         color = tuple(float(c) for c in sheen["sheenColorFactor"])  # all 0 (the default): the layer is disabled
@@ -104,4 +166,15 @@ def extension_arguments(entry, texture, warn):
         out["sheen_color"] = Texture(image, color) if image is not None else color
         image = texture(sheen["sheenRoughnessTexture"], False, True) if "sheenRoughnessTexture" in sheen else None
         out["sheen_roughness"] = Texture(image, factor, channel="r") if image is not None else factor
-    return out
+    out |= _anisotropy_arguments(extensions.get("KHR_materials_anisotropy"), texture)
+    film = extensions.get("KHR_materials_iridescence")
+    if film is not None and float(film.get("iridescenceFactor", 0.0)) > 0:  # 0 (the default): no film
+        factor = float(film["iridescenceFactor"])  # iridescence = factor * texture.r, thickness = mix(min, max, .g)
+        image = texture(film["iridescenceTexture"], False) if "iridescenceTexture" in film else None
+        out["iridescence"] = Texture(image, factor, channel="r") if image is not None else factor
+        image = texture(film["iridescenceThicknessTexture"], False) if "iridescenceThicknessTexture" in film else None
+        out["iridescence_thickness_mix"] = Texture(image, 1.0, channel="g") if image is not None else 1.0
+        out |= {"iridescence_ior": float(film.get("iridescenceIor", 1.3)),
+                "iridescence_thickness_minimum": float(film.get("iridescenceThicknessMinimum", 100.0)),
+                "iridescence_thickness_maximum": float(film.get("iridescenceThicknessMaximum", 400.0))}
+    return out | transmission_arguments(extensions, texture)  # KHR_materials_transmission

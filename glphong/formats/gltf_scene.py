@@ -13,7 +13,7 @@ from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, 
 from glphong.materials import AlphaBlend, AlphaMask, NormalMap, Texture, TextureImage, VertexColors
 from glphong.materials.cook_torrance import CookTorrance
 from glphong.materials.gltf_pbr import GltfPBR
-from glphong.formats.gltf_material_extensions import extension_arguments, extension_texture_infos
+from glphong.formats.gltf_material_extensions import extension_arguments, extension_texture_infos, tangent_frame_error
 from glphong.definitions.fresnel import SchlickFresnel
 from glphong.formats.overrides import chosen_material
 from glphong.definitions.as_json import material_from_json
@@ -408,7 +408,10 @@ def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name
     emissive_scale = 1.0 / LUMENS_PER_WATT if light_units == "photometric" else 1.0
     for name, mesh, world, index in read_gltf_primitives(gltf, variant):
         material, transform = _gltf_object_material(gltf, entries, materials, made, name, mesh, index, emissive_scale)
-        scene.add(transformed_uvs(mesh, transform), material, pose=world, name=name)
+        try:
+            scene.add(transformed_uvs(mesh, transform), material, pose=world, name=name)
+        except ValueError as exc:  # the scene's check of what the mesh serves: an extension's tangent frame, named
+            raise tangent_frame_error(gltf.path, exc, material, mesh, name, index) from None
     if lights is None:  # a file without lights is not drawn black by accident
         _, view_lights, view_ambient = default_view(scene, path)
         warnings.warn(f"{path} has no lights: glphong adds its default point light and ambient light (give "

@@ -3,13 +3,15 @@
 reaches out of the view, only the triangles that may meet it (`glphong.gpu.view_cull`, kept per object and camera).
 
 ``blend`` selects what is drawn: 0 the opaque and alpha-masked objects (every object of a scene without a blended
-material), 1 and 2 the blended objects with their layer and peel programs (`glphong.gpu.peeling.blend_key`).
+material), 1 and 2 the blended objects with their layer and peel programs (`glphong.gpu.peeling.blend_key`), 4 the
+transmissive ones (`glphong.gpu.transmission`, left out of 0 in a radiance draw).
 """
 import moderngl
 import numpy as np
 
-from glphong.gpu.peeling import blend_key, blended
+from glphong.gpu.peeling import blend_key
 from glphong.gpu.resources import ObjectEntry
+from glphong.gpu.transmission import TRANSMIT, drawn_in
 from glphong.gpu.view_cull import MIN_TRIANGLES, box_inside, visible_triangles
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
@@ -106,7 +108,7 @@ def draw_list(renderer, scene, output, aspect, frame_values=None, shadow_values=
     entries = renderer._entries
     slot = (output, planes, blend) if planes or blend else output
     for index, obj in enumerate(scene.objects):
-        if blended(obj) != bool(blend):
+        if not drawn_in(obj, blend, output):  # blended layers, transmissive surfaces (glphong.gpu.transmission)
             continue
         per_object = entries.get(obj)
         if per_object is None:
@@ -116,7 +118,7 @@ def draw_list(renderer, scene, output, aspect, frame_values=None, shadow_values=
             entry = None
         if shared is not None or entry is None or entry.state != state or entry.index != index:
             key = shared or renderer.program_key(scene, obj, output, planes)
-            key = blend_key(key, blend, obj.material.alpha_blend.textured) if blend else key
+            key = blend_key(key, blend, obj.material.alpha_blend.textured) if blend and blend != TRANSMIT else key
             program = renderer.programs.get(key)
             values = bound.uniform_values(index, key, aspect) if shared is not None else \
                 bound.object_uniform_values(index, key)

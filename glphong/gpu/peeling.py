@@ -36,7 +36,7 @@ from glphong.gpu.shadows import ShadowMap
 from glphong.shaders.keys import EncodeKey
 
 __all__ = ["BLEND_LAYERS", "MAX_BLEND_LAYERS", "blended", "blended_objects", "blend_key", "CompositeKey", "Peeling",
-           "check_blend_options", "blend_fields", "BlendCapWarning"]
+           "check_blend_options", "per_pixel_option", "blend_fields", "BlendCapWarning"]
 
 
 class BlendCapWarning(UserWarning):
@@ -68,14 +68,23 @@ def check_blend_options(renderer, scene):
         if blended(obj) and obj.material.alpha_blend.textured and obj.mesh.uvs is None:
             raise ValueError(f"object {obj.name!r}: its blended material's alpha is textured, and its mesh has no "
                              "uvs: give its MeshData uvs=, or a constant alpha")
+    wrong = per_pixel_option(renderer)
+    if wrong:
+        raise ValueError(f"the scene has blended materials (alpha_blend, glTF alphaMode BLEND), which depth "
+                         f"peeling draws with per-pixel, specialised programs and one sample a pixel; this "
+                         f"renderer has {wrong[0]}: use {wrong[1]}")
+
+
+def per_pixel_option(renderer):
+    """``(option, fix)`` of the first option of ``renderer`` that a pass drawing per pixel over a drawn image (the
+    peel, `glphong.gpu.transmission`) cannot take, naming it and its fix; None where there is none."""
     for wrong, name, fix in ((renderer.samples > 1, f"samples={renderer.samples}", "samples=1 (supersample= "
-                              "anti-aliases blended surfaces)"),
+                              "anti-aliases)"),
                              (renderer.shading != "pixel", "shading='vertex'", "shading='pixel'"),
                              (not renderer.specialise, "specialise=False", "specialise=True")):
         if wrong:
-            raise ValueError(f"the scene has blended materials (alpha_blend, glTF alphaMode BLEND), which depth "
-                             f"peeling draws with per-pixel, specialised programs and one sample a pixel; this "
-                             f"renderer has {name}: use {fix}")
+            return name, fix
+    return None
 
 
 def blend_fields(blend, supersample=1):

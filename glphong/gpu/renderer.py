@@ -18,6 +18,7 @@ from glphong.gpu.passes import check_passes, derive_passes, gbuffer_planes, requ
 from glphong.gpu.resources import (MeshBuffers, check_target_size, gl_object_count, make_target, orphan,
                                    read_attachment, release_orphans, release_resources, release_targets, target_bytes)
 from glphong.gpu.contexts import check_not_forked, create_context
+from glphong.gpu.counters import track as _track
 from glphong.scene.culling import culling_decision
 from glphong.shaders.binding import binding
 from glphong.shaders.keys import EncodeKey
@@ -30,21 +31,36 @@ from glphong.gpu.drawing import draw_objects
 from glphong.gpu.peeling import (BLEND_LAYERS, MAX_BLEND_LAYERS, CompositeKey, Peeling, blend_fields, blended_objects,
                                  check_blend_options)
 from glphong.gpu.program_keys import renderer_program_key
+from glphong.gpu.transmission import TARGET_KEY, TRANSMIT, Transmission, check_transmission_options, transmissive_objects
 from glphong.scene.scene import Scene
 
-__all__ = ["Renderer", "Frame", "GBuffer"]
+__all__ = ["Renderer", "Frame", "GBuffer", "RendererReleasedError"]
+
+
+class RendererReleasedError(RuntimeError):
+    """A `Renderer` used after its `Renderer.release` (or the end of its ``with`` block): its context and GL
+    objects are gone; the message names the call.  Make a new renderer."""
+
+
+def _released(call):
+    return RendererReleasedError(f"Renderer.{call} called after release(): this Renderer has been released (by "
+                                 "release() or the end of its `with` block), its context and GL objects are gone; "
+                                 "make a new Renderer")
 
 
 def _one_call_at_a_time(method):
     """Run a Renderer method under its lock: a renderer is usable from any thread, one call at a time.
 
     The fork check comes first (a lock copied by fork while held would hang the child), then the GL
-    objects of renderers the garbage collector found unreleased are released (`ORPHANS`)."""
+    objects of renderers the garbage collector found unreleased are released (`ORPHANS`); a renderer released
+    raises `RendererReleasedError` naming the method (but for `release`, which may be called again)."""
     @functools.wraps(method)
     def locked(self, *args, **kwargs):
         check_not_forked()
         release_orphans()
         with self._lock:
+            if self.context is None and method.__name__ != "release":
+                raise _released(f"{method.__name__}()")
             return method(self, *args, **kwargs)
     return locked
 
@@ -86,9 +102,9 @@ class Renderer:
         outward-wound mesh wholly between the near and far planes; `glphong.scene.culling`), which
         changes no pixel but a silhouette pixel where a back triangle ties with the front one in
         depth (there the front face shows).  'off': draw every triangle.
-    device : int, optional
-        The EGL device (GPU) to render on, an index of ``eglQueryDevicesEXT``'s list (default 0; EGL
-        only; `glphong.gpu.contexts.egl_device_count` says how many there are).  A batch passes it through
+    device : int or {'gpu', 'software'}, optional
+        The EGL device to render on: an index of `glphong.gpu.devices`'s list, or the first device of a
+        kind (EGL only; default: `glphong.gpu.contexts.create_context`'s).  A batch passes it through
         (``render_many(..., device=1)``).
     shadow_map_size : int
         Texels along a side of each shadow map (a cube map's face), 16 to 8192 and at most a third of the context's
@@ -169,6 +185,7 @@ class Renderer:
         self._shadow_maps = ShadowMaps(self._mgl, self._targets)
         self._matte = Matte(self._mgl, self._targets, min(TILE, self._max_size))
         self._entries = weakref.WeakKeyDictionary()  # SceneObject -> {output: ObjectEntry}
+        _track(self)  # glphong.gpu.counters.gl_objects_alive counts it while it lives
 
     def render_target_bytes(self, size=None):
         """Memory the render targets and one float32 readback need at ``size`` (default the current one) [bytes]
@@ -200,7 +217,7 @@ class Renderer:
     def backend(self):
         """Name of the OpenGL backend in use ('egl' or 'osmesa')."""
         if self.context is None:
-            raise RuntimeError("this Renderer has been released: it has no backend any more")
+            raise _released("backend")
         return self.context.backend
 
     @property
@@ -210,8 +227,6 @@ class Renderer:
     @_one_call_at_a_time
     def resize(self, width, height):
         """Change the image size; the render targets are rebuilt on next use."""
-        if self.context is None:
-            raise RuntimeError("this Renderer has been released")
         size = self._check_size(width, height)
         self._check_limits(size, self.context.renderer_name)
         if size != self._size:
@@ -252,6 +267,7 @@ class Renderer:
         names = requested_passes(passes, depth, normals)
         check_passes(scene, names, next_scene, previous_scene)
         check_blend_options(self, scene)
+        check_transmission_options(self, scene, "radiance" in names)
         geometry = [n for n in names if n not in ("radiance", "matte")]
         extra = self._draw_matte(scene) if "matte" in names else {}
         if geometry and "radiance" in names and self.samples == 1 and self.supersample == 1 \
@@ -365,11 +381,12 @@ class Renderer:
         """
         self._check_scene(scene)
         check_blend_options(self, scene)
+        check_transmission_options(self, scene)
         exposure = _validate.scalar("exposure", exposure, low=0.0, low_inclusive=False)
         resolve = _validate.choice("resolve", resolve, ("display", "linear"))
         with self.context:
             if resolve == "display" and self.supersample == 1 and self.shading == "pixel" and self.specialise \
-                    and not blended_objects(scene):  # blended layers are composited in linear float
+                    and not blended_objects(scene) and not transmissive_objects(scene):  # composited in linear float
                 target = self._target("display")
                 self._draw(scene, "display", target, {"u_exposure": exposure})
                 if self.samples > 1:
@@ -432,8 +449,6 @@ class Renderer:
     def _check_scene(self, scene):
         if not isinstance(scene, Scene):
             raise TypeError(f"scene must be a glphong.Scene (got {type(scene).__name__})")
-        if self.context is None:
-            raise RuntimeError("this Renderer has been released")
 
     def _draw_radiance(self, scene):
         """Draw the radiance; returns the single-sample framebuffer whose color is a texture, and the peel's
@@ -472,6 +487,10 @@ class Renderer:
         self._mgl.enable(moderngl.DEPTH_TEST)
         self._mgl.disable(moderngl.CULL_FACE)
         draw_objects(self, scene, output, frame_values, shadow_values, planes)
+        if output == "radiance" and transmissive_objects(scene):  # over the opaque scene (glphong.gpu.transmission)
+            transmission = self._targets.get(TARGET_KEY) or self._targets.setdefault(TARGET_KEY, Transmission(self._mgl))
+            transmission.draw(fbo, fbo.size, lambda values: draw_objects(
+                self, scene, output, (frame_values or {}) | values, shadow_values, planes, blend=TRANSMIT))
         if output != "radiance" or not blended_objects(scene):
             return None
         peeling = self._targets.get(("peeling",)) or self._targets.setdefault(("peeling",), Peeling(self._mgl))
@@ -514,7 +533,9 @@ class Renderer:
             self._meshes.pop(mesh_id).release()
 
     def release_targets(self):
-        release_targets(self.context, self._targets)
+        """Release the render targets (made again on next use); nothing to do on a released renderer."""
+        if self.context is not None:
+            release_targets(self.context, self._targets)
 
     def gl_object_count(self):
         """Number of GL objects this renderer holds (programs, textures, buffers, vertex arrays, targets)."""
@@ -530,6 +551,8 @@ class Renderer:
         self.context = None
 
     def __enter__(self):
+        if self.context is None:
+            raise _released("__enter__() (a `with` block)")
         return self
 
     def __exit__(self, *exc):

@@ -3,7 +3,8 @@
 
 Each is a set of `GltfPBR` parameters; a material uses an extension where a parameter differs from the value at which
 the extension changes nothing (or is textured), and only then is its code in the program (``#define
-GLTF_PBR_SPECULAR``, ``GLTF_PBR_CLEARCOAT``, ``GLTF_PBR_SHEEN``; `GltfExtensionFeatures.extensions`).
+GLTF_PBR_SPECULAR``, ``GLTF_PBR_CLEARCOAT``, ``GLTF_PBR_SHEEN``, ``GLTF_PBR_ANISOTROPY``;
+`GltfExtensionFeatures.extensions`).
 With ``x = (1 - |v.h|)^5``, ``f0 = ((ior - 1)/(ior + 1))^2``, ``c`` the base colour, ``m`` metallic, ``D``/``V``
 Appendix B's GGX and visibility::
 
@@ -14,6 +15,8 @@ Appendix B's GGX and visibility::
                              f_r' = mix(f_r, V_c D_c, clearcoat F_c),  alpha_c = clearcoat_roughness^2
     KHR_materials_sheen      f_r' = sheen_color D_s V_s + f_r max(min(1 - max3(sheen_color) E(n.v), ...(n.l)), 0)
                              under the coat (`glphong.materials.gltf_sheen`)
+    KHR_materials_anisotropy D V of the base anisotropic: alpha_t = mix(alpha, 1, strength^2) along the rotated
+                             tangent, alpha_b = alpha (`glphong.materials.gltf_anisotropy`; needs the tangent frame)
 
 =================== ====== ========= ======= ==========================================================================
 parameter           kind   range     neutral meaning
@@ -26,15 +29,19 @@ clearcoat           scalar [0, 1]    0       ``clearcoatFactor`` times ``clearco
 clearcoat_roughness scalar [0, 1]    0       ``clearcoatRoughnessFactor`` times ``clearcoatRoughnessTexture.g``
 sheen_color         rgb    [0, 1]    0       ``sheenColorFactor`` times ``sheenColorTexture`` (sRGB)
 sheen_roughness     scalar [0, 1]    0       ``sheenRoughnessFactor`` times ``sheenRoughnessTexture.a``
+anisotropy_strength scalar [0, 1]    0       ``anisotropyStrength`` times ``anisotropyTexture.b``
+anisotropy_rotation scalar radians   (0)     ``anisotropyRotation``: counter-clockwise from the tangent
+anisotropy_directionrgb    [0, 1]    (1,.5)  ``anisotropyTexture``'s texel: ``2 rg - 1`` the direction in tangent space
 =================== ====== ========= ======= ==========================================================================
 
-Exact as the extensions write them, with two limits of glphong's (docs/gltf_extensions.md): the coat's normal is the
-material's shading normal (its ``normal_map``; the specification's coat takes ``clearcoatNormalTexture``, or the
-unperturbed normal where there is none), and the emission is not darkened by ``1 - clearcoat F_c`` (a material with
-both warns).  A coat of roughness 0 is a mirror: a delta that a point light meets with zero measure, so it only darkens
+Exact as the extensions write them, with two limits of glphong's (docs/gltf_extensions.md): the coat's own normal
+(``clearcoat_normal``, `glphong.materials.gltf_coat_normal`) is taken on the unperturbed frame, so over a base
+``normal_map`` the coat takes the mapped normal (a material with both a ``normal_map`` and a ``clearcoat_normal`` is
+refused), and the emission is not darkened by ``1 - clearcoat F_c`` (a material with both warns).  A coat of roughness 0 is a mirror: a delta that a point light meets with zero measure, so it only darkens
 the base, as the core's roughness 0 does (`glphong.materials.gltf_pbr`).
 """
 import dataclasses
+import math
 import warnings
 
 import numpy as np
@@ -43,13 +50,19 @@ from glphong.definitions.cases import Case, _mirror_eye, _unit
 from glphong.definitions.material_base import constant_part
 from glphong.definitions.params import Param
 from glphong.definitions.surface import SurfaceInput
+from glphong.materials.gltf_anisotropy import ANISOTROPY_PARAMS, anisotropy_cases
+from glphong.materials.gltf_iridescence import (IRIDESCENCE_PARAMS, gltf_iridescence_oracle, iridescence_cases,
+                                                iridescence_gltf_fields)
+from glphong.materials.gltf_coat_normal import COAT_NORMAL_PARAMS, gltf_clearcoat_geometry, uses_coat_normal
+from glphong.materials.gltf_lobe import gltf_pbr_specular
 from glphong.materials.gltf_sheen import SHEEN_PARAMS, gltf_sheen_oracle, sheen_cases
-from glphong.twin.band import FLT_MAX
-from glphong.twin.functions import microfacet_geometry, microfacet_ggx
+from glphong.materials.gltf_transmission import (TRANSMISSION_PARAMS, VOLUME_EXTENSIONS, transmission_gltf_fields,
+                                                 volume_extensions)
+from glphong.twin.functions import microfacet_geometry
 
 # GltfExtensionFeatures and ExtensionProperties are GltfPBR's own (a class named here would become glphong.materials')
 __all__ = ["EXTENSION_PARAMS", "EXTENSIONS", "gltf_specular_fresnel", "gltf_clearcoat_fresnel",
-           "gltf_specular_parts", "gltf_clearcoat_mix", "gltf_extensions_oracle", "extension_cases",
+           "gltf_clearcoat_mix", "gltf_extensions_oracle", "extension_cases",
            "extension_gltf_fields"]
 
 _SPECULAR = Param("specular", "scalar", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
@@ -63,11 +76,18 @@ _CLEARCOAT_ROUGHNESS = Param("clearcoat_roughness", "scalar", low=0.0, high=1.0,
                                  "alpha_c = clearcoat_roughness^2")
 
 #: the extensions' parameters, appended to `GltfPBR`'s
-EXTENSION_PARAMS = (_SPECULAR, _SPECULAR_COLOR, _CLEARCOAT, _CLEARCOAT_ROUGHNESS) + SHEEN_PARAMS  # gltf_sheen
+EXTENSION_PARAMS = (_SPECULAR, _SPECULAR_COLOR, _CLEARCOAT, _CLEARCOAT_ROUGHNESS) + COAT_NORMAL_PARAMS + SHEEN_PARAMS \
+    + ANISOTROPY_PARAMS + TRANSMISSION_PARAMS + IRIDESCENCE_PARAMS  # gltf_sheen, _anisotropy, _transmission, _iridescence
 #: each extension glphong applies: its short name (the define GLTF_PBR_<NAME>), its glTF name and its parameters
 EXTENSIONS = {"specular": ("KHR_materials_specular", ("specular", "specular_color")),
               "clearcoat": ("KHR_materials_clearcoat", ("clearcoat", "clearcoat_roughness")),
-              "sheen": ("KHR_materials_sheen", ("sheen_color", "sheen_roughness"))}
+              "clearcoat_normal": ("KHR_materials_clearcoat", ("clearcoat_normal", "clearcoat_normal_strength")),
+              "sheen": ("KHR_materials_sheen", ("sheen_color", "sheen_roughness")),
+              "anisotropy": ("KHR_materials_anisotropy", ("anisotropy_strength", "anisotropy_rotation",
+                                                          "anisotropy_direction")),
+              "transmission": ("KHR_materials_transmission", ("transmission",)),
+              "iridescence": ("KHR_materials_iridescence", tuple(q.name for q in IRIDESCENCE_PARAMS))} \
+    | VOLUME_EXTENSIONS  # KHR_materials_volume and _dispersion (gltf_transmission)
 #: the coat's f0: ((1 - 1.5)/(1 + 1.5))^2, fresnel_coat's fixed ior 1.5
 CLEARCOAT_F0 = 0.04
 
@@ -95,46 +115,56 @@ def gltf_clearcoat_fresnel(n_dot_v):
     return (dtype.type(CLEARCOAT_F0) + dtype.type(1 - CLEARCOAT_F0) * y).astype(dtype)
 
 
-def gltf_specular_parts(c, m, n_dot_l, x, f0, p):
-    """``(diffuse, fresnel)``, each (N, 3), of `GltfPBR`'s twin with KHR_materials_specular, in gltf_pbr.glsl's order:
-    ``diffuse = c (n.l)/pi (1 - max F_d)(1 - m)``, ``fresnel = F_d (1 - m) + (c + (1 - c) x) m``."""
-    dtype = np.asarray(x).dtype
-    one = dtype.type(1)
-    fd = gltf_specular_fresnel(f0, p.specular, p.specular_color, x)
-    fd_max = np.max(fd, axis=-1)
-    diffuse = (c * (dtype.type(1 / np.pi) * n_dot_l)[..., None]) * (one - fd_max)[..., None] * (one - m)
-    fresnel = fd * (one - m) + (c + (one - c) * x[..., None]) * m
-    return diffuse.astype(dtype), fresnel.astype(dtype)
-
-
-def gltf_clearcoat_mix(value, f, wi, wo, n_dot_l, p, gltf_pbr_visibility_cos):
+def gltf_clearcoat_mix(value, f, wi, wo, n_dot_l, p):
     """KHR_materials_clearcoat on `GltfPBR`'s twin: ``value (1 - w) + w V_c D_c (n.l)``, ``w = clearcoat F_c(n.v)``,
-    ``alpha_c = clearcoat_roughness^2`` (gltf_pbr.glsl's order), 0 for the coat of roughness 0; value (N, 3) -> (N, 3).
-    ``gltf_pbr_visibility_cos`` is `glphong.materials.gltf_pbr.gltf_pbr_visibility_cos` (which imports this module)."""
+    ``alpha_c = clearcoat_roughness^2`` (gltf_pbr.glsl's order), the coat's lobe the base's function
+    (`glphong.materials.gltf_lobe.gltf_pbr_specular`: 0 for the coat of roughness 0); value (N, 3) -> (N, 3)."""
     dtype = np.asarray(value).dtype
-    _, n_dot_v, _, _, tan2 = microfacet_geometry(f.n, wi, wo, n_dot_l)
-    n_dot_l = np.asarray(n_dot_l).astype(dtype)
     alpha_c = np.asarray(p.clearcoat_roughness).astype(dtype) ** 2
     a2_c = (alpha_c * alpha_c).astype(dtype)
     with np.errstate(over="ignore", under="ignore", invalid="ignore", divide="ignore"):
-        coat = np.minimum(microfacet_ggx(tan2.astype(dtype), a2_c) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2_c),
-                          dtype.type(FLT_MAX))
-        coat = np.where(a2_c > 0, coat, dtype.type(0)).astype(dtype)  # roughness 0: a delta, 0 for a point light
-        weight = (np.asarray(p.clearcoat).astype(dtype) * gltf_clearcoat_fresnel(n_dot_v.astype(dtype))).astype(dtype)
+        if "clearcoat_normal" in getattr(p, "extensions", ()):  # clearcoatNormalTexture: the coat's own normal
+            valid, c_n_dot_l, c_n_dot_v, c_tan2, fresnel_cos = gltf_clearcoat_geometry(f, wi, wo, p, dtype)
+            coat = np.where(valid, gltf_pbr_specular(a2_c, c_tan2.astype(dtype), c_n_dot_l, c_n_dot_v),
+                            dtype.type(0)).astype(dtype)
+        else:  # the shading normal: the base's geometry; roughness 0: a delta, 0 for a point light
+            _, n_dot_v, _, _, tan2 = microfacet_geometry(f.n, wi, wo, n_dot_l)
+            coat = gltf_pbr_specular(a2_c, tan2.astype(dtype), np.asarray(n_dot_l).astype(dtype), n_dot_v)
+            fresnel_cos = n_dot_v.astype(dtype)
+        weight = (np.asarray(p.clearcoat).astype(dtype) * gltf_clearcoat_fresnel(fresnel_cos)).astype(dtype)
         return (value * (dtype.type(1) - weight)[..., None] + (weight * coat)[..., None]).astype(dtype)
 
 
 class ExtensionProperties:
     """`GltfPBR`'s ``properties``: the core's `Properties` read from the class, and from an instance with a coat the
-    same with ``reciprocal=False`` (the coat's Fresnel is on ``n.v`` alone, as the extension writes it)."""
+    same with ``reciprocal=False`` (the coat's Fresnel is on ``n.v`` alone, as the extension writes it), with the
+    anisotropy or a coat normal ``isotropic=False``."""
 
     def __init__(self, core):
         self.core = core
 
     def __get__(self, material, cls=None):
-        if material is None or "clearcoat" not in material.extensions():
+        used = () if material is None else material.extensions()
+        changed = {"reciprocal": False} if "clearcoat" in used else {}
+        if "anisotropy" in used or "clearcoat_normal" in used:  # a lobe not symmetric about n
+            changed["isotropic"] = False
+        return dataclasses.replace(self.core, **changed) if changed else self.core
+
+
+class ExtensionNeeds:
+    """`GltfPBR`'s ``needs``: the core's read from the class (what its GLSL reads outside the structural defines), and
+    from an instance also what the code under its structural defines reads (the class's ``structural_needs``: the
+    anisotropy's tangent frame), so that a mesh without tangents serves every glTF material but an anisotropic one."""
+
+    def __init__(self, core):
+        self.core = tuple(core)
+
+    def __get__(self, material, cls=None):
+        if material is None:
             return self.core
-        return dataclasses.replace(self.core, reciprocal=False)
+        defines = {f"{material.name.upper()}_{name}" for name, _ in material.structural_defines()}
+        extra = tuple(n for define, needs in type(material).structural_needs.items() if define in defines for n in needs)
+        return tuple(dict.fromkeys(self.core + extra))
 
 
 class GltfExtensionFeatures:
@@ -143,6 +173,10 @@ class GltfExtensionFeatures:
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
+        if "clearcoat_normal" in self.extensions() and self.normal_map is not None:
+            raise ValueError("clearcoat_normal with a normal_map: glphong's coat normal is taken on the unperturbed "
+                             "frame, which a material-level normal map replaces; give the coat's normal texture "
+                             "without normal_map (docs/gltf_extensions.md)")
         if "clearcoat" in self.extensions() and np.any(constant_part(self.emissive)):
             warnings.warn("KHR_materials_clearcoat with an emission: glphong does not darken the emission by the "
                           "coat's 1 - clearcoat F_c(n.v) (F_c = 0.04 at normal view, 1 at grazing): the emission is "
@@ -151,7 +185,7 @@ class GltfExtensionFeatures:
     def extensions(self):
         """The extensions this material uses, by short name (`EXTENSIONS`): specular where ``specular`` or
         ``specular_color`` is not 1 or is textured, clearcoat where ``clearcoat`` is not 0, sheen where
-        ``sheen_color`` is not 0 (tuple of str)."""
+        ``sheen_color`` is not 0, anisotropy where ``anisotropy_strength`` is not 0 (tuple of str)."""
         def differs(name, neutral):
             value = getattr(self, name)
             return isinstance(value, SurfaceInput) and value.texture is not None or \
@@ -161,14 +195,26 @@ class GltfExtensionFeatures:
         if differs("specular", 1.0) or differs("specular_color", 1.0):
             out.append("specular")
         if np.any(constant_part(self.clearcoat)):
-            out.append("clearcoat")
+            out += ["clearcoat", "clearcoat_normal"] if uses_coat_normal(self) else ["clearcoat"]  # gltf_coat_normal
         if np.any(constant_part(self.sheen_color)):  # sheenColorFactor 0 disables the layer, textured or not
             out.append("sheen")
+        if np.any(constant_part(self.anisotropy_strength)):  # anisotropyStrength 0 (the default): isotropic
+            out.append("anisotropy")
+        if np.any(constant_part(self.transmission)):  # transmissionFactor 0 (the default): opaque (gltf_transmission)
+            out += ["transmission", *volume_extensions(self)]  # and KHR_materials_volume, _dispersion in it
+        if np.any(constant_part(self.iridescence)):  # iridescenceFactor 0 (the default): no film (gltf_iridescence)
+            out.append("iridescence")
         return tuple(out)
 
     def defines(self):
         """``GLTF_PBR_<NAME>`` for each extension used: its code is in the program only then."""
         return tuple((name.upper(), "1") for name in self.extensions())
+
+    def library_uses(self, uber=False):
+        """`MaterialModel.library_uses`, and the library chunk ``normal_map`` (its ``surface_normal``, the coat
+        normal's formula) where the coat has its own normal."""
+        extra = ("normal_map",) if "clearcoat_normal" in self.extensions() else ()
+        return tuple(dict.fromkeys(super().library_uses(uber) + extra))
 
     def active_params(self):
         """The uniforms this instance's programs read: the extensions' only where used."""
@@ -180,13 +226,17 @@ class GltfExtensionFeatures:
         return super().structure() | {"extensions": self.extensions()}
 
 
-def gltf_extensions_oracle(base_color, metallic, roughness, ior, extensions, p, n_dot_l, n_dot_v, n_dot_h, v_dot_h):
+def gltf_extensions_oracle(base_color, metallic, roughness, ior, extensions, p, n_dot_l, n_dot_v, n_dot_h, v_dot_h,
+                           layer=None, coat=None):
     """The response of a `GltfPBR` with extensions in mpmath, straight from the extensions' text: Appendix B's ``D``
-    and ``V`` (``(n.h)^2 (alpha^2 - 1) + 1``), ``fresnel_mix`` with ``f0_color`` and ``weight`` (specular), then
-    ``mix(material, clearcoat_brdf, clearcoat F_c)`` (clearcoat), times ``n.l``; a list of 3 mpmath numbers."""
+    and ``V`` (``(n.h)^2 (alpha^2 - 1) + 1``; ``layer``, the base's ``V D``, where given: the anisotropy's,
+    `glphong.materials.gltf_anisotropy.gltf_anisotropy_oracle`), ``fresnel_mix`` with ``f0_color`` and ``weight``
+    (specular), then ``mix(material, clearcoat_brdf, clearcoat F_c)`` (clearcoat), times ``n.l``; the coat's lobe times
+    ``n_c.l`` on its own normal where ``coat = (n_c.l, n_c.v, n_c.h)`` is given (`gltf_coat_normal.coat_normal_oracle`);
+    a list of 3 mpmath numbers."""
     import mpmath  # noqa: PLC0415 - the stability suite's, kept out of import time
 
-    def d_and_v(alpha):
+    def d_and_v(alpha, n_dot_l=n_dot_l, n_dot_v=n_dot_v, n_dot_h=n_dot_h):
         a2 = alpha * alpha
         denominator = n_dot_h * n_dot_h * (a2 - 1) + 1
         if denominator == 0:
@@ -195,22 +245,26 @@ def gltf_extensions_oracle(base_color, metallic, roughness, ior, extensions, p, 
         return d / (2 * (n_dot_v * mpmath.sqrt(a2 + (1 - a2) * n_dot_l ** 2)
                          + n_dot_l * mpmath.sqrt(a2 + (1 - a2) * n_dot_v ** 2)))
 
-    layer = d_and_v(roughness * roughness)
+    layer = d_and_v(roughness * roughness) if layer is None else layer
     x = (1 - v_dot_h) ** 5
     f0 = ((ior - 1) / (ior + 1)) ** 2
     weight, color = (p.specular, p.specular_color) if "specular" in extensions else (1, [1, 1, 1])
-    fr = [min(f0 * k, 1) + (1 - min(f0 * k, 1)) * x for k in color]
+    fr = [weight * (min(f0 * k, 1) + (1 - min(f0 * k, 1)) * x) for k in color]
+    fm = [c + (1 - c) * x for c in base_color]
+    if "iridescence" in extensions:  # KHR_materials_iridescence: F = mix(F, F_iridescence, iridescence)
+        fr, fm = gltf_iridescence_oracle(fr, base_color, x, [weight * min(f0 * k, 1) for k in color], p, v_dot_h)
     out = []
-    for c, f in zip(base_color, fr):
-        dielectric = (1 - weight * max(fr)) * c / mpmath.pi + weight * f * layer
-        metal = (c + (1 - c) * x) * layer
+    for c, f, g in zip(base_color, fr, fm):
+        dielectric = (1 - max(fr)) * c / mpmath.pi + f * layer
+        metal = g * layer
         out.append((1 - metallic) * dielectric + metallic * metal)
     if "sheen" in extensions:  # KHR_materials_sheen, under the coat (gltf_sheen)
         out = gltf_sheen_oracle(out, p, n_dot_l, n_dot_v, n_dot_h)
-    if "clearcoat" in extensions:
-        w = p.clearcoat * (mpmath.mpf("0.04") + (1 - mpmath.mpf("0.04")) * (1 - n_dot_v) ** 5)
-        coat = d_and_v(p.clearcoat_roughness ** 2)
-        out = [(1 - w) * o + w * coat for o in out]
+    if "clearcoat" in extensions:  # on the coat's own normal where given (its clampedDot in the Fresnel)
+        c_l, c_v, c_h = (n_dot_l, n_dot_v, n_dot_h) if coat is None else coat
+        w = p.clearcoat * (mpmath.mpf("0.04") + (1 - mpmath.mpf("0.04")) * (1 - max(c_v, 0)) ** 5)
+        lobe = d_and_v(p.clearcoat_roughness ** 2, c_l, c_v, c_h) * c_l if c_l > 0 and c_v > 0 else 0
+        return [(1 - w) * o * n_dot_l + w * lobe for o in out]
     return [o * n_dot_l for o in out]
 
 
@@ -236,7 +290,13 @@ def extension_cases(cls):
                           cls(0.5, 0.5, 0.3, clearcoat=1.0, clearcoat_roughness=0.1, specular=0.5),
                           eye=(-float(np.sqrt(1.0 - nv * nv)), 0.0, nv), lights=(("point", _unit(40.0), e_one),),
                           note="F_c -> 1: the coat alone"))
-    return cases + sheen_cases(cls)
+    for texel, scale, theta_h in (((0.7, 0.4, 0.9), 1.0, 0.0), ((0.7, 0.4, 0.9), 1.0, 0.3), ((0.1, 0.5, 0.6), 3.0, 0.2),
+                                  ((0.5, 0.5, 1.0), 0.0, 0.1)):  # tilted, far (n_c.v or n_c.l <= 0), texel unperturbed
+        cases.append(Case(f"gltf_pbr clearcoat normal {texel} scale={scale:g} theta_h={theta_h:g}", "gltf clearcoat",
+                          cls((0.8, 0.5, 0.2), 0.2, 0.5, clearcoat=1.0, clearcoat_roughness=0.2,
+                              clearcoat_normal=texel, clearcoat_normal_strength=scale),
+                          eye=_mirror_eye(30.0, 2 * theta_h), lights=light, note="the coat on its own normal"))
+    return cases + sheen_cases(cls) + anisotropy_cases(cls) + iridescence_cases(cls)
 
 
 def extension_gltf_fields(material, texture_index):
@@ -261,10 +321,30 @@ def extension_gltf_fields(material, texture_index):
                   "clearcoatRoughnessFactor": float(constant_part(material.clearcoat_roughness))}
         textured("clearcoat", "clearcoatTexture", fields, "r")
         textured("clearcoat_roughness", "clearcoatRoughnessTexture", fields, "g")
+        normal = material.clearcoat_normal
+        if isinstance(normal, SurfaceInput) and normal.texture is not None and np.all(np.asarray(normal.scale) == 1.0):
+            fields["clearcoatNormalTexture"] = {"index": texture_index(normal.texture),
+                                                "scale": float(material.clearcoat_normal_strength)}
         out["KHR_materials_clearcoat"] = fields
     if "sheen" in used:
         fields = {"sheenColorFactor": [float(c) for c in np.broadcast_to(constant_part(material.sheen_color), 3)],
                   "sheenRoughnessFactor": float(constant_part(material.sheen_roughness))}
         textured("sheen_color", "sheenColorTexture", fields)
         out["KHR_materials_sheen"] = fields
-    return out
+    if "anisotropy" in used:
+        direction, strength = material.anisotropy_direction, material.anisotropy_strength
+        rotation = float(material.anisotropy_rotation)
+        if not isinstance(direction, SurfaceInput):  # a constant direction: its angle joins the rotation (the file's
+            dx, dy = 2.0 * np.broadcast_to(np.asarray(direction, np.float64), 3)[:2] - 1.0  # direction, the tangent)
+            rotation += math.atan2(dy, dx)  # atan2(0, 0) = 0: a zero direction takes the tangent, as the shader
+        fields = {"anisotropyStrength": float(constant_part(material.anisotropy_strength)),
+                  "anisotropyRotation": rotation}
+        if isinstance(direction, SurfaceInput) and isinstance(strength, SurfaceInput) and direction.texture is not None \
+                and direction.texture is strength.texture and strength.channel == "b" and \
+                np.all(np.asarray(direction.scale) == 1.0):
+            # the file's one texture: rg the direction, b the strength (as the loader makes them); other pairs are
+            # kept by glphong's extras only
+            fields["anisotropyTexture"] = {"index": texture_index(direction.texture)}
+        out["KHR_materials_anisotropy"] = fields
+    return out | transmission_gltf_fields(material, texture_index) \
+        | iridescence_gltf_fields(material, texture_index)  # KHR_materials_transmission, _iridescence: their modules

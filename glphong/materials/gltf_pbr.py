@@ -45,19 +45,29 @@ import numpy as np
 
 from glphong.definitions.cases import Case, _mirror_eye, _unit, generic_cases
 from glphong.materials.cook_torrance import oracle_half_vector
-from glphong.materials.gltf_extensions import (EXTENSION_PARAMS, ExtensionProperties, GltfExtensionFeatures,  # noqa: F401
-                                               extension_cases, extension_gltf_fields, gltf_clearcoat_fresnel,
-                                               gltf_clearcoat_mix, gltf_extensions_oracle, gltf_specular_fresnel,
-                                               gltf_specular_parts)
+from glphong.materials.gltf_anisotropy import (gltf_anisotropy_frame, gltf_anisotropy_ggx,  # noqa: F401
+                                               gltf_anisotropy_layer, gltf_anisotropy_oracle, gltf_anisotropy_specular,
+                                               gltf_anisotropy_visibility_cos)  # the GLSL chunk's twins, by its name
+from glphong.materials.gltf_extensions import (EXTENSION_PARAMS, ExtensionNeeds, ExtensionProperties,  # noqa: F401
+                                               GltfExtensionFeatures, extension_cases, extension_gltf_fields,
+                                               gltf_clearcoat_fresnel, gltf_clearcoat_mix, gltf_extensions_oracle,
+                                               gltf_specular_fresnel)
+from glphong.materials.gltf_iridescence import (gltf_iridescence_fresnel, gltf_iridescence_parts,  # noqa: F401
+                                                gltf_iridescence_sensitivity)  # the GLSL chunk's twins, by its name
+from glphong.materials.gltf_coat_normal import coat_normal_oracle
+from glphong.materials.gltf_lobe import gltf_pbr_specular, gltf_pbr_visibility_cos  # noqa: F401
 from glphong.materials.gltf_sheen import (gltf_sheen_albedo, gltf_sheen_distribution, gltf_sheen_l,  # noqa: F401
                                           gltf_sheen_lambda, gltf_sheen_mix)  # the GLSL chunk's twins, by its name
+from glphong.materials.gltf_transmission import (gltf_transmission_lod, gltf_transmission_response,  # noqa: F401
+                                                 gltf_transmission_weight, gltf_volume_attenuation, gltf_volume_ray,
+                                                 gltf_volume_uv)  # transmission_thin.glsl's twins, by their names
 from glphong.definitions.material import MaterialModel, Param, Properties, constant_part
 from glphong.definitions.params import GlslFile
 from glphong.definitions.surface import SurfaceInput
 from glphong.twin.band import EPS, FLT_MAX, FLT_MIN
 from glphong.twin.functions import dot as _dot, microfacet_geometry, microfacet_ggx
 
-__all__ = ["GltfPBR", "gltf_pbr_band", "gltf_pbr_ggx", "gltf_pbr_visibility_cos"]
+__all__ = ["GltfPBR", "gltf_pbr_band", "gltf_pbr_ggx", "gltf_pbr_visibility_cos", "gltf_pbr_specular"]
 
 _INV_PI = 1.0 / np.pi
 _BASE_COLOR = Param("base_color", "rgb", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
@@ -78,22 +88,16 @@ _IOR = Param("ior", "scalar", low=1.0, high=1e4, default=1.5, unit="",
 gltf_pbr_ggx = microfacet_ggx
 
 
-def gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2):
-    """``V (n.l) = n.l / (2 (n.v r_l + n.l r_v))``, ``r_x = sqrt((n.x)^2 + a2 (1 - (n.x)^2))`` (gltf_pbr.glsl)."""
-    n_dot_l = np.asarray(n_dot_l)
-    dtype = np.result_type(n_dot_l, n_dot_v)
-    n_dot_l, n_dot_v, a2 = n_dot_l.astype(dtype), np.asarray(n_dot_v).astype(dtype), np.asarray(a2).astype(dtype)
-    one = dtype.type(1)
-    r_l = np.sqrt(n_dot_l * n_dot_l + a2 * (one - n_dot_l * n_dot_l))
-    r_v = np.sqrt(n_dot_v * n_dot_v + a2 * (one - n_dot_v * n_dot_v))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        return (n_dot_l / (dtype.type(2) * (n_dot_v * r_l + n_dot_l * r_v))).astype(dtype)
-
-
 #: the parameters `gltf_pbr_band` bounds (emissive and occlusion: outside the response)
 _CORE_PARAMS = ("base_color", "metallic", "roughness", "emissive", "occlusion", "ior")
 #: KHR_materials_specular's, _clearcoat's and _sheen's defaults, at which the response is the core formula
-_CORE_AT = {"specular": 1.0, "specular_color": 1.0, "clearcoat": 0.0, "sheen_color": 0.0}
+_CORE_AT = {"specular": 1.0, "specular_color": 1.0, "clearcoat": 0.0, "sheen_color": 0.0, "transmission": 0.0,
+            "anisotropy_strength": 0.0, "iridescence": 0.0}
+#: parameters that change nothing where no extension is used
+_UNUSED_ALONE = ("extensions", "clearcoat_roughness", "sheen_roughness", "anisotropy_rotation", "anisotropy_direction",
+                 "clearcoat_normal", "clearcoat_normal_strength",
+                 "iridescence_ior", "iridescence_thickness_minimum", "iridescence_thickness_maximum",
+                 "iridescence_thickness_mix", "thickness", "attenuation_distance", "attenuation_color", "dispersion")
 
 
 def _interval(value, rel):
@@ -239,21 +243,38 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         (`glphong.materials.gltf_extensions`, docs/gltf_extensions.md).
     clearcoat, clearcoat_roughness : float or SurfaceInput
         ``KHR_materials_clearcoat`` (default 0: no coat): ``mix(f_r, V_c D_c, clearcoat F_c(n.v))``, ``alpha_c =
-        clearcoat_roughness^2``; the coat takes the shading normal.
+        clearcoat_roughness^2``; the coat takes the shading normal, or its own where given:
+    clearcoat_normal, clearcoat_normal_strength : (3,) or SurfaceInput, float
+        ``clearcoatNormalTexture`` (its texel, linear; default (0.5, 0.5, 1): the unperturbed normal) and its
+        ``scale``: the coat's normal on the unperturbed frame, not with a ``normal_map`` (needs the tangent frame;
+        `glphong.materials.gltf_coat_normal`).
     sheen_color, sheen_roughness : float or (3,) array_like or SurfaceInput, float or SurfaceInput
         ``KHR_materials_sheen`` (default 0: no sheen), under the coat: ``sheen_color D_s V_s + f_r max(min(1 -
         max3(sheen_color) E(n.v), 1 - max3(sheen_color) E(n.l)), 0)``, Charlie ``D_s`` with ``alpha_g =
         sheen_roughness^2`` (`glphong.materials.gltf_sheen`).
+    anisotropy_strength, anisotropy_rotation, anisotropy_direction : float or SurfaceInput, float, (3,) or SurfaceInput
+        ``KHR_materials_anisotropy`` (default 0: isotropic): the base's GGX ``D`` and ``V`` anisotropic with ``alpha_t
+        = mix(alpha, 1, strength^2)`` along the direction ``2 anisotropy_direction.rg - 1`` (the anisotropy
+        texture's texel, default (1, 0.5): the tangent) rotated by ``anisotropy_rotation`` [rad] in the tangent
+        frame, ``alpha_b = alpha`` across it; the strength times the texture's blue channel.  Needs the mesh's
+        tangent frame (`glphong.materials.gltf_anisotropy`).
+    iridescence, iridescence_ior : float or SurfaceInput, float
+        ``KHR_materials_iridescence`` (default 0: no film): the thin film's Fresnel ``F_irid`` (film ior default 1.3)
+        mixed into the dielectric's and the metal's Fresnel by ``iridescence`` (`glphong.materials.gltf_iridescence`).
+    iridescence_thickness_minimum, iridescence_thickness_maximum, iridescence_thickness_mix : float, float, float or SurfaceInput
+        The film's thickness ``mix(minimum, maximum, mix)`` [nm] (defaults 100, 400 and 1: 400 nm).
     """
 
     name = "gltf_pbr"
     params = (_BASE_COLOR, _METALLIC, _ROUGHNESS, _EMISSIVE, _OCCLUSION, _IOR) + EXTENSION_PARAMS  # gltf_extensions
-    needs = ("view",)
+    needs = ExtensionNeeds(("view",))  # an instance with the anisotropy needs "tangent" too (structural_needs)
+    #: what the code under a structural define reads beside `needs` (the definition check accepts it there)
+    structural_needs = {"GLTF_PBR_ANISOTROPY": ("tangent",), "GLTF_PBR_CLEARCOAT_NORMAL": ("tangent",)}
     ambient = "base_color"
     ambient_scale = 1.0 / np.pi
     emission = "emissive"
     occluded_by = "occlusion"
-    glsl = GlslFile("materials/gltf_pbr.glsl")
+    glsl = GlslFile("materials/gltf_pbr.glsl", before=("materials/gltf_iridescence.glsl",))  # under its define
     uses = ("microfacet",)
     vanishes_with = ()
     properties = ExtensionProperties(Properties(  # a coat is not reciprocal (gltf_extensions)
@@ -289,29 +310,41 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
     def _parts(self, f, wi, wo, n_dot_l, p):
         """``(valid, diffuse (N, 3), fresnel (N, 3), specular (N,), tan2, a2, v_dot_h)``: the response is ``diffuse +
         fresnel * specular`` where valid, ``specular = D V (n.l)`` (gltf_pbr.glsl's order)."""
-        valid, n_dot_v, _, v_dot_h, tan2 = microfacet_geometry(f.n, wi, wo, n_dot_l)
+        valid, n_dot_v, n_dot_h, v_dot_h, tan2 = microfacet_geometry(f.n, wi, wo, n_dot_l)
         dtype = tan2.dtype
         n_dot_l = np.asarray(n_dot_l).astype(dtype)
         roughness = np.asarray(p.roughness).astype(dtype)  # a constant, or (N,) where textured
         alpha = roughness * roughness
         a2 = alpha * alpha
         with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-            # roughness 0: D is a delta (0 for a point light); V's r_x would underflow to 0/0 for grazing l and v
-            specular = np.where(a2 > 0, np.minimum(gltf_pbr_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2),
-                                                   dtype.type(FLT_MAX)), dtype.type(0)).astype(dtype)
+            if "anisotropy" in getattr(p, "extensions", ()):  # KHR_materials_anisotropy (gltf_anisotropy)
+                specular = gltf_anisotropy_layer(f, wi, wo, n_dot_l, n_dot_v, n_dot_h, v_dot_h, alpha, p)
+            else:  # roughness 0: D is a delta (0 for a point light), 0 (gltf_lobe)
+                specular = gltf_pbr_specular(a2, tan2, n_dot_l, n_dot_v)
             x1 = np.maximum(dtype.type(1) - v_dot_h, dtype.type(0))
             x = ((x1 * x1) * (x1 * x1) * x1).astype(dtype)
             c = np.asarray(p.base_color, dtype)
             ior = np.asarray(p.ior).astype(dtype)
             r = ((ior - dtype.type(1)) / (ior + dtype.type(1))).astype(dtype)
             f0 = (r * r).astype(dtype)
-            fd = (f0 + (dtype.type(1) - f0) * x).astype(dtype)
             m = np.asarray(p.metallic).astype(dtype)[..., None]
-            diffuse = (c * (dtype.type(1 / np.pi) * n_dot_l)[..., None]) * (dtype.type(1) - fd)[..., None] \
+            extensions = getattr(p, "extensions", ())
+            if "specular" in extensions:  # KHR_materials_specular: an rgb F_d, the diffuse by 1 - max(F_d)
+                fd = gltf_specular_fresnel(f0, p.specular, p.specular_color, x)
+                fd_max = np.max(fd, axis=-1)
+            else:
+                fd_max = (f0 + (dtype.type(1) - f0) * x).astype(dtype)
+                fd = fd_max[..., None]
+            fresnel = fd * (dtype.type(1) - m) + (c + (dtype.type(1) - c) * x[..., None]) * m
+            if "iridescence" in extensions:  # KHR_materials_iridescence (gltf_iridescence)
+                film_f0 = gltf_specular_fresnel(f0, p.specular, p.specular_color, dtype.type(0)) \
+                    if "specular" in extensions else np.broadcast_to(f0[..., None], np.shape(f0) + (3,))
+                fd_max, fresnel = gltf_iridescence_parts(c, m, x, film_f0, fd, v_dot_h, p)
+            # mix(dielectric, metal, m) = (c/pi)(n.l)(1 - fd)(1 - m) + [fd (1 - m) + (c + (1 - c) x) m] V D (n.l)
+            diffuse = (c * (dtype.type(1 / np.pi) * n_dot_l)[..., None]) * (dtype.type(1) - fd_max)[..., None] \
                 * (dtype.type(1) - m)
-            fresnel = fd[..., None] * (dtype.type(1) - m) + (c + (dtype.type(1) - c) * x[..., None]) * m
-            if "specular" in getattr(p, "extensions", ()):  # KHR_materials_specular: an rgb F_d (gltf_extensions)
-                diffuse, fresnel = gltf_specular_parts(c, m, n_dot_l, x, f0, p)
+            if "transmission" in extensions:  # KHR_materials_transmission: 1 - t (gltf_transmission)
+                diffuse = diffuse * (dtype.type(1) - np.asarray(p.transmission).astype(dtype))[..., None]
         return valid, diffuse, fresnel, specular, tan2, a2, v_dot_h
 
     def response(self, f, wi, wo, n_dot_l, p):
@@ -322,7 +355,7 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         if "sheen" in getattr(p, "extensions", ()):  # KHR_materials_sheen, under the coat (gltf_sheen)
             value = gltf_sheen_mix(value, f, wi, wo, n_dot_l, p)
         if "clearcoat" in getattr(p, "extensions", ()):  # KHR_materials_clearcoat (gltf_extensions)
-            value = gltf_clearcoat_mix(value, f, wi, wo, n_dot_l, p, gltf_pbr_visibility_cos)
+            value = gltf_clearcoat_mix(value, f, wi, wo, n_dot_l, p)
         return np.where(valid[..., None], value, dtype.type(0)).astype(dtype)
 
     def band(self, f, wi, wo, n_dot_l, p, constants):
@@ -331,7 +364,7 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         at the value where the core formula holds (`_CORE_AT`: glTF's extensions at their defaults)."""
         for name, value in p.__dict__.items():
             if name in _CORE_PARAMS or (name in _CORE_AT and np.all(np.asarray(value) == _CORE_AT[name])) or \
-                    (name in ("extensions", "clearcoat_roughness", "sheen_roughness") and not getattr(p, "extensions", ())):
+                    (name in _UNUSED_ALONE and not getattr(p, "extensions", ())):
                 continue
             return super().band(f, wi, wo, n_dot_l, p, constants)
         return gltf_pbr_band(f.n, wi, wo, n_dot_l, p, constants)
@@ -346,9 +379,11 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         if h is None:
             return [mpmath.mpf(0)] * 3
         n_dot_h, v_dot_h = dot(f.n, h), abs(dot(wo, h))
-        if getattr(p, "extensions", ()):  # the extensions' own formulas (gltf_extensions)
+        if getattr(p, "extensions", ()):  # the extensions' own formulas (gltf_extensions, gltf_anisotropy)
+            layer = gltf_anisotropy_oracle(f, wi, wo, h, p) if "anisotropy" in p.extensions else None
+            coat = coat_normal_oracle(f, wi, wo, p) if "clearcoat_normal" in p.extensions else None
             return gltf_extensions_oracle(p.base_color, p.metallic, p.roughness, p.ior, p.extensions, p, n_dot_l,
-                                          n_dot_v, n_dot_h, v_dot_h)
+                                          n_dot_v, n_dot_h, v_dot_h, layer, coat)
         alpha = p.roughness * p.roughness
         a2 = alpha * alpha
         denominator = n_dot_h * n_dot_h * (a2 - 1) + 1

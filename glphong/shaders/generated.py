@@ -8,7 +8,7 @@ import numpy as np
 
 from glphong.definitions.registry import model_named, model_source
 
-__all__ = ["MATERIAL_CHUNK", "LIGHTS_CHUNK", "LOD_CHUNK", "material_chunk", "lights_chunk", "lod_chunk",
+__all__ = ["MATERIAL_CHUNK", "LIGHTS_CHUNK", "LOD_CHUNK", "material_chunk", "lights_chunk", "lod_chunk", "transmits",
            "model_chunk_label"]
 
 #: the label of the generated material chunk
@@ -99,7 +99,10 @@ def lights_chunk(key):
     ``add_lights(radiance, x, f, wo, lit)``: for each light j of kind k,
     ``valid = k_incident(x, j, wi, E)``;  ``radiance += (lit && valid && n.wi > 0) ? light_term(material_response(f,
     wi, wo, n.wi), E) : 0``.  Every light's term is computed and the gate selects it, without a branch (shade.glsl
-    says why); the loop bound is the compile-time ``<KIND>_LIGHT_COUNT`` (a uniform in the uber-shader).
+    says why); the loop bound is the compile-time ``<KIND>_LIGHT_COUNT`` (a uniform in the uber-shader).  A program
+    that `transmits` (KHR_materials_transmission) also adds, for a punctual light behind the surface,
+    ``(lit && valid && n.wi < 0) ? light_term(gltf_transmission_response(f, wi, wo, -n.wi), E) : 0``
+    (glsl/transmission_thin.glsl).
     """
     lines = ["// light loops (generated from the program key): for each light j of each kind k present",
              "//   valid = k_incident(x, j, wi, E);  L += (lit && valid && n.wi > 0) ? material_response(f, wi, wo, n.wi) E : 0",
@@ -114,11 +117,16 @@ def lights_chunk(key):
         lines.append(f"uniform float u_shadow_texel{slot};")
         if light.shadow_map == "ortho":
             lines += [f"uniform vec3 u_shadow_axis{slot};", f"uniform vec3 u_shadow_e1{slot};", f"uniform vec3 u_shadow_e2{slot};"]
+    if transmits(key):  # KHR_materials_transmission: a punctual light behind the surface (glsl/transmission_thin.glsl)
+        lines += ["vec3 gltf_transmission_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l);"]
     lines += ["", "void add_lights(inout vec3 radiance, vec3 position, ShadingFrame f, vec3 wo, bool lit)", "{",
               "    vec3 wi;", "    vec3 irradiance;", "    float n_dot_l;", "    bool valid;"]
     term = ["        n_dot_l = dot(f.n, wi);",
             "        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), irradiance);",
             "        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);"]
+    if transmits(key):
+        term += ["        vec3 through = light_term(gltf_transmission_response(f, wi, wo, -n_dot_l), irradiance);",
+                 "        radiance += (lit && valid && n_dot_l < 0.0) ? through : vec3(0.0);"]
     for light in key.lights:
         if light.extended:
             lines += _extended_loop(key, light)
@@ -140,6 +148,14 @@ def lights_chunk(key):
     lines += ["}"]
     sampled = [_sampled_response(key, light) for light in key.lights if light.extended]
     return "\n".join([line for chunk in sampled for line in chunk] + lines) + "\n"
+
+
+def transmits(key):
+    """Whether ``key``'s program holds glsl/transmission_thin.glsl: a gltf_pbr term with KHR_materials_transmission
+    (``GLTF_PBR_TRANSMISSION``) in a per-pixel radiance program that is not a blended layer (`glphong.gpu.transmission`);
+    its punctual lights' loops then also add what a light behind the surface sends through it."""
+    return key.output == "radiance" and not key.shade_per_vertex and not key.alpha_blend and \
+        any(("TRANSMISSION", "1") in t.defines for t in key.terms if t.name == "gltf_pbr")
 
 
 def closed_form(term, light):

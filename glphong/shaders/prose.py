@@ -66,8 +66,10 @@ def left_out(key, absent_terms=()):
         out.append("vertex-colour attribute (no parameter takes vertex colours)")
     if not key.textured_inputs:
         out.append("surface.glsl, texture samplers and material_inputs() (no parameter is textured)")
-    if not key.normal_map:
-        out.append("normal_map.glsl and its sampler (the material has no normal map)")
+    if not key.normal_map:  # a coat normal (gltf_pbr) calls normal_map.glsl without a normal map
+        held = "normal_map" in key.included_library()
+        out.append(("the normal map sampler" if held else "normal_map.glsl and its sampler")
+                   + " (the material has no normal map)")
     if not key.alpha_mask:
         out.append("the alpha test (the material has no alpha mask)")
     out.append("G-buffer outputs (they exist only in the G-buffer program)")

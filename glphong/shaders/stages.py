@@ -9,7 +9,7 @@ program.
 """
 from dataclasses import dataclass
 
-from glphong.shaders.generated import LIGHTS_CHUNK, LOD_CHUNK, MATERIAL_CHUNK
+from glphong.shaders.generated import LIGHTS_CHUNK, LOD_CHUNK, MATERIAL_CHUNK, transmits
 
 __all__ = ["Slot", "SHADING", "STAGES", "program_kind", "shading_chunks", "stage_chunks"]
 
@@ -37,6 +37,11 @@ def _reads_surface(key):
 
 def _normal_map(key):
     return key.normal_map
+
+
+def _normal_map_after_library(key):
+    """normal_map.glsl for the material's normal map, unless a term's ``uses`` put it in the library slot already."""
+    return key.normal_map and "normal_map" not in key.included_library()
 
 
 def _shadows(key):
@@ -70,7 +75,7 @@ SHADING = (
     "common",
     LIBRARY,
     ("surface", _reads_surface),
-    ("normal_map", _normal_map),
+    ("normal_map", _normal_map_after_library),
     TERMS,
     ("shadows", _shadows),
     MATERIAL_CHUNK,
@@ -81,7 +86,7 @@ SHADING = (
 
 #: program kind -> {"vertex": entries, "fragment": entries}
 STAGES = {
-    "radiance": {"vertex": ("mesh_vertex",), "fragment": SHADING + ("mesh_fragment",)},
+    "radiance": {"vertex": ("mesh_vertex",), "fragment": SHADING + (("transmission_thin", transmits), "mesh_fragment")},
     "display": {"vertex": ("mesh_vertex",), "fragment": SHADING + ("srgb", "mesh_fragment")},
     "per_vertex": {"vertex": SHADING + ("mesh_vertex",), "fragment": (("surface", _textured_alpha), "mesh_fragment")},
     "gbuffer": {"vertex": ("mesh_vertex",),

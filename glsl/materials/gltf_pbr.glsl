@@ -17,12 +17,18 @@
 // gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2) -> V (n.l) = n.l / (2 (n.v r_l + n.l r_v)),
 //   r_x = sqrt((n.x)^2 + a2 (1 - (n.x)^2)): the response's n.l cancels the 1/(n.l) of V, so a grazing light
 //   never forms 1/(n.l); at most 1 / (4 n.v) for roughness 0.
+// gltf_pbr_specular(a2, tan2, n_dot_l, n_dot_v) -> the GGX lobe D V (n.l) of the base and of the coat, min(., FLT_MAX)
+//   where a2 > 0, 0 where a2 = 0 (roughness 0: D is a delta; V's r_x would underflow to 0/0 for grazing l and v).
 // KHR_materials_specular (GLTF_PBR_SPECULAR; glphong/materials/gltf_extensions.py, docs/gltf_extensions.md):
 //   gltf_specular_fresnel(f0, specular, specular_color, x) -> F_d = mix(min(f0 specular_color, 1) specular, specular, x)
 //   (rgb): the dielectric = F_d V D + (1 - max(F_d.r, F_d.g, F_d.b)) c/pi; the metal unchanged.
 // KHR_materials_clearcoat (GLTF_PBR_CLEARCOAT): gltf_clearcoat_fresnel(n_dot_v) -> F_c = 0.04 + 0.96 (1 - n.v)^5
 //   (fresnel_coat with ior 1.5, on n.v); f_r = mix(f_r, V_c D_c, clearcoat F_c), alpha_c = clearcoat_roughness^2, the
-//   coat's normal the shading normal n.
+//   coat's normal the shading normal n; with GLTF_PBR_CLEARCOAT_NORMAL (clearcoatNormalTexture; reads f.t, f.b: the
+//   material then needs 'tangent', and the library chunk normal_map.glsl; glphong/materials/gltf_coat_normal.py)
+//   n_c = surface_normal(n, t, b, texel, scale) = normalize(t (s m.x) + b (s m.y) + n m.z), m = 2 texel - 1 (the
+//   base normal map's rule, normal_map.glsl), and the coat is D_c V_c (n_c.l) on n_c (0 where n_c.l or n_c.v <= 0)
+//   weighted by clearcoat F_c(max(n_c.v, 0)).
 // KHR_materials_sheen (GLTF_PBR_SHEEN; glphong/materials/gltf_sheen.py): alpha_g = sheen_roughness^2,
 //   gltf_sheen_distribution(tan2, alpha_g) -> Charlie D = (2 + 1/alpha_g) sin2h^(1/(2 alpha_g)) / (2 pi), sin2h =
 //   tan2/(1 + tan2) (from the chord: no 1 - (n.h)^2 cancellation); 0 for alpha_g = 0 (a delta at n.h = 0, which no
@@ -34,11 +40,30 @@
 //   sheen_roughness 16 (E integrated in float64 from this lobe: benchmarks/gltf_sheen_albedo.py);
 //   f_r = sheen_color D V + f_r max(min(1 - max3(sheen_color) E(n.v), 1 - max3(sheen_color) E(n.l)), 0) (the
 //   specification's albedo scaling, clamped at 0 where E max3(sheen_color) > 1), then the coat over it.
+// KHR_materials_anisotropy (GLTF_PBR_ANISOTROPY; glphong/materials/gltf_anisotropy.py; reads f.t, f.b: the material
+//   then needs 'tangent'): gltf_anisotropy_frame(n, t, b, texel, rotation, out T, out B): d = rotate(normalize(2
+//   texel.rg - 1), rotation) ((1, 0) where it is 0), T = normalize(d.x t + d.y b), B = normalize(n x T);
+//   gltf_anisotropy_ggx(n.h, T.h, B.h, at, ab) -> D = 1 / (pi at ab s^2), s = (T.h/at)^2 + (B.h/ab)^2 + (n.h)^2 (the
+//   specification's a2 w2^2 / pi divided through by a2^2: positive terms);
+//   gltf_anisotropy_visibility_cos(...) -> clamp(V, 0, 1) (n.l) = min(0.5 n.l / (n.l |(at T.v, ab B.v, n.v)| + n.v
+//   |(at T.l, ab B.l, n.l)|), n.l) (the specification's V_GGX_anisotropic, n.l cancelled);
+//   gltf_anisotropy_specular(T, B, wi, wo, n.l, n.v, n.h, v.h, alpha, strength): at = mix(alpha, 1, strength^2), ab =
+//   alpha, T.h = (T.l + T.v)/(2 v.h), B.h likewise (h = (l + v)/|l + v|, |l + v| = 2 v.h from microfacet_geometry,
+//   as its n.h); D V (n.l) in place of the base's isotropic lobe, 0 where at ab = 0 (a delta).
 // Uniforms (declared by glphong from the model's params): u_gltf_pbr_base_color, u_gltf_pbr_metallic,
 // u_gltf_pbr_roughness, u_gltf_pbr_ior, u_gltf_pbr_specular, u_gltf_pbr_specular_color, u_gltf_pbr_clearcoat,
-// u_gltf_pbr_clearcoat_roughness, u_gltf_pbr_sheen_color, u_gltf_pbr_sheen_roughness (u_gltf_pbr_emissive and
+// u_gltf_pbr_clearcoat_roughness, u_gltf_pbr_sheen_color, u_gltf_pbr_sheen_roughness, u_gltf_pbr_anisotropy_strength,
+// u_gltf_pbr_anisotropy_rotation, u_gltf_pbr_anisotropy_direction, u_gltf_pbr_clearcoat_normal,
+// u_gltf_pbr_clearcoat_normal_strength (u_gltf_pbr_emissive and
 // u_gltf_pbr_occlusion are read by generated code).
-// Key defines read here: GLTF_PBR_SPECULAR, GLTF_PBR_CLEARCOAT, GLTF_PBR_SHEEN (defined where the material uses the
+// KHR_materials_transmission (GLTF_PBR_TRANSMISSION; glphong/materials/gltf_transmission.py): a light on the viewer's
+//   side meets no BTDF, so the diffuse is weighted by 1 - transmission; what lies behind is added after shading
+//   (glsl/transmission_thin.glsl).
+// KHR_materials_iridescence (GLTF_PBR_IRIDESCENCE): gltf_iridescence_parts (materials/gltf_iridescence.glsl, read before
+//   this file) replaces the Fresnel factor, F = mix(F, F_iridescence, iridescence), dielectric and metal, and the
+//   max(F_d) that weights the diffuse; the film's base_f0 = gltf_specular_fresnel(f0, specular, specular_color, 0) =
+//   min(f0 specular_color, 1) specular with KHR_materials_specular, f0 without.
+// Key defines read here: GLTF_PBR_IRIDESCENCE, GLTF_PBR_ANISOTROPY, GLTF_PBR_CLEARCOAT_NORMAL, GLTF_PBR_SPECULAR, GLTF_PBR_CLEARCOAT, GLTF_PBR_SHEEN, GLTF_PBR_TRANSMISSION, GLTF_PBR_VOLUME (defined where the material uses the
 // extension: its code is not in the program otherwise).
 
 const float GLTF_PBR_INV_PI = 0.3183098861837907;
@@ -49,6 +74,61 @@ float gltf_pbr_visibility_cos(float n_dot_l, float n_dot_v, float a2)
     float r_v = sqrt(n_dot_v * n_dot_v + a2 * (1.0 - n_dot_v * n_dot_v));
     return n_dot_l / (2.0 * (n_dot_v * r_l + n_dot_l * r_v));
 }
+
+float gltf_pbr_specular(float a2, float tan2, float n_dot_l, float n_dot_v)
+{
+    return a2 > 0.0 ? min(microfacet_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2), FLT_MAX) : 0.0;
+}
+
+#if defined(GLTF_PBR_ANISOTROPY)
+void gltf_anisotropy_frame(vec3 n, vec3 t, vec3 b, vec3 texel, float rotation, out vec3 aniso_t, out vec3 aniso_b)
+{
+    vec3 d;
+    float len;
+    bool ok = safe_normalize(vec3(texel.rg * 2.0 - 1.0, 0.0), d, len);
+    float dx = ok ? d.x : 1.0;
+    float dy = ok ? d.y : 0.0;
+    float c = cos(rotation);
+    float s = sin(rotation);
+    float rx = c * dx - s * dy;
+    float ry = s * dx + c * dy;
+    ok = safe_normalize(t * rx + b * ry, aniso_t, len);
+    aniso_t = ok ? aniso_t : t;
+    ok = safe_normalize(cross(n, aniso_t), aniso_b, len);
+    aniso_b = ok ? aniso_b : b;
+}
+
+float gltf_anisotropy_ggx(float n_dot_h, float t_dot_h, float b_dot_h, float at, float ab)
+{
+    float x = t_dot_h / at;
+    float y = b_dot_h / ab;
+    float s = x * x + y * y + n_dot_h * n_dot_h;
+    return GLTF_PBR_INV_PI / ((at * ab) * (s * s));
+}
+
+float gltf_anisotropy_visibility_cos(float n_dot_l, float n_dot_v, float t_dot_l, float b_dot_l, float t_dot_v,
+                                     float b_dot_v, float at, float ab)
+{
+    float ggx_v = n_dot_l * sqrt(at * t_dot_v * (at * t_dot_v) + ab * b_dot_v * (ab * b_dot_v) + n_dot_v * n_dot_v);
+    float ggx_l = n_dot_v * sqrt(at * t_dot_l * (at * t_dot_l) + ab * b_dot_l * (ab * b_dot_l) + n_dot_l * n_dot_l);
+    return min(0.5 * n_dot_l / (ggx_v + ggx_l), n_dot_l);
+}
+
+float gltf_anisotropy_specular(vec3 aniso_t, vec3 aniso_b, vec3 wi, vec3 wo, float n_dot_l, float n_dot_v,
+                               float n_dot_h, float v_dot_h, float alpha, float strength)
+{
+    float t_dot_l = dot(aniso_t, wi);
+    float b_dot_l = dot(aniso_b, wi);
+    float t_dot_v = dot(aniso_t, wo);
+    float b_dot_v = dot(aniso_b, wo);
+    float h_len = 2.0 * v_dot_h;  // |l + v| (1 where invalid): microfacet_geometry's n.h = (n.l + n.v)/|l + v|
+    float at = alpha * (1.0 - strength * strength) + strength * strength;  // mix(alpha, 1, strength^2)
+    float ab = alpha;
+    float d = gltf_anisotropy_ggx(n_dot_h, (t_dot_l + t_dot_v) / h_len, (b_dot_l + b_dot_v) / h_len, at, ab);
+    float v_cos = gltf_anisotropy_visibility_cos(n_dot_l, n_dot_v, t_dot_l, b_dot_l, t_dot_v, b_dot_v, at, ab);
+    return at * ab > 0.0 ? min(d * v_cos, FLT_MAX) : 0.0;
+}
+#endif
 
 #if defined(GLTF_PBR_SPECULAR)
 vec3 gltf_specular_fresnel(float f0, float specular, vec3 specular_color, float x)
@@ -265,15 +345,27 @@ float gltf_sheen_albedo(float cos_theta, float sheen_roughness)
 }
 #endif
 
+#if defined(GLTF_PBR_VOLUME)  // KHR_materials_volume, _dispersion: their parameters, read by transmission_thin.glsl
+float gltf_pbr_thickness() { return u_gltf_pbr_thickness; }
+vec4 gltf_pbr_attenuation() { return vec4(u_gltf_pbr_attenuation_color, u_gltf_pbr_attenuation_distance); }
+float gltf_pbr_dispersion() { return u_gltf_pbr_dispersion; }
+#endif
+
 vec3 gltf_pbr_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
 {
     float n_dot_v, n_dot_h, v_dot_h, tan2;
     bool valid = microfacet_geometry(f.n, wi, wo, n_dot_l, n_dot_v, n_dot_h, v_dot_h, tan2);
     float alpha = u_gltf_pbr_roughness * u_gltf_pbr_roughness;
     float a2 = alpha * alpha;
-    // roughness 0: D is a delta (0 for a point light); V's r_x would underflow to 0/0 for grazing l and v
-    float specular = a2 > 0.0 ? min(microfacet_ggx(tan2, a2) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2), FLT_MAX)
-                              : 0.0;
+#if defined(GLTF_PBR_ANISOTROPY)  // KHR_materials_anisotropy: the base's lobe in the rotated frame (reads f.t, f.b)
+    vec3 aniso_t, aniso_b;
+    gltf_anisotropy_frame(f.n, f.t, f.b, u_gltf_pbr_anisotropy_direction, u_gltf_pbr_anisotropy_rotation, aniso_t,
+                          aniso_b);
+    float specular = gltf_anisotropy_specular(aniso_t, aniso_b, wi, wo, n_dot_l, n_dot_v, n_dot_h, v_dot_h, alpha,
+                                              u_gltf_pbr_anisotropy_strength);
+#else
+    float specular = gltf_pbr_specular(a2, tan2, n_dot_l, n_dot_v);  // 0 for roughness 0 (a delta)
+#endif
     float x1 = max(1.0 - v_dot_h, 0.0);                   // v.h = |l + v|/2 may round above 1
     float x = (x1 * x1) * (x1 * x1) * x1;
     vec3 c = u_gltf_pbr_base_color;
@@ -287,9 +379,20 @@ vec3 gltf_pbr_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
     float fd = f0 + (1.0 - f0) * x;
     float fd_max = fd;
 #endif
+    vec3 fresnel = fd * (1.0 - m) + (c + (1.0 - c) * x) * m;
+#if defined(GLTF_PBR_IRIDESCENCE)  // KHR_materials_iridescence: F = mix(F, F_iridescence, iridescence) (gltf_iridescence.glsl)
+#if defined(GLTF_PBR_SPECULAR)
+    vec3 film_f0 = gltf_specular_fresnel(f0, u_gltf_pbr_specular, u_gltf_pbr_specular_color, 0.0);
+#else
+    vec3 film_f0 = vec3(f0);
+#endif
+    gltf_iridescence_parts(c, m, x, film_f0, vec3(fd), v_dot_h, fd_max, fresnel);
+#endif
     // mix(dielectric, metal, m) = (c/pi)(n.l)(1 - fd)(1 - m) + [fd (1 - m) + (c + (1 - c) x) m] V D (n.l)
     vec3 diffuse = (c * (GLTF_PBR_INV_PI * n_dot_l)) * (1.0 - fd_max) * (1.0 - m);
-    vec3 fresnel = fd * (1.0 - m) + (c + (1.0 - c) * x) * m;
+#if defined(GLTF_PBR_TRANSMISSION)  // KHR_materials_transmission: the diffuse weighted by 1 - t (transmission_thin.glsl)
+    diffuse *= 1.0 - u_gltf_pbr_transmission;
+#endif
     vec3 value = diffuse + fresnel * specular;
 #if defined(GLTF_PBR_SHEEN)  // KHR_materials_sheen: sheen_color D V + f_r scaling, times n.l
     float alpha_g = u_gltf_pbr_sheen_roughness * u_gltf_pbr_sheen_roughness;
@@ -305,10 +408,17 @@ vec3 gltf_pbr_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
 #if defined(GLTF_PBR_CLEARCOAT)  // KHR_materials_clearcoat: mix(f_r, V_c D_c, clearcoat F_c(n.v)), times n.l
     float alpha_c = u_gltf_pbr_clearcoat_roughness * u_gltf_pbr_clearcoat_roughness;
     float a2_c = alpha_c * alpha_c;
-    // roughness 0: the coat is a delta (0 for a point light), and V's r_x would underflow to 0/0 at grazing
-    float coat = a2_c > 0.0 ? min(microfacet_ggx(tan2, a2_c) * gltf_pbr_visibility_cos(n_dot_l, n_dot_v, a2_c),
-                                  FLT_MAX) : 0.0;
+#if defined(GLTF_PBR_CLEARCOAT_NORMAL)  // clearcoatNormalTexture: the coat's own normal on the unperturbed frame
+    vec3 n_c = surface_normal(f.n, f.t, f.b, u_gltf_pbr_clearcoat_normal, u_gltf_pbr_clearcoat_normal_strength);
+    float c_n_dot_l = dot(n_c, wi);
+    float c_n_dot_v, c_n_dot_h, c_v_dot_h, c_tan2;
+    bool c_valid = microfacet_geometry(n_c, wi, wo, c_n_dot_l, c_n_dot_v, c_n_dot_h, c_v_dot_h, c_tan2);
+    float coat = c_valid ? gltf_pbr_specular(a2_c, c_tan2, c_n_dot_l, c_n_dot_v) : 0.0;  // times n_c.l
+    float coat_weight = u_gltf_pbr_clearcoat * gltf_clearcoat_fresnel(max(dot(n_c, wo), 0.0));
+#else
+    float coat = gltf_pbr_specular(a2_c, tan2, n_dot_l, n_dot_v);  // the base's lobe; 0 for roughness 0 (a delta)
     float coat_weight = u_gltf_pbr_clearcoat * gltf_clearcoat_fresnel(n_dot_v);
+#endif
     value = value * (1.0 - coat_weight) + coat_weight * coat;
 #endif
     return valid ? value : vec3(0.0);

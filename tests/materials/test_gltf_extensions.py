@@ -7,7 +7,10 @@ an independent float64 transcription of the extensions' own text, written here a
 - KHR_materials_specular's ``fresnel_mix(f0_color, ior, weight, base, layer)``: ``f0 = min(((1 - ior)/(1 + ior))^2
   f0_color, 1)``, ``fr = f0 + (1 - f0)(1 - |v.h|)^5``, ``(1 - weight max_value(fr)) base + weight fr layer``;
 - KHR_materials_clearcoat's ``fresnel_coat(normal, ior = 1.5, weight, base, layer)``: ``fr = f0 + (1 - f0)(1 -
-  |v.normal|)^5``, ``mix(base, layer, weight fr)``, ``layer = specular_brdf(alpha = clearcoatRoughness^2)``.
+  |v.normal|)^5``, ``mix(base, layer, weight fr)``, ``layer = specular_brdf(alpha = clearcoatRoughness^2)``; with
+  ``clearcoatNormalTexture`` the coat's ``normal`` is glTF's normal texture rule on the unperturbed frame, ``normalize(t
+  (s m.x) + b (s m.y) + n m.z)``, ``m = 2 texel - 1``, its Fresnel on ``clampedDot(normal, v)`` and its lobe times
+  ``normal.l`` (0 where ``normal.l`` or ``normal.v <= 0``), the base's times ``n.l``.
 """
 import json
 import warnings
@@ -23,14 +26,15 @@ Z = np.array([0.0, 0.0, 1.0])
 
 
 def specification(n, l, v, base_color, metallic, roughness, specular=1.0, specular_color=(1.0, 1.0, 1.0),
-                  clearcoat=0.0, clearcoat_roughness=0.0, ior=1.5, planted=None):
+                  clearcoat=0.0, clearcoat_roughness=0.0, ior=1.5, planted=None, clearcoat_normal=None,
+                  clearcoat_normal_strength=1.0):
     """``coated_material (n.l)`` by the extensions' formulas, float64, (N, 3); ``planted`` one of three usual mistakes
     (test_the_comparison_catches_the_usual_mistakes)."""
     h = l + v
     h = h / np.linalg.norm(h, axis=-1, keepdims=True)
     nl, nv, nh, vh = (np.sum(a * b, -1) for a, b in ((n, l), (n, v), (n, h), (v, h)))
 
-    def specular_brdf(alpha):
+    def specular_brdf(alpha, nh=nh, nv=nv, nl=nl):
         a2 = alpha ** 2
         with np.errstate(divide="ignore", invalid="ignore"):
             d = a2 / (np.pi * (nh ** 2 * (a2 - 1) + 1) ** 2)
@@ -52,9 +56,18 @@ def specification(n, l, v, base_color, metallic, roughness, specular=1.0, specul
     material = (1 - metallic) * dielectric + metallic * metal
     coat_f0 = ((1 - 1.5) / (1 + 1.5)) ** 2
     coat_cos = np.abs(vh) if planted == "coat Fresnel on v.h" else np.abs(nv)
+    coat_lobe = specular_brdf(clearcoat_roughness ** 2) * nl[:, None]
+    if clearcoat_normal is not None:  # the coat's own normal on the frame (x, y, n)
+        m = 2.0 * np.asarray(clearcoat_normal, np.float64) - 1.0
+        s = clearcoat_normal_strength
+        nc = np.array([1.0, 0.0, 0.0]) * s * m[0] + np.array([0.0, 1.0, 0.0]) * s * m[1] + n * m[2]
+        nc = nc / np.linalg.norm(nc, axis=-1, keepdims=True)
+        lc, vc, hc = (np.sum(nc * a, -1) for a in (l, v, h))
+        coat_cos = np.maximum(vc, 0.0)
+        coat_lobe = np.where(((lc > 0) & (vc > 0))[:, None],
+                             specular_brdf(clearcoat_roughness ** 2, hc, vc, lc) * lc[:, None], 0.0)
     coat_fr = (coat_f0 + (1 - coat_f0) * (1 - coat_cos) ** 5)[:, None]
-    coated = (1 - clearcoat * coat_fr) * material + clearcoat * coat_fr * specular_brdf(clearcoat_roughness ** 2)
-    return coated * nl[:, None]
+    return (1 - clearcoat * coat_fr) * material * nl[:, None] + clearcoat * coat_fr * coat_lobe
 
 
 def _pairs(count, seed, max_angle=1.45):
@@ -68,9 +81,10 @@ def _pairs(count, seed, max_angle=1.45):
 
 
 def _twin(material, l, v):
-    """The float64 twin's response at the float64 directions (no float32 rounding: the transcription's inputs)."""
+    """The float64 twin's response at the float64 directions (no float32 rounding: the transcription's inputs), in the
+    frame (x, y, z)."""
     (term,) = material.components
-    frame = ShadingFrame(np.tile(Z, (len(l), 1)))
+    frame = ShadingFrame(np.tile(Z, (len(l), 1)), np.tile([1.0, 0.0, 0.0], (len(l), 1)), np.tile([0.0, 1.0, 0.0], (len(l), 1)))
     return term.response(frame, l, v, l[:, 2].copy(), term.values())
 
 
@@ -93,11 +107,17 @@ MATERIALS = {  # name: GltfPBR arguments
     "clearcoat 1 rough 0": dict(base_color=(0.8, 0.1, 0.1), metallic=0.0, roughness=0.4, clearcoat=1.0),
     "both": dict(base_color=(0.3, 0.6, 0.2), metallic=0.3, roughness=0.4, specular=0.7, specular_color=(1.5, 1.0, 0.5),
                  clearcoat=0.8, clearcoat_roughness=0.2),
+    "coat normal tilted": dict(base_color=(0.8, 0.1, 0.1), metallic=0.0, roughness=0.5, clearcoat=1.0,
+                               clearcoat_roughness=0.1, clearcoat_normal=(0.8, 0.35, 0.8)),
+    "coat normal scaled 2.5": dict(base_color=(0.3, 0.6, 0.2), metallic=0.7, roughness=0.3, specular=0.6, clearcoat=0.7,
+                                   clearcoat_roughness=0.3, clearcoat_normal=(0.3, 0.6, 0.9),
+                                   clearcoat_normal_strength=2.5),
 }
 
 
 def _expected(arguments, l, v, planted=None):
-    values = {k: (_f32(x) if k not in ("specular_color", "base_color") else np.float32(x).astype(np.float64))
+    values = {k: (_f32(x) if k not in ("specular_color", "base_color", "clearcoat_normal")
+                  else np.float32(x).astype(np.float64))
               for k, x in arguments.items()}
     return specification(np.broadcast_to(Z, l.shape), l, v, **values, planted=planted)
 
@@ -106,7 +126,8 @@ def _expected(arguments, l, v, planted=None):
 def test_twin_equals_the_extensions_in_float64(name):
     arguments = MATERIALS[name]
     material = glphong.GltfPBR(**arguments)
-    assert material.extensions() == tuple(e for e in ("specular", "clearcoat") if any(k.startswith(e) for k in arguments))
+    assert material.extensions() == tuple(e for e in ("specular", "clearcoat", "clearcoat_normal")
+                                          if any(k.startswith(e) for k in arguments))
     l, v = _pairs(600, seed=len(name))
     np.testing.assert_allclose(_twin(material, l, v), _expected(arguments, l, v), rtol=1e-11, atol=1e-300)
 
@@ -146,14 +167,21 @@ def test_neutral_values_are_the_core_material_and_its_program():
 def test_gpu_within_the_twins_band(name, glphong_backend):
     material = glphong.GltfPBR(**MATERIALS[name])
     assert_twin_matches(material, n=400, backend=glphong_backend)
+    assert_gpu_near_transcription(material, lambda l, v: _expected(MATERIALS[name], l, v), glphong_backend)
+
+
+def assert_gpu_near_transcription(material, expected, backend, tolerance=3e-3):
+    """The GPU within ``tolerance`` of the largest channel of ``expected(l, v)`` (the transcription at the float32
+    directions the GPU is given) for 300 pairs within 1.3 rad of the normal (also used by test_gltf_anisotropy.py)."""
     l, v = _pairs(300, seed=11, max_angle=1.3)
     l32, v32 = l.astype(np.float32).astype(float), v.astype(np.float32).astype(float)
     l32 /= np.linalg.norm(l32, axis=1, keepdims=True)
     v32 /= np.linalg.norm(v32, axis=1, keepdims=True)
-    gpu = evaluate(material, l, v, backend=glphong_backend).astype(np.float64)
-    expected = _expected(MATERIALS[name], l32, v32)
-    rel = np.abs(gpu - expected) / np.max(expected, axis=1, keepdims=True)
-    assert np.all(np.isfinite(gpu)) and rel.max() < 3e-3, rel.max()
+    gpu = evaluate(material, l, v, backend=backend).astype(np.float64)
+    want = expected(l32, v32)
+    scale = np.maximum(np.max(want, axis=1, keepdims=True), 1e-6 * want.max())  # a coat normal may black out a row
+    rel = np.abs(gpu - want) / scale
+    assert np.all(np.isfinite(gpu)) and rel.max() < tolerance, rel.max()
 
 
 def _sphere_scene(material, lights, ambient=None):
@@ -227,6 +255,42 @@ def assert_planted_error_fails(old, new, material, monkeypatch, make_renderer):
 def test_planted_errors_fail(planted, monkeypatch, glphong_make_renderer):
     material = glphong.GltfPBR(**{**MATERIALS["both"], "specular_color": (3.0, 1.0, 0.5), "clearcoat": 1.0})
     assert_planted_error_fails(*PLANTED[planted], material, monkeypatch, glphong_make_renderer)
+
+
+def _coat_normal_material():
+    """A coat with a textured normal (random tilts up to about 50 degrees, scale 0.8) over a dielectric."""
+    rng = np.random.default_rng(21)
+    texel = np.concatenate([rng.integers(40, 216, (16, 16, 2)), np.full((16, 16, 1), 230)], axis=2).astype(np.uint8)
+    return glphong.GltfPBR((0.7, 0.2, 0.1), 0.0, 0.6, clearcoat=1.0, clearcoat_roughness=0.15,
+                           clearcoat_normal=glphong.Texture(texel, 1.0, srgb=False), clearcoat_normal_strength=0.8)
+
+
+def test_coat_normal_texture_verifies(glphong_backend, glphong_make_renderer):
+    material = _coat_normal_material()
+    assert material.extensions() == ("clearcoat", "clearcoat_normal") and "tangent" in material.needs
+    report = glphong.verify(_sphere_scene(material, LIGHTS["point"]()), glphong_make_renderer(64, 64, glphong_backend))
+    assert report.covered_pixels > 900 and report.passed, report.summary()
+
+
+COAT_NORMAL_PLANTED = {  # the coat's own normal ignored; its Fresnel on the shading normal
+    "coat on the shading normal": ("bool c_valid = microfacet_geometry(n_c, wi, wo,",
+                                   "bool c_valid = microfacet_geometry(f.n, wi, wo,"),
+    "coat Fresnel on n.v": ("gltf_clearcoat_fresnel(max(dot(n_c, wo), 0.0))", "gltf_clearcoat_fresnel(n_dot_v)"),
+}
+
+
+@pytest.mark.parametrize("planted", sorted(COAT_NORMAL_PLANTED))
+def test_coat_normal_planted_errors_fail(planted, monkeypatch, glphong_make_renderer):
+    assert_planted_error_fails(*COAT_NORMAL_PLANTED[planted], _coat_normal_material(), monkeypatch,
+                               glphong_make_renderer)
+
+
+def test_coat_normal_with_a_normal_map_is_refused():
+    """The coat's normal is taken on the unperturbed frame, which a material-level normal map replaces."""
+    normal_map = glphong.NormalMap(np.full((4, 4, 3), 128, np.uint8))
+    with pytest.raises(ValueError, match="clearcoat_normal with a normal_map"):
+        glphong.GltfPBR(0.5, 0.0, 0.5, clearcoat=1.0, clearcoat_normal=(0.6, 0.5, 1.0), normal_map=normal_map)
+    glphong.GltfPBR(0.5, 0.0, 0.5, clearcoat=1.0, normal_map=normal_map)  # the coat on the mapped normal: allowed
 
 
 def test_stability_cases_pass(session_gl):
@@ -324,19 +388,78 @@ def test_files_load_with_their_textures_and_save_back(tmp_path):
 
 
 def test_files_disabled_coat_and_coat_normals(tmp_path):
-    """clearcoatFactor 0 disables the layer; a coat normal other than the base's is named in a warning; out-of-range
-    factors are refused with their JSON path."""
+    """clearcoatFactor 0 disables the layer; clearcoatNormalTexture without a base normalTexture is the coat's own
+    normal (with its scale; written back); a coat normal other than a normal-mapped base's is named in a warning;
+    out-of-range factors are refused with their JSON path."""
     path = _gltf(tmp_path, {"KHR_materials_clearcoat": {"clearcoatFactor": 0.0, "clearcoatRoughnessFactor": 0.5}})
     assert glphong.load_scene(path, light_units="radiometric", lights=[]).objects[0].material.extensions() == ()
     rgb = np.full((4, 4, 3), 128, np.uint8)
-    path = _gltf(tmp_path, {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatNormalTexture": {"index": 0}}},
-                 images=[rgb])
-    with pytest.warns(UserWarning, match="coat takes the material's shading normal"):
-        glphong.load_scene(path, light_units="radiometric", lights=[])
+    rgb[..., 0] = 200
+    path = _gltf(tmp_path, {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatNormalTexture":
+                                                        {"index": 0, "scale": 0.5}}}, images=[rgb])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        scene = glphong.load_scene(path, light_units="radiometric", lights=[])
+    material = scene.objects[0].material
+    assert material.extensions() == ("clearcoat", "clearcoat_normal") and "tangent" in material.needs
+    assert material.clearcoat_normal_strength == 0.5 and material.normal_map is None
+    np.testing.assert_allclose(material.clearcoat_normal.texture.levels[0][0, 0], rgb[0, 0] / 255.0, atol=1e-3)  # linear
+    out = tmp_path / "saved.gltf"
+    glphong.save_gltf(scene, out)
+    document = json.loads(out.read_text())
+    assert document["materials"][0]["extensions"]["KHR_materials_clearcoat"]["clearcoatNormalTexture"]["scale"] == 0.5
+    del document["materials"][0]["extras"]
+    out.write_text(json.dumps(document))
+    again = glphong.load_scene(out, light_units="radiometric", lights=[]).objects[0].material
+    assert again.extensions() == ("clearcoat", "clearcoat_normal") and again.clearcoat_normal_strength == 0.5
+    for coat_normal in (None, 1):  # over a normal-mapped base: the base's normal, named
+        coat = {"clearcoatFactor": 1.0} | ({} if coat_normal is None else {"clearcoatNormalTexture": {"index": 1}})
+        path = _gltf(tmp_path, {"KHR_materials_clearcoat": coat}, normal=0, images=[rgb, rgb[::-1]])
+        with pytest.warns(UserWarning, match="coat takes the material's shading normal.*not drawn exactly"):
+            material = glphong.load_scene(path, light_units="radiometric", lights=[]).objects[0].material
+        assert material.extensions() == ("clearcoat",) and material.normal_map is not None
     path = _gltf(tmp_path, {"KHR_materials_specular": {"specularFactor": 1.5}})
     with pytest.raises(glphong.filesafety.SceneFileError,
                        match=r"materials\[0\]\.extensions\.KHR_materials_specular\.specularFactor"):
         glphong.load_scene(path, light_units="radiometric", lights=[])
+
+
+def test_files_coat_normal_scale_and_tangent_frame_refused_by_json_path(tmp_path):
+    """clearcoatNormalTexture.scale beyond glphong's bounds of clearcoat_normal_strength (|scale| <= 1e4, the
+    parameter's definition) or not a number is refused with its JSON path; a coat normal on a mesh with neither TANGENT
+    nor TEXCOORD (no tangent frame) is refused naming KHR_materials_clearcoat's clearcoatNormalTexture."""
+    rgb = np.full((4, 4, 3), 128, np.uint8)
+    for scale in (1e6, -2e4, "1"):
+        path = _gltf(tmp_path, {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatNormalTexture":
+                                                            {"index": 0, "scale": scale}}}, images=[rgb])
+        with pytest.raises(glphong.filesafety.SceneFileError, match=r"coated\.gltf: materials\[0\]\.extensions\."
+                           r"KHR_materials_clearcoat\.clearcoatNormalTexture\.scale: expected a .*number"):
+            glphong.load_scene(path, light_units="radiometric", lights=[])
+    path = _gltf(tmp_path, {"KHR_materials_clearcoat": {"clearcoatFactor": 1.0, "clearcoatNormalTexture":
+                                                        {"index": 0, "scale": 1e4}}}, images=[rgb])
+    assert glphong.load_scene(path, light_units="radiometric",
+                              lights=[]).objects[0].material.clearcoat_normal_strength == 1e4  # the bound itself
+    # a file's coat normal is a texture, which gives its mesh uvs and so a tangent frame; a file's material on a mesh
+    # without one (the loader's error for what the scene refuses) names the extensions needing it: both here
+    from glphong import primitives
+    from glphong.formats.gltf_material_extensions import tangent_frame_error
+    from glphong.scene.geometry import MeshData
+
+    sphere = primitives.sphere(2)
+    bare = MeshData(sphere.positions, sphere.normals, sphere.indices)  # no uvs, no tangents
+    material = glphong.GltfPBR(0.5, 0.0, 0.5, clearcoat=1.0, clearcoat_normal=(0.7, 0.4, 0.9),
+                               anisotropy_strength=0.5)
+    scene = glphong.Scene(glphong.PerspectiveCamera.look_at((0, -3, 0), (0, 0, 0), up=(0, 0, 1)), [])
+    with pytest.raises(ValueError) as refused:
+        scene.add(bare, material, name="quad")
+    error = tangent_frame_error(path, refused.value, material, bare, "quad", 3)
+    assert isinstance(error, glphong.filesafety.SceneFileError)
+    assert error.where == ("materials[3].extensions.KHR_materials_clearcoat.clearcoatNormalTexture, "
+                           "materials[3].extensions.KHR_materials_anisotropy")
+    assert "uses KHR_materials_clearcoat.clearcoatNormalTexture, KHR_materials_anisotropy (materials[3]), which " \
+           "needs the mesh's tangent frame" in error.message
+    other = ValueError("not an extension's")  # a material needing no tangent: the scene's error as it is
+    assert tangent_frame_error(path, other, glphong.GltfPBR(0.5, 0.0, 0.5, clearcoat=1.0), bare, "quad", 3) is other
 
 
 def test_a_coat_is_declared_and_measured_not_reciprocal():

@@ -8,6 +8,7 @@ import pyrender
 from glphong.core.validate import scalar
 from glphong.formats.gltf_data import gl_sampling
 from glphong.materials import GltfPBR, Material, NormalMap, Texture, TextureImage, VertexColors
+from glphong.materials.gltf_transmission import transmissive
 
 __all__ = ["GlphongMaterial", "gltf_pbr_of", "DRAWING"]
 
@@ -32,6 +33,10 @@ class GlphongMaterial(pyrender.Material):
             raise ValueError(f"{material!r} blends (alpha_blend): pyrender's passes draw glphong's materials opaque, so "
                              "the embedding refuses it rather than draw it wrong; composite it with glphong.Renderer "
                              "(depth peeling, docs/design.md section 16), or give the material alpha_mask= instead")
+        if transmissive(material):
+            raise ValueError(f"{material!r} transmits (KHR_materials_transmission): pyrender's passes have no image of "
+                             "the opaque scene to see through it, so the embedding refuses it rather than draw it wrong; "
+                             "draw it with glphong.Renderer (docs/transmission.md)")
         super().__init__(name=name, doubleSided=material.two_sided)
         self.glphong = material
         self.exposure = scalar("exposure", exposure, low=0.0, low_inclusive=False)
