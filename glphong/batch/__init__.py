@@ -60,6 +60,16 @@ local Dask cluster; the lock, the manifest and the journal are kept by the calli
 executor.  A worker that dies mid-batch costs no frame: the pool is made again and the frames not yet
 reported are rendered again (Dask reschedules the task itself).
 
+Faults
+------
+A frame whose ``scene_fn``, render or driver raises fails alone (the worker's renderer is made again after a
+driver's error) and the others are rendered; a write that fails (a full disk: the error names the file, the free
+space and the bytes needed) stops the batch; either way `FramesFailedError` at the end names the frames and keeps
+every frame done in the journal, so a rerun renders only the rest.  Ctrl-C journals what came back and terminates
+the pool's workers (which ignore SIGINT) at once.  A worker that dies (SIGKILL: the kernel's OOM killer) is warned
+about, and the first frame it had in flight is rendered alone on a new pool: if that dies too, the frame fails by
+name.  docs/batches.md has the table.
+
 Modules
 -------
 `glphong.batch.run` (`render_many`), `glphong.batch.folder` (the lock, the manifest, the journal, the
@@ -67,9 +77,9 @@ frames on disk, `BatchError`), `glphong.batch.workers` (the pool's initializer, 
 renderer, the local Dask cluster), `glphong.batch.bop_images` (``fmt='bop'``) and `glphong.batch.scenes`
 (`turntable_scene`, `orbit_scene`, `tabletop_scene`).
 """
-from glphong.batch.folder import BatchError
+from glphong.batch.folder import BatchError, FramesFailedError
 from glphong.batch.run import _spec_hash, render_many  # noqa: F401 - _spec_hash: glphong.batch._spec_hash
 from glphong.batch.scenes import orbit_scene, tabletop_scene, turntable_scene
 from glphong.batch.workers import _WORKER  # noqa: F401 - the worker's renderers, as glphong.batch._WORKER
 
-__all__ = ["render_many", "turntable_scene", "orbit_scene", "tabletop_scene", "BatchError"]
+__all__ = ["render_many", "turntable_scene", "orbit_scene", "tabletop_scene", "BatchError", "FramesFailedError"]

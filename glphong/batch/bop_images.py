@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from glphong.batch.folder import BatchError, _file_matches, _file_record, _regular_or_missing
+from glphong.batch.folder import BatchError, _file_matches, _file_record, _regular_or_missing, _write_error
 from glphong.core import validate as _validate
 from glphong.datasets.bop import (DEFAULT_DEPTH_SCALE, MAX_BOP_ID, image_entries, image_files, obj_id_table,
                                   render_image)
@@ -177,7 +177,11 @@ def _write_image(index, scene_id, im_id, out_dir, scene, frame, shapes, camera, 
     dirs = image_folders(root)
     for path in dirs.values():
         os.makedirs(path, exist_ok=True)
-    write_files([(os.path.join(dirs[kind], name), data) for (kind, name), data in files.items()])
+    try:
+        write_files([(os.path.join(dirs[kind], name), data) for (kind, name), data in files.items()])
+    except OSError as exc:
+        raise _write_error(exc, os.path.join(dirs["rgb"], f"{im_id:06d}.png"), f"{sum(map(len, files.values()))} bytes",
+                           f"image {im_id}'s {len(files)} files in {root}") from exc
     remove_masks_beyond(dirs, im_id, len(scene.objects))
     listed = [[f"{scene_id:06d}/{kind}/{name}", len(data), hashlib.sha256(data).hexdigest()]
               for (kind, name), data in files.items()]

@@ -17,7 +17,7 @@ try:
 except ImportError:  # Windows: no advisory locks, see _lock_folder
     fcntl = None
 
-__all__ = ["BatchError"]
+__all__ = ["BatchError", "FramesFailedError"]
 
 MANIFEST = "manifest.json"
 JOURNAL = "frames.jsonl"
@@ -31,6 +31,64 @@ _NONBLOCK = getattr(os, "O_NONBLOCK", 0)  # a FIFO put in a file's place does no
 class BatchError(RuntimeError):
     """A batch cannot run as asked: another batch's frames or a running batch in the folder, files the batch
     cannot trust (a symbolic link, frames without a manifest), a spec that cannot be pickled."""
+
+
+class FramesFailedError(BatchError):
+    """Frames of a batch failed (their scene function raised, the renderer or the driver raised, or writing failed);
+    every other frame was rendered (but after a failed write, which stops the batch), and the frames done are in
+    the folder and its journal: running the same batch again renders only the frames missing.
+
+    Attributes
+    ----------
+    failures : list of dict
+        One per failed frame, in frame order: ``{"index", "spec", "stage", "error", "traceback"}``; ``stage`` is
+        'scene_fn', 'render' or 'write'; ``error`` the exception's type and message; ``traceback`` the worker's.
+    done : int
+        Frames done in the folder (journalled), of ``total``.
+    total : int
+    """
+
+    def __init__(self, out, failures, done, total):
+        self.failures, self.done, self.total = failures, done, total
+        first = failures[0]
+        stage = {"scene_fn": "in scene_fn", "render": "rendering it", "write": "writing it"}[first["stage"]]
+        stopped = "; the batch stopped (a failed write fails the frames after it too)" \
+            if any(f["stage"] == "write" for f in failures) else ""
+        spec = repr(first["spec"])
+        spec = spec if len(spec) <= 160 else f"{spec[:60]}...{spec[-97:]}"  # a path's end names the file
+        super().__init__(f"{len(failures)} of {total} frame(s) failed; the first, frame {first['index']} (spec "
+                         f"{spec}), {stage}: {first['error']}{stopped}.  The {done} frame(s) done are "
+                         f"kept and journalled in {out}: run the same batch again to render only the "
+                         f"{total - done} missing (the worker's traceback: .failures[0]['traceback'])")
+
+
+def _write_error(exc, path, needed, what=None):
+    """An `OSError` of the same kind as ``exc``, raised while writing ``path`` (the temporary file is gone), naming the
+    file (or ``what``), and for a full disk or quota the free space there and the ``needed`` bytes (a str)."""
+    message = f"writing {what or path} failed: {exc.strerror or exc}"
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        try:
+            info = os.statvfs(os.path.dirname(path))
+            free = f"{info.f_bavail * info.f_frsize / 2**20:.1f} MiB free"
+        except (OSError, AttributeError):
+            free = "free space unknown"
+        message += f" ({free} on its file system; the file needs {needed}): free space and run the batch again"
+    return OSError(exc.errno, message)
+
+
+def _make_folder(out):
+    """Make the folder ``out`` (a `pathlib.Path`) where missing; `BatchError` naming it where it is a file, cannot be
+    made, or cannot be written (the user's rights, a read-only file system)."""
+    if out.exists() and not out.is_dir():
+        raise BatchError(f"out_dir {out} is a file, not a folder: a batch writes its frames into a folder; give another "
+                         "out_dir (or remove the file)")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise BatchError(f"out_dir {out} cannot be made: {exc.strerror or exc} ({exc.filename or out})") from exc
+    if not os.access(out, os.W_OK | os.X_OK):
+        raise BatchError(f"out_dir {out} cannot be written by this user (its mode is "
+                         f"{stat.filemode(os.stat(out).st_mode)}): give a folder this process may write")
 
 
 def _frame_name(index, fmt):
@@ -349,8 +407,10 @@ class _BatchFolder:
 
 
 def _remove_partials(out):
-    """Remove the temporary files of writers that died (``.partial-*``; a frame is renamed when whole)."""
-    for leftover in Path(out).glob(".partial-*"):
+    """Remove the temporary files of writers that died (``.partial-*``, and ``.NAME.partial-*`` of
+    `glphong.core.atomic_files.write_atomically`, which ``fmt`` 'npz' and 'exr' write through; a frame is renamed
+    when whole)."""
+    for leftover in [*Path(out).glob(".partial-*"), *Path(out).glob(".*.partial-*")]:
         try:
             leftover.unlink()
         except OSError:

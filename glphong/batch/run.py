@@ -8,11 +8,14 @@ import contextlib
 import hashlib
 import os
 import pickle
+import signal
+import warnings
+from concurrent.futures import CancelledError
 from concurrent.futures.process import BrokenProcessPool
 from pathlib import Path
 
 from glphong.batch.bop_images import BopImages, bop_settings, manifest_entry
-from glphong.batch.folder import BatchError, _BatchFolder, _FileFrames, _frame_name
+from glphong.batch.folder import BatchError, FramesFailedError, _BatchFolder, _FileFrames, _frame_name, _make_folder
 from glphong.batch.workers import _local_dask, _render_chunk, _spawn_pool
 from glphong.core import validate as _validate
 from glphong.core.timing import progress_bar
@@ -30,24 +33,68 @@ def _spec_hash(spec):
     return hashlib.sha256(data).hexdigest()[:16]
 
 
-def _render_round(folder, executor, submit, frames_per_task, bar):
-    """Submit the missing frames in chunks of ``frames_per_task`` and journal each result as it comes back;
-    True where the pool broke (a worker died) before every chunk came back."""
-    missing = folder.missing
+def _render_round(folder, executor, submit, frames_per_task, bar, failed, only=None):
+    """Submit the missing frames (but those in ``failed``; ``only`` these, where given) in chunks of
+    ``frames_per_task`` and journal each result as it comes back, adding the frames that failed to ``failed``
+    (``{index: failure}``); after a failed write the chunks not started are cancelled.  Returns the frames whose chunk
+    the pool broke on (a worker died), [] where none.  Interrupted (Ctrl-C), the chunks not started are cancelled
+    and those already back journalled first."""
+    missing = [i for i in folder.missing if i not in failed] if only is None else only
     chunks = [missing[k:k + frames_per_task] for k in range(0, len(missing), frames_per_task)]
     futures = [executor.submit(_render_chunk, *submit(chunk)) for chunk in chunks]
-    broken = False
-    for future in futures:
-        try:
-            records, renderer_name = future.result()
-        except BrokenProcessPool:
-            broken = True  # a worker died: its frames were not reported, and are rendered again
-            continue
-        folder.record(records)
-        folder.name_renderer(renderer_name)
-        if bar:
-            bar.update(len(records))
-    return broken
+    lost, journalled = [], set()
+    try:
+        for k, future in enumerate(futures):
+            try:
+                records, renderer_name, failures = future.result()
+            except BrokenProcessPool:
+                lost.extend(chunks[k])  # a worker died: its frames were not reported, and are rendered again
+                continue
+            except CancelledError:
+                continue
+            journalled.add(k)
+            _journal(folder, records, renderer_name, bar)
+            failed.update((f["index"], f) for f in failures)
+            if any(f["stage"] == "write" for f in failures):
+                for other in futures:
+                    other.cancel()
+    except BaseException:
+        for other in futures:
+            other.cancel()
+        with contextlib.suppress(Exception):  # what came back before the interruption is kept
+            for k, future in enumerate(futures):
+                if k not in journalled and future.done() and not future.cancelled() and future.exception() is None:
+                    _journal(folder, *future.result()[:2], bar)
+        raise
+    return lost
+
+
+def _journal(folder, records, renderer_name, bar):
+    folder.record(records)
+    folder.name_renderer(renderer_name)
+    if bar:
+        bar.update(len(records))
+
+
+def _deaths(processes):
+    """What ended the pool's worker ``processes`` that died by a signal (ended, after the pool's shutdown), or ''."""
+    signals = {-p.exitcode for p in processes if p.exitcode is not None and p.exitcode < 0}
+    signals = sorted(signals - {signal.SIGTERM} or signals)  # SIGTERM: the pool ends the others when one dies
+    if not signals:
+        return ""
+    names = ", ".join(signal.Signals(n).name if n in signal.Signals._value2member_map_ else str(n) for n in signals)
+    oom = " (the kernel's OOM killer sends SIGKILL to a process using too much memory: see `dmesg`)" \
+        if signal.SIGKILL in signals else ""
+    return f"; a worker was ended by {names}{oom}"
+
+
+def _stop_pool(executor):
+    """Interrupted: end the pool's workers now (a frame half-written is a temporary file, removed after), without
+    waiting for the frames they render."""
+    for process in list((getattr(executor, "_processes", None) or {}).values()):
+        with contextlib.suppress(Exception):
+            process.terminate()
+    executor.shutdown(wait=True, cancel_futures=True)
 
 
 def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy", frames_per_task=1,
@@ -113,11 +160,26 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
         A spec cannot be pickled; another batch is running in ``out_dir``; ``out_dir`` holds another
         batch's manifest, or frame files without a manifest; a frame, the manifest, the journal or the lock
         is a symbolic link or not a regular file; with ``fmt='bop'``, a scene folder (six digits) without a
-        manifest, or a file in the place of a scene's folder.
+        manifest, or a file in the place of a scene's folder; ``out_dir`` is a file, cannot be made or written;
+        the workers died three times in a row without writing a frame (the frames and the signal that ended them
+        named: SIGKILL is the kernel's OOM killer's).
+    FramesFailedError
+        A `BatchError`, at the end: frames whose ``scene_fn`` or render raised (a scene that cannot be written as
+        BOP, `glphong.datasets.write_bop` says which; a driver's error, after which the worker's renderer is made
+        again) or whose write failed (a full disk: the free space and the bytes needed; the batch stops there).
+        It names the first frame, its spec and the error, and holds every failure (``.failures``, with the
+        worker's traceback); every other frame was rendered and journalled, and a rerun renders the rest.
     TypeError, ValueError
         A bad argument (which one named): BOP arguments with another ``fmt``, ``bop_ids`` not one pair per spec
-        or a pair twice; and from the workers, a scene that cannot be written as BOP (`glphong.datasets.write_bop`
-        says which).
+        or a pair twice.
+    KeyboardInterrupt
+        Ctrl-C (SIGINT): the frames back are journalled, the pool's workers (which ignore SIGINT) are ended at once,
+        the temporary files of frames half-written removed; a rerun resumes.
+
+    Warns
+    -----
+    RuntimeWarning
+        A worker died (the frames in flight and the signal named); its frames are rendered again.
     """
 
     specs = list(specs)
@@ -136,7 +198,7 @@ def render_many(scene_fn, specs, width, height, out_dir, executor=None, fmt="npy
              **({"passes": list(passes)} if passes else {}), **({"bop": manifest_entry(bop)} if bop else {}),
              "options": {k: repr(v) for k, v in sorted(options.items())}, "specs": [_spec_hash(s) for s in specs]}
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
+    _make_folder(out)
     frames = BopImages(out, bop["ids"]) if bop else _FileFrames([str(out / _frame_name(i, fmt))
                                                                  for i in range(len(specs))])
     workers = workers or os.cpu_count() or 1
@@ -185,29 +247,53 @@ MAX_STALLED_POOLS = 3
 
 def _render_missing(folder, submit, executor, workers, frames_per_task, bar):
     """Render ``folder``'s missing frames on ``executor`` (None: a pool of ``workers`` made here and made
-    again where a worker dies; 'dask': a local Dask cluster), journalling each as it comes back."""
+    again where a worker dies; 'dask': a local Dask cluster), journalling each as it comes back;
+    `FramesFailedError` at the end where frames failed.
+
+    Where a worker of the pool made here dies, the first frame it had in flight is rendered alone on a new pool (a
+    probe): if that kills its worker too, the frame fails (its worker died rendering it: SIGKILL is what the kernel's
+    OOM killer sends) and the batch goes on without it."""
     cluster = None
     if isinstance(executor, str):
         cluster, executor = _local_dask(workers)
     own = executor is None
     stalled = 0  # pools broken in a row without a frame written
+    failed = {}  # index -> failure (glphong.batch.workers._failure)
+    suspect = None  # the first frame in flight when a worker of our pool died: rendered alone next
     try:
-        while folder.missing:
+        while [i for i in folder.missing if i not in failed] and not any(f["stage"] == "write" for f in failed.values()):
             if executor is None:
                 executor = _spawn_pool(workers)
             before = len(folder.missing)
-            broken = _render_round(folder, executor, submit, frames_per_task, bar)
-            stalled = stalled + 1 if broken and len(folder.missing) == before else 0
-            if stalled >= MAX_STALLED_POOLS:
-                raise BatchError(f"the worker processes died {stalled} times in a row without writing a frame (a "
-                                 "scene function that kills its process, or workers that cannot start): stopped")
-            if broken and own:
+            lost = _render_round(folder, executor, submit, frames_per_task, bar, failed,
+                                 None if suspect is None else [suspect])
+            processes = list((getattr(executor, "_processes", None) or {}).values())
+            stalled = stalled + 1 if lost and len(folder.missing) == before else 0
+            if lost and own:
                 executor.shutdown(wait=True, cancel_futures=True)  # every worker gone: none is writing now
                 executor = None
                 folder.remove_partials()  # a worker killed with its pool may have left a half-written file
-            elif folder.missing and not broken:
+            if stalled >= MAX_STALLED_POOLS:
+                raise BatchError(f"the worker processes died {stalled} times in a row without writing a frame (a "
+                                 "scene function that kills its process, a worker out of memory, or workers that "
+                                 f"cannot start){_deaths(processes)}: stopped with frame(s) {_listed(lost)} not "
+                                 f"written; the {len(folder.done)} frame(s) done are kept and journalled")
+            if lost and suspect is not None:  # the probe died: that frame kills its worker
+                failed[suspect] = {"index": suspect, "spec": submit([suspect])[1][0][1], "stage": "render",
+                                   "error": f"its worker process died rendering it, alone{_deaths(processes)}",
+                                   "traceback": ""}
+            elif lost:
+                warnings.warn(f"a worker died with frame(s) {_listed(lost)} in flight{_deaths(processes)}: they are "
+                              "rendered again", RuntimeWarning, stacklevel=3)
+            elif [i for i in folder.missing if i not in failed] and not failed and suspect is None:
                 missing = folder.missing
                 raise BatchError(f"{len(missing)} frame(s) were not written, e.g. {folder.paths[missing[0]]}")
+            suspect = lost[0] if lost and own and suspect is None else None
+    except BaseException:
+        if own and executor is not None:
+            _stop_pool(executor)
+            executor = None
+        raise
     finally:
         if bar:
             bar.close()
@@ -216,5 +302,13 @@ def _render_missing(folder, submit, executor, workers, frames_per_task, bar):
         if cluster is not None:
             for closing in cluster:
                 closing.close()
-    if own or cluster is not None:
-        folder.remove_partials()  # the workers are gone: no writer is left
+        if own or cluster is not None:
+            folder.remove_partials()  # the workers are gone: no writer is left
+    if failed:
+        raise FramesFailedError(folder.out, [failed[i] for i in sorted(failed)], len(folder.done), len(folder.paths))
+
+
+def _listed(indices, most=8):
+    """``indices`` as a short list: '3, 4, 9' or '3, 4, ... (12 in all)'."""
+    shown = ", ".join(map(str, indices[:most]))
+    return shown if len(indices) <= most else f"{shown}, ... ({len(indices)} in all)"

@@ -15,13 +15,14 @@ import sys
 import tempfile
 import threading
 import time
+import traceback
 from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor
 from functools import partial
 from pathlib import Path
 
 import numpy as np
 from glphong.batch.bop_images import bop_job
-from glphong.batch.folder import _CLOEXEC, _NOFOLLOW, _file_digest, _frame_name
+from glphong.batch.folder import _CLOEXEC, _NOFOLLOW, _file_digest, _frame_name, _write_error
 from glphong.datasets import save_exr, save_npz
 from glphong.gpu.renderer import Renderer
 
@@ -40,7 +41,8 @@ def _set_threads(threads):
 
 
 def _init_worker(threads, parent_pid):
-    """Pool worker initialiser: `_set_threads`, then `_die_with_parent`.
+    """Pool worker initialiser: `_set_threads`, SIGINT ignored (Ctrl-C reaches the terminal's whole process group:
+    the parent ends its workers itself, `glphong.batch.run._stop_pool`), then `_die_with_parent`.
 
     Parameters
     ----------
@@ -50,6 +52,7 @@ def _init_worker(threads, parent_pid):
         The pid of the process that started the pool.
     """
     _set_threads(threads)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
     _die_with_parent(parent_pid)
 
 
@@ -101,7 +104,17 @@ def _local_dask(workers):
 
 
 def _write_frame(frame, final, out_dir, fmt):
-    """Write ``frame`` to ``final`` through a temporary file renamed when whole; ``(size, sha256)`` of it."""
+    """Write ``frame`` to ``final`` through a temporary file renamed when whole; ``(size, sha256)`` of it.  An
+    `OSError` names ``final`` (and, for a full disk, the free space and the bytes the frame needs)."""
+    try:
+        return _write_frame_file(frame, final, out_dir, fmt)
+    except OSError as exc:
+        radiance = 128 + frame.radiance.size * 4  # a float32 .npy: its header and data
+        needed = f"{radiance} bytes" if fmt == "npy" else f"up to {radiance} bytes ({fmt}, compressed)"
+        raise _write_error(exc, final, needed) from exc
+
+
+def _write_frame_file(frame, final, out_dir, fmt):
     handle, temporary = tempfile.mkstemp(dir=out_dir, prefix=".partial-", suffix=f".{fmt}")
     os.close(handle)
     try:
@@ -142,34 +155,80 @@ def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options, passes=
         image's files and JSON entries, `glphong.batch.bop_images.BopImages`).
     renderer_name : str
         The worker's GL renderer.
+    failures : list of dict
+        The frames that failed (`_failure`): their scene function or render raised (the others go on; after an
+        error that is not a TypeError or ValueError the renderer is made again), or their write did (the rest of
+        the chunk is not rendered).  KeyboardInterrupt and SystemExit are raised, not reported.
     """
 
     renderer = _renderer(width, height, options)
-    records, pending = [], None
+    records, failures, pending = [], [], None
     try:
         for index, spec in items:
-            if fmt == "bop":  # the GPU's part here, the files' on the writer thread
-                job = bop_job(renderer, scene_fn(spec), index, out_dir, bop,
-                              partial(_renderer, 3 * width, 3 * height, options))
-            else:
-                job = partial(_write_record, index, renderer.render(scene_fn(spec), passes=passes or None), out_dir,
-                              fmt)
-            if pending is not None:  # the previous frame's files, written while this one rendered
-                records.append(pending.result())
-            pending = _writer().submit(job)
+            stage = "scene_fn"
+            try:
+                scene = scene_fn(spec)
+                stage = "render"
+                if fmt == "bop":  # the GPU's part here, the files' on the writer thread
+                    job = bop_job(renderer, scene, index, out_dir, bop,
+                                  partial(_renderer, 3 * width, 3 * height, options))
+                else:
+                    job = partial(_write_record, index, renderer.render(scene, passes=passes or None), out_dir, fmt)
+            except Exception as exc:  # noqa: BLE001 - the frame fails, the batch says which and goes on
+                failures.append(_failure(index, spec, stage, exc))
+                if stage == "render" and not isinstance(exc, (TypeError, ValueError)):
+                    renderer = _renew_renderer(width, height, options)  # a driver's error: the next frame starts afresh
+                continue
+            if pending is not None and not _finish_write(pending, records, failures):
+                pending = None
+                break  # a write failed (a full disk fails the next one too): stop, the parent says so
+            pending = (index, spec, _writer().submit(job))
     finally:
         if pending is not None:  # a frame being written is finished (or its error raised) before this returns
-            records.append(pending.result())
-    return records, renderer.context.renderer_name
+            _finish_write(pending, records, failures)
+    return records, renderer.context.renderer_name, failures
+
+
+def _finish_write(pending, records, failures):
+    """Wait for the write of ``pending`` (``(index, spec, future)``): its record appended to ``records``, or its
+    `OSError` to ``failures``; False where it failed."""
+    index, spec, future = pending
+    try:
+        records.append(future.result())
+        return True
+    except OSError as exc:
+        failures.append(_failure(index, spec, "write", exc))
+        return False
+
+
+def _failure(index, spec, stage, exc):
+    """What the parent reports of a frame that failed (plain data: an exception may not unpickle in the parent)."""
+    return {"index": index, "spec": spec, "stage": stage, "error": f"{type(exc).__name__}: {exc}",
+            "traceback": "".join(traceback.format_exception(exc))}
+
+
+def _renew_renderer(width, height, options):
+    """Release the worker's renderer of that size and options (a driver reported an error with it) and make another."""
+    old = _WORKER.pop(_renderer_key(width, height, options), None)
+    if old is not None:
+        try:
+            old.release()
+        except Exception:  # noqa: BLE001 - a context in a bad state: dropped either way
+            pass
+    return _renderer(width, height, options)
 
 
 def _renderer(width, height, options):
     """The worker's renderer of that size and those options, made on first use and kept (`_WORKER`)."""
-    key = (width, height, tuple(sorted(options.items())))
+    key = _renderer_key(width, height, options)
     renderer = _WORKER.get(key)
     if renderer is None or renderer.context is None:
         renderer = _WORKER[key] = Renderer(width, height, **options)
     return renderer
+
+
+def _renderer_key(width, height, options):
+    return width, height, tuple(sorted(options.items()))
 
 
 def _write_record(index, frame, out_dir, fmt):

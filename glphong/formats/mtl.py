@@ -6,20 +6,23 @@ An MTL file describes the fixed-function Phong its authors saw; each entry becom
 - ``illum 0``: colour ``Kd`` with no lighting: a constant radiance ``ka = Kd`` and nothing lit;
 - ``illum 1``: ``Kd (n.l) E + Ka L_a`` (no specular term);
 - ``illum 2``: ``Kd (n.l) E + Ks max(v.r, 0)^Ns E + Ka L_a``;
-- ``illum 3`` to ``10`` (reflections, refraction, ray tracing): rendered as ``illum 2``, with a warning;
+- ``illum 3`` to ``10`` (ray-traced reflection, glass, refraction, Fresnel, shadows onto invisible surfaces:
+  `ILLUM_MODELS`): rendered as ``illum 2``, with a warning naming the model; any other ``illum`` (the
+  specification defines 0 to 10) is an error naming the file and line, as are colours and ``Ns`` beyond what
+  `glphong.MtlPhong` takes (negative, not finite, beyond float32);
 - ``map_Kd`` / ``map_Ks``: textures (sRGB, trilinear, repeat) that ``Kd`` / ``Ks`` multiply, read only from
   inside the MTL file's folder (`glphong.filesafety`).
 """
 import io
-import math
 import warnings
 from pathlib import Path
 
 from glphong.core.filesafety import SceneFileError, decode_image, read_bytes, read_text, resolve_reference
 from glphong.materials import Texture
+from glphong.core.validate import FLT_MAX
 from glphong.materials.mtl import MtlPhong
 
-__all__ = ["parse_mtl", "material_from_mtl", "MTL_IMAGE_FORMATS"]
+__all__ = ["parse_mtl", "material_from_mtl", "MTL_IMAGE_FORMATS", "ILLUM_MODELS"]
 
 
 def parse_mtl(path, limits=None, allow_outside=False):
@@ -44,8 +47,9 @@ def parse_mtl(path, limits=None, allow_outside=False):
     Raises
     ------
     glphong.filesafety.SceneFileError
-        A keyword with values that are not finite numbers, or an image path leaving the folder, naming the
-        file and line.
+        A ``Kd``/``Ks``/``Ka`` that is not 1 or 3 numbers from 0 to the float32 maximum, an ``Ns`` that is not
+        one such number, an ``illum`` that is not an integer from 0 to 10, or an image path leaving the folder,
+        naming the file and line and what was expected.
     """
     out, current = {}, None
     # line by line from a stream: a file of a billion empty lines is never a list of a billion strings
@@ -68,21 +72,43 @@ def parse_mtl(path, limits=None, allow_outside=False):
                               stacklevel=2)
             current[keyword] = resolve_reference(path, values[-1], where, allow_outside, percent_encoded=False)
             continue
-        try:
-            if keyword in ("Kd", "Ks", "Ka"):
-                numbers = [float(v) for v in values[:3]]
-                current[keyword] = tuple(numbers * 3 if len(numbers) == 1 else numbers)
-                if len(current[keyword]) != 3 or not all(math.isfinite(v) for v in current[keyword]):
-                    raise ValueError
-            elif keyword == "Ns":
-                current["Ns"] = float(values[0])
-                if not math.isfinite(current["Ns"]):
-                    raise ValueError
-            else:
-                current["illum"] = int(values[0])
-        except (ValueError, IndexError):
-            raise SceneFileError(path, f"{keyword} needs finite numbers (got {' '.join(values)!r:.80})", where) from None
+        current[keyword] = _value(path, keyword, values, where)
     return out
+
+
+#: what each MTL illumination model asks for (the MTL specification's list, 0 to 10; glphong draws 0, 1 and 2)
+ILLUM_MODELS = {0: "colour on, ambient off", 1: "colour on, ambient on", 2: "highlight on",
+                3: "reflection on and ray trace on", 4: "transparency: glass on, reflection: ray trace on",
+                5: "reflection: Fresnel on and ray trace on",
+                6: "transparency: refraction on, reflection: Fresnel off and ray trace on",
+                7: "transparency: refraction on, reflection: Fresnel on and ray trace on",
+                8: "reflection on and ray trace off", 9: "transparency: glass on, reflection: ray trace off",
+                10: "casts shadows onto invisible surfaces"}
+
+
+def _value(path, keyword, values, where):
+    """The value of an MTL ``Kd``/``Ks``/``Ka`` (3 numbers, or 1 repeated), ``Ns`` or ``illum`` line, checked
+    against what glphong's `glphong.MtlPhong` takes; `SceneFileError` naming the file, the line and what was
+    expected."""
+    got = f"(got {' '.join(values)!r:.80})"
+    if keyword == "illum":
+        if len(values) != 1 or not values[0].lstrip("+-").isdigit() or int(values[0]) not in ILLUM_MODELS:
+            raise SceneFileError(path, "illum needs one integer from 0 to 10, the MTL specification's illumination "
+                                 f"models {got}", where)
+        return int(values[0])
+    try:
+        numbers = [float(v) for v in values]
+    except ValueError:
+        numbers = []
+    if keyword == "Ns":
+        if len(numbers) != 1 or not 0.0 <= numbers[0] <= FLT_MAX:  # NaN fails too
+            raise SceneFileError(path, f"Ns needs finite numbers: one, the specular exponent, from 0 to {FLT_MAX:.6g} "
+                                 f"(a float32; the MTL specification's range is 0 to 1000) {got}", where)
+        return numbers[0]
+    if len(numbers) not in (1, 3) or not all(0.0 <= v <= FLT_MAX for v in numbers):  # spectral and xyz forms fail
+        raise SceneFileError(path, f"{keyword} needs finite numbers: 3, r g b (or 1 for all three), each from 0 to "
+                             f"{FLT_MAX:.6g} (a float32; reflectances, 0 to 1 in the MTL specification) {got}", where)
+    return tuple(numbers * 3 if len(numbers) == 1 else numbers)
 
 
 #: image formats an MTL map may be (Pillow plugins asked for; no EPS or PDF reaches Ghostscript)
@@ -126,8 +152,8 @@ def material_from_mtl(entry, name="", source="", limits=None):
     if illum == 1:
         return MtlPhong(kd, 0.0, q, ka)
     if illum != 2:
-        warnings.warn(f"{source}: material {name!r} has illum {illum} (reflection, refraction or ray tracing): "
-                      "glphong renders it as illum 2 (Kd, Ks, Ns and Ka)", stacklevel=3)
+        warnings.warn(f"{source}: material {name!r} has illum {illum} ({ILLUM_MODELS[illum]}): glphong renders it as "
+                      "illum 2 (Kd, Ks, Ns and Ka, highlight on)", stacklevel=3)
     return MtlPhong(kd, ks, q, ka)
 
 

@@ -10,6 +10,8 @@ import weakref
 import moderngl
 import numpy as np
 
+from glphong.gpu.resources import available_memory
+
 __all__ = ["TextureStore"]
 
 
@@ -30,6 +32,7 @@ class TextureStore:
         self._mgl = mgl
         self._entries = {}  # digest -> (weakref to the TableData, texture)
         self.uploads = 0
+        self.limits = None  # (GL_MAX_TEXTURE_SIZE, GL_MAX_3D_TEXTURE_SIZE, GL_RENDERER), read at the first upload
 
     def texture(self, table):
         """The texture holding ``table`` (uploaded on first use).  A `TableData`: texel ``(k, j, i)`` is
@@ -39,10 +42,34 @@ class TextureStore:
         if entry is not None and entry[0]() is not None:
             return entry[1]
         self._purge()
+        self._check_fits(table)
         texture = self._upload_image(table) if hasattr(table, "levels") else self._upload_table(table)
         self._entries[table.digest] = (weakref.ref(table), texture)
         self.uploads += 1
         return texture
+
+    def _check_fits(self, table):
+        """ValueError naming ``table`` (a texture image or a table) where a side is beyond this context's largest
+        texture, or its upload (a copy of its bytes, then the driver's: twice `nbytes`) beyond 80% of the memory
+        available (`glphong.gpu.resources.available_memory`), before anything is copied or allocated."""
+        if self.limits is None:  # inside a draw: the context is current
+            info = self._mgl.info
+            self.limits = (info["GL_MAX_TEXTURE_SIZE"], info["GL_MAX_3D_TEXTURE_SIZE"], info["GL_RENDERER"])
+        image = hasattr(table, "levels")
+        sides = table.size if image else tuple(reversed(table.array.shape[:-1]))
+        name = f"texture image {table.source or table.digest[:8]}" if image else \
+            f"table {table.source or table.digest[:8]} of shape {table.array.shape}"
+        limit, which = (self.limits[1], "GL_MAX_3D_TEXTURE_SIZE") if len(sides) == 3 else \
+            (self.limits[0], "GL_MAX_TEXTURE_SIZE")
+        if max(sides) > limit:
+            raise ValueError(f"{name}: {'x'.join(map(str, sides))} texels, beyond this context's {which} = {limit} "
+                             f"({self.limits[2]}): use a smaller texture")
+        needed = 2 * table.nbytes
+        available = available_memory()
+        if available is not None and needed > 0.8 * available:
+            raise ValueError(f"{name}: uploading it needs about {needed / 2**20:.0f} MiB (its {table.nbytes} bytes "
+                             f"copied, then the driver's copy); this machine has {available / 2**20:.0f} MiB "
+                             "available (at most 80% of it may be used): use a smaller texture")
 
     def _upload_image(self, image):
         levels = image.levels

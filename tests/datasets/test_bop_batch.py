@@ -261,10 +261,10 @@ def test_an_interrupted_batch_resumes_to_the_same_files(tmp_path):
     out = tmp_path / "batch"
     with pytest.raises(KeyboardInterrupt):
         render_many(_stopped_at_3, specs, W, H, out, executor=InlineExecutor(), **keywords)
-    # the JSON files written on the way out hold the three images done and no other (here the tasks ran as they
-    # were submitted: images 4 and 5 were written but never reported), and every file is whole
+    # the JSON files written on the way out hold the images done and no other (here the tasks ran as they were
+    # submitted: images 4 and 5 came back before the interruption was seen, and were journalled), and every file is whole
     partial = snapshot(out)
-    for scene_id, images in ((0, ["0", "1", "2"]), (1, [])):
+    for scene_id, images in ((0, ["0", "1", "2"]), (1, ["0", "1"])):
         for name in ("scene_camera", "scene_gt", "scene_gt_info"):
             assert list(json.loads((out / f"{scene_id:06d}" / f"{name}.json").read_text())) == images
     assert all(expected[name] == digest for name, digest in partial.items() if not name.endswith(".json"))
@@ -332,12 +332,12 @@ def test_bad_arguments_fail_before_anything_is_written(tmp_path, case):
 
 def test_scenes_and_folders_bop_cannot_take(glphong_make_renderer, tmp_path):
     inline = dict(executor=InlineExecutor(), fmt="bop", progress=False)
-    # a pose that is not rigid: write_bop's message, from the worker, and nothing written
-    with pytest.raises(ValueError, match="must be rigid"):
+    # a pose that is not rigid: write_bop's message, from the worker (the frame named), and nothing written
+    with pytest.raises(BatchError, match="must be rigid"):
         render_many(_bent, [0], W, H, tmp_path / "bent", **inline)
     assert sorted(os.listdir(tmp_path / "bent")) == [".lock", "frames.jsonl", "manifest.json"]
     # obj_ids that miss an object of a frame
-    with pytest.raises(ValueError, match="instance_id 2"):
+    with pytest.raises(BatchError, match="instance_id 2"):
         render_many(tabletop_scene, [0], W, H, tmp_path / "missing", obj_ids={1: 1}, **inline)
     # a BOP folder written image by image (no manifest) is not adopted
     write_bop(tmp_path / "split", tabletop_scene(0), glphong_make_renderer(W, H, "osmesa"))
