@@ -39,7 +39,7 @@ from glphong.materials.normalized import NormalizedBlinnPhong, NormalizedPhong
 from glphong.materials.oren_nayar import OrenNayar
 from glphong.materials.phong import Phong
 from glphong.materials.ward import Ward
-from glphong.gpu.renderer import Frame, GBuffer, Renderer
+from glphong.gpu.renderer import Frame, GBuffer, Renderer, RendererReleasedError
 from glphong.scene.scene import Scene, SceneObject
 from glphong.checks.verify import VerifyReport, verify
 
@@ -50,7 +50,7 @@ __all__ = [
     "ExtendedLight", "RectLight", "PolygonLight", "SphereLight", "DiskLight", "EnvironmentLight",
     "Material", "MaterialModel", "MaterialSum", "Param", "Lambert", "Phong", "BlinnPhong", "Diffuse", "NormalizedPhong",
     "NormalizedBlinnPhong", "CookTorrance", "GltfPBR", "Lafortune", "OrenNayar", "Ward", "AshikhminShirley", "MeasuredBRDF", "MtlPhong", "SchlickFresnel",
-    "DielectricFresnel", "Texture", "VertexColors", "NormalMap", "AlphaMask", "AlphaBlend", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "Frame", "GBuffer",
+    "DielectricFresnel", "Texture", "VertexColors", "NormalMap", "AlphaMask", "AlphaBlend", "Scene", "SceneObject", "load_scene", "save_gltf", "Renderer", "RendererReleasedError", "Frame", "GBuffer",
     "verify", "VerifyReport", "describe", "format_descriptions", "create_context", "available_backends", "BackendUnavailableError",
     "datasets", "imaging", "lights", "materials", "primitives", "radiometry", "reference", "filesafety", "__version__",
 ]

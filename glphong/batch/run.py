@@ -78,10 +78,13 @@ def _journal(folder, records, renderer_name, bar):
 
 def _deaths(processes):
     """What ended the pool's worker ``processes`` that died by a signal (ended, after the pool's shutdown), or ''."""
-    signals = {-p.exitcode for p in processes if p.exitcode is not None and p.exitcode < 0}
-    signals = sorted(signals - {signal.SIGTERM} or signals)  # SIGTERM: the pool ends the others when one dies
-    if not signals:
-        return ""
+    codes = [p.exitcode for p in processes if p.exitcode is not None]
+    ended = {-c for c in codes if c < 0}
+    signals = sorted(ended - {signal.SIGTERM})  # SIGTERM: the pool ends the others when one dies
+    exits = sorted({c for c in codes if c > 0})
+    if not signals:  # a worker that exited itself (os._exit, a crash's status), or only the pool's SIGTERM
+        return f"; a worker exited with status {', '.join(map(str, exits))}" if exits else \
+            ("; a worker was ended by SIGTERM" if ended else "")
     names = ", ".join(signal.Signals(n).name if n in signal.Signals._value2member_map_ else str(n) for n in signals)
     oom = " (the kernel's OOM killer sends SIGKILL to a process using too much memory: see `dmesg`)" \
         if signal.SIGKILL in signals else ""

@@ -373,7 +373,7 @@ def test_iridescence_is_declared_and_measured_reciprocal():
 
     material = glphong.GltfPBR(**MATERIALS["film ior 2.5 above the base's, mixed"])
     assert material.properties.reciprocal
-    report = properties(material)
+    report = properties(material, theta_i=[0.5])  # one albedo: the energy question is not asked here
     assert report.reciprocal, report
 
 
