@@ -30,6 +30,7 @@ from glphong.checks.reference import incident_light, safe_normalize, shade_input
 from glphong.checks.tolerances import BAND
 from glphong.definitions.surface import _bilinear
 from glphong.gpu.transmission import transmissive_objects
+from glphong.materials.gltf_diffuse_transmission import gltf_diffuse_transmission_response
 from glphong.materials.gltf_pbr import gltf_pbr_band
 from glphong.materials.gltf_transmission import (background_levels, gltf_transmission_lod, gltf_transmission_response,
                                                  gltf_transmission_weight, gltf_volume_attenuation, gltf_volume_ray,
@@ -157,7 +158,8 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
         n_dot_v = np.einsum("ij,ij->i", f.n, wo)
         c = _parameter("u_gltf_pbr_base_color", u, f, 3)
         m = _parameter("u_gltf_pbr_metallic", u, f, 1)
-        t = _parameter("u_gltf_pbr_transmission", u, f, 1)
+        used = obj.material.extensions()  # transmission, diffuse_transmission or both (gltf_diffuse_transmission)
+        t = _parameter("u_gltf_pbr_transmission", u, f, 1) if "transmission" in used else np.zeros(len(f.n))
         r = _parameter("u_gltf_pbr_roughness", u, f, 1)
         ior = _parameter("u_gltf_pbr_ior", u, f, 1)
         weight = gltf_transmission_weight(n_dot_v, c, m, t, ior)
@@ -165,7 +167,7 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
         # parameters' own intervals where textured
         c_lo, c_hi = _bounds("u_gltf_pbr_base_color", u, f, 3)
         m_lo, m_hi = _bounds("u_gltf_pbr_metallic", u, f, 1)
-        t_lo, t_hi = _bounds("u_gltf_pbr_transmission", u, f, 1)
+        t_lo, t_hi = _bounds("u_gltf_pbr_transmission", u, f, 1) if "transmission" in used else (t, t)
         slack = (5.0 * band.D + band.A) * EPS
         fresnel = weight / np.maximum(c * ((1.0 - m) * t)[:, None], np.finfo(float).tiny)
         w_lo = c_lo * ((1.0 - m_hi) * t_lo)[:, None] * np.maximum(fresnel - slack, 0.0)
@@ -187,9 +189,17 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
             hi[is_rough] = background_lookup(pyramids[2], uv, level)[2]
         value = np.where(valid[:, None], weight * b, 0.0)
         ends = np.stack([w_lo * lo, w_lo * hi, w_hi * lo, w_hi * hi])
+        scales = [(c_lo * ((1.0 - m_hi) * t_lo)[:, None], c_hi * ((1.0 - m_lo) * t_hi)[:, None])]
+        diffuse = None
+        if "diffuse_transmission" in used:  # (1 - m) (1 - t) dt c_dt and its interval
+            dt, c_dt = (_parameter(f"u_gltf_pbr_diffuse_transmission{s}", u, f, k) for s, k in (("", 1), ("_color", 3)))
+            (dt_lo, dt_hi), (cd_lo, cd_hi) = (_bounds(f"u_gltf_pbr_diffuse_transmission{s}", u, f, k)
+                                              for s, k in (("", 1), ("_color", 3)))
+            diffuse = (dt, c_dt)
+            scales.append((cd_lo * ((1.0 - m_hi) * (1.0 - t_hi) * dt_lo)[:, None],
+                           cd_hi * ((1.0 - m_lo) * (1.0 - t_lo) * dt_hi)[:, None]))
         lights, lights_low, lights_high = _lights_behind(key, u, position, f.n, wo, valid, (c, m, t, r, ior),
-                                                        (c_lo * ((1.0 - m_hi) * t_lo)[:, None],
-                                                         c_hi * ((1.0 - m_lo) * t_hi)[:, None]), band)
+                                                        scales, band, used, diffuse)
         out[rows, columns] = value + lights
         out_low[rows, columns] = np.where(valid[:, None], ends.min(axis=0), np.minimum(value, 0.0)) + lights_low
         out_high[rows, columns] = np.where(valid[:, None], ends.max(axis=0), np.maximum(value, 0.0)) + lights_high
@@ -198,15 +208,20 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
     return TransmissionTwin(out, out_low, out_high, pixels, rough, reference)
 
 
-def _lights_behind(key, u, position, n, wo, lit, parameters, scale, band):
+def _lights_behind(key, u, position, n, wo, lit, parameters, scales, band, used=("transmission",), diffuse=None):
     """``(value, low, high)``, each (N, 3): what the punctual lights behind the surface send through it
-    (`gltf_transmission_response` times E, where ``n.wi < 0``, the generated loops' gate).  The band: the lobe ``D V
+    (`gltf_transmission_response` where ``used`` holds 'transmission', `gltf_diffuse_transmission_response` with
+    ``diffuse = (dt, c_dt)`` where it holds 'diffuse_transmission', times E, where ``n.wi < 0``, the generated loops'
+    gate).  ``scales``: ``(low, high)`` of ``(1 - m) t c``, then of ``(1 - m) (1 - t) dt c_dt``.  The diffuse's band:
+    ``1 - F`` over ``v.h'``'s interval times ``n_dot_l`` to ``D eps``, the scale's and the irradiance's intervals, to
+    ``A eps``.  The band: the lobe ``D V
     (n.l')`` by `glphong.materials.gltf_pbr.gltf_pbr_band` at the mirrored direction (a metal of base colour 1 is that
     lobe alone; its directions to ``D + 4`` eps: the mirror's own rounding), times ``1 - F`` over ``v.h``'s interval
     and ``scale = (low, high)`` of ``(1 - m) t c``, times the light's irradiance interval, to ``A eps``; low 0 where
     ``|n.wi| <= D eps`` (the gate may go either way)."""
     value, low, high = (np.zeros((len(position), 3)) for _ in range(3))
     c, m, t, roughness, ior = parameters
+    scale = scales[0]
     tol = band.D * EPS
     wide = dataclasses.replace(band, D=band.D + 4.0)
     for valid, wi, irradiance, (e_low, e_high) in incident_light(position, key, u, band=band):
@@ -216,8 +231,10 @@ def _lights_behind(key, u, position, n, wo, lit, parameters, scale, band):
             continue
         certain = lit & valid & (n_dot_wi < -tol)
         n_dot_l = -n_dot_wi
-        response = gltf_transmission_response(n, wi, wo, n_dot_l, c, m, t, roughness, ior)
-        value += np.where((lit & valid & (n_dot_wi < 0.0))[:, None], response * irradiance, 0.0)
+        gate = (lit & valid & (n_dot_wi < 0.0))[:, None]
+        response = gltf_transmission_response(n, wi, wo, n_dot_l, c, m, t, roughness, ior) \
+            if "transmission" in used else np.zeros_like(value)
+        value += np.where(gate, response * irradiance, 0.0)
         k = np.flatnonzero(possible)
         mirrored = wi[k] + (2.0 * n_dot_l[k])[:, None] * n[k]
         lobe = SimpleNamespace(base_color=np.ones(3), metallic=np.ones(len(k)), roughness=roughness[k], ior=ior[k])
@@ -227,6 +244,18 @@ def _lights_behind(key, u, position, n, wo, lit, parameters, scale, band):
         f0 = ((ior[k] - 1.0) / (ior[k] + 1.0)) ** 2
         one_minus = [1.0 - (f0 + (1.0 - f0) * np.maximum(1.0 - half + s, 0.0) ** 5) for s in (spread, -spread)]
         rel = band.A * EPS
+        if diffuse is not None:  # KHR_materials_diffuse_transmission (gltf_diffuse_transmission)
+            dt, c_dt = diffuse
+            value += np.where(gate, gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior)
+                              * irradiance, 0.0)
+            d_lo, d_hi = scales[1]
+            cos_lo, cos_hi = np.maximum(n_dot_l[k] - tol, 0.0) / np.pi, (n_dot_l[k] + tol) / np.pi
+            lo = d_lo[k] * (np.maximum(one_minus[0], 0.0) * cos_lo)[:, None] * e_low[k] * (1.0 - rel)
+            hi = d_hi[k] * (one_minus[1] * cos_hi)[:, None] * e_high[k] * (1.0 + rel)
+            low[k] += np.where(certain[k][:, None], lo, 0.0)
+            high[k] += hi
+        if "transmission" not in used:
+            continue
         with np.errstate(invalid="ignore", over="ignore"):
             lo = scale[0][k] * (np.maximum(one_minus[0], 0.0) * lobe_low[:, 0])[:, None] * e_low[k] * (1.0 - rel)
             hi = scale[1][k] * (one_minus[1] * lobe_high[:, 0])[:, None] * e_high[k] * (1.0 + rel)

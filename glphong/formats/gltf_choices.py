@@ -23,11 +23,10 @@ REQUIRED_OK = ("KHR_lights_punctual", "KHR_mesh_quantization", "KHR_draco_mesh_c
                "EXT_meshopt_compression", "KHR_meshopt_compression", "KHR_texture_basisu", "EXT_texture_webp",
                "KHR_materials_variants", "KHR_materials_specular", "KHR_materials_clearcoat",
                "KHR_materials_sheen", "KHR_materials_anisotropy", "KHR_materials_iridescence", "KHR_materials_transmission",
-               "KHR_materials_volume", "KHR_materials_dispersion")
+               "KHR_materials_volume", "KHR_materials_dispersion", "KHR_materials_diffuse_transmission")
 #: required extensions whose loss changes appearance only: read without them, with a warning
 APPEARANCE_ONLY = ("EXT_texture_avif",
-                   "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness",
-                   "KHR_materials_diffuse_transmission")
+                   "KHR_materials_unlit", "KHR_materials_pbrSpecularGlossiness")
 #: extensions glphong applies where a file uses them (`extensionsUsed`); any other is warned about, by name
 APPLIED = REQUIRED_OK
 

@@ -67,6 +67,8 @@ class Program:
         # with the textbook view vector (numerics='auto'), a term that declares the view but never reads it leaves the
         # eye unread: the stable form's validity no longer gates the lights
         self.optional |= {"u_eye"} if "view" in getattr(key, "numerics", ()) else set()
+        # the transmission pass's background (glphong.gpu.transmission): unread by a diffuse transmission's program
+        self.optional |= {"u_transmission_background", "u_transmission_levels"}
         #: the bytes last written to each uniform (`write` skips unchanged ones)
         self._written = {}
         #: sampler uniforms in texture-unit order

@@ -56,21 +56,23 @@ def check_transmission_options(renderer, scene, radiance=True):
     if not chosen:
         return
     name = scene.objects[chosen[0]].name
+    used = scene.objects[chosen[0]].material.extensions()
+    named = " and ".join(f"KHR_materials_{e}" for e in ("transmission", "diffuse_transmission") if e in used)
     if any(obj.material.alpha_blend is not None for obj in scene.objects):
-        raise ValueError(f"object {name!r} is transmissive (KHR_materials_transmission) and the scene has blended "
+        raise ValueError(f"object {name!r} is transmissive ({named}) and the scene has blended "
                          "materials (alpha_blend, glTF alphaMode BLEND): glphong does not draw both in one frame yet")
     extended = [light for light in scene.lights if light.extent == "extended"]
     if radiance and extended:
-        raise ValueError(f"object {name!r} is transmissive (KHR_materials_transmission) and the scene has a "
+        raise ValueError(f"object {name!r} is transmissive ({named}) and the scene has a "
                          f"{type(extended[0]).__name__}: glphong transmits point, spot and directional lights through "
                          "a surface, not area or environment lights yet (their light behind the surface would be "
                          "left out); light the scene with punctual lights, or give the material transmission=0")
     if radiance and not scene.lights:
-        raise ValueError(f"object {name!r} is transmissive (KHR_materials_transmission) and the scene has no light: "
+        raise ValueError(f"object {name!r} is transmissive ({named}) and the scene has no light: "
                          "its program reads the view only where a light is lit; add a light")
     wrong = per_pixel_option(renderer)
     if wrong:
-        raise ValueError(f"object {name!r} is transmissive (KHR_materials_transmission), which is drawn over the "
+        raise ValueError(f"object {name!r} is transmissive ({named}), which is drawn over the "
                          f"opaque scene with per-pixel, specialised programs and one sample a pixel; this renderer "
                          f"has {wrong[0]}: use {wrong[1]}")
 

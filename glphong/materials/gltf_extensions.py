@@ -17,6 +17,8 @@ Appendix B's GGX and visibility::
                              under the coat (`glphong.materials.gltf_sheen`)
     KHR_materials_anisotropy D V of the base anisotropic: alpha_t = mix(alpha, 1, strength^2) along the rotated
                              tangent, alpha_b = alpha (`glphong.materials.gltf_anisotropy`; needs the tangent frame)
+    KHR_materials_diffuse_transmission  the diffuse times 1 - dt in front; dt c_dt/pi (1 - F(v.h')) for lights behind
+                             (`glphong.materials.gltf_diffuse_transmission`)
 
 =================== ====== ========= ======= ==========================================================================
 parameter           kind   range     neutral meaning
@@ -51,6 +53,8 @@ from glphong.definitions.material_base import constant_part
 from glphong.definitions.params import Param
 from glphong.definitions.surface import SurfaceInput
 from glphong.materials.gltf_anisotropy import ANISOTROPY_PARAMS, anisotropy_cases
+from glphong.materials.gltf_diffuse_transmission import (DIFFUSE_TRANSMISSION_EXCLUDES, DIFFUSE_TRANSMISSION_PARAMS,
+                                                         diffuse_transmission_gltf_fields)
 from glphong.materials.gltf_iridescence import (IRIDESCENCE_PARAMS, gltf_iridescence_oracle, iridescence_cases,
                                                 iridescence_gltf_fields)
 from glphong.materials.gltf_coat_normal import COAT_NORMAL_PARAMS, gltf_clearcoat_geometry, uses_coat_normal
@@ -77,7 +81,8 @@ _CLEARCOAT_ROUGHNESS = Param("clearcoat_roughness", "scalar", low=0.0, high=1.0,
 
 #: the extensions' parameters, appended to `GltfPBR`'s
 EXTENSION_PARAMS = (_SPECULAR, _SPECULAR_COLOR, _CLEARCOAT, _CLEARCOAT_ROUGHNESS) + COAT_NORMAL_PARAMS + SHEEN_PARAMS \
-    + ANISOTROPY_PARAMS + TRANSMISSION_PARAMS + IRIDESCENCE_PARAMS  # gltf_sheen, _anisotropy, _transmission, _iridescence
+    + ANISOTROPY_PARAMS + TRANSMISSION_PARAMS + IRIDESCENCE_PARAMS \
+    + DIFFUSE_TRANSMISSION_PARAMS  # gltf_sheen, _anisotropy, _transmission, _iridescence, _diffuse_transmission
 #: each extension glphong applies: its short name (the define GLTF_PBR_<NAME>), its glTF name and its parameters
 EXTENSIONS = {"specular": ("KHR_materials_specular", ("specular", "specular_color")),
               "clearcoat": ("KHR_materials_clearcoat", ("clearcoat", "clearcoat_roughness")),
@@ -86,7 +91,9 @@ EXTENSIONS = {"specular": ("KHR_materials_specular", ("specular", "specular_colo
               "anisotropy": ("KHR_materials_anisotropy", ("anisotropy_strength", "anisotropy_rotation",
                                                           "anisotropy_direction")),
               "transmission": ("KHR_materials_transmission", ("transmission",)),
-              "iridescence": ("KHR_materials_iridescence", tuple(q.name for q in IRIDESCENCE_PARAMS))} \
+              "iridescence": ("KHR_materials_iridescence", tuple(q.name for q in IRIDESCENCE_PARAMS)),
+              "diffuse_transmission": ("KHR_materials_diffuse_transmission",
+                                       ("diffuse_transmission", "diffuse_transmission_color"))} \
     | VOLUME_EXTENSIONS  # KHR_materials_volume and _dispersion (gltf_transmission)
 #: the coat's f0: ((1 - 1.5)/(1 + 1.5))^2, fresnel_coat's fixed ior 1.5
 CLEARCOAT_F0 = 0.04
@@ -181,6 +188,12 @@ class GltfExtensionFeatures:
             warnings.warn("KHR_materials_clearcoat with an emission: glphong does not darken the emission by the "
                           "coat's 1 - clearcoat F_c(n.v) (F_c = 0.04 at normal view, 1 at grazing): the emission is "
                           "drawn as it is (docs/gltf_extensions.md)", stacklevel=3)
+        used = self.extensions()
+        both = [EXTENSIONS[name][0] for name in DIFFUSE_TRANSMISSION_EXCLUDES if name in used]
+        if "diffuse_transmission" in used and both:
+            raise ValueError(f"KHR_materials_diffuse_transmission with {', '.join(both)}: glphong does not draw that "
+                             "extension's layer over the light that diffuse transmission brings from behind the "
+                             "surface; give diffuse_transmission=0 or leave the other out (docs/gltf_extensions.md)")
 
     def extensions(self):
         """The extensions this material uses, by short name (`EXTENSIONS`): specular where ``specular`` or
@@ -204,6 +217,8 @@ class GltfExtensionFeatures:
             out += ["transmission", *volume_extensions(self)]  # and KHR_materials_volume, _dispersion in it
         if np.any(constant_part(self.iridescence)):  # iridescenceFactor 0 (the default): no film (gltf_iridescence)
             out.append("iridescence")
+        if np.any(constant_part(self.diffuse_transmission)):  # diffuseTransmissionFactor 0 (the default): opaque
+            out.append("diffuse_transmission")  # (gltf_diffuse_transmission)
         return tuple(out)
 
     def defines(self):
@@ -255,7 +270,8 @@ def gltf_extensions_oracle(base_color, metallic, roughness, ior, extensions, p, 
         fr, fm = gltf_iridescence_oracle(fr, base_color, x, [weight * min(f0 * k, 1) for k in color], p, v_dot_h)
     out = []
     for c, f, g in zip(base_color, fr, fm):
-        dielectric = (1 - max(fr)) * c / mpmath.pi + f * layer
+        keep = 1 - p.diffuse_transmission if "diffuse_transmission" in extensions else 1  # light in front: 1 - dt
+        dielectric = (1 - max(fr)) * c / mpmath.pi * keep + f * layer
         metal = g * layer
         out.append((1 - metallic) * dielectric + metallic * metal)
     if "sheen" in extensions:  # KHR_materials_sheen, under the coat (gltf_sheen)
@@ -347,4 +363,5 @@ def extension_gltf_fields(material, texture_index):
             fields["anisotropyTexture"] = {"index": texture_index(direction.texture)}
         out["KHR_materials_anisotropy"] = fields
     return out | transmission_gltf_fields(material, texture_index) \
-        | iridescence_gltf_fields(material, texture_index)  # KHR_materials_transmission, _iridescence: their modules
+        | iridescence_gltf_fields(material, texture_index) \
+        | diffuse_transmission_gltf_fields(material, texture_index)  # _transmission, _iridescence, ...: their modules

@@ -61,6 +61,7 @@ from glphong.materials.gltf_sheen import (gltf_sheen_albedo, gltf_sheen_distribu
 from glphong.materials.gltf_transmission import (gltf_transmission_lod, gltf_transmission_response,  # noqa: F401
                                                  gltf_transmission_weight, gltf_volume_attenuation, gltf_volume_ray,
                                                  gltf_volume_uv)  # transmission_thin.glsl's twins, by their names
+from glphong.materials.gltf_diffuse_transmission import gltf_diffuse_transmission_response  # noqa: F401,E402
 from glphong.definitions.material import MaterialModel, Param, Properties, constant_part
 from glphong.definitions.params import GlslFile
 from glphong.definitions.surface import SurfaceInput
@@ -92,12 +93,13 @@ gltf_pbr_ggx = microfacet_ggx
 _CORE_PARAMS = ("base_color", "metallic", "roughness", "emissive", "occlusion", "ior")
 #: KHR_materials_specular's, _clearcoat's and _sheen's defaults, at which the response is the core formula
 _CORE_AT = {"specular": 1.0, "specular_color": 1.0, "clearcoat": 0.0, "sheen_color": 0.0, "transmission": 0.0,
-            "anisotropy_strength": 0.0, "iridescence": 0.0}
+            "anisotropy_strength": 0.0, "iridescence": 0.0, "diffuse_transmission": 0.0}
 #: parameters that change nothing where no extension is used
 _UNUSED_ALONE = ("extensions", "clearcoat_roughness", "sheen_roughness", "anisotropy_rotation", "anisotropy_direction",
                  "clearcoat_normal", "clearcoat_normal_strength",
                  "iridescence_ior", "iridescence_thickness_minimum", "iridescence_thickness_maximum",
-                 "iridescence_thickness_mix", "thickness", "attenuation_distance", "attenuation_color", "dispersion")
+                 "iridescence_thickness_mix", "thickness", "attenuation_distance", "attenuation_color", "dispersion",
+                 "diffuse_transmission_color")
 
 
 def _interval(value, rel):
@@ -263,6 +265,10 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         mixed into the dielectric's and the metal's Fresnel by ``iridescence`` (`glphong.materials.gltf_iridescence`).
     iridescence_thickness_minimum, iridescence_thickness_maximum, iridescence_thickness_mix : float, float, float or SurfaceInput
         The film's thickness ``mix(minimum, maximum, mix)`` [nm] (defaults 100, 400 and 1: 400 nm).
+    diffuse_transmission, diffuse_transmission_color : float or SurfaceInput, float or (3,) array_like or SurfaceInput
+        ``KHR_materials_diffuse_transmission`` (default 0 and 1: opaque): the diffuse times ``1 - dt`` for lights in
+        front, and ``dt diffuse_transmission_color / pi (1 - F)`` for point, spot and directional lights behind the
+        surface (`glphong.materials.gltf_diffuse_transmission`; drawn as glphong draws transmissive surfaces).
     """
 
     name = "gltf_pbr"
@@ -345,6 +351,8 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
                 * (dtype.type(1) - m)
             if "transmission" in extensions:  # KHR_materials_transmission: 1 - t (gltf_transmission)
                 diffuse = diffuse * (dtype.type(1) - np.asarray(p.transmission).astype(dtype))[..., None]
+            if "diffuse_transmission" in extensions:  # KHR_materials_diffuse_transmission: 1 - dt in front
+                diffuse = diffuse * (dtype.type(1) - np.asarray(p.diffuse_transmission).astype(dtype))[..., None]
         return valid, diffuse, fresnel, specular, tan2, a2, v_dot_h
 
     def response(self, f, wi, wo, n_dot_l, p):

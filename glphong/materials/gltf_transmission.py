@@ -61,9 +61,10 @@ VOLUME_EXTENSIONS = {"volume": ("KHR_materials_volume", ("thickness", "attenuati
 
 
 def transmissive(material):
-    """Whether ``material`` transmits (a `GltfPBR` using KHR_materials_transmission)."""
+    """Whether ``material`` transmits (a `GltfPBR` using KHR_materials_transmission or _diffuse_transmission: both
+    are drawn over the opaque scene, their lights behind the surface added by the same loops)."""
     extensions = getattr(material, "extensions", None)
-    return callable(extensions) and "transmission" in extensions()
+    return callable(extensions) and bool({"transmission", "diffuse_transmission"} & set(extensions()))
 
 
 def volume_extensions(material):
@@ -145,7 +146,7 @@ def transmission_gltf_fields(material, texture_index):
     ``KHR_materials_volume`` and ``KHR_materials_dispersion`` where it uses them (dict, empty otherwise): the factors,
     and the textures where the parameter reads the channel glTF gives it (``transmissionTexture.r``,
     ``thicknessTexture.g``); an attenuation distance of FLT_MAX is left out (the specification's +Infinity)."""
-    if not transmissive(material):
+    if "transmission" not in material.extensions():
         return {}
     out = {"KHR_materials_transmission": _factor_and_texture(material.transmission, "transmissionFactor",
                                                              "transmissionTexture", "r", texture_index)}

@@ -102,7 +102,9 @@ def lights_chunk(key):
     says why); the loop bound is the compile-time ``<KIND>_LIGHT_COUNT`` (a uniform in the uber-shader).  A program
     that `transmits` (KHR_materials_transmission) also adds, for a punctual light behind the surface,
     ``(lit && valid && n.wi < 0) ? light_term(gltf_transmission_response(f, wi, wo, -n.wi), E) : 0``
-    (glsl/transmission_thin.glsl).
+    (glsl/transmission_thin.glsl), and one with KHR_materials_diffuse_transmission
+    ``(lit && valid && n.wi < 0) ? light_term(gltf_diffuse_transmission_response(f, wi, wo, -n.wi), E) : 0``
+    (glsl/materials/gltf_pbr.glsl).
     """
     lines = ["// light loops (generated from the program key): for each light j of each kind k present",
              "//   valid = k_incident(x, j, wi, E);  L += (lit && valid && n.wi > 0) ? material_response(f, wi, wo, n.wi) E : 0",
@@ -117,16 +119,16 @@ def lights_chunk(key):
         lines.append(f"uniform float u_shadow_texel{slot};")
         if light.shadow_map == "ortho":
             lines += [f"uniform vec3 u_shadow_axis{slot};", f"uniform vec3 u_shadow_e1{slot};", f"uniform vec3 u_shadow_e2{slot};"]
-    if transmits(key):  # KHR_materials_transmission: a punctual light behind the surface (glsl/transmission_thin.glsl)
-        lines += ["vec3 gltf_transmission_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l);"]
+    behind = _behind(key)  # KHR_materials_transmission, _diffuse_transmission: a punctual light behind the surface
+    lines += [f"vec3 {name}(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l);" for name, _ in behind]
     lines += ["", "void add_lights(inout vec3 radiance, vec3 position, ShadingFrame f, vec3 wo, bool lit)", "{",
               "    vec3 wi;", "    vec3 irradiance;", "    float n_dot_l;", "    bool valid;"]
     term = ["        n_dot_l = dot(f.n, wi);",
             "        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), irradiance);",
             "        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);"]
-    if transmits(key):
-        term += ["        vec3 through = light_term(gltf_transmission_response(f, wi, wo, -n_dot_l), irradiance);",
-                 "        radiance += (lit && valid && n_dot_l < 0.0) ? through : vec3(0.0);"]
+    for name, through in behind:
+        term += [f"        vec3 {through} = light_term({name}(f, wi, wo, -n_dot_l), irradiance);",
+                 f"        radiance += (lit && valid && n_dot_l < 0.0) ? {through} : vec3(0.0);"]
     for light in key.lights:
         if light.extended:
             lines += _extended_loop(key, light)
@@ -153,9 +155,19 @@ def lights_chunk(key):
 def transmits(key):
     """Whether ``key``'s program holds glsl/transmission_thin.glsl: a gltf_pbr term with KHR_materials_transmission
     (``GLTF_PBR_TRANSMISSION``) in a per-pixel radiance program that is not a blended layer (`glphong.gpu.transmission`);
-    its punctual lights' loops then also add what a light behind the surface sends through it."""
-    return key.output == "radiance" and not key.shade_per_vertex and not key.alpha_blend and \
-        any(("TRANSMISSION", "1") in t.defines for t in key.terms if t.name == "gltf_pbr")
+    its punctual lights' loops then also add what a light behind the surface sends through it (`_behind`)."""
+    return any(name == "gltf_transmission_response" for name, _ in _behind(key))
+
+
+def _behind(key):
+    """``(function, variable)`` of each response to a punctual light behind the surface in ``key``'s program: the
+    transmission's BTDF (glsl/transmission_thin.glsl), the diffuse transmission's (glsl/materials/gltf_pbr.glsl)."""
+    if key.output != "radiance" or key.shade_per_vertex or key.alpha_blend:
+        return []
+    defines = {d for t in key.terms if t.name == "gltf_pbr" for d in t.defines}
+    return [(name, through) for define, name, through in (
+        ("TRANSMISSION", "gltf_transmission_response", "through"),
+        ("DIFFUSE_TRANSMISSION", "gltf_diffuse_transmission_response", "diffuse_through")) if (define, "1") in defines]
 
 
 def closed_form(term, light):

@@ -63,7 +63,13 @@
 //   this file) replaces the Fresnel factor, F = mix(F, F_iridescence, iridescence), dielectric and metal, and the
 //   max(F_d) that weights the diffuse; the film's base_f0 = gltf_specular_fresnel(f0, specular, specular_color, 0) =
 //   min(f0 specular_color, 1) specular with KHR_materials_specular, f0 without.
-// Key defines read here: GLTF_PBR_IRIDESCENCE, GLTF_PBR_ANISOTROPY, GLTF_PBR_CLEARCOAT_NORMAL, GLTF_PBR_SPECULAR, GLTF_PBR_CLEARCOAT, GLTF_PBR_SHEEN, GLTF_PBR_TRANSMISSION, GLTF_PBR_VOLUME (defined where the material uses the
+// KHR_materials_diffuse_transmission (GLTF_PBR_DIFFUSE_TRANSMISSION; glphong/materials/gltf_diffuse_transmission.py):
+//   a light in front sees the diffuse times 1 - dt (dt = u_gltf_pbr_diffuse_transmission); a light behind,
+//   gltf_diffuse_transmission_response(f, wi, wo, n_dot_l), n_dot_l = -n.wi > 0 (called by the generated light loops
+//   where n.wi < 0, glphong/shaders/generated.py):
+//   (1 - m) (1 - t) dt (c_dt / pi) (1 - F(v.h')) n_dot_l, l' = wi + 2 n_dot_l n, h' = normalize(l' + v),
+//   F = f0 + (1 - f0) (1 - v.h')^5, c_dt = u_gltf_pbr_diffuse_transmission_color, t the transmission (0 without it).
+// Key defines read here: GLTF_PBR_DIFFUSE_TRANSMISSION, GLTF_PBR_IRIDESCENCE, GLTF_PBR_ANISOTROPY, GLTF_PBR_CLEARCOAT_NORMAL, GLTF_PBR_SPECULAR, GLTF_PBR_CLEARCOAT, GLTF_PBR_SHEEN, GLTF_PBR_TRANSMISSION, GLTF_PBR_VOLUME (defined where the material uses the
 // extension: its code is not in the program otherwise).
 
 const float GLTF_PBR_INV_PI = 0.3183098861837907;
@@ -345,6 +351,27 @@ float gltf_sheen_albedo(float cos_theta, float sheen_roughness)
 }
 #endif
 
+#if defined(GLTF_PBR_DIFFUSE_TRANSMISSION)  // KHR_materials_diffuse_transmission: the diffuse BTDF of a light behind
+vec3 gltf_diffuse_transmission_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
+{
+    vec3 mirrored = wi + (2.0 * n_dot_l) * f.n;
+    float n_dot_v, n_dot_h, v_dot_h, tan2;
+    bool valid = microfacet_geometry(f.n, mirrored, wo, n_dot_l, n_dot_v, n_dot_h, v_dot_h, tan2);
+    float r = (u_gltf_pbr_ior - 1.0) / (u_gltf_pbr_ior + 1.0);
+    float f0 = r * r;
+    float x1 = max(1.0 - v_dot_h, 0.0);
+    float fresnel = f0 + (1.0 - f0) * ((x1 * x1) * (x1 * x1) * x1);
+#if defined(GLTF_PBR_TRANSMISSION)
+    float t = u_gltf_pbr_transmission;
+#else
+    float t = 0.0;
+#endif
+    float scale = (1.0 - u_gltf_pbr_metallic) * (1.0 - t) * u_gltf_pbr_diffuse_transmission;
+    vec3 value = u_gltf_pbr_diffuse_transmission_color * ((scale * GLTF_PBR_INV_PI) * (1.0 - fresnel) * n_dot_l);
+    return valid ? value : vec3(0.0);
+}
+#endif
+
 #if defined(GLTF_PBR_VOLUME)  // KHR_materials_volume, _dispersion: their parameters, read by transmission_thin.glsl
 float gltf_pbr_thickness() { return u_gltf_pbr_thickness; }
 vec4 gltf_pbr_attenuation() { return vec4(u_gltf_pbr_attenuation_color, u_gltf_pbr_attenuation_distance); }
@@ -392,6 +419,9 @@ vec3 gltf_pbr_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
     vec3 diffuse = (c * (GLTF_PBR_INV_PI * n_dot_l)) * (1.0 - fd_max) * (1.0 - m);
 #if defined(GLTF_PBR_TRANSMISSION)  // KHR_materials_transmission: the diffuse weighted by 1 - t (transmission_thin.glsl)
     diffuse *= 1.0 - u_gltf_pbr_transmission;
+#endif
+#if defined(GLTF_PBR_DIFFUSE_TRANSMISSION)  // KHR_materials_diffuse_transmission: the diffuse weighted by 1 - dt
+    diffuse *= 1.0 - u_gltf_pbr_diffuse_transmission;
 #endif
     vec3 value = diffuse + fresnel * specular;
 #if defined(GLTF_PBR_SHEEN)  // KHR_materials_sheen: sheen_color D V + f_r scaling, times n.l

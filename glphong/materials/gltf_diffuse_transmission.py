@@ -1,0 +1,90 @@
+"""KHR_materials_diffuse_transmission on `glphong.GltfPBR` (docs/gltf_extensions.md; GLSL: ``glsl/materials/
+gltf_pbr.glsl`` under the structural define ``GLTF_PBR_DIFFUSE_TRANSMISSION``).  The extension's dielectric::
+
+    fresnel_mix(ior, base = mix(diffuse_brdf(c), diffuse_btdf(diffuse_transmission_color), dt), layer = specular_brdf)
+
+``dt`` the diffuse transmission, ``diffuse_btdf(color) = color / pi`` for light on the far side, 0 on the viewer's.
+So a light in front (``n.l > 0``) sees the core's diffuse times ``1 - dt``; a point, spot or directional light behind
+the surface (``n.wi < 0``) sends, with its irradiance ``E`` and ``n_dot_l = -n.wi``::
+
+    (1 - m) (1 - t) dt (c_dt / pi) (1 - F(v.h')) n_dot_l E,   l' = wi + 2 n_dot_l n (the light mirrored),
+    h' = normalize(l' + v),  F = f0 + (1 - f0) (1 - v.h')^5,  f0 = ((ior - 1)/(ior + 1))^2
+
+(``t`` KHR_materials_transmission's weight, which overrides the diffuse transmission: the extension's combined
+formula; the Fresnel at the mirrored half vector is the glTF Sample Viewer's).  It is added by the light loops of
+the transmissive programs (`glphong.shaders.generated.lights_chunk`, glphong/gpu/transmission.py) and their twin
+(`glphong.checks.transmission_twin`).  Not with KHR_materials_specular, _iridescence, _clearcoat or _sheen (their
+layers over a light behind the surface are not drawn: refused by name).
+
+=========================== ====== ======= ======= ==================================================================
+parameter                   kind   range   neutral meaning
+=========================== ====== ======= ======= ==================================================================
+diffuse_transmission        scalar [0, 1]  0       ``diffuseTransmissionFactor`` times ``diffuseTransmissionTexture.a``
+diffuse_transmission_color  rgb    [0, 1]  1       ``diffuseTransmissionColorFactor`` times its texture (sRGB)
+=========================== ====== ======= ======= ==================================================================
+"""
+import numpy as np
+
+from glphong.definitions.material_base import constant_part
+from glphong.definitions.params import Param
+from glphong.definitions.surface import SurfaceInput
+from glphong.twin.functions import microfacet_geometry
+
+__all__ = ["DIFFUSE_TRANSMISSION_PARAMS", "DIFFUSE_TRANSMISSION_EXCLUDES", "gltf_diffuse_transmission_response",
+           "diffuse_transmission_gltf_fields"]
+
+_DT = Param("diffuse_transmission", "scalar", low=0.0, high=1.0, default=0.0, unit="", textureable=True,
+            doc="KHR_materials_diffuse_transmission diffuseTransmissionFactor (times diffuseTransmissionTexture.a): "
+                "the diffuse's share transmitted to the far side")
+_DT_COLOR = Param("diffuse_transmission_color", "rgb", low=0.0, high=1.0, default=1.0, unit="", textureable=True,
+                  doc="KHR_materials_diffuse_transmission diffuseTransmissionColorFactor (times its texture, sRGB): "
+                      "the colour of the diffusely transmitted light")
+#: the extension's parameters, appended to `GltfPBR`'s (`glphong.materials.gltf_extensions`)
+DIFFUSE_TRANSMISSION_PARAMS = (_DT, _DT_COLOR)
+#: the extensions refused beside it (their layers over a light behind the surface are not drawn)
+DIFFUSE_TRANSMISSION_EXCLUDES = ("specular", "iridescence", "clearcoat", "sheen")
+
+
+def gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior):
+    """The diffuse BTDF of a punctual light behind the surface times ``n_dot_l = -n.wi > 0`` (gltf_pbr.glsl's
+    ``gltf_diffuse_transmission_response``): ``(1 - m) (1 - t) dt (c_dt / pi) (1 - F(v.h')) n_dot_l`` (module
+    docstring).
+
+    Parameters
+    ----------
+    n, wi, wo : (N, 3) ndarray
+        Unit normal, direction toward the light (behind: ``n.wi < 0``) and toward the viewer.
+    n_dot_l : (N,) ndarray
+        ``-n.wi``.
+    c_dt : (N, 3) or (3,) ndarray
+        The diffuse transmission colour.
+    m, t, dt, ior : (N,) ndarray or float
+        Metallic, transmission, diffuse transmission, index of refraction.
+
+    Returns
+    -------
+    (N, 3) float64 ndarray [1/sr]
+    """
+    n_dot_l = np.asarray(n_dot_l, np.float64)
+    mirrored = wi + (2.0 * n_dot_l)[:, None] * n
+    valid, _, _, v_dot_h, _ = microfacet_geometry(n, mirrored, wo, n_dot_l)
+    ior = np.asarray(ior, np.float64)
+    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
+    fresnel = f0 + (1.0 - f0) * np.maximum(1.0 - v_dot_h, 0.0) ** 5
+    scale = (1.0 - np.asarray(m, np.float64)) * (1.0 - np.asarray(t, np.float64)) * np.asarray(dt, np.float64)
+    value = np.asarray(c_dt, np.float64) * ((scale * (1.0 / np.pi)) * (1.0 - fresnel) * n_dot_l)[:, None]
+    return np.where(valid[:, None], value, 0.0)
+
+
+def diffuse_transmission_gltf_fields(material, texture_index):
+    """``{"KHR_materials_diffuse_transmission": {...}}`` for a `GltfPBR` that uses the extension, else ``{}``: the
+    factors and ``diffuseTransmissionColorTexture`` where the colour is textured (sRGB); ``diffuseTransmissionTexture``'s
+    alpha is not written (glphong holds it as a grey image, and its own ``extras`` keep it, as ``specularTexture``)."""
+    if "diffuse_transmission" not in material.extensions():
+        return {}
+    weight, color = material.diffuse_transmission, material.diffuse_transmission_color
+    fields = {"diffuseTransmissionFactor": float(constant_part(weight)),
+              "diffuseTransmissionColorFactor": [float(c) for c in np.broadcast_to(constant_part(color), 3)]}
+    if isinstance(color, SurfaceInput) and color.texture is not None:
+        fields["diffuseTransmissionColorTexture"] = {"index": texture_index(color.texture)}
+    return {"KHR_materials_diffuse_transmission": fields}
