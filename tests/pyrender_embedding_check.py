@@ -128,6 +128,12 @@ def main(platform):
         result["blended"] = "accepted"
     except ValueError as exc:
         result["blended"] = str(exc)
+    for name, keywords in (("transmissive", {"transmission": 0.5}), ("diffuse_transmissive", {"diffuse_transmission": 0.5})):
+        try:  # lit through the surface: pyrender's passes have no image behind it nor lights behind it
+            GlphongMaterial(glphong.GltfPBR(0.5, 0.0, 0.5, **keywords))
+            result[name] = "accepted"
+        except ValueError as exc:
+            result[name] = str(exc)
     renderer.delete()
     # a GlphongMaterial drawn by a renderer glphong was not enabled on: an error, not a black image
     # (after the first renderer is deleted: on EGL deleting one OffscreenRenderer ends the shared display)

@@ -70,6 +70,8 @@ def test_refusals_name_the_problem(measured):
     assert "cannot be instanced" in m["instanced"]
     assert "not enabled on" in m["not_enabled"] and "enable(renderer)" in m["not_enabled"]
     assert "blends (alpha_blend)" in m["blended"] and "glphong.Renderer" in m["blended"]
+    assert "transmits (KHR_materials_transmission)" in m["transmissive"]
+    assert "transmits (KHR_materials_diffuse_transmission)" in m["diffuse_transmissive"]
 
 
 def test_metallic_roughness_material_converts_to_gltf_pbr(measured):

@@ -34,9 +34,11 @@ class GlphongMaterial(pyrender.Material):
                              "the embedding refuses it rather than draw it wrong; composite it with glphong.Renderer "
                              "(depth peeling, docs/design.md section 16), or give the material alpha_mask= instead")
         if transmissive(material):
-            raise ValueError(f"{material!r} transmits (KHR_materials_transmission): pyrender's passes have no image of "
-                             "the opaque scene to see through it, so the embedding refuses it rather than draw it wrong; "
-                             "draw it with glphong.Renderer (docs/transmission.md)")
+            names = " and ".join(f"KHR_materials_{name}" for name in material.extensions()
+                                 if name in ("transmission", "diffuse_transmission"))
+            raise ValueError(f"{material!r} transmits ({names}): pyrender's passes have no image of the opaque scene "
+                             "to see through it, nor its lights behind the surface, so the embedding refuses it rather "
+                             "than draw it wrong; draw it with glphong.Renderer (docs/transmission.md)")
         super().__init__(name=name, doubleSided=material.two_sided)
         self.glphong = material
         self.exposure = scalar("exposure", exposure, low=0.0, low_inclusive=False)
