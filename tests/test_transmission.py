@@ -391,6 +391,24 @@ def test_files_without_transmission_and_bad_factors(tmp_path):
             glphong.load_scene(path, light_units="radiometric", lights=[])
 
 
+def test_layers_not_drawn_over_transmission_are_refused_and_left_out_of_files(tmp_path):
+    """A coat, sheen, specular or film over a transmissive surface is not drawn over what it lets through: GltfPBR
+    refuses the pair by name, and a file's glass loads with its transmission and without the layer, named in a
+    warning (a neutral KHR_materials_specular, as exporters write it, is left out silently)."""
+    for layer, keywords in (("clearcoat", {"clearcoat": 1.0}), ("sheen", {"sheen_color": 0.5}),
+                            ("specular", {"specular": 0.5}), ("iridescence", {"iridescence": 1.0})):
+        for through in ("transmission", "diffuse_transmission"):
+            with pytest.raises(ValueError, match=rf"KHR_materials_{through} with KHR_materials_{layer}"):
+                glphong.GltfPBR(0.5, 0.0, 0.2, **{through: 0.5}, **keywords)
+    path = _gltf_file(tmp_path, {"KHR_materials_transmission": {"transmissionFactor": 1.0},
+                                 "KHR_materials_clearcoat": {"clearcoatFactor": 1.0},
+                                 "KHR_materials_specular": {"specularFactor": 1.0}})
+    with pytest.warns(UserWarning, match=r"KHR_materials_transmission with KHR_materials_clearcoat: .*left out") as seen:
+        material = glphong.load_scene(path, light_units="radiometric", lights=[]).objects[0].material
+    assert material.extensions() == ("transmission",)
+    assert not any("KHR_materials_specular" in str(w.message) for w in seen)
+
+
 def test_volume_and_dispersion_load_from_files_and_save_back(tmp_path):
     rgba = np.random.default_rng(4).integers(0, 256, (8, 8, 4), dtype=np.uint8)
     extensions = {"KHR_materials_transmission": {"transmissionFactor": 1.0},

@@ -24,9 +24,11 @@ import numpy as np
 
 from glphong.formats.gltf_transmission import TRANSMISSION_FACTORS, TRANSMISSION_TEXTURES, transmission_arguments
 from glphong.core.filesafety import SceneFileError
+from glphong.definitions.surface import SurfaceInput
 from glphong.materials import Texture
 from glphong.materials.gltf_coat_normal import COAT_NORMAL_PARAMS
-from glphong.materials.gltf_extensions import EXTENSIONS
+from glphong.materials.gltf_extensions import EXTENSION_PARAMS, EXTENSIONS
+from glphong.materials.gltf_diffuse_transmission import DIFFUSE_TRANSMISSION_EXCLUDES
 
 __all__ = ["MATERIAL_EXTENSIONS", "extension_arguments", "check_material_extensions", "extension_texture_infos",
            "tangent_frame_error"]
@@ -177,4 +179,26 @@ def extension_arguments(entry, texture, warn):
         out |= {"iridescence_ior": float(film.get("iridescenceIor", 1.3)),
                 "iridescence_thickness_minimum": float(film.get("iridescenceThicknessMinimum", 100.0)),
                 "iridescence_thickness_maximum": float(film.get("iridescenceThicknessMaximum", 400.0))}
-    return out | transmission_arguments(extensions, texture)  # KHR_materials_transmission
+    return _without_layers_over_transmission(out | transmission_arguments(extensions, texture), warn)
+
+
+def _without_layers_over_transmission(out, warn):
+    """``out`` less the layers glphong does not draw over the light a surface lets through
+    (`DIFFUSE_TRANSMISSION_EXCLUDES`, refused by `glphong.GltfPBR` itself), each left out named in a warning: a
+    file's glass keeps its transmission, drawn without its coat, sheen, specular or film."""
+    through = [EXTENSIONS[n][0] for n in ("transmission", "diffuse_transmission")
+               if n in out and (isinstance(out[n], SurfaceInput) or float(out[n]) > 0)]
+    if not through:
+        return out
+    defaults = {p.name: p.default for p in EXTENSION_PARAMS}
+    dropped = []
+    for name in DIFFUSE_TRANSMISSION_EXCLUDES:
+        keys = [k for k in EXTENSIONS[name][1] if k in out]
+        if any(isinstance(out[k], SurfaceInput) or np.any(np.asarray(out[k], np.float64) != defaults[k]) for k in keys):
+            dropped.append(EXTENSIONS[name][0])
+        for key in keys + (["clearcoat_normal", "clearcoat_normal_strength"] if name == "clearcoat" else []):
+            out.pop(key, None)
+    if dropped:
+        warn(f"{' and '.join(through)} with {', '.join(dropped)}: glphong does not draw that layer over the light the "
+             "surface lets through, so it is left out (docs/gltf_extensions.md)")
+    return out

@@ -189,16 +189,26 @@ class GltfExtensionFeatures:
                           "coat's 1 - clearcoat F_c(n.v) (F_c = 0.04 at normal view, 1 at grazing): the emission is "
                           "drawn as it is (docs/gltf_extensions.md)", stacklevel=3)
         used = self.extensions()
-        both = [EXTENSIONS[name][0] for name in DIFFUSE_TRANSMISSION_EXCLUDES if name in used]
-        if "diffuse_transmission" in used and both:
-            raise ValueError(f"KHR_materials_diffuse_transmission with {', '.join(both)}: glphong does not draw that "
-                             "extension's layer over the light that diffuse transmission brings from behind the "
-                             "surface; give diffuse_transmission=0 or leave the other out (docs/gltf_extensions.md)")
+        for through in ("transmission", "diffuse_transmission"):  # the layers not drawn over the light let through
+            both = [EXTENSIONS[name][0] for name in DIFFUSE_TRANSMISSION_EXCLUDES if name in used]
+            if through in used and both:
+                raise ValueError(f"{EXTENSIONS[through][0]} with {', '.join(both)}: glphong does not draw that "
+                                 "extension's layer over the light the surface lets through (from behind it, or the "
+                                 f"scene seen through it); give {through}=0 or leave the other out "
+                                 "(docs/gltf_extensions.md)")
 
     def extensions(self):
         """The extensions this material uses, by short name (`EXTENSIONS`): specular where ``specular`` or
         ``specular_color`` is not 1 or is textured, clearcoat where ``clearcoat`` is not 0, sheen where
-        ``sheen_color`` is not 0, anisotropy where ``anisotropy_strength`` is not 0 (tuple of str)."""
+        ``sheen_color`` is not 0, anisotropy where ``anisotropy_strength`` is not 0 (tuple of str).  Found once
+        and kept (a material is immutable; the frame's draw asks it of every object)."""
+        found = self.__dict__.get("_extensions_used")
+        if found is None:
+            found = self._extensions_used()
+            object.__setattr__(self, "_extensions_used", found)
+        return found
+
+    def _extensions_used(self):
         def differs(name, neutral):
             value = getattr(self, name)
             return isinstance(value, SurfaceInput) and value.texture is not None or \
