@@ -18,6 +18,8 @@ Phases (each count an option, 0 skips it; docs/long_runs.md has the figures):
 - ``--workers`` (default 10000): frames through `glphong.batch.render_many`'s 'spawn' pool of 2 workers;
   ``--dask`` (default 10000): through ``render_many(executor="dask")``, a 2-worker local cluster; tasks of `CYCLE`
   frames.  Frame 0 of each batch must be bit-identical to this process's first render (same size and backend).
+  ``--batches`` (default 1) such batches in a row from this process: its resident memory after each and its largest
+  during each (read every 0.2 s), against its memory before the first.
 
 Sampled after ``gc.collect()`` every ``--sample-every`` frames (and ten times per renderer and context phase):
 resident memory (/proc/self/statm), open descriptors (/proc/self/fd), threads (/proc/self/task), what glphong holds
@@ -35,6 +37,7 @@ import gc
 import json
 import os
 import tempfile
+import threading
 import time
 import warnings
 
@@ -257,26 +260,55 @@ def contexts_phase(n, backends, log):
             "whole": whole, "mib_per_context": round(whole["rss_end_minus_start_mib"] / max(n, 1), 4), "samples": samples}
 
 
-def batch_phase(n, width, height, backend, every, first, executor, log):
-    """``n`` frames through `render_many` (``executor`` None: the 'spawn' pool; 'dask'), 2 workers."""
+def _rss_mib():
+    with open("/proc/self/statm") as f:
+        return int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+
+class _PeakRss(threading.Thread):
+    """This process's largest resident memory [MiB] while it runs, read every ``interval`` seconds."""
+
+    def __init__(self, interval=0.2):
+        super().__init__(daemon=True)
+        self.interval, self.peak, self.halt = interval, _rss_mib(), threading.Event()
+
+    def run(self):
+        while not self.halt.wait(self.interval):
+            self.peak = max(self.peak, _rss_mib())
+
+
+def batch_phase(n, width, height, backend, every, first, executor, log, batches=1):
+    """``n`` frames through `render_many` (``executor`` None: the 'spawn' pool; 'dask'), 2 workers; ``batches``
+    such batches in a row (each its own pool or cluster), the workers' samples those of the first, this process's
+    resident memory after each and its largest during each."""
     from glphong.batch import render_many
 
     # tasks of CYCLE frames, samples at the first frame of a task: the frame a worker rendered before each sample is
     # then always the last of a cycle (its meshes, not yet released, are counted), and after its first task a worker
     # has made every program
     every = max(1, round(every / CYCLE)) * CYCLE
-    before = probe()
-    with tempfile.TemporaryDirectory(prefix="glphong-soak-") as tmp:
-        stats = os.path.join(tmp, "workers.jsonl")
-        start = time.perf_counter()
-        paths = render_many(worker_scene, [(i, stats, every) for i in range(n)], width, height,
-                            os.path.join(tmp, "frames"), executor=executor, workers=2, frames_per_task=CYCLE,
-                            progress=False, backend=backend)
-        seconds = time.perf_counter() - start
-        identical = bool(np.array_equal(np.load(paths[0]).view(np.uint32),
-                                        np.ascontiguousarray(first.radiance).view(np.uint32)))
-        with open(stats) as f:
-            rows = [json.loads(line) for line in f]
+    before, after_each, peaks = probe(), [], []
+    for b in range(batches):
+        with tempfile.TemporaryDirectory(prefix="glphong-soak-") as tmp:
+            stats = os.path.join(tmp, "workers.jsonl")
+            watch = _PeakRss()
+            watch.start()
+            start = time.perf_counter()
+            paths = render_many(worker_scene, [(i, stats if b == 0 else None, every) for i in range(n)], width,
+                                height, os.path.join(tmp, "frames"), executor=executor, workers=2,
+                                frames_per_task=CYCLE, progress=False, backend=backend)
+            seconds = time.perf_counter() - start if b == 0 else seconds
+            watch.halt.set()
+            watch.join()
+            peaks.append(round(watch.peak - before["rss_mib"], 3))
+            identical = bool(np.array_equal(np.load(paths[0]).view(np.uint32),
+                                            np.ascontiguousarray(first.radiance).view(np.uint32))) if b == 0 else identical
+            if b == 0:
+                with open(stats) as f:
+                    rows = [json.loads(line) for line in f]
+        after_each.append(round(probe()["rss_mib"] - before["rss_mib"], 3))
+        log(f"{executor or 'spawn pool'} batch {b + 1}: parent rss {after_each[-1]:+.2f} MiB after, "
+            f"{peaks[-1]:+.2f} MiB at most during")
     after = probe()
     workers = {}
     for row in sorted(rows, key=lambda r: r["frame"]):
@@ -288,6 +320,7 @@ def batch_phase(n, width, height, backend, every, first, executor, log):
     return {"frames": n, "executor": executor or "spawn", "seconds": round(seconds, 1),
             "frames_per_second": round(n / seconds, 1), "frame0_identical": identical,
             "parent": {"rss_change_mib": round(after["rss_mib"] - before["rss_mib"], 3),
+                       "rss_change_after_each_batch_mib": after_each, "rss_peak_change_during_each_batch_mib": peaks,
                        "fds_change": after["fds"] - before["fds"], "threads_change": after["threads"] - before["threads"]},
             "workers": per_worker}
 
@@ -332,6 +365,8 @@ def main(argv=None):
     parser.add_argument("--contexts", type=int, default=1000)
     parser.add_argument("--workers", type=int, default=10_000, help="frames through render_many's spawn pool")
     parser.add_argument("--dask", type=int, default=10_000, help="frames through render_many(executor='dask')")
+    parser.add_argument("--batches", type=int, default=1,
+                        help="batches of --workers and of --dask frames in a row from this process (its memory after each)")
     parser.add_argument("--size", type=int, nargs=2, default=(32, 24), metavar=("W", "H"))
     parser.add_argument("--backend", default="auto", choices=("auto", "egl", "osmesa"), help="of the frames and batches")
     parser.add_argument("--backends", default=",".join(BACKENDS),
@@ -358,9 +393,11 @@ def main(argv=None):
     if args.contexts:
         report["contexts"] = contexts_phase(args.contexts, backends, log)
     if args.workers:
-        report["workers"] = batch_phase(args.workers, width, height, args.backend, args.sample_every, first, None, log)
+        report["workers"] = batch_phase(args.workers, width, height, args.backend, args.sample_every, first, None, log,
+                                        args.batches)
     if args.dask:
-        report["dask"] = batch_phase(args.dask, width, height, args.backend, args.sample_every, first, "dask", log)
+        report["dask"] = batch_phase(args.dask, width, height, args.backend, args.sample_every, first, "dask", log,
+                                     args.batches)
     report["end"] = probe()
     if args.json:
         with open(args.json, "w") as f:

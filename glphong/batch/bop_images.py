@@ -279,6 +279,11 @@ class BopImages:
         for scene_id in self.scenes:
             remove_temporaries(str(self.out / f"{scene_id:06d}"))
 
+    def kept(self, value):
+        """What the batch keeps in memory of an image journalled with ``value``: all of it (its scene's JSON files
+        are written from the entries)."""
+        return value
+
     def recorded(self, done, indices):
         """Write the JSON files of each scene of ``indices`` whose images are all ``done`` now."""
         for scene_id in sorted({self.ids[i][0] for i in indices}):

@@ -297,7 +297,8 @@ class _FileFrames:
     value is ``{"size", "sha256"}`` of its file as its worker wrote it.
 
     `_BatchFolder` asks a batch's frames to ``parse`` a journal record's value, whether a frame on disk is
-    ``trusted``, to ``remove_partials``, and, as frames come back and at the end, ``recorded`` and ``finish``
+    ``trusted``, to ``remove_partials``, what it keeps in memory of a journalled value (``kept``), and, as frames
+    come back and at the end, ``recorded`` and ``finish``
     (nothing to do here; `glphong.batch.bop_images.BopImages` writes its scenes' JSON files then).
 
     Parameters
@@ -324,6 +325,10 @@ class _FileFrames:
 
     def remove_partials(self):
         """Remove what writers that died left beyond ``.partial-*`` in the folder (nothing for these frames)."""
+
+    def kept(self, value):
+        """What the batch keeps in memory of a frame journalled with ``value``: nothing (None), the journal holds it."""
+        return None
 
     def recorded(self, done, indices):
         """Frames ``indices`` were journalled; ``done`` the values of every frame done (nothing to do here)."""
@@ -366,6 +371,7 @@ class _BatchFolder:
             records = _read_journal(journal, len(self.paths), self.frames.parse)
             self.done = {i: records[i] for i in range(len(self.paths)) if self.frames.trusted(i, records.get(i))}
             _replace_atomically(journal, "".join(_record_line(i, v) for i, v in sorted(self.done.items())))
+            self.done = {i: self.frames.kept(v) for i, v in self.done.items()}
             self.journal = _open_regular(journal, os.O_WRONLY | os.O_APPEND, "the frame journal")
         except BaseException:
             self.__exit__(None, None, None)
@@ -387,7 +393,7 @@ class _BatchFolder:
         """Journal the frames ``records`` (``(index, value)`` each, as a worker returned them)."""
         for index, value in records:
             os.write(self.journal, _record_line(index, value).encode())
-            self.done[index] = value
+            self.done[index] = self.frames.kept(value)
         self.frames.recorded(self.done, [index for index, _ in records])
 
     def remove_partials(self):

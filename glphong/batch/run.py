@@ -4,6 +4,7 @@ The folder (lock, manifest, journal) is kept by the calling process (`glphong.ba
 are rendered by workers (`glphong.batch.workers`): a 'spawn' pool made here by default, made again where
 a worker dies, a local Dask cluster, or any ``concurrent.futures.Executor``.
 """
+import collections
 import contextlib
 import hashlib
 import os
@@ -33,40 +34,61 @@ def _spec_hash(spec):
     return hashlib.sha256(data).hexdigest()[:16]
 
 
-def _render_round(folder, executor, submit, frames_per_task, bar, failed, only=None):
+def _render_round(folder, executor, submit, frames_per_task, bar, failed, only=None, in_flight=2):
     """Submit the missing frames (but those in ``failed``; ``only`` these, where given) in chunks of
-    ``frames_per_task`` and journal each result as it comes back, adding the frames that failed to ``failed``
-    (``{index: failure}``); after a failed write the chunks not started are cancelled.  Returns the frames whose chunk
-    the pool broke on (a worker died), [] where none.  Interrupted (Ctrl-C), the chunks not started are cancelled
-    and those already back journalled first."""
+    ``frames_per_task``, at most ``in_flight`` chunks submitted and not yet back, and journal each result in
+    submission order, adding the frames that failed to ``failed`` (``{index: failure}``).  Each chunk's future and
+    result are dropped once journalled, so the parent holds no per-frame object but the folder's, whatever the
+    batch's length, and a Dask worker keeps a task's result only until then.  After a failed write the chunks not
+    started are cancelled and no more submitted.  Returns the frames whose chunk the pool broke on (a worker died:
+    those in flight, then those not yet submitted), [] where none.  Interrupted (Ctrl-C), the chunks not started
+    are cancelled and those already back journalled first."""
     missing = [i for i in folder.missing if i not in failed] if only is None else only
-    chunks = [missing[k:k + frames_per_task] for k in range(0, len(missing), frames_per_task)]
-    futures = [executor.submit(_render_chunk, *submit(chunk)) for chunk in chunks]
-    lost, journalled = [], set()
+    chunks = (missing[k:k + frames_per_task] for k in range(0, len(missing), frames_per_task))
+    pending = collections.deque()  # (chunk, future), oldest first
+    lost, unsent, stop = [], [], False
     try:
-        for k, future in enumerate(futures):
+        while True:
+            while not stop and len(pending) < in_flight:
+                chunk = next(chunks, None)
+                if chunk is None:
+                    break
+                try:
+                    pending.append((chunk, executor.submit(_render_chunk, *submit(chunk))))
+                except BrokenProcessPool:  # a worker died: the pool takes no more
+                    unsent = [i for c in (chunk, *chunks) for i in c]
+                    stop = True
+            if not pending:
+                break
+            chunk, future = pending[0]
             try:
                 records, renderer_name, failures = future.result()
             except BrokenProcessPool:
-                lost.extend(chunks[k])  # a worker died: its frames were not reported, and are rendered again
+                lost.extend(chunk)  # a worker died: its frames were not reported, and are rendered again
                 continue
             except CancelledError:
                 continue
-            journalled.add(k)
+            finally:
+                if pending and pending[0][1] is future and future.done():
+                    pending.popleft()
+            del future, chunk
             _journal(folder, records, renderer_name, bar)
             failed.update((f["index"], f) for f in failures)
-            if any(f["stage"] == "write" for f in failures):
-                for other in futures:
+            write_failed = any(f["stage"] == "write" for f in failures)
+            del records, failures
+            if write_failed:
+                stop = True
+                for _, other in pending:
                     other.cancel()
     except BaseException:
-        for other in futures:
+        for _, other in pending:
             other.cancel()
         with contextlib.suppress(Exception):  # what came back before the interruption is kept
-            for k, future in enumerate(futures):
-                if k not in journalled and future.done() and not future.cancelled() and future.exception() is None:
+            for _, future in pending:
+                if future.done() and not future.cancelled() and future.exception() is None:
                     _journal(folder, *future.result()[:2], bar)
         raise
-    return lost
+    return lost + unsent
 
 
 def _journal(folder, records, renderer_name, bar):
@@ -269,7 +291,7 @@ def _render_missing(folder, submit, executor, workers, frames_per_task, bar):
                 executor = _spawn_pool(workers)
             before = len(folder.missing)
             lost = _render_round(folder, executor, submit, frames_per_task, bar, failed,
-                                 None if suspect is None else [suspect])
+                                 None if suspect is None else [suspect], 2 * _slots(executor, workers))
             processes = list((getattr(executor, "_processes", None) or {}).values())
             stalled = stalled + 1 if lost and len(folder.missing) == before else 0
             if lost and own:
@@ -309,6 +331,17 @@ def _render_missing(folder, submit, executor, workers, frames_per_task, bar):
             folder.remove_partials()  # the workers are gone: no writer is left
     if failed:
         raise FramesFailedError(folder.out, [failed[i] for i in sorted(failed)], len(folder.done), len(folder.paths))
+
+
+def _slots(executor, workers):
+    """How many tasks ``executor`` runs at once: its pool's processes or threads, a Dask client's threads, else
+    ``workers``."""
+    slots = getattr(executor, "_max_workers", None)
+    client = getattr(executor, "_client", None)  # distributed's ClientExecutor
+    if client is not None:
+        with contextlib.suppress(Exception):
+            slots = sum(client.nthreads().values())
+    return max(1, slots or workers)
 
 
 def _listed(indices, most=8):

@@ -91,16 +91,21 @@ def _spawn_pool(workers):
 
 
 def _local_dask(workers):
-    """``((client, cluster), executor)``: a local Dask cluster of ``workers`` single-threaded processes."""
+    """``((client, cluster), executor)``: a local Dask cluster of ``workers`` single-threaded processes, without a
+    dashboard and without the workers' statistical profiler (which nobody can see without a dashboard, and which
+    keeps up to ``distributed.admin.low-level-log-length`` (1000) one-second profiles of the task thread's stacks:
+    about 1.1 MiB a worker per 10^3 frames of a batch, until 1000 s of work, in docs/long_runs.md's soak)."""
     try:
+        import dask
         from distributed import Client, LocalCluster
     except ImportError:
         raise ImportError("executor='dask' needs dask.distributed: pip install 'glphong[dask]'") from None
     threads = max(1, (os.cpu_count() or 1) // workers)
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                           env={"LP_NUM_THREADS": str(threads)})
+    with dask.config.set({"distributed.worker.profile.enabled": False}):  # the nannies pass it to their workers
+        cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                               env={"LP_NUM_THREADS": str(threads)})
     client = Client(cluster)
-    return (client, cluster), client.get_executor()
+    return (client, cluster), client.get_executor(pure=False)  # a task writes files: never one result for two
 
 
 def _write_frame(frame, final, out_dir, fmt):
