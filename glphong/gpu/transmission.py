@@ -21,7 +21,7 @@ import math
 import moderngl
 import numpy as np
 
-from glphong.gpu.peeling import per_pixel_option
+from glphong.gpu.peeling import blended, per_pixel_option
 from glphong.gpu.shadows import ShadowMap
 from glphong.materials.gltf_transmission import background_levels, transmissive
 
@@ -44,7 +44,7 @@ def drawn_in(obj, blend, output):
     `TRANSMIT` in a radiance draw (and as an opaque one in every other output: the G-buffer, the matte)."""
     if blend == TRANSMIT:
         return transmissive(obj.material)
-    if (obj.material.alpha_blend is not None) != bool(blend):
+    if blended(obj) != bool(blend):
         return False
     return bool(blend) or output != "radiance" or not transmissive(obj.material)
 
@@ -58,7 +58,7 @@ def check_transmission_options(renderer, scene, radiance=True):
     name = scene.objects[chosen[0]].name
     used = scene.objects[chosen[0]].material.extensions()
     named = " and ".join(f"KHR_materials_{e}" for e in ("transmission", "diffuse_transmission") if e in used)
-    if any(obj.material.alpha_blend is not None for obj in scene.objects):
+    if any(blended(obj) for obj in scene.objects):
         raise ValueError(f"object {name!r} is transmissive ({named}) and the scene has blended "
                          "materials (alpha_blend, glTF alphaMode BLEND): glphong does not draw both in one frame yet")
     extended = [light for light in scene.lights if light.extent == "extended"]
