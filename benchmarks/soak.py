@@ -297,13 +297,14 @@ def batch_phase(n, width, height, backend, every, first, executor, log, batches=
             paths = render_many(worker_scene, [(i, stats if b == 0 else None, every) for i in range(n)], width,
                                 height, os.path.join(tmp, "frames"), executor=executor, workers=2,
                                 frames_per_task=CYCLE, progress=False, backend=backend)
-            seconds = time.perf_counter() - start if b == 0 else seconds
+            elapsed = time.perf_counter() - start
             watch.halt.set()
             watch.join()
             peaks.append(round(watch.peak - before["rss_mib"], 3))
-            identical = bool(np.array_equal(np.load(paths[0]).view(np.uint32),
-                                            np.ascontiguousarray(first.radiance).view(np.uint32))) if b == 0 else identical
-            if b == 0:
+            if b == 0:  # the first batch's time, frame 0 and worker samples are the ones reported
+                seconds = elapsed
+                identical = bool(np.array_equal(np.load(paths[0]).view(np.uint32),
+                                                np.ascontiguousarray(first.radiance).view(np.uint32)))
                 with open(stats) as f:
                     rows = [json.loads(line) for line in f]
         after_each.append(round(probe()["rss_mib"] - before["rss_mib"], 3))

@@ -181,7 +181,7 @@ class GltfFile:
         """Whether a meshopt-compressed view's parent buffer holds plain data a reader without the decoder may read
         (the extension's rule: a buffer marked ``fallback: true`` holds none)."""
         parent = self.document["buffers"][view["buffer"]]
-        marks = parent.get("extensions", {})
+        marks = parent.get("extensions") if isinstance(parent.get("extensions"), dict) else {}
         return not any(isinstance(marks.get(name), dict) and marks[name].get("fallback") is True for name in MESHOPT)
 
     def view(self, index):
