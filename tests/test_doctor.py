@@ -90,3 +90,19 @@ def test_readme_driver_lines_survive_without_osmesa():
             assert "libosmesa6" not in line or "|| " in line, (page, line)
     ci = (root / ".ci" / "run").read_text(encoding="utf-8")
     assert "libosmesa6" in ci and "GLPHONG_REQUIRE_BACKENDS=egl,osmesa" in ci
+
+
+def test_vendor_files_named_by_the_environment_are_read_bounded(tmp_path, monkeypatch):
+    """A vendor file the environment names is read up to 64 KiB: /dev/zero or a huge file is reported unreadable
+    instead of read without end; a well-formed one names its library."""
+    from glphong.tools import doctor
+
+    good = tmp_path / "10_test.json"
+    good.write_text('{"file_format_version": "1.0.0", "ICD": {"library_path": "libEGL_test.so.0"}}')
+    big = tmp_path / "20_big.json"
+    big.write_bytes(b" " * (doctor._VENDOR_FILE_BYTES + 1))
+    monkeypatch.setenv("__EGL_VENDOR_LIBRARY_FILENAMES", f"{good}:{big}:/dev/zero")
+    found = {path: (library, why) for path, library, why in doctor._vendor_files()}
+    assert found[str(good)] == ("libEGL_test.so.0", None)
+    for path in (str(big), "/dev/zero"):
+        assert found[path][0] is None and "more than 65536 bytes" in found[path][1]

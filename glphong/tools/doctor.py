@@ -82,12 +82,19 @@ def _vendor_files():
     found = []
     for path in files:
         try:
-            with open(path) as handle:
-                library = json.load(handle)["ICD"]["library_path"]
+            with open(path, "rb") as handle:  # at most 64 KiB (a vendor file is some 100 bytes; a path from the
+                text = handle.read(_VENDOR_FILE_BYTES + 1)  # environment may name /dev/zero or a huge file)
+            if len(text) > _VENDOR_FILE_BYTES:
+                raise ValueError(f"more than {_VENDOR_FILE_BYTES} bytes: not an EGL vendor file")
+            library = json.loads(text)["ICD"]["library_path"]
             found.append((path, library, None))
         except (OSError, ValueError, KeyError, TypeError) as exc:
             found.append((path, None, f"unreadable ({type(exc).__name__}: {exc})"))
     return found
+
+
+#: the largest EGL vendor JSON file the doctor reads [bytes]
+_VENDOR_FILE_BYTES = 65536
 
 
 def _hints(what, packages):
