@@ -138,9 +138,9 @@ def test_a_full_disk_names_the_file_and_the_space_and_leaves_no_partial_file(tmp
 
     def disk_fills_at_the_third(path, array):
         saved.append(path)
-        if len(saved) == 3:
-            with open(path, "wb") as handle:
-                handle.write(b"\x93NUMPY half")
+        if len(saved) == 3:  # the worker saves into the open temporary file
+            path.write(b"\x93NUMPY half")
+            path.flush()
             raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
         return save(path, array)
 

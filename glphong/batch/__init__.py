@@ -4,7 +4,7 @@ A batch is a list of small picklable specs (a camera angle, a material parameter
 picklable top-level function ``scene_fn(spec) -> Scene`` that builds each frame's scene in the worker (a
 pickled scene would carry and re-upload its meshes).  Frames are written to ``out_dir`` as float32
 radiance ``.npy`` files of shape ``(height, width, 3)`` (or 8-bit sRGB PNG files) named by their index,
-``frame_NNNNNN.npy``; each is written to a temporary file (``.partial-*``) and renamed, so a frame file is
+``frame_NNNNNN.npy``; each is written to a temporary file (``.NAME.partial-*``) and renamed, so a frame file is
 whole or absent.  With ``fmt='bop'`` each frame is an image of a BOP scene (`glphong.batch.bop_images`): the
 workers write its PNG files, each whole, and the calling process the scenes' JSON files from the entries
 the workers return.

@@ -12,6 +12,8 @@ import stat
 import tempfile
 from pathlib import Path
 
+from glphong.core.atomic_files import write_atomically
+
 try:
     import fcntl
 except ImportError:  # Windows: no advisory locks, see _lock_folder
@@ -187,13 +189,9 @@ def _create_exclusive(path, text):
 
 
 def _replace_atomically(path, text):
-    """Replace ``path`` by a file holding ``text`` (a temporary file renamed over it)."""
-    temporary = _write_temporary(path.parent, text)
-    try:
-        os.replace(temporary, path)
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
+    """Replace ``path`` by a file holding ``text`` (UTF-8), whole or not at all
+    (`glphong.core.atomic_files.write_atomically`)."""
+    write_atomically(path, lambda temporary: Path(temporary).write_text(text, encoding="utf-8"))
 
 
 def _read_manifest(path, limit):

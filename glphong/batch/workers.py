@@ -12,7 +12,6 @@ import multiprocessing
 import os
 import signal
 import sys
-import tempfile
 import threading
 import time
 import traceback
@@ -23,6 +22,8 @@ from pathlib import Path
 import numpy as np
 from glphong.batch.bop_images import bop_job
 from glphong.batch.folder import _CLOEXEC, _NOFOLLOW, _file_digest, _frame_name, _write_error
+from glphong.core.atomic_files import write_atomically
+from glphong.core.imaging import png_bytes
 from glphong.datasets import save_exr, save_npz
 from glphong.gpu.renderer import Renderer
 
@@ -108,37 +109,39 @@ def _local_dask(workers):
     return (client, cluster), client.get_executor(pure=False)  # a task writes files: never one result for two
 
 
-def _write_frame(frame, final, out_dir, fmt):
+def _write_frame(frame, final, fmt):
     """Write ``frame`` to ``final`` through a temporary file renamed when whole; ``(size, sha256)`` of it.  An
     `OSError` names ``final`` (and, for a full disk, the free space and the bytes the frame needs)."""
     try:
-        return _write_frame_file(frame, final, out_dir, fmt)
+        return _write_frame_file(frame, final, fmt)
     except OSError as exc:
         radiance = 128 + frame.radiance.size * 4  # a float32 .npy: its header and data
         needed = f"{radiance} bytes" if fmt == "npy" else f"up to {radiance} bytes ({fmt}, compressed)"
         raise _write_error(exc, final, needed) from exc
 
 
-def _write_frame_file(frame, final, out_dir, fmt):
-    handle, temporary = tempfile.mkstemp(dir=out_dir, prefix=".partial-", suffix=f".{fmt}")
-    os.close(handle)
-    try:
+def _write_frame_file(frame, final, fmt):
+    """Write ``frame`` to ``final`` whole or not at all (`glphong.core.atomic_files.write_atomically`); the
+    ``(size, sha256)`` of what was written, read back from the temporary file before it is renamed."""
+    written = []
+
+    def write(temporary):
         if fmt == "npy":
-            np.save(temporary, np.ascontiguousarray(frame.radiance, dtype=np.float32))
+            with open(temporary, "wb") as stream:
+                np.save(stream, np.ascontiguousarray(frame.radiance, dtype=np.float32))
         elif fmt == "png":
-            frame.save_png(temporary)
+            with open(temporary, "wb") as stream:
+                stream.write(png_bytes(frame.radiance))
         else:  # every pass of the frame
             (save_npz if fmt == "npz" else save_exr)(temporary, frame)
         handle = os.open(temporary, os.O_RDONLY | _NOFOLLOW | _CLOEXEC)
         try:
-            written = _file_digest(handle)
+            written.append(_file_digest(handle))
         finally:
             os.close(handle)
-        os.replace(temporary, final)
-    finally:
-        if os.path.exists(temporary):
-            os.remove(temporary)
-    return written
+
+    write_atomically(final, write)
+    return written[0]
 
 
 def _render_chunk(scene_fn, items, width, height, out_dir, fmt, options, passes=(), bop=None):
@@ -237,7 +240,7 @@ def _renderer_key(width, height, options):
 
 
 def _write_record(index, frame, out_dir, fmt):
-    size, sha256 = _write_frame(frame, Path(out_dir) / _frame_name(index, fmt), out_dir, fmt)
+    size, sha256 = _write_frame(frame, Path(out_dir) / _frame_name(index, fmt), fmt)
     return index, {"size": size, "sha256": sha256}
 
 
