@@ -15,6 +15,7 @@ import numpy as np
 
 import glphong
 from glphong import primitives
+from glphong.analysis.error_maps import error_image
 from glphong.imaging import save_png
 
 
@@ -43,10 +44,7 @@ def main(out_path="transparency.png", width=400, height=300):
     scene = build_scene()
     with glphong.Renderer(width, height) as renderer:
         report = glphong.verify(scene, renderer)
-    error = np.nanmax(np.where(report.mask[..., None], report.relative_error, 0.0), axis=-1)
-    shade = np.clip((np.log10(np.maximum(error, 1e-8)) + 8.0) / 3.0, 0.0, 1.0)
-    shade[~report.mask] = 0.0
-    errors = np.repeat(shade[..., None], 3, axis=-1)
+    errors = error_image(report, low=1e-8, high=1e-5)
     errors[report.blend.unchecked] = (1.0, 0.0, 0.0)
     peak = float(report.gpu.max())
     save_png(out_path, np.concatenate([report.gpu / peak, errors], axis=1))
