@@ -68,7 +68,8 @@ class Limits:
         Largest image decoded, width times height [px]; default 4096 x 4096 (a 16.8 Mpx texture takes
         about 0.5 GB while its mip pyramid is built in float64).
     nodes : int
-        Most glTF nodes, meshes, accessors (each); default 1,000,000.
+        Most glTF nodes, meshes, accessors (each), and node instances a scene draws (a node shared by several
+        parents counts once per path); default 1,000,000.
     decoded_bytes : int
         Most bytes of arrays and pixels decoded from one scene file, counted at their widest (float64) before
         they are made [bytes]; default 4 GiB.  Bounds what instancing and aliasing could multiply: many

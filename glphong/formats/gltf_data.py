@@ -12,11 +12,13 @@ absent), the ``TEXCOORD_<n>`` its material's textures read (`glphong.formats.glt
 float64, from glTF's top-left origin to glphong's bottom-left), ``TANGENT``, ``COLOR_0`` (linear; normalised
 integers scaled to [0, 1]) and the indices, with the material a ``KHR_materials_variants`` variant chooses.
 Nothing is merged or reordered, so a file written by `glphong.save_gltf` reads back the very arrays it
-holds.  Triangle strips and fans are triangulated (strips alternate their winding as the specification
-says); points and lines are skipped with a warning; sparse accessors are applied; Draco-compressed primitives
-and meshopt-compressed buffer views are decoded by optional packages (`glphong.formats.gltf_compressed`); morph
-targets and skins are drawn in the rest pose, with one warning.  Images are PNG, JPEG, WebP (``EXT_texture_webp``)
-or KTX2 (``KHR_texture_basisu``).
+holds; only a primitive without ``TANGENT`` whose material reads the tangent frame (a normal texture, anisotropy, a
+coat normal texture) gets MikkTSpace tangents from its uvs, as the specification asks (`glphong.scene.mikktspace`),
+with a copy of each vertex whose triangles' tangents differ appended.  Triangle strips and fans are triangulated
+(strips alternate their winding as the specification says); points and lines are skipped with a warning; sparse
+accessors are applied; Draco-compressed primitives and meshopt-compressed buffer views are decoded by optional
+packages (`glphong.formats.gltf_compressed`); morph targets and skins are drawn in the rest pose, with one warning.
+Images are PNG, JPEG, WebP (``EXT_texture_webp``) or KTX2 (``KHR_texture_basisu``).
 
 Extensions: `REQUIRED_OK` are read; `APPEARANCE_ONLY` cost appearance only and are warned about where required;
 any other required extension is refused by name; one a file uses (``extensionsUsed``) that glphong does not apply
@@ -37,10 +39,12 @@ from glphong.formats.gltf_compressed import (MESHOPT, OPTIONAL_DECODERS, decode_
                                              decoder_available, draco_primitive, meshopt_extension)
 from glphong.formats.gltf_choices import (APPEARANCE_ONLY, APPLIED, REQUIRED_OK, check_attribute_type,
                                           material_uv_set, primitive_material, variant_index)
+from glphong.formats.gltf_nodes import node_worlds
 from glphong.formats.gltf_validate import COMPONENT_BYTES, TYPE_WIDTHS, validate_gltf
 from glphong.scene.geometry import MeshData
+from glphong.scene.mikktspace import mikktspace_vertices
 
-__all__ = ["GltfFile", "glb_chunks", "node_matrices", "read_accessor", "read_gltf_primitives", "read_gltf_image",
+__all__ = ["GltfFile", "glb_chunks", "node_worlds", "read_accessor", "read_gltf_primitives", "read_gltf_image",
            "texture_sampling", "gl_sampling", "REQUIRED_OK", "APPEARANCE_ONLY", "APPLIED"]
 
 _DTYPES = {5120: np.int8, 5121: np.uint8, 5122: np.int16, 5123: np.uint16, 5125: np.uint32, 5126: np.float32}
@@ -244,6 +248,7 @@ def read_accessor(gltf, index):
         data, stride = gltf.view(accessor["bufferView"])
         rows = _strided(gltf, data, accessor.get("byteOffset", 0), count, row, stride or row, where)
         values = np.ascontiguousarray(rows).view(dtype).reshape(count, width)
+        values = values if values.flags.aligned else values.copy()  # an unaligned accessor (validate_gltf warns)
     else:
         values = np.zeros((count, width), dtype)
     if "sparse" in accessor:
@@ -272,46 +277,6 @@ def _apply_sparse(gltf, sparse, values, dtype, width, where):
     values = values.copy()
     values[indices] = np.ascontiguousarray(rows).view(dtype).reshape(n, width)
     return values
-
-
-def _local_matrix(node):
-    if "matrix" in node:
-        return np.asarray(node["matrix"], dtype=np.float64).reshape(4, 4).T  # column-major in glTF
-    t = np.asarray(node.get("translation", (0.0, 0.0, 0.0)), dtype=np.float64)
-    x, y, z, w = node.get("rotation", (0.0, 0.0, 0.0, 1.0))
-    r = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-                  [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-                  [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
-    m = np.eye(4)
-    m[:3, :3] = r * np.asarray(node.get("scale", (1.0, 1.0, 1.0)), dtype=np.float64)
-    m[:3, 3] = t
-    return m
-
-
-def node_matrices(document):
-    """World matrices of every node reachable from the default scene, by node index.
-
-    The hierarchy is walked iteratively (a legal chain thousands of nodes deep loads); the document is
-    validated (`glphong.formats.gltf_validate`), so it is a forest and each node is reached once.  Without a
-    ``scenes`` array, every node without a parent is a root.
-    """
-    nodes = document.get("nodes", [])
-    scenes = document.get("scenes")
-    if scenes:
-        roots = scenes[document.get("scene", 0)].get("nodes", [])
-    else:
-        children = {c for node in nodes for c in node.get("children", [])}
-        roots = [k for k in range(len(nodes)) if k not in children]
-    out = {}
-    stack = [(root, np.eye(4)) for root in reversed(roots)]
-    while stack:
-        index, parent = stack.pop()
-        if index in out:  # unreachable for a validated document; kept so a walk can never loop
-            raise SceneFileError("(glTF document)", f"node {index} is reached twice", f"nodes[{index}]")
-        world = parent @ _local_matrix(nodes[index])
-        out[index] = world
-        stack.extend((child, world) for child in reversed(nodes[index].get("children", [])))
-    return out
 
 
 def _triangles(gltf, mode, indices, where):
@@ -369,15 +334,37 @@ def _primitive_arrays(gltf, primitive, where, uv_set):
     return positions, indices, {k: _attribute(gltf, primitive, n, where) for k, n in names.items()}
 
 
-def _primitive_mesh(gltf, primitive, where, key, uv_set):
+def _primitive_mesh(gltf, primitive, where, key, uv_set, mikktspace):
     """The `MeshData` of one primitive, or None (no triangles); made once per file and ``key`` (mesh index,
-    primitive index, uv set), so every node that instances a mesh shares its arrays (and the renderer its buffers)."""
+    primitive index, uv set, whether it takes MikkTSpace tangents), so every node that instances a mesh shares its
+    arrays (and the renderer its buffers)."""
     if key not in gltf._meshes:
-        gltf._meshes[key] = _new_primitive_mesh(gltf, primitive, where, uv_set)
+        gltf._meshes[key] = _new_primitive_mesh(gltf, primitive, where, uv_set, mikktspace)
     return gltf._meshes[key]
 
 
-def _new_primitive_mesh(gltf, primitive, where, uv_set):
+def _reads_tangents(entry):
+    """Whether a glTF material entry reads the tangent frame: a ``normalTexture``, ``KHR_materials_anisotropy`` or
+    ``KHR_materials_clearcoat``'s ``clearcoatNormalTexture``."""
+    extensions = entry.get("extensions", {}) if isinstance(entry, dict) else {}
+    coat = extensions.get("KHR_materials_clearcoat")
+    return isinstance(entry, dict) and ("normalTexture" in entry or "KHR_materials_anisotropy" in extensions
+                                        or (isinstance(coat, dict) and "clearcoatNormalTexture" in coat))
+
+
+def _with_mikktspace(positions, normals, triangles, uvs, colors):
+    """The arrays of a primitive without ``TANGENT`` given MikkTSpace tangents from its (glphong, v-up) uvs, as the
+    specification asks: ``(positions, normals, triangles, uvs, colors, tangents)``, a vertex split where its
+    triangles' tangents differ (`glphong.scene.mikktspace`).  A tangent made of non-finite normals or uvs is 0 (the
+    shader's basis around n)."""
+    with np.errstate(all="ignore"):
+        source, triangles, tangents = mikktspace_vertices(positions, normals, triangles, uvs)
+    tangents[~np.all(np.isfinite(tangents), axis=1)] = (0.0, 0.0, 0.0, 1.0)
+    return (positions[source], normals[source], triangles, uvs[source], None if colors is None else colors[source],
+            tangents)
+
+
+def _new_primitive_mesh(gltf, primitive, where, uv_set, mikktspace):
 
     mode = primitive.get("mode", _TRIANGLES)
     if mode not in (_TRIANGLES, _STRIP, _FAN):
@@ -397,6 +384,10 @@ def _new_primitive_mesh(gltf, primitive, where, uv_set):
             name = f"TEXCOORD_{uv_set}" if name == "uv" else name
             raise SceneFileError(gltf.path, f"{name} has {len(values)} elements, POSITION {count}",
                                  f"{where}.attributes.{name}")
+    for name in ("TANGENT", "uv", "COLOR_0"):  # NORMAL may hold them: such a vertex is shaded ambient only
+        if attributes[name] is not None and not np.all(np.isfinite(attributes[name])):
+            name = f"TEXCOORD_{uv_set}" if name == "uv" else name
+            raise SceneFileError(gltf.path, f"{name} holds NaN or infinite values", f"{where}.attributes.{name}")
     indices = np.arange(count, dtype=np.int64) if indices is None else indices
     if len(indices) and int(indices.max()) >= count:
         raise SceneFileError(gltf.path, f"index {int(indices.max())} is beyond the {count} vertices", f"{where}.indices")
@@ -413,8 +404,12 @@ def _new_primitive_mesh(gltf, primitive, where, uv_set):
         uvs = uvs.astype(np.float64)  # a copy: the accessor's array is shared
         uvs[:, 1] = 1.0 - uvs[:, 1]  # glTF's origin is the image's top-left corner
     colors = attributes["COLOR_0"]
-    return MeshData(positions, normals, triangles, uvs=uvs, tangents=attributes["TANGENT"],
-                    colors=None if colors is None else np.clip(colors[:, :3], 0.0, 1.0))
+    colors = None if colors is None else np.clip(colors[:, :3], 0.0, 1.0)
+    tangents = attributes["TANGENT"]
+    if mikktspace and tangents is None and uvs is not None:
+        positions, normals, triangles, uvs, colors, tangents = _with_mikktspace(positions, normals, triangles, uvs,
+                                                                                colors)
+    return MeshData(positions, normals, triangles, uvs=uvs, tangents=tangents, colors=colors)
 
 
 def read_gltf_primitives(gltf, variant=None):
@@ -431,7 +426,8 @@ def read_gltf_primitives(gltf, variant=None):
     -------
     list of (name, MeshData, world (4, 4) ndarray, material index or None)
         ``name`` is the node's (``node<i>`` where it has none), with ``.<k>`` for the k-th primitive of a
-        mesh of several.  The mesh's uvs are the ``TEXCOORD_<n>`` its material's textures read
+        mesh of several; a node reached by several paths gives one entry per path (`glphong.formats.gltf_nodes`).
+        The mesh's uvs are the ``TEXCOORD_<n>`` its material's textures read
         (`glphong.formats.gltf_choices.material_uv_set`; ``TEXCOORD_0`` without a material or textures).
 
     Raises
@@ -442,7 +438,7 @@ def read_gltf_primitives(gltf, variant=None):
     document = gltf.document
     chosen = variant_index(document, variant, gltf.path)
     out = []
-    worlds = node_matrices(document)
+    worlds = node_worlds(document, gltf.limits)  # one world per path: a shared node is drawn per path
     materials = document.get("materials", [])
     for index, node in enumerate(document.get("nodes", [])):
         if "mesh" not in node or index not in worlds:
@@ -456,12 +452,13 @@ def read_gltf_primitives(gltf, variant=None):
             where = f"meshes[{node['mesh']}].primitives[{k}]"
             material = primitive_material(primitive, chosen)
             uv_set = (material_uv_set(materials[material]) or 0) if material is not None else 0
-            mesh = _primitive_mesh(gltf, primitive, where, (node["mesh"], k, uv_set), uv_set)
+            mikktspace = material is not None and _reads_tangents(materials[material])
+            mesh = _primitive_mesh(gltf, primitive, where, (node["mesh"], k, uv_set, mikktspace), uv_set, mikktspace)
             if mesh is not None and uv_set and mesh.uvs is None:
                 gltf.warn_once(("uv set", where), f"{where}: material {material}'s textures read TEXCOORD_{uv_set}, "
                                "which the primitive lacks: drawn without its textures")
             if mesh is not None:
-                out.append((name, mesh, worlds[index], material))
+                out.extend((name, mesh, world, material) for world in worlds[index])
     return out
 
 

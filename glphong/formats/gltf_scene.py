@@ -9,7 +9,8 @@ import numpy as np
 from glphong.core.filesafety import SceneFileError
 from glphong.core.radiometry import LUMENS_PER_WATT
 from glphong.formats.gltf_choices import check_one_uv_set
-from glphong.formats.gltf_data import GltfFile, node_matrices, read_gltf_image, read_gltf_primitives, texture_sampling
+from glphong.formats.gltf_data import GltfFile, read_gltf_image, read_gltf_primitives, texture_sampling
+from glphong.formats.gltf_nodes import node_worlds
 from glphong.materials import AlphaBlend, AlphaMask, NormalMap, Texture, TextureImage, VertexColors
 from glphong.materials.cook_torrance import CookTorrance
 from glphong.materials.gltf_pbr import GltfPBR
@@ -87,7 +88,7 @@ def material_from_extras(entry, gltf, where=""):
                              f"{where}.extras.glphong") from None
 
 
-def gltf_view(document, camera_name=None, light_units=None, source=""):
+def gltf_view(document, camera_name=None, light_units=None, source="", limits=None):
     """The camera and lights of a glTF document: ``(camera or None, [lights])``.
 
     The camera is the node camera named ``camera_name`` (by the camera's or its node's name) or the first
@@ -96,11 +97,13 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
     ``'photometric'`` (the glTF specification: point and spot intensity in candela, directional illuminance in
     lux; ``I = cd color / 683`` [W/sr], ``E = lux color / 683``) or ``'radiometric'`` (intensity taken as W/sr and
     W/m^2).  Each light type is read by the light kind whose ``gltf_type`` it is (`glphong.lights.LightModel.from_gltf`):
-    point (with its ``range``), spot (cone angles and ``range``) and directional.
+    point (with its ``range``), spot (cone angles and ``range``) and directional.  A node reached by several paths
+    (`glphong.formats.gltf_nodes`) gives a light per path; a camera node, its first path's pose.  ``limits``
+    (`glphong.filesafety.Limits`) bounds the paths walked.
     """
 
     nodes = document.get("nodes", [])
-    worlds = node_matrices(document)
+    worlds = node_worlds(document, limits)  # {node: [world per path]}
     cameras = document.get("cameras", [])
     camera = None
     for index, node in enumerate(nodes):
@@ -109,7 +112,7 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
         spec = cameras[node["camera"]]
         if camera_name is not None and camera_name not in (spec.get("name"), node.get("name")):
             continue
-        pose = worlds[index].copy()
+        pose = worlds[index][0].copy()
         pose[:3, :3] /= np.linalg.norm(pose[:3, :3], axis=0)  # a camera node's scale does not apply
         if spec.get("type") == "orthographic":
             o = spec["orthographic"]
@@ -137,16 +140,16 @@ def gltf_view(document, camera_name=None, light_units=None, source=""):
                              "'radiometric' (W/sr and W/m^2)")
         scale = (1.0 / LUMENS_PER_WATT if light_units == "photometric" else 1.0) * light.get("intensity", 1.0)
         colour = np.asarray(light.get("color", (1.0, 1.0, 1.0)), dtype=np.float64) * scale
-        world = worlds[index]
         if kind is None:
             raise ValueError(f"{source}: light type {light.get('type')!r} is not one glphong knows "
                              f"({', '.join(sorted(_GLTF_KINDS))})")
-        pose = world.copy()
-        pose[:3, :3] /= np.linalg.norm(pose[:3, :3], axis=0)  # a light node's scale does not apply
-        try:
-            lights.append(kind.from_gltf(colour, light, pose))
-        except (TypeError, ValueError) as exc:
-            raise ValueError(f"{source}: light {light.get('name', reference['light'])!r}: {exc}") from None
+        for world in worlds[index]:
+            pose = world.copy()
+            pose[:3, :3] /= np.linalg.norm(pose[:3, :3], axis=0)  # a light node's scale does not apply
+            try:
+                lights.append(kind.from_gltf(colour, light, pose))
+            except (TypeError, ValueError) as exc:
+                raise ValueError(f"{source}: light {light.get('name', reference['light'])!r}: {exc}") from None
     return camera, lights
 
 
@@ -392,7 +395,7 @@ def load_gltf(path, camera, lights, ambient, materials, light_units, camera_name
 
     gltf = GltfFile(path, limits, allow_outside)
     document = gltf.document
-    file_camera, file_lights = gltf_view(document, camera_name, light_units, str(path))
+    file_camera, file_lights = gltf_view(document, camera_name, light_units, str(path), limits)
     written = _glphong_extras(document)
     if lights is None and (file_lights or written):
         lights = file_lights

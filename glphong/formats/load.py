@@ -1,9 +1,9 @@
 """`load_scene`: a scene file as a `glphong.Scene`, by its suffix.
 
 - ``.obj``: `glphong.formats.obj.read_obj` (one object per material, ``usemtl``) with the MTL files it names
-  (``mtllib``, `glphong.formats.mtl`), read by glphong itself so that ``Kd``, ``Ks``, ``Ka`` and ``Ns`` keep
-  their decimal values (trimesh keeps 8-bit colours, and drops every material of a file whose MTL it
-  cannot parse).  An OBJ file has no camera and no light: it gets the default view
+  (``mtllib``, `glphong.formats.mtl`; one name with spaces where that file exists, `_library_names`), read by
+  glphong itself so that ``Kd``, ``Ks``, ``Ka`` and ``Ns`` keep their decimal values (trimesh keeps 8-bit colours,
+  and drops every material of a file whose MTL it cannot parse).  An OBJ file has no camera and no light: it gets the default view
   (`glphong.scene.from_trimesh.default_view`; MTL's ``Ka`` multiplies its ambient light).
 - ``.gltf``, ``.glb``: `glphong.formats.gltf_scene` (its own arrays, camera, lights and materials).
 
@@ -103,7 +103,7 @@ def _mtl_libraries(path, text, allow_outside, limits):
     for match in _MTLLIB.finditer(text):
         line += text.count("\n", position, match.start())
         position = match.start()
-        for name in match.group(1).split():
+        for name in _library_names(path, match.group(1), f"line {line}", allow_outside):
             library = resolve_reference(path, name, f"line {line}", allow_outside, percent_encoded=False)
             if library in read:
                 continue
@@ -114,6 +114,22 @@ def _mtl_libraries(path, text, allow_outside, limits):
                 warnings.warn(f"{path}: mtllib {name!r:.80} not found next to it; its materials get defaults",
                               stacklevel=3)
     return mtl
+
+
+def _library_names(path, names, where, allow_outside):
+    """The MTL file names of one ``mtllib`` line (``names``: the rest of the line): the whole of it as one name where
+    it has spaces and a file of that name exists inside the folder (three.js's MTLLoader reads the rest of the line as
+    one name, Blender tries it first: obj2gltf's ``box mtllib.obj`` names ``box mtllib.mtl``), else each word (the
+    OBJ specification's list of files).  Each name is still confined by `resolve_reference`."""
+    whole = names.strip()
+    if len(whole.split()) > 1:
+        try:
+            target = resolve_reference(path, whole, where, allow_outside, percent_encoded=False)
+        except SceneFileError:  # the words are resolved, and refused, one by one
+            target = None
+        if target is not None and target.is_file() and (path.resolve().parent / whole.replace("\\", "/")).is_file():
+            return [whole]  # the second test: as named, not as resolve() folded a ".." after a missing folder
+    return whole.split()
 
 
 def _load_obj(path, camera, lights, ambient, materials, allow_outside, limits):
