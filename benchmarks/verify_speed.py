@@ -21,14 +21,23 @@ imported in a worker process of its own (``PYTHONPATH`` and ``GLPHONG_GLSL_DIR``
 script's scenes on request.  Per scene and size, after a warm-up, ``--rounds`` rounds alternate the workers (before,
 after, before, after, ...); each round times ``--repeats`` renders (their median) and one verify in each worker.
 Printed per version: the medians over the rounds of the render, the verify and their ratio, with the ratio's spread
-(25th to 75th percentile), and whether the two versions' verify arrays are equal bit for bit.
+(25th to 75th percentile); each round's verify after over before, in wall time and in the worker's CPU time
+(``time.process_time``: less moved by other jobs on the machine than wall time, but llvmpipe's threads count in it);
+and whether the two versions' verify arrays are equal bit for bit.
+
+``--shadow-step BEFORE`` times the shadow step alone (`glphong.checks.shadows.shadow_visibility` of every receiver
+and shadowing light, on the G-buffer of each scene), BEFORE's ``glphong/checks/shadows.py`` loaded under another
+name in this process against this checkout's, interleaved over ``--rounds`` rounds: wall and CPU time, their ratios
+and whether the arrays are equal bit for bit.
 
 Run:  python benchmarks/verify_speed.py [--backend egl] [--sizes 64 256] [--repeats 7] [--verify-repeats 3]
       [--scenes ...] [--save DIR | --compare DIR] [--profile SCENE]
       python benchmarks/verify_speed.py --against /tmp/before [--tree DIR] [--rounds 5] [--sizes ...] [--scenes ...]
+      python benchmarks/verify_speed.py --shadow-step /tmp/before [--rounds 5] [--sizes ...] [--scenes ...]
 """
 import argparse
 import cProfile
+import importlib.util
 import os
 import pstats
 import subprocess
@@ -41,7 +50,10 @@ import numpy as np
 
 import glphong
 from glphong import primitives
+from glphong.checks import shadows
 from glphong.core.timing import median_seconds
+from glphong.shaders.binding import binding
+from glphong.twin.functions import safe_normalize
 
 ARRAYS = ("reference", "low", "high", "exact", "outside", "mask", "shadow_band")
 LIGHTS8 = [(1.5 * np.cos(a), 1.5 * np.sin(a), 1.0 + 0.5 * np.sin(3 * a))
@@ -88,14 +100,14 @@ def _worker(backend):
         if size not in renderers:
             renderers[size] = glphong.Renderer(size, size, backend=backend)
         scene = scenes.setdefault(name, SCENES[name]())
-        start = time.perf_counter()
+        start, cpu = time.perf_counter(), time.process_time()
         if command == "render":
             renderers[size].render(scene)
         else:
             report = glphong.verify(scene, renderers[size])
             if command == "save":
                 np.savez(rest[0], **_arrays(report))
-        print(time.perf_counter() - start, flush=True)
+        print(time.perf_counter() - start, time.process_time() - cpu, flush=True)
 
 
 class _Version:
@@ -108,12 +120,14 @@ class _Version:
         self.root = self.process.stdout.readline().strip()
 
     def ask(self, *words):
+        """Seconds the request took: ``(wall, CPU of the worker process)``."""
         self.process.stdin.write(" ".join(str(w) for w in words) + "\n")
         self.process.stdin.flush()
         answer = self.process.stdout.readline()
         if not answer:
             raise RuntimeError(f"the worker of {self.process.args} stopped")
-        return float(answer)
+        wall, cpu = answer.split()
+        return float(wall), float(cpu)
 
     def close(self):
         self.process.stdin.close()
@@ -126,21 +140,22 @@ def _against(args):
     print(f"before: glphong from {versions['before'].root}; after: from {versions['after'].root}; {args.rounds} rounds, "
           f"render: median of {args.repeats}\n")
     print("| scene | size | render before [ms] | verify before [ms] | before / render | render after [ms] | "
-          "verify after [ms] | after / render | same arrays |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "verify after [ms] | after / render | verify after / before: wall, CPU | same arrays |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     with tempfile.TemporaryDirectory() as folder:
         for size in args.sizes:
             for name in args.scenes:
-                times = {v: {"render": [], "verify": [], "ratio": []} for v in versions}
+                times = {v: {"render": [], "verify": [], "ratio": [], "cpu": []} for v in versions}
                 for v, worker in versions.items():  # warm-up, and the arrays
                     worker.ask("render", name, size)
                     worker.ask("save", name, size, f"{folder}/{v}.npz")
                 for _ in range(args.rounds):
                     for v, worker in versions.items():
-                        render = float(np.median([worker.ask("render", name, size) for _ in range(args.repeats)]))
-                        check = worker.ask("verify", name, size)
+                        render = float(np.median([worker.ask("render", name, size)[0] for _ in range(args.repeats)]))
+                        check, cpu = worker.ask("verify", name, size)
                         times[v]["render"].append(render)
                         times[v]["verify"].append(check)
+                        times[v]["cpu"].append(cpu)
                         times[v]["ratio"].append(check / render)
                 before, after = (np.load(f"{folder}/{v}.npz") for v in versions)
                 differ = [k for k in set(before.files) | set(after.files) if k not in before.files
@@ -151,9 +166,73 @@ def _against(args):
                     cells.append(f"{1000 * np.median(times[v]['render']):.1f} | {1000 * np.median(times[v]['verify']):.0f} | "
                                  f"{np.median(ratio):.0f}x ({np.percentile(ratio, 25):.0f}-{np.percentile(ratio, 75):.0f})")
                 same = "yes" if not differ else f"no: {', '.join(sorted(differ))}"
+                # each round's after over the same round's before: wall, and the CPU time of the worker
+                wall, cpu = (np.array(times["after"][k]) / np.array(times["before"][k]) for k in ("verify", "cpu"))
+                cells.append(f"{np.median(wall):.2f} ({np.percentile(wall, 25):.2f}-{np.percentile(wall, 75):.2f}), "
+                             f"{np.median(cpu):.2f} ({np.percentile(cpu, 25):.2f}-{np.percentile(cpu, 75):.2f})")
                 print(f"| {name} | {size} | {' | '.join(cells)} | {same} |", flush=True)
     for worker in versions.values():
         worker.close()
+
+
+def _shadow_inputs(scene, renderer):
+    """``(setup, position, normal, receiver index)`` of each shadowing light at each object's pixels, as the twin
+    passes them to `shadow_visibility` (`glphong.checks.reference.shade_inputs`)."""
+    gbuffer = renderer.gbuffer(scene)
+    out = []
+    for index, obj in enumerate(scene.objects):
+        selection = gbuffer.object_index == index
+        key = renderer.program_key(scene, obj)
+        if not key.shadow_slots or not selection.any():
+            continue
+        position = gbuffer.position[selection].astype(np.float64)
+        normal = safe_normalize(gbuffer.face[selection].astype(np.float64))[1]
+        out += [(setup, position, normal, index) for setup in binding(scene).shadow_setups(key.lights, key.shadow_size)]
+    return out
+
+
+def _shadow_step(args):
+    """``--shadow-step BEFORE``: the shadow step alone (`shadow_visibility` of every receiver and shadowing light),
+    BEFORE's glphong/checks/shadows.py (loaded under another name, on this checkout's glphong) against this
+    checkout's, interleaved in one process: wall and CPU time, and whether their arrays are equal bit for bit."""
+    spec = importlib.util.spec_from_file_location("shadows_before", args.shadow_step / "glphong/checks/shadows.py")
+    before = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(before)
+    versions = {"before": before, "after": shadows}
+    print(f"shadow step: before {spec.origin}, after {shadows.__file__}; {args.rounds} rounds\n")
+    print("| scene | size | points | before wall [ms] | after wall [ms] | after / before wall | before CPU [ms] | "
+          "after CPU [ms] | after / before CPU | same arrays |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for size in args.sizes:
+        with glphong.Renderer(size, size, backend=args.backend) as renderer:
+            for name in args.scenes:
+                scenes = {v: SCENES[name]() for v in versions}  # each version caches its casters on its own scene
+                inputs = _shadow_inputs(scenes["after"], renderer)
+                if not inputs:
+                    continue
+                radius = renderer.shadow_settings[1]
+
+                def step(v):
+                    return [versions[v].shadow_visibility(scenes[v], setup, x, n, radius, scenes[v].objects[index])
+                            for setup, x, n, index in inputs]
+
+                arrays = {v: step(v) for v in versions}  # warm-up (the casters' intersectors), and the arrays
+                same = all(np.array_equal(a, b) and a.dtype == b.dtype for one, other in
+                           zip(arrays["before"], arrays["after"]) for a, b in zip(one, other))
+                times = {v: {"wall": [], "cpu": []} for v in versions}
+                for _ in range(args.rounds):
+                    for v in versions:
+                        start, cpu = time.perf_counter(), time.process_time()
+                        step(v)
+                        times[v]["wall"].append(time.perf_counter() - start)
+                        times[v]["cpu"].append(time.process_time() - cpu)
+                cells = []
+                for k in ("wall", "cpu"):
+                    ratio = np.array(times["after"][k]) / np.array(times["before"][k])
+                    cells.append(f"{1000 * np.median(times['before'][k]):.0f} | {1000 * np.median(times['after'][k]):.0f} "
+                                 f"| {np.median(ratio):.2f} ({np.percentile(ratio, 25):.2f}-{np.percentile(ratio, 75):.2f})")
+                print(f"| {name} | {size} | {sum(len(x) for _, x, _, _ in inputs)} | {' | '.join(cells)} | "
+                      f"{'yes' if same else 'NO'} |", flush=True)
 
 
 def main():
@@ -170,6 +249,7 @@ def main():
     parser.add_argument("--tree", type=Path, default=Path(__file__).resolve().parent.parent,
                         help="root of the version compared (after; default: this checkout)")
     parser.add_argument("--rounds", type=int, default=5)
+    parser.add_argument("--shadow-step", type=Path, help="root of the version whose shadow step to compare with")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
@@ -177,6 +257,9 @@ def main():
         return
     if args.against:
         _against(args)
+        return
+    if args.shadow_step:
+        _shadow_step(args)
         return
     if args.profile:
         size = args.sizes[0]

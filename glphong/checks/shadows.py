@@ -24,6 +24,13 @@ texel's centre (half a texel diagonal away) too.
 The ring is a sampling of the disc of radius ``rho``: a shadow boundary that enters the disc and leaves it between
 two neighbouring ring rays without crossing the centre ray (a caster thinner than ``rho`` at that distance) is not
 seen.  The test scenes have none.
+
+What is cast (docs/speed.md, "Verify against the render"): the centre rays first; where one is neither clear nor
+blocked the point is in the band whatever its ring meets, and the ring is not cast; rays proven clear without a cast
+(`_clear_without_a_cast`) are not cast either.  Both leave the visibility and the band as casting every ray would.
+Embree's first hits are read as trimesh's ``intersects_id`` reads them, bit for bit, without its wrapper's copies
+(`_first_hits`), and the points and rays are taken in chunks (`CHUNK_POINTS`, `CHUNK`) whose temporaries stay small
+(below the C allocator's threshold for fresh pages from the kernel, and in cache).
 """
 import numpy as np
 import trimesh
@@ -37,6 +44,10 @@ __all__ = ["shadow_visibility", "shadow_plane_angle", "shadow_plane_length", "sh
 SHADOW_QUANTUM = 16 * 2.0 ** -24
 #: rays around the centre one
 RING = 8
+#: rays `_first_hits` casts at once
+CHUNK = 1 << 14
+#: points `shadow_visibility` takes at once (nine rays each)
+CHUNK_POINTS = 1 << 11
 
 
 def shadow_plane_angle(d, c, offset):
@@ -60,7 +71,8 @@ def shadow_bias(plane, scale):
 
 
 def _caster_mesh(scene):
-    """One trimesh of every caster's triangles in world space (cached on the scene per set of objects)."""
+    """One trimesh of every caster's triangles in world space (cached on the scene per set of objects, with each
+    receiver's `_cull`)."""
     casters = tuple(obj for obj in scene.objects if obj.casts_shadow)
     cached = getattr(scene, "_shadow_casters", None)
     if cached is not None and cached[0] == tuple(id(o) for o in casters):
@@ -72,7 +84,7 @@ def _caster_mesh(scene):
         offset += len(obj.mesh.positions)
     mesh = trimesh.Trimesh(np.concatenate(vertices), np.concatenate(faces), process=False) if casters else None
     intersector = None if mesh is None else _intersector(mesh)
-    scene._shadow_casters = (tuple(id(o) for o in casters), intersector)
+    scene._shadow_casters = (tuple(id(o) for o in casters), intersector, {})
     return intersector
 
 
@@ -93,40 +105,118 @@ def _intersector(mesh):
                           "pip install 'glphong[shadows]'") from None
 
 
+def _unitize(directions):
+    """``trimesh.util.unitize`` of rows (N, 3), bit for bit: its sums of squares in its order (``(x^2 + y^2) + z^2``,
+    by `dot`, without its BLAS call), the same reciprocal of the norms above its zero and the same product."""
+    norm = np.sqrt(dot(directions, directions))
+    valid = norm > trimesh.util.TOL_ZERO
+    norm[valid] **= -1
+    return directions * norm[:, None]
+
+
+def _faces(intersector, origin=None):
+    """Each caster triangle's first corner and unit normal, (F, 3) float64 each, as ``mesh.triangles[:, 0]`` and
+    ``mesh.face_normals`` hold them; with ``origin`` (3,), also ``planes_lines``' offset ``(corner - origin) .
+    normal`` of each triangle's plane, (F,) (`dot`: its order and rounding).  Cached on the intersector (the offsets
+    of the last 8 origins)."""
+    faces = getattr(intersector, "_glphong_faces", None)
+    if faces is None:
+        mesh = intersector.mesh
+        faces = intersector._glphong_faces = (np.ascontiguousarray(mesh.triangles[:, 0, :]),
+                                              np.ascontiguousarray(mesh.face_normals), {})
+    corner, normal, offsets = faces
+    if origin is None:
+        return corner, normal
+    key = origin.tobytes()
+    offset = offsets.get(key)
+    if offset is None:
+        if len(offsets) >= 8:
+            offsets.clear()
+        offset = offsets[key] = dot(corner - origin, normal)
+    return corner, normal, offset
+
+
+def _repeated(intersector, row, count):
+    """``count`` rows (count, 3) of ``row`` (1, 3) float32, from a block of `CHUNK` rows cached on the intersector."""
+    block = getattr(intersector, "_glphong_origins", None)
+    if block is None or len(block) < count or block[0].tobytes() != row[0].tobytes():
+        block = intersector._glphong_origins = np.repeat(row, max(count, CHUNK), axis=0)
+    return block[:count]
+
+
 def _first_hits(intersector, origins, directions):
+    """`_first_hits_of` in chunks of `CHUNK` rays (each ray's arithmetic is its own: the same bits, with small
+    temporaries)."""
+    origins = np.asarray(origins, dtype=np.float64)
+    if len(directions) <= CHUNK:
+        return _first_hits_of(intersector, origins, directions)
+    out = np.empty(len(directions))
+    for a in range(0, len(directions), CHUNK):
+        b = a + CHUNK
+        out[a:b] = _first_hits_of(intersector, origins if origins.ndim == 1 else origins[a:b], directions[a:b])
+    return out
+
+
+def _first_hits_of(intersector, origins, directions):
     """Distance along each ray to its first hit (inf where none), float64 (N,).
 
-    With Embree, trimesh's ``intersects_id`` first-hit path, step by step and bit for bit (the directions unitized by
-    trimesh, one query of its Embree scene, the hit's float64 point on the triangle's plane by
-    ``trimesh.intersections.planes_lines``), without its copies of every ray (a ray-offset array, the live rays'
-    gather, the stuck-ray bookkeeping) that a single first hit does not use, and without gathering the rays where
-    every one hit (each ray a shadow test casts ends on a caster, nearly always)."""
-    out = np.full(len(origins), np.inf)
-    if intersector is None or not len(origins):
+    ``origins`` (N, 3), or (3,) for one point every ray starts from; ``directions`` (N, 3).  With Embree, trimesh's
+    ``intersects_id`` first-hit path, step by step and bit for bit: the directions unitized as trimesh does
+    (`_unitize`), one query of its Embree scene with its float32 origins and directions, and the hit's float64 point
+    on the reported triangle's plane as ``trimesh.intersections.planes_lines`` forms it (its row dot products, a
+    BLAS product with ones, are the sequential sums of `dot`; a line within 1e-5 of the plane is no hit).  Without
+    trimesh's copies of every ray, gathers where every ray hit, and with one origin the origin's offset to each
+    triangle's plane formed once per triangle, not once per ray."""
+    out = np.full(len(directions), np.inf)
+    if intersector is None or not len(directions):
         return out
     origins = np.asarray(origins, dtype=np.float64)
+    one = origins.ndim == 1
     if not type(intersector).__module__.endswith("ray_pyembree"):  # trimesh's float64 intersector
+        origins = np.broadcast_to(origins, directions.shape)
         _, ray, location = intersector.intersects_id(origins, directions, multiple_hits=False, return_locations=True)
         start, toward = origins[ray], directions[ray]
+        if one:
+            start = origins[0]
+        ordered = False
     else:
-        unit = trimesh.util.unitize(np.asarray(directions, dtype=np.float64))
-        triangle = intersector._scene.run(origins, unit)
+        unit = _unitize(np.asarray(directions, dtype=np.float64))
+        embree = intersector._scene  # trimesh's wrap of the Embree scene: its offset, scale and the scene
+        scaled = ((origins.reshape(-1, 3) - embree.origin) * embree.scale).astype(np.float32)
+        if one:  # the same float32 origin in every row
+            scaled = _repeated(intersector, scaled, len(unit))
+        triangle = embree.scene.run(scaled, unit.astype(np.float32))
         every = bool(np.all(triangle != -1))
-        ray = np.arange(len(origins)) if every else np.nonzero(triangle != -1)[0]
-        start, unit = (origins, unit) if every else (origins[ray], unit[ray])
-        mesh = intersector.mesh
+        ray = np.arange(len(unit)) if every else np.nonzero(triangle != -1)[0]
         hit = triangle if every else triangle[ray]
-        location, valid = trimesh.intersections.planes_lines(mesh.triangles[hit, 0, :], mesh.face_normals[hit],
-                                                             start, unit)
-        toward = directions if every else directions[ray]
+        if not every:
+            unit = np.take(unit, ray, axis=0)
+        start = origins if one or every else np.take(origins, ray, axis=0)
+        if one:  # planes_lines' (corner - origin) . normal, once per triangle
+            _, normal, offset = _faces(intersector, origins)
+            normal, offset = np.take(normal, hit, axis=0), np.take(offset, hit)
+        else:
+            corner, normal = _faces(intersector)
+            normal = np.take(normal, hit, axis=0)
+            offset = dot(np.take(corner, hit, axis=0) - start, normal)
+        along = dot(unit, normal)
+        valid = np.abs(along) > 1e-5
+        toward = directions if every else np.take(directions, ray, axis=0)
         if not valid.all():
-            ray, start, toward = ray[valid], start[valid], toward[valid]
+            ray, unit, toward, offset, along = ray[valid], unit[valid], toward[valid], offset[valid], along[valid]
+            start = start if one else start[valid]
+        ordered = every and len(ray) == len(out)  # each ray's hit, in order
+        location = unit * (offset / along)[:, None]
+        location += start
     if len(ray):
-        t = np.einsum("ij,ij->i", location - start, toward)
+        location -= start  # a fresh array: from here the hit's offset from the ray's origin
+        t = np.einsum("ij,ij->i", location, toward)
         keep = t > 0.0
+        if ordered and keep.all():  # every ray hit, each once, in order
+            return t
         rays = ray[keep]
         if np.all(rays[1:] > rays[:-1]):  # each ray once, in order (Embree's first hits): a plain assignment
-            out[rays] = np.minimum(out[rays], t[keep])
+            out[rays] = t[keep]
         else:
             np.minimum.at(out, rays, t[keep])
     return out
@@ -172,42 +262,69 @@ def _flat(obj):
     return n, 0.5 * float(height.max() + height.min()), thickness + tilt * 1e-5 * size + 1e-12 * size
 
 
-def _clear_without_a_cast(scene, receiver, origins, directions, threshold):
+def _cull(scene, receiver):
+    """What `_clear_without_a_cast` proves rays clear by, for the points of ``receiver``: ``(flat, spheres, size)``,
+    the receiver's `_flat` slab (None where it casts no shadow), every other caster's bounding sphere ``(centre,
+    radius)`` and the largest ``|coordinate|`` of their vertices; None where nothing is proven (no receiver, more than 8
+    other casters, or a receiver that casts shadows and is not flat)."""
+    others = [obj for obj in scene.objects if obj.casts_shadow and obj is not receiver]
+    flat = _flat(receiver) if receiver is not None and receiver.casts_shadow else None
+    if receiver is None or len(others) > 8 or (receiver.casts_shadow and flat is None):
+        return None
+    vertices = [_world_vertices(obj) for obj in others]
+    spheres = []
+    for v in vertices:
+        centre = 0.5 * (v.max(axis=0) + v.min(axis=0))
+        spheres.append((centre, float(np.max(np.linalg.norm(v - centre, axis=1))) * (1.0 + 1e-9)))
+    return flat, spheres, max([float(np.max(np.abs(v))) for v in vertices], default=0.0)
+
+
+def _clear_without_a_cast(cull, origins, directions, threshold):
     """Rays that provably meet no caster nearer than ``threshold`` (their first hit, whichever triangle Embree
-    reports, no nearer), so that casting them would find them clear: (RING + 1, N) bool.
+    reports, no nearer), so that casting them would find them clear: (R, N) bool, for rays of ``origins`` (R, N, 3)
+    or (3,), ``directions`` (R, N, 3) and ``threshold`` (R, N), by ``cull`` (`_cull`; None: none).
 
     Where the receiver casts shadows it must be flat (`_flat`): a ray meets it only in its slab, at ``t_r +-
     slack / |n.u|`` from ``t_r``, the distance to its plane, which must lie beyond the threshold (the receiver's own
     plane at ``x`` is the tangent plane the threshold is measured from, less ``p + q``).  Every other caster must
     keep its bounding sphere off the segment from the ray's origin to the threshold, the sphere widened by 5 % of the
-    scene's size: the distance trimesh reports is to the plane of the triangle Embree's float32 says the ray hits,
-    which a ray down to ``|u.n| = 1e-5`` (trimesh's cut) meets up to ``1e5`` float32 errors (``3e-7`` of the size)
-    away from the triangle.  At most 8 other casters are tested (beyond, nothing is proven)."""
-    others = [obj for obj in scene.objects if obj.casts_shadow and obj is not receiver]
-    flat = _flat(receiver) if receiver is not None and receiver.casts_shadow else None
-    if receiver is None or len(others) > 8 or (receiver.casts_shadow and flat is None):
+    scene's size (the casters' and these rays' origins' largest coordinate): the distance trimesh reports is to the
+    plane of the triangle Embree's float32 says the ray hits, which a ray down to ``|u.n| = 1e-5`` (trimesh's cut)
+    meets up to ``1e5`` float32 errors (``3e-7`` of the size) away from the triangle.  At most 8 other casters are
+    tested (beyond, nothing is proven)."""
+    if cull is None:
         return np.zeros(threshold.shape, bool)
+    flat, spheres, size = cull
     proven = np.isfinite(threshold) & (threshold > 0.0)
     limit = threshold * (1.0 + 1e-9)
-    vertices = [_world_vertices(obj) for obj in others]
-    one = origins.ndim == 1 or not any(origins.strides[:-1])  # the light's position for every ray (a cube map)
-    size = max([float(np.max(np.abs(v))) for v in vertices]
-               + [float(np.max(np.abs(origins[(0,) * (origins.ndim - 1)] if one else origins)))])
-    origins = np.broadcast_to(origins, threshold.shape + (3,))
-    directions = np.broadcast_to(directions, threshold.shape + (3,))
+    size = max(size, float(np.max(np.abs(origins))))
     with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         if flat is not None:
             n, c, slack = flat
-            cos = np.abs(dot(directions, n))
-            t = (c - dot(origins, n)) / dot(directions, n)
+            along = dot(directions, n)
+            cos = np.abs(along)
+            t = (c - dot(origins, n)) / along
             proven &= (cos > 1e-6) & (t - slack / cos >= limit)
-        for v in vertices:
-            centre = 0.5 * (v.max(axis=0) + v.min(axis=0))
-            radius = float(np.max(np.linalg.norm(v - centre, axis=1))) * (1.0 + 1e-9) + 0.05 * size
+        for centre, radius in spheres:
+            radius = radius + 0.05 * size
             w = centre - origins
             along = np.clip(dot(w, directions), 0.0, limit)
-            proven &= dot(w - along[..., None] * directions, w - along[..., None] * directions) > radius * radius
+            off = w - along[..., None] * directions
+            proven &= dot(off, off) > radius * radius
     return proven & np.isfinite(limit)
+
+
+def _cast(intersector, origins, directions, which, hits):
+    """`_first_hits` of the rays ``which`` (R, N) bool, of ``origins`` (R, N, 3) or (3,) and ``directions`` (R, N,
+    3), into ``hits`` (R, N) there (each ray is cast on its own: which others go with it changes nothing)."""
+    if which.all():
+        hits[...] = _first_hits(intersector, origins if origins.ndim == 1 else origins.reshape(-1, 3),
+                                np.ascontiguousarray(directions).reshape(-1, 3)).reshape(hits.shape)
+    elif which.any():
+        rays = np.flatnonzero(which)
+        np.put(hits, rays, _first_hits(
+            intersector, origins if origins.ndim == 1 else np.take(origins.reshape(-1, 3), rays, axis=0),
+            np.take(np.ascontiguousarray(directions).reshape(-1, 3), rays, axis=0)))
 
 
 def shadow_visibility(scene, setup, position, normal, filter_radius, receiver=None):
@@ -232,62 +349,79 @@ def shadow_visibility(scene, setup, position, normal, filter_radius, receiver=No
     exact, low, high : (N,) float64 ndarray
         The ray-cast visibility (0 or 1) and the interval the shadow map's may lie in (the exact value where
         certain, [0, 1] in the band).
+
+    Notes
+    -----
+    The points are taken `CHUNK_POINTS` at a time (each point's arithmetic is its own: the same bits, with small
+    temporaries).  The centre rays are cast first; where one is neither clear nor blocked, the point is in
+    the band whatever its ring rays meet, and they are not cast.
     """
     intersector = _caster_mesh(scene)
+    culls = scene._shadow_casters[2]  # per receiver, dropped with the casters
+    if id(receiver) not in culls:
+        culls[id(receiver)] = _cull(scene, receiver)
+    cull = culls[id(receiver)]
+    exact, certain = np.zeros(len(position)), np.zeros(len(position), bool)
+    for a in range(0, len(position), CHUNK_POINTS):
+        b = a + CHUNK_POINTS
+        exact[a:b], certain[a:b] = _visibility(intersector, cull, setup, position[a:b], normal[a:b], filter_radius)
+    return exact, np.where(certain, exact, 0.0), np.where(certain, exact, 1.0)
+
+
+def _visibility(intersector, cull, setup, position, normal, filter_radius):
+    """`shadow_visibility` of points (N, 3) and normals (N, 3): ``(exact, certain)``, (N,) float64 and bool."""
     n_points = len(position)
-    if not n_points:
-        empty = np.zeros(0)
-        return empty, empty, empty
     reach = (filter_radius + 0.5) * np.sqrt(2.0) * setup.texel  # the farthest texel centre the lookup reads
     band = (filter_radius * np.sqrt(2.0) + 1.0) * setup.texel  # the filter's radius plus one texel
     scale_x = np.max(np.abs(position), axis=1) + np.max(np.abs(setup.origin))
     if setup.map == "cube":
-        light = setup.origin
-        v = position - light
+        v = position - setup.origin
         d = np.linalg.norm(v, axis=1)
         with np.errstate(invalid="ignore", divide="ignore"):
             u = v / d[:, None]
         m = np.max(np.abs(u), axis=1)  # a cube texel along u subtends at most texel m (glsl/shadows.glsl)
-        reach, radius = reach * m, band * m
-        c = np.abs(dot(normal, u))
-        plane = shadow_plane_angle(d, c, reach)
-        ring, _ = _ring(u, radius)
-        origins = np.broadcast_to(light, (RING + 1, n_points, 3))
-        directions = np.concatenate([u[None], ring])
+        plane = shadow_plane_angle(d, np.abs(dot(normal, u)), reach * m)
+        origins, directions = setup.origin, u[None]  # every ray starts at the light
     else:
-        axis = setup.axis
-        d = (position - setup.origin) @ axis
-        c = np.abs(normal @ axis)
-        plane = shadow_plane_length(c, reach)
-        start = position - d[:, None] * axis
-        _, across = _ring(np.broadcast_to(axis, (n_points, 3)), np.full(n_points, band))
-        origins = np.concatenate([start[None], start[None] + band * across])
-        directions = np.broadcast_to(axis, (RING + 1, n_points, 3))
+        d = (position - setup.origin) @ setup.axis
+        plane = shadow_plane_length(np.abs(normal @ setup.axis), reach)
+        start = position - d[:, None] * setup.axis
+        origins, directions = start[None], np.broadcast_to(setup.axis, (1, n_points, 3))
     q = SHADOW_QUANTUM * (np.abs(d) + scale_x)
     bias = shadow_bias(plane, np.abs(d) + scale_x)
-    planes = _plane_distance(normal[None], position[None], origins, directions)
-    planes[0] = d
-    threshold = np.concatenate([(d - q)[None], planes[1:] - plane - q])  # clear where the first hit is no nearer
-    cast = ~_clear_without_a_cast(scene, receiver, origins, directions, threshold).reshape(-1)
-    rays = np.ascontiguousarray(directions).reshape(-1, 3)
-    starts = np.broadcast_to(setup.origin, rays.shape) if setup.map == "cube" else origins.reshape(-1, 3)
-    if cast.all():
-        hits = _first_hits(intersector, starts, rays)
-    else:  # a ray proven clear: as if it met nothing
-        hits = np.full(len(rays), np.inf)
-        hits[cast] = _first_hits(intersector, starts[cast], rays[cast])
-    hits = hits.reshape(RING + 1, n_points)
     # the centre ray reaches x unless something is nearer than d - q, and is blocked for the map by what is nearer
-    # than d - B; a ring ray reaches the receiver where nothing comes nearer than its distance to x's tangent plane
-    # less p + q (the neighbouring triangles' share of B: with x's own plane's p, the map cannot fall short of
-    # d - B), and is blocked where something does by more than B + p (so the map's texels within the filter's reach,
-    # whose own plane is at most p nearer than d, hold something nearer than d - B)
+    # than d - B
+    hits = np.full((1, n_points), np.inf)  # a ray proven clear: as if it met nothing
+    _cast(intersector, origins, directions, ~_clear_without_a_cast(cull, origins, directions, (d - q)[None]), hits)
+    clear = hits[0] >= d - q
+    blocked = hits[0] < d - bias
+    # where the centre ray is neither, the point is in the band whatever the ring rays meet: they are not cast
+    certain = np.zeros(n_points, bool)
+    k = np.flatnonzero(clear | blocked)
+    if not len(k):
+        return clear.astype(np.float64), certain
+    k = slice(None) if len(k) == n_points else k
+    position, normal, plane, q, bias = position[k], normal[k], plane[k], q[k], bias[k]
+    if setup.map == "cube":
+        ring, _ = _ring(u[k], band * m[k])
+        origins, directions = setup.origin, ring
+        with np.errstate(divide="ignore", invalid="ignore"):  # the light's offset to x's plane is every ray's
+            t = dot(normal, v[k]) / dot(normal, ring)
+        planes = np.where(np.isfinite(t) & (t > 0.0), t, np.inf)  # `_plane_distance`, (RING, N)
+    else:
+        _, across = _ring(np.broadcast_to(setup.axis, (len(position), 3)), np.full(len(position), band))
+        origins = start[k][None] + band * across
+        directions = np.broadcast_to(setup.axis, origins.shape)
+        planes = _plane_distance(normal, position, origins, setup.axis)
+    # a ring ray reaches the receiver where nothing comes nearer than its distance to x's tangent plane less p + q
+    # (the neighbouring triangles' share of B: with x's own plane's p, the map cannot fall short of d - B), and is
+    # blocked where something does by more than B + p (so the map's texels within the filter's reach, whose own plane
+    # is at most p nearer than d, hold something nearer than d - B)
+    hits = np.full(planes.shape, np.inf)
+    _cast(intersector, origins, directions, ~_clear_without_a_cast(cull, origins, directions, planes - plane - q), hits)
     with np.errstate(invalid="ignore"):  # inf - inf where a ring ray meets neither the receiver's plane nor a caster
-        deficit = np.nan_to_num(planes - hits, nan=-np.inf)
-    clear = deficit <= plane + q
-    blocked = deficit > bias + plane
-    clear[0] = hits[0] >= d - q
-    blocked[0] = hits[0] < d - bias
-    exact = clear[0].astype(np.float64)
-    certain = np.all(clear, axis=0) | np.all(blocked, axis=0)
-    return exact, np.where(certain, exact, 0.0), np.where(certain, exact, 1.0)
+        deficit = planes - hits
+    np.nan_to_num(deficit, copy=False, nan=-np.inf)
+    certain[k] = ((clear[k] & np.all(deficit <= plane + q, axis=0))
+                  | (blocked[k] & np.all(deficit > bias + plane, axis=0)))
+    return clear.astype(np.float64), certain

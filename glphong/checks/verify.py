@@ -14,7 +14,12 @@ from glphong.gpu.peeling import blended_objects
 from glphong.gpu.transmission import transmissive_objects
 from glphong.gpu.renderer import Renderer
 
-__all__ = ["VerifyReport", "verify", "compare", "relative_error"]
+__all__ = ["VerifyReport", "verify", "compare", "relative_error", "TWIN_CHUNK"]
+
+#: pixels `twin_and_band` shades at once: their temporaries (a few hundred kB) stay below the C allocator's threshold
+#: for mapping fresh pages, which a whole object's (MBs) cross on every array (docs/speed.md, "Verify against the
+#: render")
+TWIN_CHUNK = 4096
 
 
 @dataclass(frozen=True)
@@ -326,7 +331,7 @@ def exact_image(scene, gbuffer, shadows=None, closed_forms=True, sample=None):
 
 def twin_and_band(scene, gbuffer, band=BAND, shadows=None):
     """The float64 twin of a G-buffer, its tolerance band and the shadow band, in one pass over the objects (the
-    shadowing lights' rays are cast once).
+    shadowing lights' rays are cast once), each object's pixels `TWIN_CHUNK` at a time.
 
     Returns
     -------
@@ -340,13 +345,20 @@ def twin_and_band(scene, gbuffer, band=BAND, shadows=None):
     ref = np.zeros(gbuffer.position.shape)
     low, high = np.zeros_like(ref), np.zeros_like(ref)
     shadow_band = np.zeros(gbuffer.mask.shape, bool)
+    ref_rows, low_rows, high_rows = (a.reshape(-1, 3) for a in (ref, low, high))  # rows of pixels, written by index
     for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, band=band, shadows=shadows):
-        # the lights' directions and irradiance, computed once for the twin and its band
-        lights = reference.incident_light(position, key, u, band=band) if key.num_lights else []
-        ref[selection] = reference.shade_point(position, f, n_valid, u.get("u_eye"), key, u, obj.material,
-                                               incident=lights)
-        low[selection], high[selection] = point_band(key, u, position, f, n_valid, obj.material, band, incident=lights)
+        pixels = np.flatnonzero(selection)  # in the order of the selection's pixels, as shade_inputs takes them
+        for a in range(0, len(pixels), TWIN_CHUNK):  # each pixel's arithmetic is its own: chunks change no bit
+            part = slice(a, a + TWIN_CHUNK)
+            here, frame, valid = (position, f, n_valid) if len(pixels) <= TWIN_CHUNK else \
+                (position[part], f.select(part), n_valid[part])
+            # the lights' directions and irradiance, computed once for the twin and its band
+            lights = reference.incident_light(here, key, u, band=band) if key.num_lights else []
+            ref_rows[pixels[part]] = reference.shade_point(here, frame, valid, u.get("u_eye"), key, u, obj.material,
+                                                           incident=lights)
+            low_rows[pixels[part]], high_rows[pixels[part]] = point_band(key, u, here, frame, valid, obj.material,
+                                                                         band, incident=lights)
         for v in f.visibility or ():
             if v is not None:
-                shadow_band[selection] |= v[1] != v[2]
+                shadow_band.reshape(-1)[pixels[v[1] != v[2]]] = True
     return ref, low, high, shadow_band

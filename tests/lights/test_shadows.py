@@ -19,6 +19,7 @@ import trimesh
 
 import glphong
 from glphong import primitives
+from glphong.checks import shadows
 from glphong.checks.shadows import shadow_visibility
 from glphong.shaders.binding import binding
 from glphong.shaders import assembly
@@ -260,13 +261,11 @@ def test_rays_not_cast_are_clear_and_change_nothing(name, kind, monkeypatch, glp
     """Rays to a flat receiver that provably meet nothing before their threshold are not cast
     (`_clear_without_a_cast`): cast anyway, each is clear (its first hit no nearer than the threshold), and verify's
     arrays are those of casting every ray, bit for bit."""
-    from glphong.checks import shadows
-
     proofs = []
     original = shadows._clear_without_a_cast
 
-    def record(scene, receiver, origins, directions, threshold):
-        proven = original(scene, receiver, origins, directions, threshold)
+    def record(cull, origins, directions, threshold):
+        proven = original(cull, origins, directions, threshold)
         shape = threshold.shape + (3,)
         proofs.append((np.broadcast_to(origins, shape)[proven], np.broadcast_to(directions, shape)[proven],
                        threshold[proven]))
@@ -280,8 +279,117 @@ def test_rays_not_cast_are_clear_and_change_nothing(name, kind, monkeypatch, glp
     intersector = shadows._caster_mesh(scene)
     for origins, directions, threshold in proofs:
         assert np.all(shadows._first_hits(intersector, origins, np.ascontiguousarray(directions)) >= threshold)
-    monkeypatch.setattr(shadows, "_clear_without_a_cast",
-                        lambda scene, receiver, o, d, threshold: np.zeros(threshold.shape, bool))
+    monkeypatch.setattr(shadows, "_clear_without_a_cast", lambda cull, o, d, threshold: np.zeros(threshold.shape, bool))
     every = glphong.verify(scene, renderer)
     for field in ("reference", "low", "high", "outside", "shadow_band"):
         assert np.array_equal(getattr(culled, field), getattr(every, field)), field
+
+
+def _embree():
+    """trimesh's Embree intersector (the test is skipped without embreex, the ``[shadows]`` extra)."""
+    return pytest.importorskip("trimesh.ray.ray_pyembree").RayMeshIntersector
+
+
+def _plain_hits(intersector, origins, directions):
+    """Each ray's first hit as trimesh's own first-hit query gives it (``intersects_id``): the distance along the
+    direction to the hit location, inf where none (or not ahead)."""
+    _, ray, location = intersector.intersects_id(origins, directions, multiple_hits=False, return_locations=True)
+    t = np.einsum("ij,ij->i", location - origins[ray], directions[ray])
+    out = np.full(len(origins), np.inf)
+    np.minimum.at(out, ray[t > 0.0], t[t > 0.0])
+    return out
+
+
+def _plain_visibility(scene, setup, position, normal, filter_radius):
+    """`shadow_visibility` as its rules read (the module's docstring), every one of the nine rays of every point cast
+    through trimesh's ``intersects_id`` on a fresh intersector: ``(exact, low, high)``."""
+    intersector = _embree()(shadows._caster_mesh(scene).mesh)
+    n_points = len(position)
+    reach = (filter_radius + 0.5) * np.sqrt(2.0) * setup.texel
+    band = (filter_radius * np.sqrt(2.0) + 1.0) * setup.texel
+    if setup.map == "cube":
+        v = position - setup.origin
+        d = np.linalg.norm(v, axis=1)
+        u = v / d[:, None]
+        m = np.max(np.abs(u), axis=1)
+        plane = shadows.shadow_plane_angle(d, np.abs(shadows.dot(normal, u)), reach * m)
+        ring, _ = shadows._ring(u, band * m)
+        origins = np.broadcast_to(setup.origin, (9, n_points, 3))
+        directions = np.concatenate([u[None], ring])
+    else:
+        d = (position - setup.origin) @ setup.axis
+        plane = shadows.shadow_plane_length(np.abs(normal @ setup.axis), reach)
+        start = position - d[:, None] * setup.axis
+        _, across = shadows._ring(np.broadcast_to(setup.axis, (n_points, 3)), np.full(n_points, band))
+        origins = np.concatenate([start[None], start[None] + band * across])
+        directions = np.broadcast_to(setup.axis, (9, n_points, 3))
+    scale = np.abs(d) + (np.max(np.abs(position), axis=1) + np.max(np.abs(setup.origin)))
+    q = shadows.SHADOW_QUANTUM * scale
+    bias = shadows.shadow_bias(plane, scale)
+    planes = shadows._plane_distance(normal[None], position[None], origins, directions)
+    hits = _plain_hits(intersector, np.ascontiguousarray(origins).reshape(-1, 3),
+                       np.ascontiguousarray(directions).reshape(-1, 3)).reshape(9, n_points)
+    with np.errstate(invalid="ignore"):
+        deficit = np.nan_to_num(planes - hits, nan=-np.inf)
+    clear, blocked = deficit <= plane + q, deficit > bias + plane
+    clear[0], blocked[0] = hits[0] >= d - q, hits[0] < d - bias
+    exact = clear[0].astype(np.float64)
+    certain = np.all(clear, axis=0) | np.all(blocked, axis=0)
+    return exact, np.where(certain, exact, 0.0), np.where(certain, exact, 1.0)
+
+
+@pytest.mark.parametrize("filter_radius", [0, 1])
+@pytest.mark.parametrize("name, kind", [("sphere over plane", "point"), ("sphere over plane", "spot"),
+                                        ("sphere over plane", "directional"), ("grazing", "point"),
+                                        ("grazing", "directional"), ("torus", "point"), ("box on box", "spot")])
+def test_visibility_is_every_ray_cast_plainly(name, kind, filter_radius, monkeypatch, glphong_make_renderer):
+    """`shadow_visibility` leaves rays out (proven clear, or the ring of a point whose centre ray is neither clear
+    nor blocked), takes the points in chunks and casts through Embree without trimesh's wrapper: its visibility and
+    band are, bit for bit, those of casting all nine rays of every point through trimesh's own first-hit query."""
+    monkeypatch.setattr(shadows, "CHUNK_POINTS", 701)  # several chunks (rows not in fours), a last one shorter
+    monkeypatch.setattr(shadows, "CHUNK", 997)
+    cast = []
+    original = shadows._first_hits
+    monkeypatch.setattr(shadows, "_first_hits", lambda i, o, d: cast.append(len(d)) or original(i, o, d))
+    scene = SCENES[name](kind)
+    renderer = glphong_make_renderer(96, 72, "egl", shadow_map_size=256, shadow_filter_radius=filter_radius)
+    gbuffer = renderer.gbuffer(scene)
+    points = 0
+    for index, obj in enumerate(scene.objects):
+        selection = gbuffer.object_index == index
+        key = renderer.program_key(scene, obj)
+        (setup,) = binding(scene).shadow_setups(key.lights, key.shadow_size)
+        position = gbuffer.position[selection].astype(np.float64)
+        face = gbuffer.face[selection].astype(np.float64)
+        face /= np.linalg.norm(face, axis=1)[:, None]
+        got = shadow_visibility(scene, setup, position, face, filter_radius, obj)
+        for a, b in zip(got, _plain_visibility(scene, setup, position, face, filter_radius)):
+            assert a.dtype == b.dtype and np.array_equal(a, b)
+        points += len(position)
+    assert 0 < sum(cast) <= 9 * points
+    if name == "sphere over plane":  # the floor's rays beside the sphere; the ring where the centre decides nothing
+        assert sum(cast) < 0.9 * 9 * points
+
+
+def test_first_hits_are_trimeshs(monkeypatch):
+    """`_first_hits` against trimesh's own first-hit query, bit for bit: rays from one point and from a point each,
+    misses, rays along the floor (trimesh's cut: a line within 1e-5 of a plane is no hit), in chunks."""
+    monkeypatch.setattr(shadows, "CHUNK", 999)
+    scene = sphere_over_plane("point")
+    intersector = shadows._caster_mesh(scene)
+    plain = _embree()(intersector.mesh)
+    rng = np.random.default_rng(7)
+    light = np.array([0.3, 0.2, 2.0])
+    directions = rng.normal(size=(5000, 3)) * [0.6, 0.6, 1.0] - [0.0, 0.0, 1.0]
+    origins = np.concatenate([np.broadcast_to(light, (2500, 3)), rng.uniform(-2.5, 2.5, (2500, 3))])
+    # grazing the floor (z = 0): from just above it, 1e-6 to 1e-4 off parallel
+    slope = np.geomspace(1e-6, 1e-4, 400)
+    graze_o = np.column_stack([np.full(400, -1.9), rng.uniform(-1.5, 1.5, 400), 2.0 * slope])
+    graze_d = np.column_stack([np.ones(400), np.zeros(400), -slope])
+    origins, directions = np.concatenate([origins, graze_o]), np.concatenate([directions, graze_d])
+    expected = _plain_hits(plain, origins, directions)
+    assert np.isinf(expected).sum() > 1000 and np.isfinite(expected).sum() > 1000
+    assert np.isinf(expected[-400:]).sum() > 50 and np.isfinite(expected[-400:]).sum() > 50
+    assert np.array_equal(shadows._first_hits(intersector, origins, directions), expected)
+    one = _plain_hits(plain, np.broadcast_to(light, (2500, 3)).copy(), directions[:2500])
+    assert np.array_equal(shadows._first_hits(intersector, light, directions[:2500]), one)
