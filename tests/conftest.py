@@ -123,6 +123,9 @@ def pyrender_check():
     ``GLPHONG_REQUIRE_BACKENDS`` names it."""
 
     def run(script, platform, timeout=600):
+        # glphong's verdict first: without the backend (no libOSMesa: Debian's Mesa 25.1 and newer), `import pyrender`
+        # itself fails inside PyOpenGL, before the script can report BackendUnavailable
+        require_backend(platform).release()
         env = {k: v for k, v in os.environ.items() if k != "PYOPENGL_PLATFORM"}
         out = subprocess.run([sys.executable, str(script), platform], capture_output=True, text=True, timeout=timeout,
                              env=env)

@@ -106,3 +106,26 @@ def test_vendor_files_named_by_the_environment_are_read_bounded(tmp_path, monkey
     assert found[str(good)] == ("libEGL_test.so.0", None)
     for path in (str(big), "/dev/zero"):
         assert found[path][0] is None and "more than 65536 bytes" in found[path][1]
+
+
+def test_osmesa_hints_agree_with_the_releases_tried():
+    """Where ``libosmesa6`` exists, as docs/install.md's table records it from installs on each release (issue 42):
+    Ubuntu 24.04, 25.10 and 26.04 keep it (Mesa 25.1.7, ``mesa-compat``) although their Mesa is 25.2 or newer;
+    Debian unstable has none.  The hints glphong prints said "Ubuntu 22.04 to 25.04" and "Mesa 25.1 and newer have
+    no OSMesa"; they now name the same releases as the table."""
+    from pathlib import Path
+
+    from glphong.gpu.contexts import PACKAGES, _install_hint
+
+    table = (Path(__file__).resolve().parent.parent / "docs" / "install.md").read_text(encoding="utf-8")
+    rows = {line.split("|")[1].strip(): line.split("|")[5] for line in table.splitlines()
+            if line.startswith(("| Debian", "| Ubuntu"))}
+    with_osmesa = [name for name, osmesa in rows.items() if "libosmesa6" in osmesa and "none" not in osmesa]
+    without = [name for name, osmesa in rows.items() if name not in with_osmesa]
+    assert [name.split(" (")[0] for name in with_osmesa] == [
+        "Debian 12", "Debian 13", "Ubuntu 22.04", "Ubuntu 24.04", "Ubuntu 25.04", "Ubuntu 25.10", "Ubuntu 26.04"]
+    assert [name.split(" (")[0] for name in without] == ["Debian unstable"]
+    hint = PACKAGES["osmesa"]["Debian/Ubuntu"]
+    assert "Debian 12 and 13, Ubuntu 22.04 to 26.04" in hint and "none in Debian unstable" in hint
+    assert "none in Debian unstable" in _install_hint("osmesa")
+    assert "Mesa 25.1 and newer have no OSMesa" not in _install_hint("osmesa")

@@ -36,8 +36,9 @@ def test_the_example_passes_outside_the_checkout(tmp_path):
     assert code == 0, output[-3000:]
     summary = output.strip().splitlines()[-1]
     assert " passed" in summary and "failed" not in summary
-    if os.environ.get("GLPHONG_REQUIRE_BACKENDS"):
-        assert "6 passed" in summary, summary  # 3 tests x 2 backends
+    required = {name.strip() for name in os.environ.get("GLPHONG_REQUIRE_BACKENDS", "").split(",") if name.strip()}
+    passed = int(summary.split(" passed")[0].split()[-1])
+    assert passed >= 3 * len(required), summary  # 3 tests on each required backend (EGL only where OSMesa is gone)
 
 
 def test_one_operator_in_the_glsl_fails_with_a_report(tmp_path):

@@ -55,17 +55,19 @@ SYSTEM_PACKAGES = {
     "egl": "libegl1 libegl-mesa0 libgl1-mesa-dri",
     "osmesa": "libosmesa6",
 }
-"""Debian/Ubuntu packages providing each backend (``libosmesa6`` exists only up to Mesa 25.0: Debian 12 and 13,
-Ubuntu up to 25.04)."""
+"""Debian/Ubuntu packages providing each backend (``libosmesa6``: Debian 12 and 13, Ubuntu 22.04 to 26.04, where
+Ubuntu's ``mesa-compat`` keeps Mesa 25.1's OSMesa; not Debian unstable, whose Mesa 25.1 and newer have none:
+docs/install.md)."""
 
 PACKAGES = {
     "egl": {"Debian/Ubuntu": "apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri",
             "Fedora": "dnf install libglvnd-egl mesa-libEGL mesa-dri-drivers",
             "conda-forge": "conda install -c conda-forge libegl (libglvnd's libEGL; Mesa's EGL vendor and drivers "
                            "come from the system packages above; not tried by this project)"},
-    "osmesa": {"Debian/Ubuntu": "apt-get install libosmesa6 (Mesa before 25.1 only: Debian 12 and 13, Ubuntu "
-                                "22.04 to 25.04)",
-               "Fedora": "dnf install mesa-libOSMesa (Fedora 42 and older: Mesa 25.1 removed OSMesa)",
+    "osmesa": {"Debian/Ubuntu": "apt-get install libosmesa6 (Debian 12 and 13, Ubuntu 22.04 to 26.04; none in "
+                                "Debian unstable, whose Mesa is 25.1 or newer)",
+               "Fedora": "dnf install mesa-libOSMesa (Mesa before 25.1; with Mesa 25.1 and newer, Fedora 42's updates "
+                         "and 43: dnf install mesa-compat-libOSMesa; not tried by this project)",
                "conda-forge": "conda install -c conda-forge mesalib (its builds of Mesa before 25.1; not tried by "
                               "this project)"},
 }
@@ -431,7 +433,7 @@ def _try_create(backend, require, device=None):
 def _install_hint(backend):
     hint = f"Debian/Ubuntu: apt-get install {SYSTEM_PACKAGES[backend]}"
     if backend == "osmesa":
-        hint += " (Mesa 25.1 and newer have no OSMesa: use EGL there)"
+        hint += " (none in Debian unstable, whose Mesa 25.1 and newer has no OSMesa: use EGL there)"
     return hint + "; other systems and what is missing here: glphong doctor"
 
 
