@@ -34,6 +34,7 @@ _ARGUMENTS = {
     "fresnel_grazing": lambda out: [str(out / "fresnel_grazing.png")],
     "textured_scene": lambda out: [str(out)],
     "transparency": lambda out: [str(out / "transparency.png")],
+    "gltf_layers": lambda out: [str(out / "gltf_layers.png")],
     "custom_material": lambda out: [str(out / "custom_material.png")],
     "custom_light": lambda out: [str(out / "custom_light.png")],
     "model_scene": lambda out: [str(EXAMPLES / "data" / "torus.obj"), str(out / "model_scene.png")],
