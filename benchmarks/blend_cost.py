@@ -13,13 +13,12 @@ Not measured: many small blended objects (each peel draws all of them), lights w
 Run:  python benchmarks/blend_cost.py [--repeats 9] [--backend egl] [--sizes 256 512] [--layers 1 2 4 8 16]
 """
 import argparse
-import statistics
 
 import numpy as np
 
 import glphong
 from glphong import primitives
-from glphong.core.timing import alternating_times
+from glphong.core.timing import alternating_times, quartiles_ms
 
 
 def scene(layers, blended):
@@ -33,12 +32,6 @@ def scene(layers, blended):
         out.add(primitives.plane(2.0, segments=4), glphong.Lambert(0.2 + 0.02 * k, alpha_blend=blend), pose=pose)
     out.add(primitives.plane(6.0, segments=8), glphong.Lambert(0.6))
     return out
-
-
-def quartiles(times):
-    """``(q1, median, q3)`` [ms] of a list of times [s]."""
-    q = statistics.quantiles(times, n=4) if len(times) > 1 else [times[0]] * 3
-    return tuple(1000.0 * v for v in (q[0], statistics.median(times), q[2]))
 
 
 def main():
@@ -59,7 +52,7 @@ def main():
                 times = alternating_times({"opaque": lambda: renderer.render(opaque),
                                            "blended": lambda: renderer.render(blended)},
                                           repeats=args.repeats, warmup=1)
-                (a1, a, a3), (b1, b, b3) = quartiles(times["opaque"]), quartiles(times["blended"])
+                (a1, a, a3), (b1, b, b3) = quartiles_ms(times["opaque"]), quartiles_ms(times["blended"])
                 print(f"| {size} | {layers} | {a:.1f} ({a1:.1f}-{a3:.1f}) | {b:.1f} ({b1:.1f}-{b3:.1f}) | "
                       f"{b / a:.2f} | {(b - a) / layers:.1f} |", flush=True)
 

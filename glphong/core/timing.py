@@ -2,7 +2,7 @@
 import statistics
 import time
 
-__all__ = ["median_seconds", "alternating_medians", "alternating_times", "progress_bar"]
+__all__ = ["median_seconds", "alternating_medians", "alternating_times", "quartiles_ms", "progress_bar"]
 
 
 def median_seconds(run, repeats=7, warmup=2):
@@ -41,6 +41,12 @@ def alternating_times(runs, repeats=7, warmup=2):
 def alternating_medians(runs, repeats=7, warmup=2):
     """Median wall time [s] of each of several callables (`alternating_times`), dict of str to float."""
     return {name: statistics.median(t) for name, t in alternating_times(runs, repeats, warmup).items()}
+
+
+def quartiles_ms(times):
+    """``(q1, median, q3)`` [ms] of a list of wall times [s] (all three the one time where there is one)."""
+    q = statistics.quantiles(times, n=4) if len(times) > 1 else [times[0]] * 3
+    return tuple(1000.0 * v for v in (q[0], statistics.median(times), q[2]))
 
 
 def progress_bar(total, enabled=True, unit="point"):
