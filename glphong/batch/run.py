@@ -325,8 +325,7 @@ def _render_missing(folder, submit, executor, workers, frames_per_task, bar):
         if own and executor is not None:
             executor.shutdown()
         if cluster is not None:
-            for closing in cluster:
-                closing.close()
+            cluster.close()  # the client, the cluster, then the Dask configuration (all three, whatever raises)
         if own or cluster is not None:
             folder.remove_partials()  # the workers are gone: no writer is left
     if failed:

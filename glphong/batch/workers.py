@@ -7,6 +7,7 @@ keeps and writes each atomically; `_local_dask` starts the local Dask cluster of
 Functions the pool runs (`_init_worker`, `_render_chunk`) are top-level functions of this module: a
 'spawn' worker unpickles them by their module path.
 """
+import contextlib
 import ctypes
 import multiprocessing
 import os
@@ -91,22 +92,42 @@ def _spawn_pool(workers):
                                initializer=_init_worker, initargs=(threads, os.getpid()))
 
 
+#: Dask settings of the local cluster of ``executor='dask'``: off or empty, what only a dashboard (this cluster has
+#: none) or someone debugging Dask would read, and what grew with a batch: the workers' statistical profiler (a stack
+#: sample every 10 ms, up to ``low-level-log-length`` one-second profiles: about 1.1 MiB a worker per 10^3 frames),
+#: the logs "for developers" (each connection's last ``low-level-log-length`` (1000) message batches: in the
+#: scheduler, which runs in this process, every task's arguments, a chunk's specs, sent to a worker, and each graph
+#: the client sent; the scheduler's transitions and events), and the system monitor's history (``log-length``
+#: (7200) samples, 0.5 s apart).  docs/long_runs.md has the figures.
+_DASK_SETTINGS = {"distributed.worker.profile.enabled": False,
+                  "distributed.admin.low-level-log-length": 0,
+                  "distributed.admin.system-monitor.log-length": 1}
+
+
 def _local_dask(workers):
-    """``((client, cluster), executor)``: a local Dask cluster of ``workers`` single-threaded processes, without a
-    dashboard and without the workers' statistical profiler (which nobody can see without a dashboard, and which
-    keeps up to ``distributed.admin.low-level-log-length`` (1000) one-second profiles of the task thread's stacks:
-    about 1.1 MiB a worker per 10^3 frames of a batch, until 1000 s of work, in docs/long_runs.md's soak)."""
+    """``(cluster, executor)``: a local Dask cluster of ``workers`` single-threaded processes, without a dashboard,
+    and without what only a dashboard or someone debugging Dask would read (`_DASK_SETTINGS`): the workers'
+    statistical profiler, and the logs that kept in this process the arguments of the tasks sent to each worker, its
+    last 1000 message batches (about 35 kB a task of 84 small specs: 0.47 MiB per 10^3 frames).  ``cluster`` is a
+    `contextlib.ExitStack`: its ``close()`` closes the client, then the cluster, then gives this process its Dask
+    configuration back.  The settings stay in it until then: the scheduler reads them again for a worker that
+    connects anew (one restarted, or one that lost its connection under load), and the nannies pass them to their
+    workers."""
     try:
         import dask
         from distributed import Client, LocalCluster
     except ImportError:
         raise ImportError("executor='dask' needs dask.distributed: pip install 'glphong[dask]'") from None
     threads = max(1, (os.cpu_count() or 1) // workers)
-    with dask.config.set({"distributed.worker.profile.enabled": False}):  # the nannies pass it to their workers
+    with contextlib.ExitStack() as starting:
+        starting.enter_context(dask.config.set(_DASK_SETTINGS))
         cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
                                env={"LP_NUM_THREADS": str(threads)})
-    client = Client(cluster)
-    return (client, cluster), client.get_executor(pure=False)  # a task writes files: never one result for two
+        starting.callback(cluster.close)
+        client = Client(cluster)
+        starting.callback(client.close)
+        running = starting.pop_all()  # started: closed by the caller, in reverse order
+    return running, client.get_executor(pure=False)  # a task writes files: never one result for two
 
 
 def _write_frame(frame, final, fmt):
