@@ -18,6 +18,8 @@
 //   that draws the object's surface (radiance, G-buffer, per-vertex), so the G-buffer covers what the radiance does.
 // NORMAL_MAP: n = surface_normal(shading_frame(n, tangent, uv), texture(u_normal_map_texture, uv).rgb, scale)
 //   (normal_map.glsl) where n is valid, before the G-buffer is written and before shading: both see the mapped normal.
+// HAS_UNPERTURBED: a radiance program keeps the frame before the map in unperturbed_frame (normal_map.glsl); a G-buffer
+//   program writes the normal before the map (n where there is none) at PLANE_UNPERTURBED_LOCATION.
 // HAS_FACE: the triangle's own normal, from the derivatives of the interpolated position (the slope of the shadow
 //   bias, shadows.glsl): a G-buffer plane, and shadow_face_normal when shading.
 // HAS_OBJECT: the G-buffer plane of the point in the object's own frame (xyz [m], w = 1), for the frame passes.
@@ -33,7 +35,7 @@
 //   1 (the layer): out = vec4(a L, a), a = u_alpha_blend: premultiplied, composited front to back by the blend unit
 //     (C += (1 - A) c, A += (1 - A) a); discarded at the end where z != z_k (this layer's depth), so textures are
 //     sampled in uniform control flow; 3: the same with a = u_alpha_blend * texture(u_alpha_blend_texture, uv).r.
-// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, HAS_FACE, HAS_OBJECT, NUM_LOD_TEXTURES,
+// Key defines read here: HAS_NORMAL, HAS_TANGENT, HAS_UV, HAS_COLOR, HAS_INPUTS, HAS_LOD, HAS_FACE, HAS_OBJECT, HAS_UNPERTURBED, NUM_LOD_TEXTURES,
 // WRITES_PLANES, PLANE_NORMAL, PLANE_OBJECT, PLANE_UV, PLANE_*_LOCATION, TWO_SIDED, OUTPUT_GBUFFER, OUTPUT_DISPLAY, SHADE_PER_VERTEX, NEEDS_VIEW, NORMAL_MAP, ALPHA_MASK,
 // GLTF_PBR_TRANSMISSION (a radiance program of a transmissive gltf_pbr, glphong/gpu/transmission.py): after shading,
 //   out += gltf_transmission_radiance(...) (transmission_thin.glsl), what lies behind the surface seen through it.
@@ -135,6 +137,9 @@ layout(location = PLANE_LOD_LOCATION) out vec4 out_lod;
 #if HAS_FACE
 layout(location = PLANE_FACE_LOCATION) out vec4 out_face;
 #endif
+#if HAS_UNPERTURBED
+layout(location = PLANE_UNPERTURBED_LOCATION) out vec4 out_unperturbed;
+#endif
 #else
 #if NEEDS_VIEW
 uniform vec4 u_eye;  // homogeneous eye (e, w): the view vector at x is normalize(e - w x)
@@ -196,9 +201,15 @@ void main()
     blend_alpha *= surface_texture(u_alpha_blend_texture, uv).r;  // in uniform control flow: implicit derivatives
 #endif
 #endif
+#if HAS_UNPERTURBED && OUTPUT_GBUFFER
+    out_unperturbed = vec4(n, 1.0);  // the normal before the map
+#endif
 #if NORMAL_MAP
     vec3 texel = surface_texture(u_normal_map_texture, uv);  // in uniform control flow: implicit derivatives
     ShadingFrame geometric = shading_frame(n, tangent, uv);
+#if HAS_UNPERTURBED && !OUTPUT_GBUFFER
+    unperturbed_frame = geometric;  // the frame before the map, for a term that needs 'unperturbed' (normal_map.glsl)
+#endif
     n = n_valid ? surface_normal(geometric.n, geometric.t, geometric.b, texel, u_normal_map_scale) : n;
 #endif
 #if HAS_FACE
@@ -242,7 +253,7 @@ void main()
 #else
     out_radiance = vec4(shade_point(v_position, shading_frame(n, tangent, uv), n_valid, u_eye), 1.0);
 #if defined(GLTF_PBR_TRANSMISSION) && !defined(ALPHA_BLEND) && !SHADE_PER_VERTEX  // transmission_thin.glsl
-    out_radiance.rgb += gltf_transmission_radiance(n, n_valid, v_position, u_eye);
+    out_radiance.rgb += gltf_transmission_radiance(shading_frame(n, tangent, uv), n_valid, v_position, u_eye);
 #endif
 #endif
 #endif

@@ -6,6 +6,10 @@
 // surface_normal(n, t, b, texel, scale) -> n' [unit], in the frame of the interpolated normal n and the tangent t,
 //   bitangent b of shading_frame() (b = sign(w) cross(n, t), glTF's); n itself where n' does not normalise (a texel
 //   of (0.5, 0.5, 0.5) with scale 0).  Called in main() with the texel sampled in uniform control flow.
+// unperturbed_frame (HAS_UNPERTURBED: a lit term needs 'unperturbed'): the ShadingFrame before the material's normal
+//   map, shading_frame(n, tangent, uv) of the interpolated normal, set by main() (mesh_fragment.glsl) before shading;
+//   read by a coat normal (materials/gltf_pbr.glsl), which KHR_materials_clearcoat takes on that frame.
+// Key defines read here: HAS_UNPERTURBED.
 
 vec3 surface_normal(vec3 n, vec3 t, vec3 b, vec3 texel, float scale)
 {
@@ -15,3 +19,7 @@ vec3 surface_normal(vec3 n, vec3 t, vec3 b, vec3 texel, float scale)
     float len;
     return safe_normalize(p, mapped, len) ? mapped : n;
 }
+
+#if defined(HAS_UNPERTURBED) && HAS_UNPERTURBED
+ShadingFrame unperturbed_frame;
+#endif

@@ -6,8 +6,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
+import glphong
 from glphong.gpu.contexts import BACKENDS
 
 # glphong's own pytest plugin (fixtures glphong_backend, glphong_context, glphong_renderer,
@@ -170,3 +172,24 @@ def load_example():
         spec.loader.exec_module(module)
         return module
     return load
+
+
+@pytest.fixture
+def lights_behind_scene():
+    """``build(glass, material, name='glass')``: a transmissive mesh ``glass`` drawn with ``material`` at the origin
+    over a Lambert floor 1 m below it, seen from above, lit from behind it (a point, a spot and a directional light
+    below or through it) and from in front (a point light): the transmission tests' scene for lights on both
+    sides."""
+    def build(glass, material, name="glass"):
+        camera = glphong.PerspectiveCamera.look_at((0.3, -0.4, 2.5), (0.0, 0.0, 0.0))
+        scene = glphong.Scene(camera, [glphong.PointLight((0.2, 0.1, -0.6), 5.0),
+                                       glphong.SpotLight((-0.3, 0.0, -0.8), (0.2, 0.0, 1.0), 2.0,
+                                                         outer_cone_angle=1.2),
+                                       glphong.DirectionalLight((0.1, 0.2, 1.0), 1.5),
+                                       glphong.PointLight((1.0, -1.0, 2.0), 20.0)])
+        pose = np.eye(4)
+        pose[2, 3] = -1.0
+        scene.add(glphong.primitives.plane(4.0, segments=4), glphong.Lambert(0.4), pose=pose, name="floor")
+        scene.add(glass, material, name=name)
+        return scene
+    return build

@@ -474,7 +474,8 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None, only
     f : ShadingFrame
         The G-buffer normal renormalised (mesh_fragment.glsl), and the frame built from the
         G-buffer's tangent and uv where the key reads them (`shading_frame`), with the surface
-        inputs from the G-buffer's uv, vertex colour and levels of detail (`material_inputs`).
+        inputs from the G-buffer's uv, vertex colour and levels of detail (`material_inputs`); where the key has
+        ``has_unperturbed``, ``f.unperturbed`` the frame of the G-buffer's normal before the normal map.
     n_valid : (N,) bool ndarray
     """
     height, width = gbuffer.mask.shape
@@ -496,6 +497,11 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None, only
         tangent = gbuffer.tangent[selection].astype(dtype) if key.has_tangent else None
         uv = gbuffer.uv[selection].astype(dtype) if key.has_uv else None
         f = shading_frame(n, tangent, uv, key)
+        unperturbed = None
+        if key.has_unperturbed:  # the frame before the normal map, for a term that needs it (mesh_fragment.glsl)
+            unperturbed = shading_frame(safe_normalize(gbuffer.unperturbed[selection].astype(dtype))[1], tangent, uv,
+                                        key)
+            f = replace(f, unperturbed=unperturbed)
         if key.inputs:
             color = gbuffer.color[selection].astype(np.float64) if key.has_color else None
             lod = gbuffer.lod[selection].astype(np.float64) if key.textured_inputs else None
@@ -505,7 +511,8 @@ def shade_inputs(scene, gbuffer, dtype=np.float64, band=None, shadows=None, only
                 inputs = material_inputs(uv64, color, lod, key, uniforms)
             else:  # the values and their intervals from one sampling of each texture
                 inputs, bounds = input_bounds(uv64, color, lod, key, uniforms, band)
-            f = type(f)(f.n, f.t, f.b, f.uv, {k: v.astype(dtype) for k, v in inputs.items()}, bounds)
+            f = type(f)(f.n, f.t, f.b, f.uv, {k: v.astype(dtype) for k, v in inputs.items()}, bounds,
+                        unperturbed=unperturbed)
         if key.shadow_slots:
             _, face, _ = safe_normalize(gbuffer.face[selection].astype(np.float64))  # the triangles' own normals
             f = replace(f, visibility=_visibility(scene, key, gbuffer.position[selection].astype(np.float64), face,

@@ -5,7 +5,10 @@ At each pixel whose nearest surface (the GPU's G-buffer) is transmissive, the tw
 (the shading twin, its diffuse weighted by ``1 - t``) what the surface transmits, transmission_thin.glsl function by
 function:
 
-    L_t = gltf_transmission_weight(n.v, c, m, t, ior) * B,   w = (1 - m) t (1 - F(n.v)) c
+    L_t = gltf_transmission_radiance(...) = gltf_transmission_weight(n.v, c, m, t, ior) * B * keep,
+    w = (1 - m) t (1 - max3(F(n.v))) c,  keep = gltf_transmission_layers(n.v, n.v) (the sheen's and the coat's)
+
+(`glphong.materials.gltf_transmission`'s twins compute the value, this module the band).
 
 ``B`` from the twin of the background: the scene without its transmissive objects, its G-buffer drawn by the GPU and
 shaded by the twin (``shade``: `glphong.checks.verify.twin_and_band`), which is the opaque surface the pixel's ray
@@ -16,7 +19,8 @@ means (`glphong.materials.gltf_transmission.background_levels`, in float64) at t
 of the lobe is measured apart (benchmarks/transmission_rough.py, docs/transmission.md).
 
 The band: ``w`` to ``(5 D + A) eps`` of ``(1 - m) t c`` (the Fresnel's slope in ``n.v`` is at most 5, ``n.v`` to ``D
-eps``; the chain's rounding ``A eps``), times the background's band: at roughness 0 the pixel's low and high, above 0
+eps``; the chain's rounding ``A eps``; the specular's interval where textured), times ``keep``'s interval
+(`_layers_bounds`), times the background's band: at roughness 0 the pixel's low and high, above 0
 the least and the greatest texel of the low and high pyramids that the lookup weights, on the two levels about the
 level of detail (and the one below where float32 may round it across an integer).
 """
@@ -30,10 +34,13 @@ from glphong.checks.reference import incident_light, safe_normalize, shade_input
 from glphong.checks.tolerances import BAND
 from glphong.definitions.surface import _bilinear
 from glphong.gpu.transmission import transmissive_objects
+from glphong.materials.gltf_coat_normal import gltf_clearcoat_normal
 from glphong.materials.gltf_diffuse_transmission import gltf_diffuse_transmission_response
 from glphong.materials.gltf_pbr import gltf_pbr_band
-from glphong.materials.gltf_transmission import (background_levels, gltf_transmission_lod, gltf_transmission_response,
-                                                 gltf_transmission_weight, gltf_volume_attenuation, gltf_volume_ray,
+from glphong.materials.gltf_transmission import (background_levels, gltf_transmission_fresnel,
+                                                 gltf_transmission_layers, gltf_transmission_lod,
+                                                 gltf_transmission_radiance, gltf_transmission_response,
+                                                 gltf_transmission_sample, gltf_volume_attenuation, gltf_volume_ray,
                                                  gltf_volume_uv)
 from glphong.scene.scene import Scene
 from glphong.twin.band import EPS
@@ -88,14 +95,13 @@ def background_lookup(levels, uv, lod):
     lod = np.minimum(np.asarray(lod, np.float64), top)
     d1 = np.floor(lod).astype(np.int64)
     frac = lod - d1
-    value = np.zeros((len(uv), levels[0].shape[2]))
+    value = gltf_transmission_sample(levels, uv, lod)  # the GPU's lookup (gltf_transmission)
     low = np.full(value.shape, np.inf)
     high = np.full(value.shape, -np.inf)
     for k in np.unique(d1):
         at = d1 == k
-        a, texels_a = _bilinear(levels[k], uv[at], "clamp")
-        b, texels_b = _bilinear(levels[min(k + 1, top)], uv[at], "clamp")
-        value[at] = (1.0 - frac[at])[:, None] * a + frac[at][:, None] * b
+        texels_a = _bilinear(levels[k], uv[at], "clamp")[1]
+        texels_b = _bilinear(levels[min(k + 1, top)], uv[at], "clamp")[1]
         spread = [texels_a, np.where((frac[at] > 0)[None, :, None], texels_b, texels_a)]
         near = np.abs(lod[at] - np.round(lod[at])) < 1e-4
         if k > 0 and near.any():
@@ -148,6 +154,7 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
     rough = np.zeros((height, width), bool)
     chosen = set(transmissive_objects(scene))
     pyramids = None
+    tol = band.D * EPS
     for selection, obj, key, u, position, f, n_valid in shade_inputs(scene, gbuffer, band=band):
         if int(gbuffer.object_index[selection][0]) not in chosen:
             continue
@@ -156,38 +163,37 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
         wo_valid, wo, _ = safe_normalize(eye[:3] - position * eye[3])
         valid = n_valid & wo_valid
         n_dot_v = np.einsum("ij,ij->i", f.n, wo)
-        c = _parameter("u_gltf_pbr_base_color", u, f, 3)
-        m = _parameter("u_gltf_pbr_metallic", u, f, 1)
         used = obj.material.extensions()  # transmission, diffuse_transmission or both (gltf_diffuse_transmission)
-        t = _parameter("u_gltf_pbr_transmission", u, f, 1) if "transmission" in used else np.zeros(len(f.n))
-        r = _parameter("u_gltf_pbr_roughness", u, f, 1)
-        ior = _parameter("u_gltf_pbr_ior", u, f, 1)
-        weight = gltf_transmission_weight(n_dot_v, c, m, t, ior)
+        p = _material(u, f, used)
+        if pyramids is None:  # GL row order: row 0 at the bottom
+            pyramids = [background_levels(reference[::-1])]
+        fragcoord = np.stack([columns + 0.5, height - 1 - rows + 0.5], axis=1)
+        volume = _volume(obj, u, f) if "volume" in used else None
+        value = gltf_transmission_radiance(pyramids[0], fragcoord, position, f.n, wo, valid, p, volume)
         # the weight's band: the Fresnel's slope in n.v (<= 5) times n.v's error, and the chain's rounding; the
-        # parameters' own intervals where textured
+        # parameters' own intervals where textured (F grows with specular and specular_color)
         c_lo, c_hi = _bounds("u_gltf_pbr_base_color", u, f, 3)
         m_lo, m_hi = _bounds("u_gltf_pbr_metallic", u, f, 1)
-        t_lo, t_hi = _bounds("u_gltf_pbr_transmission", u, f, 1) if "transmission" in used else (t, t)
+        t_lo, t_hi = _bounds("u_gltf_pbr_transmission", u, f, 1) if "transmission" in used else (p.t, p.t)
         slack = (5.0 * band.D + band.A) * EPS
-        fresnel = weight / np.maximum(c * ((1.0 - m) * t)[:, None], np.finfo(float).tiny)
-        w_lo = c_lo * ((1.0 - m_hi) * t_lo)[:, None] * np.maximum(fresnel - slack, 0.0)
-        w_hi = c_hi * ((1.0 - m_lo) * t_hi)[:, None] * (fresnel + slack)
-        lod = gltf_transmission_lod(r.astype(np.float32), ior.astype(np.float32), np.log2(width))
+        fr_lo, fr_hi = _one_minus_fresnel(u, f, used, p.ior, n_dot_v, n_dot_v, tol)
+        w_lo = c_lo * ((1.0 - m_hi) * t_lo)[:, None] * np.maximum(fr_lo - slack, 0.0)[:, None]
+        w_hi = c_hi * ((1.0 - m_lo) * t_hi)[:, None] * (fr_hi + slack)[:, None]
+        keep_lo, keep_hi = _layers_bounds(u, f, used, np.maximum(n_dot_v, 0.0), np.maximum(n_dot_v, 0.0), tol,
+                                          _coat_cosines(u, f, used, wo))
+        w_lo, w_hi = w_lo * keep_lo[:, None], w_hi * keep_hi[:, None]
+        lod = gltf_transmission_lod(p.r.astype(np.float32), p.ior.astype(np.float32), np.log2(width))
         is_rough = lod > 0
-        b = reference[rows, columns].copy()
         lo, hi = b_low[rows, columns].copy(), b_high[rows, columns].copy()
-        volume = "volume" in obj.material.extensions()
-        if (is_rough.any() or volume) and pyramids is None:  # GL row order: row 0 at the bottom
-            pyramids = [background_levels(a[::-1]) for a in (reference, b_low, b_high)]
+        if (is_rough.any() or volume) and len(pyramids) == 1:
+            pyramids += [background_levels(a[::-1]) for a in (b_low, b_high)]
         if volume:  # KHR_materials_volume (and _dispersion): the lookup where the exit point projects
-            b, lo, hi, is_rough = _through_volume(obj, u, f, position, wo, r, ior, pyramids, width)
+            lo, hi, is_rough = _through_volume(obj, u, f, position, wo, p.r, p.ior, pyramids, width)
         elif is_rough.any():
-            uv = np.stack([(columns[is_rough] + 0.5) / width, (height - 1 - rows[is_rough] + 0.5) / height], axis=1)
+            uv = fragcoord[is_rough] / np.array([width, height])
             level = lod[is_rough].astype(np.float64)
-            b[is_rough] = background_lookup(pyramids[0], uv, level)[0]
             lo[is_rough] = background_lookup(pyramids[1], uv, level)[1]
             hi[is_rough] = background_lookup(pyramids[2], uv, level)[2]
-        value = np.where(valid[:, None], weight * b, 0.0)
         ends = np.stack([w_lo * lo, w_lo * hi, w_hi * lo, w_hi * hi])
         scales = [(c_lo * ((1.0 - m_hi) * t_lo)[:, None], c_hi * ((1.0 - m_lo) * t_hi)[:, None])]
         diffuse = None
@@ -198,8 +204,7 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
             diffuse = (dt, c_dt)
             scales.append((cd_lo * ((1.0 - m_hi) * (1.0 - t_hi) * dt_lo)[:, None],
                            cd_hi * ((1.0 - m_lo) * (1.0 - t_lo) * dt_hi)[:, None]))
-        lights, lights_low, lights_high = _lights_behind(key, u, position, f.n, wo, valid, (c, m, t, r, ior),
-                                                        scales, band, used, diffuse)
+        lights, lights_low, lights_high = _lights_behind(key, u, f, position, wo, valid, p, scales, band, used, diffuse)
         out[rows, columns] = value + lights
         out_low[rows, columns] = np.where(valid[:, None], ends.min(axis=0), np.minimum(value, 0.0)) + lights_low
         out_high[rows, columns] = np.where(valid[:, None], ends.max(axis=0), np.maximum(value, 0.0)) + lights_high
@@ -208,22 +213,165 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
     return TransmissionTwin(out, out_low, out_high, pixels, rough, reference)
 
 
-def _lights_behind(key, u, position, n, wo, lit, parameters, scales, band, used=("transmission",), diffuse=None):
+def _material(u, f, used):
+    """The transmissive material's parameters at the fragments, as `gltf_transmission_radiance` reads them: ``c``,
+    ``m``, ``t`` (0 without KHR_materials_transmission), ``r``, ``ior``; ``specular`` ``(specular, specular_color)``
+    with KHR_materials_specular; ``layers``, `gltf_transmission_layers`' keywords for the sheen and the coat."""
+    n = len(f.n)
+    layers = {}
+    if "sheen" in used:
+        layers |= {"sheen_color": _parameter("u_gltf_pbr_sheen_color", u, f, 3),
+                   "sheen_roughness": _parameter("u_gltf_pbr_sheen_roughness", u, f, 1)}
+    if "clearcoat" in used:
+        layers["clearcoat"] = _parameter("u_gltf_pbr_clearcoat", u, f, 1)
+    if "clearcoat_normal" in used:  # the coat's own normal, on the unperturbed frame (gltf_coat_normal)
+        layers["coat_normal"] = _coat_normal(u, f, _parameter("u_gltf_pbr_clearcoat_normal", u, f, 3))
+    specular = (_parameter("u_gltf_pbr_specular", u, f, 1), _parameter("u_gltf_pbr_specular_color", u, f, 3)) \
+        if "specular" in used else None
+    film = _film(u, f, _parameter("u_gltf_pbr_iridescence", u, f, 1),
+                 _parameter("u_gltf_pbr_iridescence_thickness_mix", u, f, 1)) if "iridescence" in used else None
+    return SimpleNamespace(c=_parameter("u_gltf_pbr_base_color", u, f, 3), m=_parameter("u_gltf_pbr_metallic", u, f, 1),
+                           t=_parameter("u_gltf_pbr_transmission", u, f, 1) if "transmission" in used else np.zeros(n),
+                           r=_parameter("u_gltf_pbr_roughness", u, f, 1), ior=_parameter("u_gltf_pbr_ior", u, f, 1),
+                           specular=specular, layers=layers, film=film)
+
+
+def _coat_normal(u, f, texel):
+    """``n_c`` (N, 3) of the texel ``texel`` (N, 3) (`gltf_clearcoat_normal`, in float64)."""
+    scale = _parameter("u_gltf_pbr_clearcoat_normal_strength", u, f, 1)
+    return gltf_clearcoat_normal(f, SimpleNamespace(clearcoat_normal=texel, clearcoat_normal_strength=scale[0]),
+                                 np.dtype(np.float64))
+
+
+def _coat_cosines(u, f, used, wo):
+    """``(low, high)`` of the coat's cosine ``max(n_c.v, 0)`` (N,) each, over the corners of the coat normal's texel
+    interval where textured; None without a coat normal."""
+    if "clearcoat_normal" not in used:
+        return None
+    lo, hi = _bounds("u_gltf_pbr_clearcoat_normal", u, f, 3)
+    texels = [np.stack([(lo, hi)[i][:, k] for k, i in enumerate(index)], axis=1) for index in np.ndindex(2, 2, 2)]
+    cosines = [np.maximum(np.einsum("ij,ij->i", _coat_normal(u, f, texel), wo), 0.0) for texel in texels]
+    return np.min(cosines, axis=0), np.max(cosines, axis=0)
+
+
+def _volume(obj, u, f):
+    """KHR_materials_volume's (and _dispersion's) inputs of `gltf_transmission_radiance` for ``obj``'s fragments."""
+    return {"thickness": _parameter("u_gltf_pbr_thickness", u, f, 1),
+            "scale": np.linalg.norm(np.asarray(u["u_model"], np.float64)[:3, :3], axis=0),  # GLSL's u_model[k].xyz
+            "view_projection": np.asarray(u["u_view_projection"], np.float64),
+            "color": np.asarray(u["u_gltf_pbr_attenuation_color"], np.float64),
+            "distance": float(u["u_gltf_pbr_attenuation_distance"]),
+            "dispersion": float(u["u_gltf_pbr_dispersion"]) if "dispersion" in obj.material.extensions() else 0.0}
+
+
+def _one_minus_fresnel(u, f, used, ior, cos_low, cos_high, spread=0.0):
+    """``(low, high)`` of ``1 - max3(F)`` (`gltf_transmission_fresnel`), (N,) each: at ``cos_low`` with the greatest
+    specular and specular colour (F grows with both, falls with the cosine), at ``cos_high`` with the least; with the
+    film, `_one_minus_film` (``spread``: its cosine's own tolerance)."""
+    if "iridescence" in used:
+        return _one_minus_film(u, f, used, ior, cos_low, cos_high, spread)
+    if "specular" not in used:
+        return tuple(1.0 - gltf_transmission_fresnel(ior, c)[:, 0] for c in (cos_low, cos_high))
+    (s_lo, s_hi), (k_lo, k_hi) = (_bounds(name, u, f, k) for name, k in (("u_gltf_pbr_specular", 1),
+                                                                         ("u_gltf_pbr_specular_color", 3)))
+    return (1.0 - np.max(gltf_transmission_fresnel(ior, cos_low, s_hi, k_hi), axis=-1),
+            1.0 - np.max(gltf_transmission_fresnel(ior, cos_high, s_lo, k_lo), axis=-1))
+
+
+#: the float32 film's error, absolute in ``1 - max3(F')`` per unit ``iridescence`` (KHR_materials_iridescence over
+#: transmission): gltf_iridescence_fresnel's float32 chain (phases to 40 rad, the sensitivity's sums cancelling) moves
+#: max3(F_iridescence) by at most 3.2e-6 (the twin in float32 against float64, 10^5 random cosines, thicknesses to
+#: 1200 nm, film iors 1 to 2.3, base f0s), taken about 4 times (docs/transmission.md, "Layers over transmission")
+FILM_SLACK = 1.2e-5
+
+
+def _film(u, f, iridescence, thickness_mix):
+    """`gltf_transmission_fresnel`'s ``film`` mapping at the weight ``iridescence`` and ``thickness_mix`` (N,):
+    ``thickness = mix(minimum, maximum, thickness_mix)`` [nm] as gltf_transmission_fresnel forms it."""
+    low, high = (float(u[f"u_gltf_pbr_iridescence_thickness_{end}"]) for end in ("minimum", "maximum"))
+    return {"iridescence": iridescence, "iridescence_ior": _parameter("u_gltf_pbr_iridescence_ior", u, f, 1),
+            "thickness": low * (1.0 - thickness_mix) + high * thickness_mix}
+
+
+def _one_minus_film(u, f, used, ior, cos_low, cos_high, spread):
+    """``(low, high)`` of ``1 - max3(F')`` with KHR_materials_iridescence's film (`gltf_transmission_fresnel`), (N,)
+    each.  F' is not monotone in the cosine, the thickness or the film's base (the specular's, per channel), so the
+    band is first-order, as `glphong.definitions.material.MaterialModel.band`'s: the value at the parameters and the
+    cosine's middle, plus and minus twice the sum of its largest moves when each input alone goes to either end of its
+    interval (the cosine's moved ``spread`` each way; a textured parameter's interval, each channel of an rgb one
+    apart), widened by `FILM_SLACK` times the greatest weight."""
+    names = [("u_gltf_pbr_iridescence", 1), ("u_gltf_pbr_iridescence_thickness_mix", 1)]
+    if "specular" in used:
+        names += [("u_gltf_pbr_specular", 1), ("u_gltf_pbr_specular_color", 3)]
+    values = [np.array(_parameter(name, u, f, k)) for name, k in names]
+    boxes = [_bounds(name, u, f, k) for name, k in names]
+
+    def one_minus(c, inputs):
+        specular = inputs[2:] if "specular" in used else (None, None)
+        return 1.0 - np.max(gltf_transmission_fresnel(ior, c, *specular, _film(u, f, inputs[0], inputs[1])), axis=-1)
+
+    middle = 0.5 * (cos_low + cos_high)
+    value = one_minus(middle, values)
+    move = np.maximum(np.abs(one_minus(cos_low - spread, values) - value),
+                      np.abs(one_minus(cos_high + spread, values) - value))
+    for i, (low, high) in enumerate(boxes):
+        for channel in range(values[i].shape[1]) if values[i].ndim == 2 else (None,):
+            ends = []
+            for end in (low, high):
+                moved = list(values)
+                moved[i] = values[i].copy()
+                if channel is None:
+                    moved[i] = np.asarray(end, np.float64).copy()
+                else:
+                    moved[i][:, channel] = np.asarray(end, np.float64)[:, channel]
+                ends.append(np.abs(one_minus(middle, moved) - value))
+            move = move + np.maximum(*ends)
+    margin = 2.0 * move + FILM_SLACK * boxes[0][1]
+    return value - margin, value + margin
+
+
+def _layers_bounds(u, f, used, n_dot_v, n_dot_l, tol, coat=None):
+    """``(low, high)`` of `gltf_transmission_layers` (N,): the least and greatest over the corners of the sheen's and
+    the coat's parameter intervals and of the cosines moved ``tol`` each way (the coat's own cosine's interval
+    ``coat``, `_coat_cosines`, moved ``16 tol``: n_c's rounding), to ``8 eps`` relative (the table's lookup and the
+    products' rounding)."""
+    if "sheen" not in used and "clearcoat" not in used:
+        return np.ones(len(n_dot_v)), np.ones(len(n_dot_v))
+    boxes = [[{}]]
+    if "sheen" in used:
+        colors, roughs = _bounds("u_gltf_pbr_sheen_color", u, f, 3), _bounds("u_gltf_pbr_sheen_roughness", u, f, 1)
+        boxes.append([{"sheen_color": c, "sheen_roughness": r} for c in colors for r in roughs])
+    if "clearcoat" in used:
+        cosines = [{}] if coat is None else [{"coat_n_dot_v": np.clip(coat[0] - 16.0 * tol, 0.0, 1.0)},
+                                             {"coat_n_dot_v": np.clip(coat[1] + 16.0 * tol, 0.0, 1.0)}]
+        boxes.append([{"clearcoat": c} | k for c in _bounds("u_gltf_pbr_clearcoat", u, f, 1) for k in cosines])
+    corners = [{}]
+    for box in boxes:
+        corners = [a | b for a in corners for b in box]
+    values = [gltf_transmission_layers(np.clip(n_dot_v + dv, 0.0, 1.0), np.clip(n_dot_l + dl, 0.0, 1.0), **corner)
+              for corner in corners for dv in (-tol, tol) for dl in (-tol, tol)]
+    return np.min(values, axis=0) * (1.0 - 8.0 * EPS), np.max(values, axis=0) * (1.0 + 8.0 * EPS)
+
+
+def _lights_behind(key, u, f, position, wo, lit, p, scales, band, used=("transmission",), diffuse=None):
     """``(value, low, high)``, each (N, 3): what the punctual lights behind the surface send through it
     (`gltf_transmission_response` where ``used`` holds 'transmission', `gltf_diffuse_transmission_response` with
     ``diffuse = (dt, c_dt)`` where it holds 'diffuse_transmission', times E, where ``n.wi < 0``, the generated loops'
-    gate).  ``scales``: ``(low, high)`` of ``(1 - m) t c``, then of ``(1 - m) (1 - t) dt c_dt``.  The diffuse's band:
-    ``1 - F`` over ``v.h'``'s interval times ``n_dot_l`` to ``D eps``, the scale's and the irradiance's intervals, to
-    ``A eps``.  The band: the lobe ``D V
-    (n.l')`` by `glphong.materials.gltf_pbr.gltf_pbr_band` at the mirrored direction (a metal of base colour 1 is that
-    lobe alone; its directions to ``D + 4`` eps: the mirror's own rounding), times ``1 - F`` over ``v.h``'s interval
+    gate); ``p`` the material (`_material`).  ``scales``: ``(low, high)`` of ``(1 - m) t c``, then of ``(1 - m) (1 -
+    t) dt c_dt``.  The diffuse's band: ``1 - F`` over ``v.h'``'s interval times ``n_dot_l`` to ``D eps``, the scale's
+    and the irradiance's intervals, to ``A eps``.  The band: the lobe ``D V (n.l')`` by
+    `glphong.materials.gltf_pbr.gltf_pbr_band` at the mirrored direction (a metal of base colour 1 is that lobe alone;
+    its directions to ``D + 4`` eps: the mirror's own rounding), times ``1 - max3(F)`` over ``v.h``'s interval (and
+    the specular's, `_one_minus_fresnel`), times the layers' interval (`_layers_bounds` at ``n.v`` and ``n_dot_l``),
     and ``scale = (low, high)`` of ``(1 - m) t c``, times the light's irradiance interval, to ``A eps``; low 0 where
     ``|n.wi| <= D eps`` (the gate may go either way)."""
+    n = f.n
     value, low, high = (np.zeros((len(position), 3)) for _ in range(3))
-    c, m, t, roughness, ior = parameters
     scale = scales[0]
     tol = band.D * EPS
     wide = dataclasses.replace(band, D=band.D + 4.0)
+    n_dot_v = np.einsum("ij,ij->i", n, wo)
+    coat = _coat_cosines(u, f, used, wo)
     for valid, wi, irradiance, (e_low, e_high) in incident_light(position, key, u, band=band):
         n_dot_wi = np.einsum("ij,ij->i", n, wi)
         possible = lit & valid & (n_dot_wi < tol)
@@ -232,61 +380,66 @@ def _lights_behind(key, u, position, n, wo, lit, parameters, scales, band, used=
         certain = lit & valid & (n_dot_wi < -tol)
         n_dot_l = -n_dot_wi
         gate = (lit & valid & (n_dot_wi < 0.0))[:, None]
-        response = gltf_transmission_response(n, wi, wo, n_dot_l, c, m, t, roughness, ior) \
+        response = gltf_transmission_response(n, wi, wo, n_dot_l, p.c, p.m, p.t, p.r, p.ior, p.specular, p.layers,
+                                              p.film) \
             if "transmission" in used else np.zeros_like(value)
         value += np.where(gate, response * irradiance, 0.0)
         k = np.flatnonzero(possible)
         mirrored = wi[k] + (2.0 * n_dot_l[k])[:, None] * n[k]
-        lobe = SimpleNamespace(base_color=np.ones(3), metallic=np.ones(len(k)), roughness=roughness[k], ior=ior[k])
+        lobe = SimpleNamespace(base_color=np.ones(3), metallic=np.ones(len(k)), roughness=p.r[k], ior=p.ior[k])
         lobe_low, lobe_high = gltf_pbr_band(n[k], mirrored, wo[k], n_dot_l[k], lobe, wide)
         half = np.sqrt(np.einsum("ij,ij->i", mirrored + wo[k], mirrored + wo[k])) / 2.0
         spread = wide.D * EPS + 3.0 * EPS
-        f0 = ((ior[k] - 1.0) / (ior[k] + 1.0)) ** 2
-        one_minus = [1.0 - (f0 + (1.0 - f0) * np.maximum(1.0 - half + s, 0.0) ** 5) for s in (spread, -spread)]
+        one_minus = [1.0 - gltf_transmission_fresnel(p.ior[k], c)[:, 0] for c in (half - spread, half + spread)]
         rel = band.A * EPS
+        cancel = band.A * EPS  # 1 - F where F -> 1 (ior far above 1): F's own rounding, absolute, as the weight's slack
         if diffuse is not None:  # KHR_materials_diffuse_transmission (gltf_diffuse_transmission)
             dt, c_dt = diffuse
-            value += np.where(gate, gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior)
+            value += np.where(gate, gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, p.m, p.t, dt, p.ior)
                               * irradiance, 0.0)
             d_lo, d_hi = scales[1]
             cos_lo, cos_hi = np.maximum(n_dot_l[k] - tol, 0.0) / np.pi, (n_dot_l[k] + tol) / np.pi
-            lo = d_lo[k] * (np.maximum(one_minus[0], 0.0) * cos_lo)[:, None] * e_low[k] * (1.0 - rel)
-            hi = d_hi[k] * (one_minus[1] * cos_hi)[:, None] * e_high[k] * (1.0 + rel)
+            lo = d_lo[k] * (np.maximum(one_minus[0] - cancel, 0.0) * cos_lo)[:, None] * e_low[k] * (1.0 - rel)
+            hi = d_hi[k] * ((one_minus[1] + cancel) * cos_hi)[:, None] * e_high[k] * (1.0 + rel)
             low[k] += np.where(certain[k][:, None], lo, 0.0)
             high[k] += hi
         if "transmission" not in used:
             continue
+        if "specular" in used or "iridescence" in used:  # over the specular's interval too; the film's F'
+            sub = SimpleNamespace(n=n[k], inputs={q: v[k] for q, v in (f.inputs or {}).items()},
+                                  input_bounds={q: tuple(b[k] for b in v) for q, v in (f.input_bounds or {}).items()})
+            one_minus = list(_one_minus_fresnel(u, sub, used, p.ior[k], half - spread, half + spread))
+        keep_lo, keep_hi = _layers_bounds(u, f, used, np.maximum(n_dot_v, 0.0), n_dot_l, tol, coat)
         with np.errstate(invalid="ignore", over="ignore"):
-            lo = scale[0][k] * (np.maximum(one_minus[0], 0.0) * lobe_low[:, 0])[:, None] * e_low[k] * (1.0 - rel)
-            hi = scale[1][k] * (one_minus[1] * lobe_high[:, 0])[:, None] * e_high[k] * (1.0 + rel)
+            lo = scale[0][k] * (np.maximum(one_minus[0] - cancel, 0.0) * lobe_low[:, 0] * keep_lo[k])[:, None] \
+                * e_low[k] * (1.0 - rel)
+            hi = scale[1][k] * ((one_minus[1] + cancel) * lobe_high[:, 0] * keep_hi[k])[:, None] * e_high[k] \
+                * (1.0 + rel)
         low[k] += np.where(certain[k][:, None], np.nan_to_num(lo, nan=0.0), 0.0)
         high[k] += np.nan_to_num(hi, nan=np.inf, posinf=np.inf)
     return value, low, high
 
 
 def _through_volume(obj, u, f, position, wo, roughness, ior, pyramids, width):
-    """``(B, low, high, filtered)`` of a volume's fragments (transmission_thin.glsl's ``gltf_volume_light``, per channel
-    its own ior where the material disperses): the lookup of the background's pyramid where the exit point projects,
-    attenuated; the band the least and greatest texel the lookup may weight (the footprints at the exit's uv moved a
-    hundredth of a texel each way: float32 places it within that) times the attenuation to ``(A + 8 |y ln c|) eps``
-    relative (``y = d / distance``).  ``filtered``: where the level of detail is above 0."""
+    """``(low, high, filtered)`` of a volume's fragments' ``B`` (transmission_thin.glsl's ``gltf_volume_light``,
+    `glphong.materials.gltf_transmission.gltf_volume_light`, per channel its own ior where the material disperses):
+    the least and greatest texel the lookup may weight (the footprints at the exit's uv moved a hundredth of a texel
+    each way: float32 places it within that) times the attenuation to ``(A + 8 |y ln c|) eps`` relative (``y = d /
+    distance``).  ``filtered``: where the level of detail is above 0."""
     n = len(position)
-    thickness = _parameter("u_gltf_pbr_thickness", u, f, 1)
-    color = np.asarray(u["u_gltf_pbr_attenuation_color"], np.float64)
-    distance = float(u["u_gltf_pbr_attenuation_distance"])
-    scale = np.linalg.norm(np.asarray(u["u_model"], np.float64)[:3, :3], axis=0)  # GLSL's u_model[k].xyz: columns
-    view_projection = np.asarray(u["u_view_projection"], np.float64)
+    volume = _volume(obj, u, f)
+    color, distance = volume["color"], volume["distance"]
     etas = [ior]
-    if "dispersion" in obj.material.extensions():
-        half = (ior - 1.0) * 0.025 * float(u["u_gltf_pbr_dispersion"])
-        etas = [ior - half, ior, ior + half]
-    value, low, high = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
+    if volume["dispersion"]:
+        half = (ior - 1.0) * 0.025 * volume["dispersion"]
+        etas = [np.maximum(ior - half, 1.0), ior, ior + half]  # the red kept at 1 or above (transmission_thin.glsl)
+    low, high = np.zeros((n, 3)), np.zeros((n, 3))
     filtered = np.zeros(n, bool)
     size = np.array([pyramids[0][0].shape[1], pyramids[0][0].shape[0]], np.float64)
     for k, eta in enumerate(etas):
         channels = slice(None) if len(etas) == 1 else slice(k, k + 1)
-        ray = gltf_volume_ray(f.n, wo, eta, thickness, scale)
-        uv = gltf_volume_uv(position + ray, view_projection)
+        ray = gltf_volume_ray(f.n, wo, eta, volume["thickness"], volume["scale"])
+        uv = gltf_volume_uv(position + ray, volume["view_projection"])
         lod = gltf_transmission_lod(roughness.astype(np.float32), np.asarray(eta).astype(np.float32),
                                     np.log2(width)).astype(np.float64)
         filtered |= lod > 0
@@ -294,15 +447,13 @@ def _through_volume(obj, u, f, position, wo, roughness, ior, pyramids, width):
         with np.errstate(divide="ignore", invalid="ignore"):
             y = np.sqrt(np.einsum("ij,ij->i", ray, ray)) / distance
             slack = np.nan_to_num((16.0 + 8.0 * np.abs(y[:, None] * np.log(color))) * EPS, nan=0.0, posinf=0.0)
-        sampled = background_lookup(pyramids[0], uv, lod)[0]
         ends = []
         for dx, dy in ((0.0, 0.0), (-0.01, -0.01), (0.01, -0.01), (-0.01, 0.01), (0.01, 0.01)):
             moved = uv + np.array([dx, dy]) / size
             ends += [background_lookup(pyramids[1], moved, lod)[1], background_lookup(pyramids[2], moved, lod)[2]]
-        value[:, channels] = (sampled * attenuation)[:, channels]
         low[:, channels] = (np.min(ends, axis=0) * attenuation * (1.0 - slack))[:, channels]
         high[:, channels] = (np.max(ends, axis=0) * attenuation * (1.0 + slack))[:, channels]
-    return value, low, high, filtered
+    return low, high, filtered
 
 
 def transmission_check(scene, renderer, gbuffer, shade, band=BAND, exact=None):

@@ -240,6 +240,13 @@ class MaterialModel(Material, Definition):
 
     # ---- what the program key and the uniforms are made of (uniform_name, source, source_hash: `Definition`)
     @classmethod
+    def uniform_guard(cls, name):
+        """The define under which a program declares the uniform of parameter ``name``, or None (the default:
+        every program of the model declares it).  A model whose GLSL reads a parameter only under one of its
+        structural defines (`defines`, prefixed ``<MODEL>_``) may name that define."""
+        return None
+
+    @classmethod
     def uniform_declarations(cls):
         """The GLSL declarations of the model's uniforms, generated from `params` and `tables`; where the
         model has a `fresnel_slot`, also its Fresnel uniforms and ``vec3 <name>_fresnel(float c)``."""
@@ -247,10 +254,12 @@ class MaterialModel(Material, Definition):
         for p in cls.uniform_params():
             line = f"{p.glsl_type} {cls.uniform_name(p.name)};  // {p.kind} in {p.interval}{' [' + p.unit + ']' if p.unit else ''}"
             if p.textureable:  # a surface input: a global set per fragment by material_inputs() (key.py)
-                lines += [f"#if defined({surface_define(cls.name, p.name)})", f"{line}, per fragment: material_inputs()",
-                          "#else", f"uniform {line}", "#endif"]
+                entry = [f"#if defined({surface_define(cls.name, p.name)})", f"{line}, per fragment: material_inputs()",
+                         "#else", f"uniform {line}", "#endif"]
             else:
-                lines.append(f"uniform {line}")
+                entry = [f"uniform {line}"]
+            guard = cls.uniform_guard(p.name)
+            lines += [f"#if defined({guard})", *entry, "#endif"] if guard else entry
         lines += [f"uniform {t.glsl_type} {cls.uniform_name(t.name)};  // table {t.shape} x {t.channels}"
                   f"{' [' + t.unit + ']' if t.unit else ''}" for t in cls.tables]
         if cls.fresnel_slot is not None:

@@ -93,18 +93,25 @@ def _mesh(builder, mesh, material_index):
     return {"primitives": [{"attributes": attributes, "indices": indices, "material": material_index}]}
 
 
-def _texture(builder, image, cache):
+def _texture(builder, image, cache, alpha=None):
+    """The index of the glTF texture of ``image`` (written once); ``alpha`` ('r', 'g' or 'b'): an RGBA image whose
+    alpha (and colour) is that channel, for a field glTF reads from the alpha (``diffuseTransmissionTexture``)."""
     from PIL import Image
 
-    if image.digest in cache:
-        return cache[image.digest]
+    name = image.digest if alpha is None else (image.digest, alpha)
+    if name in cache:
+        return cache[name]
+    pixels = image.pixels8()
+    if alpha is not None:
+        grey = pixels[..., "rgb".index(alpha)]
+        pixels = np.stack([grey, grey, grey, grey], axis=-1)
     png = BytesIO()
-    Image.fromarray(image.pixels8()).save(png, format="PNG")
+    Image.fromarray(pixels).save(png, format="PNG")
     source = builder.append("images", {"bufferView": builder.view(png.getvalue()), "mimeType": "image/png"})
     sampler = builder.append("samplers", {
         "wrapS": _REPEAT if image.wrap == "repeat" else _CLAMP, "wrapT": _REPEAT if image.wrap == "repeat" else _CLAMP,
         "magFilter": _LINEAR, "minFilter": _LINEAR_MIPMAP_LINEAR if image.filter == "trilinear" else _LINEAR})
-    index = cache[image.digest] = builder.append("textures", {"source": source, "sampler": sampler})
+    index = cache[name] = builder.append("textures", {"source": source, "sampler": sampler})
     return index
 
 
@@ -125,7 +132,8 @@ def _base_color(material):
 def _material(builder, material, cache):
     stored = material_to_json(material, texture_index=lambda image: _texture(builder, image, cache))
     (term,) = material.components if len(material.components) == 1 else (None,)
-    fields = term.gltf_fields(lambda image: _texture(builder, image, cache)) if term is not None else None
+    fields = term.gltf_fields(lambda image, alpha=None: _texture(builder, image, cache, alpha)) \
+        if term is not None else None
     if fields is not None:  # a glTF material (GltfPBR): its own fields, as they are, for other viewers
         pbr, out = fields
     else:

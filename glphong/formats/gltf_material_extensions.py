@@ -7,8 +7,8 @@ validated with their JSON paths (`check_material_extensions`): ``KHR_materials_s
   specularColorTexture.rgb`` (sRGB);
 - ``clearcoat = clearcoatFactor * clearcoatTexture.r``, ``clearcoat_roughness = clearcoatRoughnessFactor *
   clearcoatRoughnessTexture.g`` (linear); ``clearcoatNormalTexture`` (linear, its ``scale``) is the coat's own normal
-  where the material has no ``normalTexture`` (`glphong.materials.gltf_coat_normal`); over a normal-mapped base the
-  coat takes the base's normal, and a coat normal other than it is named in a warning;
+  on the unperturbed frame, also over a ``normalTexture``, which perturbs the base alone (without it the coat keeps
+  the unperturbed normal; `glphong.materials.gltf_coat_normal`);
 - ``sheen_color = sheenColorFactor * sheenColorTexture.rgb`` (sRGB), ``sheen_roughness = sheenRoughnessFactor *
   sheenRoughnessTexture.a`` (linear); ``sheenColorFactor`` 0 (the default) disables the layer;
 - ``iridescence = iridescenceFactor * iridescenceTexture.r``, ``iridescence_thickness_mix = iridescenceThicknessTexture.g``
@@ -29,6 +29,7 @@ from glphong.materials import Texture
 from glphong.materials.gltf_coat_normal import COAT_NORMAL_PARAMS
 from glphong.materials.gltf_extensions import EXTENSION_PARAMS, EXTENSIONS
 from glphong.materials.gltf_diffuse_transmission import DIFFUSE_TRANSMISSION_EXCLUDES
+from glphong.materials.gltf_transmission import TRANSMISSION_EXCLUDES
 
 __all__ = ["MATERIAL_EXTENSIONS", "extension_arguments", "check_material_extensions", "extension_texture_infos",
            "tangent_frame_error"]
@@ -149,17 +150,10 @@ def extension_arguments(entry, texture, warn):
             factor = float(coat.get(factor_key, 0.0))
             image = texture(coat[key], False) if key in coat else None
             out[name] = Texture(image, factor, channel=channel) if image is not None else factor
-        base_normal = entry.get("normalTexture", {}).get("index")
-        coat_normal = coat.get("clearcoatNormalTexture", {}).get("index")
-        image = texture(coat["clearcoatNormalTexture"], False) if coat_normal is not None else None
-        if base_normal is None and image is not None:  # the coat's own normal on the unperturbed frame: exact
+        image = texture(coat["clearcoatNormalTexture"], False) if "clearcoatNormalTexture" in coat else None
+        if image is not None:  # the coat's own normal on the unperturbed frame, a normal-mapped base's too: exact
             out["clearcoat_normal"] = Texture(image, 1.0)
             out["clearcoat_normal_strength"] = float(coat["clearcoatNormalTexture"].get("scale", 1.0))
-        elif base_normal != coat_normal:  # a coat normal over a normal-mapped base: the base's (gltf_coat_normal)
-            warn("KHR_materials_clearcoat: glphong's coat takes the material's shading normal ("
-                 + ("its normalTexture" if base_normal is not None else "the unperturbed normal") + "), the file's coat "
-                 + (f"normal is texture {coat_normal}" if coat_normal is not None else "the unperturbed normal")
-                 + ("" if base_normal is None else ": a coat normal over a normal-mapped base is not drawn exactly"))
     sheen = extensions.get("KHR_materials_sheen")
     if sheen is not None and any(float(c) > 0 for c in sheen.get("sheenColorFactor", (0.0, 0.0, 0.0))):
         color = tuple(float(c) for c in sheen["sheenColorFactor"])  # all 0 (the default): the layer is disabled
@@ -183,22 +177,29 @@ def extension_arguments(entry, texture, warn):
 
 
 def _without_layers_over_transmission(out, warn):
-    """``out`` less the layers glphong does not draw over the light a surface lets through
-    (`DIFFUSE_TRANSMISSION_EXCLUDES`, refused by `glphong.GltfPBR` itself), each left out named in a warning: a
-    file's glass keeps its transmission, drawn without its coat, sheen, specular or film."""
-    through = [EXTENSIONS[n][0] for n in ("transmission", "diffuse_transmission")
-               if n in out and (isinstance(out[n], SurfaceInput) or float(out[n]) > 0)]
+    """``out`` less the layers glphong does not draw over the light a surface lets through, refused by `glphong.GltfPBR`
+    itself, each left out named in a warning: over KHR_materials_transmission none (`TRANSMISSION_EXCLUDES`: the
+    specular, sheen, coat, on its own normal too, and film are drawn); over KHR_materials_diffuse_transmission the
+    coat, sheen, specular and film (`DIFFUSE_TRANSMISSION_EXCLUDES`).  A file's glass keeps its transmission, drawn without them."""
+    def used(n):
+        return n in out and (isinstance(out[n], SurfaceInput) or float(out[n]) > 0)
+
+    through = [n for n in ("transmission", "diffuse_transmission") if used(n)]
     if not through:
         return out
+    excludes = set(TRANSMISSION_EXCLUDES) | (set(DIFFUSE_TRANSMISSION_EXCLUDES) if "diffuse_transmission" in through
+                                             else set())
     defaults = {p.name: p.default for p in EXTENSION_PARAMS}
     dropped = []
-    for name in DIFFUSE_TRANSMISSION_EXCLUDES:
+    for name in sorted(excludes, key=list(EXTENSIONS).index):
         keys = [k for k in EXTENSIONS[name][1] if k in out]
-        if any(isinstance(out[k], SurfaceInput) or np.any(np.asarray(out[k], np.float64) != defaults[k]) for k in keys):
+        differs = any(isinstance(out[k], SurfaceInput) or np.any(np.asarray(out[k], np.float64) != defaults[k])
+                      for k in keys)
+        if differs:
             dropped.append(EXTENSIONS[name][0])
         for key in keys + (["clearcoat_normal", "clearcoat_normal_strength"] if name == "clearcoat" else []):
             out.pop(key, None)
     if dropped:
-        warn(f"{' and '.join(through)} with {', '.join(dropped)}: glphong does not draw that layer over the light the "
-             "surface lets through, so it is left out (docs/gltf_extensions.md)")
+        warn(f"{' and '.join(EXTENSIONS[n][0] for n in through)} with {', '.join(dropped)}: glphong does not draw "
+             "that layer over the light the surface lets through, so it is left out (docs/gltf_extensions.md)")
     return out

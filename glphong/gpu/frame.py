@@ -140,6 +140,10 @@ class GBuffer:
     object_coordinates : (H, W, 3) float32 ndarray or None
         The covered point in its object's own frame [m] (the interpolated vertex position before the pose), where
         a frame pass asks for it (`glphong.gpu.passes`).
+    unperturbed : (H, W, 3) float32 ndarray or None
+        The unit normal before the material's normal map (``normal`` where the object's material has none), where a
+        drawn term needs ``'unperturbed'``: a coat normal over a normal-mapped `glphong.GltfPBR`, whose coat
+        KHR_materials_clearcoat takes on the unperturbed frame.
     """
 
     position: np.ndarray
@@ -152,6 +156,7 @@ class GBuffer:
     lod: np.ndarray = None
     face: np.ndarray = None
     object_coordinates: np.ndarray = None
+    unperturbed: np.ndarray = None
 
     @classmethod
     def from_planes(cls, position, normal, planes, copy=True):
@@ -161,7 +166,7 @@ class GBuffer:
         views of the given ones (strided: the frame passes gather their covered pixels from them), not C-ordered
         copies."""
         mask = position[..., 3] > 0.0
-        channels = {"tangent": 4, "uv": 2, "color": 3, "lod": 4, "face": 3, "object": 3}
+        channels = {"tangent": 4, "uv": 2, "color": 3, "lod": 4, "face": 3, "object": 3, "unperturbed": 3}
         keep = np.ascontiguousarray if copy else (lambda a: a)
         extra = {("object_coordinates" if name == "object" else name): keep(plane[..., :channels[name]])
                  for name, plane in planes.items()}

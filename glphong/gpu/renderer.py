@@ -22,7 +22,7 @@ from glphong.gpu.counters import track as _track
 from glphong.scene.culling import culling_decision
 from glphong.shaders.binding import binding
 from glphong.shaders.keys import EncodeKey
-from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, PASS_PLANES
+from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, MAX_GBUFFER_TARGETS, PASS_PLANES
 from glphong.shaders.numerics import NUMERICS
 from glphong.gpu.shadows import ShadowMaps
 from glphong.gpu.matte import MATTE_K, MATTE_SAMPLES, MAX_MATTE_K, MAX_MATTE_SAMPLES, TILE, Matte
@@ -31,7 +31,8 @@ from glphong.gpu.drawing import draw_objects
 from glphong.gpu.peeling import (BLEND_LAYERS, MAX_BLEND_LAYERS, CompositeKey, Peeling, blend_fields, blended_objects,
                                  check_blend_options)
 from glphong.gpu.program_keys import renderer_program_key
-from glphong.gpu.transmission import TARGET_KEY, TRANSMIT, Transmission, check_transmission_options, transmissive_objects
+from glphong.gpu.transmission import (TARGET_KEY, TRANSMIT, Transmission, background_need, check_transmission_options,
+                                    transmissive_objects)
 from glphong.scene.scene import Scene
 
 __all__ = ["Renderer", "Frame", "GBuffer", "RendererReleasedError"]
@@ -434,6 +435,11 @@ class Renderer:
         planes = frozenset(planes)
         needs = binding(scene).gbuffer_needs() | planes
         extras = [n for n in GBUFFER_PLANES if n in needs]
+        if 2 + len(extras) > MAX_GBUFFER_TARGETS:  # every plane at once: a coat over a normal map with all the rest
+            raise ValueError(f"this G-buffer would need {2 + len(extras)} planes (position, normal, "
+                             f"{', '.join(extras)}), more than the {MAX_GBUFFER_TARGETS} one draw writes: ask for the "
+                             "frame passes with samples=1 and supersample=1 (drawn beside the radiance) or from a "
+                             "scene without the plane's need")
         with self.context:
             fbo = self._target(("gbuffer", *extras))
             self._draw(scene, "gbuffer", fbo, planes=planes)
@@ -490,7 +496,8 @@ class Renderer:
         if output == "radiance" and transmissive_objects(scene):  # over the opaque scene (glphong.gpu.transmission)
             transmission = self._targets.get(TARGET_KEY) or self._targets.setdefault(TARGET_KEY, Transmission(self._mgl))
             transmission.draw(fbo, fbo.size, lambda values: draw_objects(
-                self, scene, output, (frame_values or {}) | values, shadow_values, planes, blend=TRANSMIT))
+                self, scene, output, (frame_values or {}) | values, shadow_values, planes, blend=TRANSMIT),
+                background_need(scene, fbo.size[0]), self.programs, self._fullscreen)
         if output != "radiance" or not blended_objects(scene):
             return None
         peeling = self._targets.get(("peeling",)) or self._targets.setdefault(("peeling",), Peeling(self._mgl))

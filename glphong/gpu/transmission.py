@@ -4,29 +4,37 @@ docs/transmission.md): the opaque scene first, then the transmissive surfaces se
 A frame of a scene with transmissive objects draws, into the radiance target:
 
 1. every other object (opaque and alpha-masked), as a frame without them;
-2. the background: that image (RGBA32F, the internal size) read back once, its pyramid of 2x2 box means made on the
-   host in float32 (`glphong.materials.gltf_transmission.background_levels`) and uploaded as one mipmapped texture
-   (GL_LINEAR_MIPMAP_LINEAR, clamped to the edge);
+2. the background, where a drawn program reads it (`background_need`): that image (RGBA32F, the internal size) copied
+   on the GPU into level 0 of one mipmapped texture (GL_LINEAR_MIPMAP_LINEAR, clamped to the edge), through a pixel
+   buffer; where a program may look it up above level 0 (roughness above 0, a volume), its pyramid of 2x2 box means,
+   each level drawn from the one above by glsl/transmission_pyramid.glsl, the same float32 bits as the host's
+   `glphong.materials.gltf_transmission.background_levels` (tested); a frame whose every transmissive surface reads
+   the texel at its own pixel (roughness 0 or ior 1, thin walls) makes level 0 alone, one whose surfaces read no
+   background (``KHR_materials_diffuse_transmission`` alone) makes nothing;
 3. the transmissive objects, depth-tested against the opaque depth and writing it, their radiance programs (the
    define ``GLTF_PBR_TRANSMISSION``) reading the background at their own pixel (transmission_thin.glsl): the nearest
    transmissive surface of a pixel is drawn, and it sees the opaque scene alone (a transmissive surface behind another
    is not seen through it: the glTF Sample Viewer's and Filament's rule, which the twin follows).
 
-A scene without transmissive objects draws as before, bit for bit (its programs contain none of this).  Not with
-blended materials in the same scene, multisampling, per-vertex shading or the uber-shader (a clear error names the
-option).
+``Transmission.method = "host"`` keeps the path before (the image read back, its pyramid made on the host in float32
+and every level uploaded, every frame): the reference the GPU path is tested against, bit for bit, and benchmarked
+against (benchmarks/transmission_cost.py).  A scene without transmissive objects draws as before, bit for bit (its
+programs contain none of this).  Not with blended materials in the same scene, multisampling, per-vertex shading or
+the uber-shader (a clear error names the option).
 """
 import math
+from dataclasses import dataclass
 
 import moderngl
 import numpy as np
 
 from glphong.gpu.peeling import blended, per_pixel_option
 from glphong.gpu.shadows import ShadowMap
-from glphong.materials.gltf_transmission import background_levels, transmissive
+from glphong.materials.gltf_transmission import background_levels, gltf_transmission_lod, transmissive
+from glphong.shaders.keys import EncodeKey
 
-__all__ = ["TRANSMIT", "transmissive_objects", "drawn_in", "check_transmission_options", "Transmission",
-           "TARGET_KEY"]
+__all__ = ["TRANSMIT", "transmissive_objects", "drawn_in", "check_transmission_options", "background_need",
+           "PyramidKey", "Transmission", "TARGET_KEY"]
 
 #: `glphong.gpu.drawing.draw_list`'s selector of the transmissive objects (0 the others, 1 and 2 blended layers)
 TRANSMIT = 4
@@ -51,7 +59,7 @@ def drawn_in(obj, blend, output):
 
 def check_transmission_options(renderer, scene, radiance=True):
     """ValueError naming the option where ``renderer`` cannot draw the transmissive objects of ``scene`` (``radiance``:
-    the frame draws the radiance, which needs a light)."""
+    the frame draws the radiance, whose lights must be punctual ones)."""
     chosen = transmissive_objects(scene)
     if not chosen:
         return
@@ -67,9 +75,6 @@ def check_transmission_options(renderer, scene, radiance=True):
                          f"{type(extended[0]).__name__}: glphong transmits point, spot and directional lights through "
                          "a surface, not area or environment lights yet (their light behind the surface would be "
                          "left out); light the scene with punctual lights, or give the material transmission=0")
-    if radiance and not scene.lights:
-        raise ValueError(f"object {name!r} is transmissive ({named}) and the scene has no light: "
-                         "its program reads the view only where a light is lit; add a light")
     wrong = per_pixel_option(renderer)
     if wrong:
         raise ValueError(f"object {name!r} is transmissive ({named}), which is drawn over the "
@@ -77,35 +82,126 @@ def check_transmission_options(renderer, scene, radiance=True):
                          f"has {wrong[0]}: use {wrong[1]}")
 
 
+def background_need(scene, width):
+    """What the transmission pass of a frame of ``scene`` reads of the background, ``width`` [px] its width: 'none'
+    (no drawn program reads it: KHR_materials_diffuse_transmission alone, or no transmissive object), 'texel' (every
+    surface of KHR_materials_transmission reads the texel at its own pixel: thin walls, level of detail 0) or
+    'pyramid' (a volume, or a level of detail above 0: its roughness factor, an upper bound of a textured roughness,
+    as `gltf_transmission_lod` forms it in float32, whose rule grows with the roughness)."""
+    need = "none"
+    levels = np.float32(math.log2(width))
+    for index in transmissive_objects(scene):
+        material = scene.objects[index].material
+        used = material.extensions()
+        if "transmission" not in used:
+            continue
+        roughness = np.float32(getattr(material.roughness, "scale", material.roughness))
+        if "volume" in used or gltf_transmission_lod(roughness, np.float32(material.ior), levels) > 0:
+            return "pyramid"
+        need = "texel"
+    return need
+
+
+@dataclass(frozen=True)
+class PyramidKey(EncodeKey):
+    """Key of the pass that draws one level of the background's pyramid from the level above
+    (glsl/transmission_pyramid.glsl): a full-screen pass like the 8-bit encoding's
+    (`glphong.shaders.keys.EncodeKey`), with its own fragment stage."""
+
+    def defines(self):
+        return []
+
+    def fragment_chunks(self):
+        return ("transmission_pyramid",)
+
+    def describe(self):
+        return "transmission background pyramid"
+
+
 class Transmission:
-    """The background texture of one renderer (its levels at the internal size).
+    """The background texture of one renderer (its levels at the internal size), and what copies the opaque image
+    into it and draws its pyramid.
 
     Parameters
     ----------
     mgl : moderngl.Context
+
+    Attributes
+    ----------
+    method : str
+        'gpu' (the default: the background copied and its pyramid drawn on the GPU, only as far as the frame's
+        programs read it) or 'host' (the path before: read back, `background_levels` in float32 on the host, every
+        level uploaded, every frame; the reference of the tests and benchmarks).
+    made : str or None
+        What the last frame made: 'none', 'texel' (level 0), 'pyramid' (every level); None before the first.
     """
 
     def __init__(self, mgl):
         self._mgl = mgl
         self._texture = None
+        self._buffer = None
+        self._scratch = None
+        self.method = "gpu"
+        self.made = None
 
-    def _background(self, levels):
-        """The mipmapped texture holding ``levels`` (GL row order), made again where the size changed."""
-        size = (levels[0].shape[1], levels[0].shape[0])
+    def _background(self, size, mipmaps):
+        """The mipmapped RGBA32F texture of ``size`` (made again where the size changed), filtered through its
+        levels where ``mipmaps`` (else its level 0 alone is ever looked up)."""
         if self._texture is None or self._texture.size != size:
-            if self._texture is not None:
-                self._texture.release()
+            self._release_targets()
             self._texture = self._mgl.texture(size, 4, dtype="f4")
-            self._texture.build_mipmaps()  # allocates every level; each is written below
-            self._texture.filter = (moderngl.LINEAR_MIPMAP_LINEAR, moderngl.LINEAR)
+            self._texture.build_mipmaps()  # allocates every level; each is written before it is read
             self._texture.repeat_x = self._texture.repeat_y = False
-        for k, level in enumerate(levels):
-            self._texture.write(np.ascontiguousarray(level, np.float32), level=k)
+            self._buffer = self._mgl.buffer(reserve=16 * size[0] * size[1])
+        flt = (moderngl.LINEAR_MIPMAP_LINEAR if mipmaps else moderngl.LINEAR, moderngl.LINEAR)
+        if self._texture.filter != flt:
+            self._texture.filter = flt
         return self._texture
 
-    def draw(self, target, size, draw):
-        """Read the opaque image of ``target`` (its first attachment, drawn), make the background, and draw the
-        transmissive objects over it.
+    def _host_levels(self, target, size):
+        """The path before: the opaque image read back, its float32 pyramid uploaded level by level."""
+        opaque = np.empty((size[1], size[0], 4), np.float32)
+        target.read_into(opaque, components=4, attachment=0, dtype="f4")
+        texture = self._background(size, True)
+        for k, level in enumerate(background_levels(opaque, np.float32)):
+            texture.write(np.ascontiguousarray(level, np.float32), level=k)
+        return texture
+
+    def _gpu_levels(self, target, size, pyramid, program, fullscreen):
+        """The opaque image copied into level 0 through the pixel buffer (GL to GL) and, with ``pyramid``, each level
+        ``k + 1`` drawn from level ``k`` (glsl/transmission_pyramid.glsl) into a scratch target and copied in."""
+        texture = self._background(size, pyramid)
+        target.read_into(self._buffer, components=4, attachment=0, dtype="f4")
+        texture.write(self._buffer, level=0)
+        if not pyramid:
+            return texture
+        first = (max(size[0] // 2, 1), max(size[1] // 2, 1))
+        if self._scratch is None or self._scratch.size != first:
+            if self._scratch is not None:
+                self._release_scratch()
+            color = self._mgl.texture(first, 4, dtype="f4")
+            color.filter = (moderngl.NEAREST, moderngl.NEAREST)
+            self._scratch = self._mgl.framebuffer([color])
+        self._scratch.use()
+        try:
+            texture.use(location=0)
+            vertex_array = fullscreen(program)
+            width, height, k = size[0], size[1], 0
+            while width > 1 or height > 1:
+                width, height = max(width // 2, 1), max(height // 2, 1)
+                self._scratch.viewport = (0, 0, width, height)
+                program.bind({"u_background": 0, "u_level": k})
+                vertex_array.render(moderngl.TRIANGLES, vertices=3)
+                self._scratch.read_into(self._buffer, viewport=(0, 0, width, height), components=4, dtype="f4")
+                k += 1
+                texture.write(self._buffer, level=k)
+        finally:  # the scratch target never stays bound (binding a released one is GL_INVALID_OPERATION)
+            target.use()
+        return texture
+
+    def draw(self, target, size, draw, need="pyramid", programs=None, fullscreen=None):
+        """Make the background of ``target``'s opaque image (its first attachment, drawn) as far as ``need`` asks, and
+        draw the transmissive objects over it.
 
         Parameters
         ----------
@@ -114,27 +210,50 @@ class Transmission:
         size : (int, int)
             Its size [px].
         draw : callable
-            ``draw(values)``: draw the transmissive objects (`TRANSMIT`) with the frame uniforms ``values`` added.
+            ``draw(values)``: draw the transmissive objects (`TRANSMIT`) with the frame uniforms ``values`` added
+            (none where ``need`` is 'none').
+        need : str
+            `background_need` of the frame: 'none', 'texel' or 'pyramid'.
+        programs : glphong.gpu.programs.ProgramCache
+            The renderer's programs, of which 'pyramid' takes the `PyramidKey` program; ``fullscreen(program)`` its
+            vertex array.
 
         Returns
         -------
-        (H, W, 4) float32 ndarray
-            The background's level 0, GL row order (row 0 at the bottom).
+        str
+            What was made (`made`).
         """
-        opaque = np.empty((size[1], size[0], 4), np.float32)
-        target.read_into(opaque, components=4, attachment=0, dtype="f4")
-        texture = self._background(background_levels(opaque, np.float32))
+        if self.method == "host":
+            texture, self.made = self._host_levels(target, size), "pyramid"
+        elif need == "none":
+            texture, self.made = None, "none"
+        else:
+            pyramid = need == "pyramid"
+            program = programs.get(PyramidKey()) if pyramid else None
+            texture, self.made = self._gpu_levels(target, size, pyramid, program, fullscreen), need
         target.use()
-        draw({"u_transmission_background": ShadowMap(texture, None),
-              "u_transmission_levels": float(math.log2(size[0]))})
-        return opaque
+        draw({} if texture is None else {"u_transmission_background": ShadowMap(texture, None),
+                                         "u_transmission_levels": float(math.log2(size[0]))})
+        return self.made
 
     def gl_object_count(self):
-        """GL objects held: the background texture."""
-        return int(self._texture is not None)
+        """GL objects held: the background texture and its pixel buffer, the scratch target and its texture."""
+        return 2 * int(self._texture is not None) + 2 * int(self._scratch is not None)
 
-    def release(self):
-        """Release the background texture (context entered)."""
+    def _release_scratch(self):
+        for texture in self._scratch.color_attachments:
+            texture.release()
+        self._scratch.release()
+        self._scratch = None
+
+    def _release_targets(self):
         if self._texture is not None:
             self._texture.release()
-        self._texture = None
+            self._buffer.release()
+        if self._scratch is not None:
+            self._release_scratch()
+        self._texture = self._buffer = None
+
+    def release(self):
+        """Release the background texture, its pixel buffer and the scratch target (context entered)."""
+        self._release_targets()

@@ -28,7 +28,7 @@ import numpy as np
 from glphong.definitions.material_base import constant_part
 from glphong.definitions.params import Param
 from glphong.definitions.surface import SurfaceInput
-from glphong.twin.functions import microfacet_geometry
+from glphong.twin.functions import fresnel_schlick, microfacet_geometry
 
 __all__ = ["DIFFUSE_TRANSMISSION_PARAMS", "DIFFUSE_TRANSMISSION_EXCLUDES", "gltf_diffuse_transmission_response",
            "diffuse_transmission_gltf_fields"]
@@ -68,9 +68,8 @@ def gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior):
     n_dot_l = np.asarray(n_dot_l, np.float64)
     mirrored = wi + (2.0 * n_dot_l)[:, None] * n
     valid, _, _, v_dot_h, _ = microfacet_geometry(n, mirrored, wo, n_dot_l)
-    ior = np.asarray(ior, np.float64)
-    f0 = ((ior - 1.0) / (ior + 1.0)) ** 2
-    fresnel = f0 + (1.0 - f0) * np.maximum(1.0 - v_dot_h, 0.0) ** 5
+    r = (np.asarray(ior, np.float64) - 1.0) / (np.asarray(ior, np.float64) + 1.0)
+    fresnel = fresnel_schlick((r * r)[..., None], v_dot_h)[..., 0]
     scale = (1.0 - np.asarray(m, np.float64)) * (1.0 - np.asarray(t, np.float64)) * np.asarray(dt, np.float64)
     value = np.asarray(c_dt, np.float64) * ((scale * (1.0 / np.pi)) * (1.0 - fresnel) * n_dot_l)[:, None]
     return np.where(valid[:, None], value, 0.0)
@@ -78,13 +77,16 @@ def gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior):
 
 def diffuse_transmission_gltf_fields(material, texture_index):
     """``{"KHR_materials_diffuse_transmission": {...}}`` for a `GltfPBR` that uses the extension, else ``{}``: the
-    factors and ``diffuseTransmissionColorTexture`` where the colour is textured (sRGB); ``diffuseTransmissionTexture``'s
-    alpha is not written (glphong holds it as a grey image, and its own ``extras`` keep it, as ``specularTexture``)."""
+    factors, ``diffuseTransmissionTexture`` where the weight is textured (``texture_index(image, alpha=channel)``: an
+    image whose alpha holds the channel the weight reads, as glTF reads it) and ``diffuseTransmissionColorTexture``
+    where the colour is (sRGB)."""
     if "diffuse_transmission" not in material.extensions():
         return {}
     weight, color = material.diffuse_transmission, material.diffuse_transmission_color
     fields = {"diffuseTransmissionFactor": float(constant_part(weight)),
               "diffuseTransmissionColorFactor": [float(c) for c in np.broadcast_to(constant_part(color), 3)]}
+    if isinstance(weight, SurfaceInput) and weight.texture is not None:
+        fields["diffuseTransmissionTexture"] = {"index": texture_index(weight.texture, alpha=weight.channel)}
     if isinstance(color, SurfaceInput) and color.texture is not None:
         fields["diffuseTransmissionColorTexture"] = {"index": texture_index(color.texture)}
     return {"KHR_materials_diffuse_transmission": fields}

@@ -36,11 +36,11 @@ anisotropy_rotation scalar radians   (0)     ``anisotropyRotation``: counter-clo
 anisotropy_directionrgb    [0, 1]    (1,.5)  ``anisotropyTexture``'s texel: ``2 rg - 1`` the direction in tangent space
 =================== ====== ========= ======= ==========================================================================
 
-Exact as the extensions write them, with two limits of glphong's (docs/gltf_extensions.md): the coat's own normal
-(``clearcoat_normal``, `glphong.materials.gltf_coat_normal`) is taken on the unperturbed frame, so over a base
-``normal_map`` the coat takes the mapped normal (a material with both a ``normal_map`` and a ``clearcoat_normal`` is
-refused), and the emission is not darkened by ``1 - clearcoat F_c`` (a material with both warns).  A coat of roughness 0 is a mirror: a delta that a point light meets with zero measure, so it only darkens
-the base, as the core's roughness 0 does (`glphong.materials.gltf_pbr`).
+Exact as the extensions write them, with one limit of glphong's (docs/gltf_extensions.md): the emission is not
+darkened by ``1 - clearcoat F_c`` (a material with both warns).  The coat's normal (``clearcoat_normal``,
+`glphong.materials.gltf_coat_normal`) is taken on the unperturbed frame, also over a base ``normal_map``.  A coat of
+roughness 0 is a mirror: a delta that a point light meets with zero measure, so it only darkens the base, as the
+core's roughness 0 does (`glphong.materials.gltf_pbr`).
 """
 import dataclasses
 import math
@@ -58,10 +58,10 @@ from glphong.materials.gltf_diffuse_transmission import (DIFFUSE_TRANSMISSION_EX
 from glphong.materials.gltf_iridescence import (IRIDESCENCE_PARAMS, gltf_iridescence_oracle, iridescence_cases,
                                                 iridescence_gltf_fields)
 from glphong.materials.gltf_coat_normal import COAT_NORMAL_PARAMS, gltf_clearcoat_geometry, uses_coat_normal
-from glphong.materials.gltf_lobe import gltf_pbr_specular
+from glphong.materials.gltf_lobe import gltf_clearcoat_fresnel, gltf_pbr_specular
 from glphong.materials.gltf_sheen import SHEEN_PARAMS, gltf_sheen_oracle, sheen_cases
-from glphong.materials.gltf_transmission import (TRANSMISSION_PARAMS, VOLUME_EXTENSIONS, transmission_gltf_fields,
-                                                 volume_extensions)
+from glphong.materials.gltf_transmission import (TRANSMISSION_EXCLUDES, TRANSMISSION_PARAMS, VOLUME_EXTENSIONS,
+                                                 transmission_gltf_fields, volume_extensions)
 from glphong.twin.functions import microfacet_geometry
 
 # GltfExtensionFeatures and ExtensionProperties are GltfPBR's own (a class named here would become glphong.materials')
@@ -95,8 +95,6 @@ EXTENSIONS = {"specular": ("KHR_materials_specular", ("specular", "specular_colo
               "diffuse_transmission": ("KHR_materials_diffuse_transmission",
                                        ("diffuse_transmission", "diffuse_transmission_color"))} \
     | VOLUME_EXTENSIONS  # KHR_materials_volume and _dispersion (gltf_transmission)
-#: the coat's f0: ((1 - 1.5)/(1 + 1.5))^2, fresnel_coat's fixed ior 1.5
-CLEARCOAT_F0 = 0.04
 
 
 def gltf_specular_fresnel(f0, specular, specular_color, x):
@@ -110,16 +108,6 @@ def gltf_specular_fresnel(f0, specular, specular_color, x):
     specular = np.asarray(specular).astype(dtype)[..., None]
     dielectric_f0 = (np.minimum(f0 * np.asarray(specular_color).astype(dtype), one) * specular).astype(dtype)
     return (dielectric_f0 + (specular - dielectric_f0) * x.astype(dtype)[..., None]).astype(dtype)
-
-
-def gltf_clearcoat_fresnel(n_dot_v):
-    """KHR_materials_clearcoat's ``F_c = 0.04 + 0.96 (1 - n.v)^5`` (gltf_pbr.glsl; fresnel_coat with ior 1.5, on n.v).
-    (...) -> (...), dimensionless."""
-    n_dot_v = np.asarray(n_dot_v)
-    dtype = n_dot_v.dtype if n_dot_v.dtype.kind == "f" else np.float64
-    y1 = np.maximum(dtype.type(1) - n_dot_v.astype(dtype), dtype.type(0))
-    y = ((y1 * y1) * (y1 * y1) * y1).astype(dtype)
-    return (dtype.type(CLEARCOAT_F0) + dtype.type(1 - CLEARCOAT_F0) * y).astype(dtype)
 
 
 def gltf_clearcoat_mix(value, f, wi, wo, n_dot_l, p):
@@ -180,17 +168,14 @@ class GltfExtensionFeatures:
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
-        if "clearcoat_normal" in self.extensions() and self.normal_map is not None:
-            raise ValueError("clearcoat_normal with a normal_map: glphong's coat normal is taken on the unperturbed "
-                             "frame, which a material-level normal map replaces; give the coat's normal texture "
-                             "without normal_map (docs/gltf_extensions.md)")
         if "clearcoat" in self.extensions() and np.any(constant_part(self.emissive)):
             warnings.warn("KHR_materials_clearcoat with an emission: glphong does not darken the emission by the "
                           "coat's 1 - clearcoat F_c(n.v) (F_c = 0.04 at normal view, 1 at grazing): the emission is "
                           "drawn as it is (docs/gltf_extensions.md)", stacklevel=3)
         used = self.extensions()
-        for through in ("transmission", "diffuse_transmission"):  # the layers not drawn over the light let through
-            both = [EXTENSIONS[name][0] for name in DIFFUSE_TRANSMISSION_EXCLUDES if name in used]
+        for through, excludes in (("transmission", TRANSMISSION_EXCLUDES),  # the layers not drawn over the light
+                                  ("diffuse_transmission", DIFFUSE_TRANSMISSION_EXCLUDES)):  # let through
+            both = [EXTENSIONS[name][0] for name in excludes if name in used]
             if through in used and both:
                 raise ValueError(f"{EXTENSIONS[through][0]} with {', '.join(both)}: glphong does not draw that "
                                  "extension's layer over the light the surface lets through (from behind it, or the "
@@ -235,10 +220,23 @@ class GltfExtensionFeatures:
         """``GLTF_PBR_<NAME>`` for each extension used: its code is in the program only then."""
         return tuple((name.upper(), "1") for name in self.extensions())
 
+    @classmethod
+    def uniform_guard(cls, name):
+        """KHR_materials_transmission's, _volume's (_dispersion's with them: the volume's code reads it) and
+        _diffuse_transmission's uniforms are declared only in the programs that use the extension (its
+        ``GLTF_PBR_<NAME>``); every other parameter's in every program."""
+        for extension, define in (("transmission", "TRANSMISSION"), ("volume", "VOLUME"), ("dispersion", "VOLUME"),
+                                  ("diffuse_transmission", "DIFFUSE_TRANSMISSION")):
+            if name in EXTENSIONS[extension][1]:
+                return f"GLTF_PBR_{define}"
+        return super().uniform_guard(name)
+
     def library_uses(self, uber=False):
         """`MaterialModel.library_uses`, and the library chunk ``normal_map`` (its ``surface_normal``, the coat
-        normal's formula) where the coat has its own normal."""
+        normal's formula) where the coat has its own normal, ``fresnel`` (``fresnel_schlick``) where it transmits."""
         extra = ("normal_map",) if "clearcoat_normal" in self.extensions() else ()
+        if {"transmission", "diffuse_transmission"} & set(self.extensions()):  # their Schlick (transmission_thin.glsl)
+            extra += ("fresnel",)
         return tuple(dict.fromkeys(super().library_uses(uber) + extra))
 
     def active_params(self):
@@ -280,7 +278,8 @@ def gltf_extensions_oracle(base_color, metallic, roughness, ior, extensions, p, 
         fr, fm = gltf_iridescence_oracle(fr, base_color, x, [weight * min(f0 * k, 1) for k in color], p, v_dot_h)
     out = []
     for c, f, g in zip(base_color, fr, fm):
-        keep = 1 - p.diffuse_transmission if "diffuse_transmission" in extensions else 1  # light in front: 1 - dt
+        keep = (1 - p.diffuse_transmission if "diffuse_transmission" in extensions else 1) \
+            * (1 - p.transmission if "transmission" in extensions else 1)  # light in front: (1 - dt)(1 - t)
         dielectric = (1 - max(fr)) * c / mpmath.pi * keep + f * layer
         metal = g * layer
         out.append((1 - metallic) * dielectric + metallic * metal)

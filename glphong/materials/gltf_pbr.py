@@ -54,13 +54,18 @@ from glphong.materials.gltf_extensions import (EXTENSION_PARAMS, ExtensionNeeds,
                                                gltf_specular_fresnel)
 from glphong.materials.gltf_iridescence import (gltf_iridescence_fresnel, gltf_iridescence_parts,  # noqa: F401
                                                 gltf_iridescence_sensitivity)  # the GLSL chunk's twins, by its name
-from glphong.materials.gltf_coat_normal import coat_normal_oracle
+from glphong.materials.gltf_coat_normal import coat_normal_oracle, gltf_clearcoat_normal  # noqa: F401
 from glphong.materials.gltf_lobe import gltf_pbr_specular, gltf_pbr_visibility_cos  # noqa: F401
 from glphong.materials.gltf_sheen import (gltf_sheen_albedo, gltf_sheen_distribution, gltf_sheen_l,  # noqa: F401
-                                          gltf_sheen_lambda, gltf_sheen_mix)  # the GLSL chunk's twins, by its name
-from glphong.materials.gltf_transmission import (gltf_transmission_lod, gltf_transmission_response,  # noqa: F401
-                                                 gltf_transmission_weight, gltf_volume_attenuation, gltf_volume_ray,
-                                                 gltf_volume_uv)  # transmission_thin.glsl's twins, by their names
+                                          gltf_sheen_lambda, gltf_sheen_mix,
+                                          gltf_sheen_scaling)  # the GLSL chunk's twins, by its name
+from glphong.materials.gltf_transmission import (gltf_transmission_background,  # noqa: F401
+                                                 gltf_transmission_fresnel, gltf_transmission_layers,
+                                                 gltf_transmission_lod, gltf_transmission_radiance,
+                                                 gltf_transmission_response, gltf_transmission_sample,
+                                                 gltf_transmission_weight, gltf_volume_attenuation, gltf_volume_light,
+                                                 gltf_volume_ray, gltf_volume_uv)  # transmission_thin.glsl's twins
+from glphong.materials.gltf_transmission_cases import transmission_stability_cases  # docs/transmission.md
 from glphong.materials.gltf_diffuse_transmission import gltf_diffuse_transmission_response  # noqa: F401,E402
 from glphong.definitions.material import MaterialModel, Param, Properties, constant_part
 from glphong.definitions.params import GlslFile
@@ -248,8 +253,9 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         clearcoat_roughness^2``; the coat takes the shading normal, or its own where given:
     clearcoat_normal, clearcoat_normal_strength : (3,) or SurfaceInput, float
         ``clearcoatNormalTexture`` (its texel, linear; default (0.5, 0.5, 1): the unperturbed normal) and its
-        ``scale``: the coat's normal on the unperturbed frame, not with a ``normal_map`` (needs the tangent frame;
-        `glphong.materials.gltf_coat_normal`).
+        ``scale``: the coat's normal on the unperturbed frame, the interpolated normal's, also over a ``normal_map``
+        (which perturbs the base alone: the coat of a normal-mapped material keeps the unperturbed normal unless given
+        its own); needs the tangent frame (`glphong.materials.gltf_coat_normal`).
     sheen_color, sheen_roughness : float or (3,) array_like or SurfaceInput, float or SurfaceInput
         ``KHR_materials_sheen`` (default 0: no sheen), under the coat: ``sheen_color D_s V_s + f_r max(min(1 -
         max3(sheen_color) E(n.v), 1 - max3(sheen_color) E(n.l)), 0)``, Charlie ``D_s`` with ``alpha_g =
@@ -274,8 +280,9 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
     name = "gltf_pbr"
     params = (_BASE_COLOR, _METALLIC, _ROUGHNESS, _EMISSIVE, _OCCLUSION, _IOR) + EXTENSION_PARAMS  # gltf_extensions
     needs = ExtensionNeeds(("view",))  # an instance with the anisotropy needs "tangent" too (structural_needs)
-    #: what the code under a structural define reads beside `needs` (the definition check accepts it there)
-    structural_needs = {"GLTF_PBR_ANISOTROPY": ("tangent",), "GLTF_PBR_CLEARCOAT_NORMAL": ("tangent",)}
+    #: what the code under a structural define reads beside `needs` (the definition check accepts it there); a coat
+    #: normal reads the frame before a base normal map ('unperturbed', gltf_coat_normal)
+    structural_needs = {"GLTF_PBR_ANISOTROPY": ("tangent",), "GLTF_PBR_CLEARCOAT_NORMAL": ("tangent", "unperturbed")}
     ambient = "base_color"
     ambient_scale = 1.0 / np.pi
     emission = "emissive"
@@ -416,7 +423,7 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
 
     @classmethod
     def stability_cases(cls):
-        return _stability_cases() + extension_cases(cls)
+        return _stability_cases() + extension_cases(cls) + transmission_stability_cases(cls)
 
 
 def _stability_cases():

@@ -24,7 +24,7 @@ from glphong.twin.band import FLT_MAX
 from glphong.twin.functions import microfacet_geometry
 
 __all__ = ["SHEEN_PARAMS", "gltf_sheen_distribution", "gltf_sheen_l", "gltf_sheen_lambda", "gltf_sheen_albedo",
-           "gltf_sheen_mix", "gltf_sheen_oracle", "sheen_cases"]
+           "gltf_sheen_scaling", "gltf_sheen_mix", "gltf_sheen_oracle", "sheen_cases"]
 
 _SHEEN_COLOR = Param("sheen_color", "rgb", low=0.0, high=1.0, default=0.0, unit="", textureable=True,
                      doc="KHR_materials_sheen sheenColorFactor (times sheenColorTexture, sRGB): the sheen's colour")
@@ -92,19 +92,43 @@ def gltf_sheen_albedo(cos_theta, sheen_roughness):
     return _mix(low, high, t).astype(dtype)
 
 
+def gltf_sheen_scaling(n_dot_v, n_dot_l, sheen_color, sheen_roughness):
+    """The specification's albedo scaling ``max(min(1 - m E(n.v), 1 - m E(n.l)), 0)``, ``m = max3(sheen_color)``, E
+    `gltf_sheen_albedo` (gltf_pbr.glsl's ``gltf_sheen_scaling``: the base's under the sheen, and
+    transmission_thin.glsl's over the light let through).
+
+    Parameters
+    ----------
+    n_dot_v, n_dot_l : (N,) ndarray
+        The view's and the light's cosines (float32 or float64: the arithmetic follows ``n_dot_v``).
+    sheen_color : (N, 3) or (3,) ndarray
+    sheen_roughness : (N,) ndarray or float
+
+    Returns
+    -------
+    (N,) ndarray, dimensionless, in [0, 1]
+    """
+    n_dot_v = np.asarray(n_dot_v)
+    dtype = n_dot_v.dtype if n_dot_v.dtype.kind == "f" else np.dtype(np.float64)
+    n_dot_v, n_dot_l = n_dot_v.astype(dtype), np.asarray(n_dot_l).astype(dtype)
+    r = np.asarray(sheen_roughness).astype(dtype)
+    sc_max = np.max(np.broadcast_to(np.asarray(sheen_color).astype(dtype), n_dot_v.shape + (3,)), axis=-1)
+    one = dtype.type(1)
+    return np.maximum(np.minimum(one - sc_max * gltf_sheen_albedo(n_dot_v, r),
+                                 one - sc_max * gltf_sheen_albedo(n_dot_l, r)), dtype.type(0)).astype(dtype)
+
+
 def gltf_sheen_mix(value, f, wi, wo, n_dot_l, p):
-    """KHR_materials_sheen on `GltfPBR`'s twin: ``value scaling + sheen_color D V (n.l)``, ``scaling = max(min(1 - m
-    E(n.v), 1 - m E(n.l)), 0)``, ``m = max3(sheen_color)`` (gltf_pbr.glsl's order); value (N, 3) -> (N, 3)."""
+    """KHR_materials_sheen on `GltfPBR`'s twin: ``value scaling + sheen_color D V (n.l)``, ``scaling =
+    gltf_sheen_scaling(n.v, n.l)`` (gltf_pbr.glsl's order); value (N, 3) -> (N, 3)."""
     dtype = np.asarray(value).dtype
     _, n_dot_v, _, _, tan2 = microfacet_geometry(f.n, wi, wo, n_dot_l)
     n_dot_l, n_dot_v, tan2 = (np.asarray(a).astype(dtype) for a in (n_dot_l, n_dot_v, tan2))
     r = np.asarray(p.sheen_roughness).astype(dtype)
     alpha_g = (r * r).astype(dtype)
     sc = np.asarray(p.sheen_color, dtype)
-    sc_max = np.max(np.broadcast_to(sc, np.shape(value)), axis=-1)
     one = dtype.type(1)
-    scaling = np.maximum(np.minimum(one - sc_max * gltf_sheen_albedo(n_dot_v, r),
-                                    one - sc_max * gltf_sheen_albedo(n_dot_l, r)), dtype.type(0)).astype(dtype)
+    scaling = gltf_sheen_scaling(n_dot_v, n_dot_l, sc, r)
     with np.errstate(divide="ignore", over="ignore", invalid="ignore", under="ignore"):
         v_cos = (one / ((one + gltf_sheen_lambda(n_dot_v, alpha_g) + gltf_sheen_lambda(n_dot_l, alpha_g))
                         * (dtype.type(4) * n_dot_v))).astype(dtype)

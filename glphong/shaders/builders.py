@@ -111,9 +111,11 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
                              f"one level of detail per size); {type(material).__name__} has {len(shown)}")
         return replace(gbuffer_key(material, gbuffer_needs or (), len(shown)), normal_map=spec.normal_map,
                        alpha_mask=spec.alpha_mask)
-    # lights matter only to a material with a term that reflects them
+    # lights matter only to a material with a term that reflects them; a radiance program of KHR_materials_
+    # transmission reads its terms' parameters and the normal with or without a light (glsl/transmission_thin.glsl)
     lights = _as_light_keys(lights)
-    lit = bool(lights) and any(not t.vanishes() for t in material.components)
+    lit = (bool(lights) or (output == "radiance" and _sees_through(material))) and \
+        any(not t.vanishes() for t in material.components)
     terms = term_keys(material, lit, _ambient_present(ambient_radiance), extended=any(k.extended for k in lights),
                       occludable=any(k.occludable for k in lights))
     lights = tuple(_with_usage(k, terms) if k.extended else k for k in lights)
@@ -135,12 +137,19 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
         has_face=lit and any(k.shadowed for k in lights),
         has_normal=lit,
         has_tangent="tangent" in needs or normal_map,
+        has_unperturbed=normal_map and "unperturbed" in needs,
         has_uv="uv" in needs or any("texture" in m for m in modes) or normal_map or alpha_mask == 2,
         two_sided=material.two_sided and lit,
         has_color=any("vertex" in m for m in modes),
         normal_map=normal_map,
         alpha_mask=alpha_mask,
     )
+
+
+def _sees_through(material):
+    """Whether ``material`` uses KHR_materials_transmission (a `GltfPBR`'s extensions)."""
+    extensions = getattr(material, "extensions", None)
+    return callable(extensions) and "transmission" in extensions()
 
 
 def _with_usage(light, terms):
@@ -253,9 +262,9 @@ def lod_slots(images):
 
 def gbuffer_key(material, needs=(), lod_textures=0):
     """The G-buffer-program key of one material: its two-sided flag, the scene's extra G-buffer outputs
-    ``needs`` ('tangent', 'uv', 'color', 'lod', 'face', 'object') and the number of its textures whose level of
-    detail it writes."""
+    ``needs`` ('tangent', 'uv', 'color', 'lod', 'face', 'object', 'unperturbed') and the number of its textures whose
+    level of detail it writes."""
     return ProgramKey(output="gbuffer", has_normal=True, two_sided=material.two_sided,
                       has_tangent="tangent" in needs, has_uv="uv" in needs, has_color="color" in needs,
                       has_lod="lod" in needs, lod_textures=lod_textures, has_face="face" in needs,
-                      has_object="object" in needs)
+                      has_object="object" in needs, has_unperturbed="unperturbed" in needs)

@@ -35,6 +35,7 @@ def program_defines(key):
         ("HAS_LOD", b(key.has_lod)),
         ("HAS_FACE", b(key.has_face)),
         ("HAS_OBJECT", b(key.has_object)),
+        ("HAS_UNPERTURBED", b(key.has_unperturbed)),
         ("NORMAL_MAP", b(key.normal_map)),
         ("ALPHA_MASK", str(key.alpha_mask)),
         *((("ALPHA_BLEND", str(key.alpha_blend)),) if key.alpha_blend else ()),  # only in a blended layer's programs

@@ -13,7 +13,8 @@ from dataclasses import dataclass
 
 from glphong.core.glsl_files import library_chunks
 from glphong.shaders.defines import program_defines
-from glphong.shaders.generated import LIGHTS_CHUNK, LOD_CHUNK, MATERIAL_CHUNK, lights_chunk, lod_chunk, material_chunk
+from glphong.shaders.generated import (LIGHTS_CHUNK, LOD_CHUNK, MATERIAL_CHUNK, lights_chunk, lod_chunk, material_chunk,
+                                     transmits)
 from glphong.shaders.options import FORMULATIONS, GBUFFER_PLANES, NUMERICS_PIECES, OUTPUTS, PASS_PLANES, SHADOW_PASSES
 from glphong.shaders.prose import describe_key, left_out
 from glphong.shaders.stages import shading_chunks, stage_chunks
@@ -204,6 +205,10 @@ class ProgramKey:
     has_object : bool
         Whether the program interpolates the point in the object's own frame (the vertex position before the pose);
         a G-buffer program then writes it, the 'object' plane of the frame passes.
+    has_unperturbed : bool
+        A lit term reads the frame before the material's normal map (the need 'unperturbed': a coat normal over a
+        normal-mapped `GltfPBR`): the radiance program keeps it in ``unperturbed_frame`` (glsl/normal_map.glsl); for
+        a G-buffer program: whether it writes the interpolated normal before the map, the 'unperturbed' plane.
     pass_planes : tuple of str
         Radiance programs only: the planes (`glphong.shaders.options.PASS_PLANES`, in that order) it writes beside the
         radiance, at locations 1, 2, ...: the frame passes from the shading draw itself (multiple render targets).
@@ -239,6 +244,7 @@ class ProgramKey:
     alpha_blend: int = 0
     has_face: bool = False
     has_object: bool = False
+    has_unperturbed: bool = False
     pass_planes: tuple = ()
     shadow_size: int = 0
     shadow_filter: int = 0
@@ -269,10 +275,11 @@ class ProgramKey:
 
     @property
     def needs_view(self):
-        """True when the program needs the eye position: a lit term reads v, or per-vertex
-        two-sided shading turns the normal toward the eye."""
+        """True when the program needs the eye position: a lit term reads v, per-vertex two-sided shading
+        turns the normal toward the eye, or it draws what a transmissive surface lets through (`transmits`: its
+        weight reads v with or without a light)."""
         return (self.num_lights > 0 and any("view" in t.needs for t in self.lit_terms)) or \
-            (self.shade_per_vertex and self.two_sided and self.has_normal)
+            (self.shade_per_vertex and self.two_sided and self.has_normal) or transmits(self)
 
     @property
     def inputs(self):

@@ -2,7 +2,8 @@
 planes, how a surface input is made, and the limits (docs/design.md sections 3, 5 and 8)."""
 
 __all__ = ["UBER_MAX_LIGHTS", "OUTPUTS", "SHADOW_PASSES", "FORMULATIONS", "NUMERICS_DEFINES", "NUMERICS_PIECES",
-           "TEXTBOOK_PIECES", "GBUFFER_PLANES", "PASS_PLANES", "INPUT_MODES", "MAX_TEXTURED_INPUTS"]
+           "TEXTBOOK_PIECES", "GBUFFER_PLANES", "MAX_GBUFFER_TARGETS", "PASS_PLANES", "INPUT_MODES",
+           "MAX_TEXTURED_INPUTS"]
 
 #: light-array size per kind in the uber-shader (its counts are runtime uniforms up to this)
 UBER_MAX_LIGHTS = 8
@@ -21,8 +22,12 @@ NUMERICS_PIECES = tuple(NUMERICS_DEFINES)
 #: lobes are pow())
 TEXTBOOK_PIECES = ("falloff", "light", "normal", "view")
 #: the G-buffer's planes beyond position and normal, in attachment order (a scene's present ones, packed); 'object':
-#: the point in the object's own frame (the frame passes' object coordinates, NOCS and flow)
-GBUFFER_PLANES = ("tangent", "uv", "color", "lod", "face", "object")
+#: the point in the object's own frame (the frame passes' object coordinates, NOCS and flow); 'unperturbed': the
+#: interpolated normal before the material's normal map, where a term reads that frame (a coat normal, `gltf_pbr`)
+GBUFFER_PLANES = ("tangent", "uv", "color", "lod", "face", "object", "unperturbed")
+#: the most planes one G-buffer draw writes, position and normal included (GL 3.3's least GL_MAX_DRAW_BUFFERS, and
+#: llvmpipe's)
+MAX_GBUFFER_TARGETS = 8
 #: the planes a radiance program may write beside the radiance for the frame passes (multiple render targets, in this
 #: order from location 1; a program writes the ones its key's ``pass_planes`` names): the world position with the object's
 #: index + 1 in w, the shading normal, the point in the object's frame, the uv

@@ -43,6 +43,10 @@ class ShadingFrame:
     visibility : tuple or None
         Per light of the program, in loop order: None (the light casts no shadows) or ``(exact, low, high)``,
         each (N,), its ray-cast visibility and the interval a shadow map may give (`glphong.checks.shadows`).
+    unperturbed : ShadingFrame or None
+        The frame before the material's normal map (normal_map.glsl's ``unperturbed_frame``: `shading_frame` of the
+        interpolated normal), where it perturbed ``n`` and a term needs ``'unperturbed'``; None otherwise (then
+        this frame is the unperturbed one).
     """
 
     n: np.ndarray
@@ -52,6 +56,7 @@ class ShadingFrame:
     inputs: dict = None
     input_bounds: dict = None
     visibility: tuple = None
+    unperturbed: "ShadingFrame" = None
 
     def select(self, mask):
         """The frame at the points where ``mask`` is true."""
@@ -61,7 +66,9 @@ class ShadingFrame:
             {k: (lo[mask], hi[mask]) for k, (lo, hi) in self.input_bounds.items()}
         visibility = None if self.visibility is None else \
             tuple(None if v is None else tuple(a[mask] for a in v) for v in self.visibility)
-        return ShadingFrame(self.n[mask], pick(self.t), pick(self.b), pick(self.uv), inputs, bounds, visibility)
+        unperturbed = None if self.unperturbed is None else self.unperturbed.select(mask)
+        return ShadingFrame(self.n[mask], pick(self.t), pick(self.b), pick(self.uv), inputs, bounds, visibility,
+                            unperturbed)
 
 
 #: common.glsl FLT_MAX: vectors with a larger (or NaN) component do not normalise

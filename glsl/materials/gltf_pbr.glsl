@@ -24,11 +24,13 @@
 //   (rgb): the dielectric = F_d V D + (1 - max(F_d.r, F_d.g, F_d.b)) c/pi; the metal unchanged.
 // KHR_materials_clearcoat (GLTF_PBR_CLEARCOAT): gltf_clearcoat_fresnel(n_dot_v) -> F_c = 0.04 + 0.96 (1 - n.v)^5
 //   (fresnel_coat with ior 1.5, on n.v); f_r = mix(f_r, V_c D_c, clearcoat F_c), alpha_c = clearcoat_roughness^2, the
-//   coat's normal the shading normal n; with GLTF_PBR_CLEARCOAT_NORMAL (clearcoatNormalTexture; reads f.t, f.b: the
-//   material then needs 'tangent', and the library chunk normal_map.glsl; glphong/materials/gltf_coat_normal.py)
-//   n_c = surface_normal(n, t, b, texel, scale) = normalize(t (s m.x) + b (s m.y) + n m.z), m = 2 texel - 1 (the
-//   base normal map's rule, normal_map.glsl), and the coat is D_c V_c (n_c.l) on n_c (0 where n_c.l or n_c.v <= 0)
-//   weighted by clearcoat F_c(max(n_c.v, 0)).
+//   coat's normal the shading normal n; with GLTF_PBR_CLEARCOAT_NORMAL (clearcoatNormalTexture, or a base normal map;
+//   reads f.t, f.b: the material then needs 'tangent', 'unperturbed', and the library chunk normal_map.glsl;
+//   glphong/materials/gltf_coat_normal.py) gltf_clearcoat_normal(f) -> n_c = surface_normal(n, t, b, texel, scale) =
+//   normalize(t (s m.x) + b (s m.y) + n m.z), m = 2 texel - 1 (the base normal map's rule, normal_map.glsl) on the
+//   unperturbed frame (t, b, n): f, or where the material's normal map perturbed f (HAS_UNPERTURBED)
+//   unperturbed_frame, the frame before the map (normal_map.glsl); the coat is D_c V_c (n_c.l) on n_c (0 where n_c.l
+//   or n_c.v <= 0) weighted by clearcoat F_c(max(n_c.v, 0)), also over the light let through (transmission_thin.glsl).
 // KHR_materials_sheen (GLTF_PBR_SHEEN; glphong/materials/gltf_sheen.py): alpha_g = sheen_roughness^2,
 //   gltf_sheen_distribution(tan2, alpha_g) -> Charlie D = (2 + 1/alpha_g) sin2h^(1/(2 alpha_g)) / (2 pi), sin2h =
 //   tan2/(1 + tan2) (from the chord: no 1 - (n.h)^2 cancellation); 0 for alpha_g = 0 (a delta at n.h = 0, which no
@@ -38,8 +40,9 @@
 //   sheen V (n.l) = 1 / ((1 + lambda(n.v) + lambda(n.l)) 4 n.v) (the response's n.l cancels V's);
 //   gltf_sheen_albedo(cos, sheen_roughness) -> E: bilinear in the table GLTF_SHEEN_E at sqrt(cos) 32 and
 //   sheen_roughness 16 (E integrated in float64 from this lobe: benchmarks/gltf_sheen_albedo.py);
-//   f_r = sheen_color D V + f_r max(min(1 - max3(sheen_color) E(n.v), 1 - max3(sheen_color) E(n.l)), 0) (the
-//   specification's albedo scaling, clamped at 0 where E max3(sheen_color) > 1), then the coat over it.
+//   gltf_sheen_scaling(n_dot_v, n_dot_l) -> max(min(1 - max3(sheen_color) E(n.v), 1 - max3(sheen_color) E(n.l)), 0)
+//   (the specification's albedo scaling, clamped at 0 where E max3(sheen_color) > 1; also transmission_thin.glsl's,
+//   over the light let through); f_r = sheen_color D V + f_r gltf_sheen_scaling(n.v, n.l), then the coat over it.
 // KHR_materials_anisotropy (GLTF_PBR_ANISOTROPY; glphong/materials/gltf_anisotropy.py; reads f.t, f.b: the material
 //   then needs 'tangent'): gltf_anisotropy_frame(n, t, b, texel, rotation, out T, out B): d = rotate(normalize(2
 //   texel.rg - 1), rotation) ((1, 0) where it is 0), T = normalize(d.x t + d.y b), B = normalize(n x T);
@@ -69,7 +72,7 @@
 //   where n.wi < 0, glphong/shaders/generated.py):
 //   (1 - m) (1 - t) dt (c_dt / pi) (1 - F(v.h')) n_dot_l, l' = wi + 2 n_dot_l n, h' = normalize(l' + v),
 //   F = f0 + (1 - f0) (1 - v.h')^5, c_dt = u_gltf_pbr_diffuse_transmission_color, t the transmission (0 without it).
-// Key defines read here: GLTF_PBR_DIFFUSE_TRANSMISSION, GLTF_PBR_IRIDESCENCE, GLTF_PBR_ANISOTROPY, GLTF_PBR_CLEARCOAT_NORMAL, GLTF_PBR_SPECULAR, GLTF_PBR_CLEARCOAT, GLTF_PBR_SHEEN, GLTF_PBR_TRANSMISSION, GLTF_PBR_VOLUME (defined where the material uses the
+// Key defines read here: HAS_UNPERTURBED, GLTF_PBR_DIFFUSE_TRANSMISSION, GLTF_PBR_IRIDESCENCE, GLTF_PBR_ANISOTROPY, GLTF_PBR_CLEARCOAT_NORMAL, GLTF_PBR_SPECULAR, GLTF_PBR_CLEARCOAT, GLTF_PBR_SHEEN, GLTF_PBR_TRANSMISSION, GLTF_PBR_VOLUME (defined where the material uses the
 // extension: its code is not in the program otherwise).
 
 const float GLTF_PBR_INV_PI = 0.3183098861837907;
@@ -151,6 +154,18 @@ float gltf_clearcoat_fresnel(float n_dot_v)
     float y = (y1 * y1) * (y1 * y1) * y1;
     return 0.04 + 0.96 * y;
 }
+
+#if defined(GLTF_PBR_CLEARCOAT_NORMAL)
+vec3 gltf_clearcoat_normal(ShadingFrame f)
+{
+#if defined(HAS_UNPERTURBED) && HAS_UNPERTURBED  // a base normal map perturbed f: the frame before it
+    ShadingFrame g = unperturbed_frame;
+#else
+    ShadingFrame g = f;
+#endif
+    return surface_normal(g.n, g.t, g.b, u_gltf_pbr_clearcoat_normal, u_gltf_pbr_clearcoat_normal_strength);
+}
+#endif
 #endif
 
 #if defined(GLTF_PBR_SHEEN)
@@ -349,6 +364,14 @@ float gltf_sheen_albedo(float cos_theta, float sheen_roughness)
     float high = mix(GLTF_SHEEN_E[j * 33 + 33 + i], GLTF_SHEEN_E[j * 33 + 34 + i], s);
     return mix(low, high, t);
 }
+
+float gltf_sheen_scaling(float n_dot_v, float n_dot_l)
+{
+    vec3 sc = u_gltf_pbr_sheen_color;
+    float sc_max = max(sc.r, max(sc.g, sc.b));
+    return max(min(1.0 - sc_max * gltf_sheen_albedo(n_dot_v, u_gltf_pbr_sheen_roughness),
+                   1.0 - sc_max * gltf_sheen_albedo(n_dot_l, u_gltf_pbr_sheen_roughness)), 0.0);
+}
 #endif
 
 #if defined(GLTF_PBR_DIFFUSE_TRANSMISSION)  // KHR_materials_diffuse_transmission: the diffuse BTDF of a light behind
@@ -358,9 +381,7 @@ vec3 gltf_diffuse_transmission_response(ShadingFrame f, vec3 wi, vec3 wo, float 
     float n_dot_v, n_dot_h, v_dot_h, tan2;
     bool valid = microfacet_geometry(f.n, mirrored, wo, n_dot_l, n_dot_v, n_dot_h, v_dot_h, tan2);
     float r = (u_gltf_pbr_ior - 1.0) / (u_gltf_pbr_ior + 1.0);
-    float f0 = r * r;
-    float x1 = max(1.0 - v_dot_h, 0.0);
-    float fresnel = f0 + (1.0 - f0) * ((x1 * x1) * (x1 * x1) * x1);
+    float fresnel = fresnel_schlick(vec3(r * r), v_dot_h).x;  // fresnel.glsl (library chunk)
 #if defined(GLTF_PBR_TRANSMISSION)
     float t = u_gltf_pbr_transmission;
 #else
@@ -427,9 +448,7 @@ vec3 gltf_pbr_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
 #if defined(GLTF_PBR_SHEEN)  // KHR_materials_sheen: sheen_color D V + f_r scaling, times n.l
     float alpha_g = u_gltf_pbr_sheen_roughness * u_gltf_pbr_sheen_roughness;
     vec3 sc = u_gltf_pbr_sheen_color;
-    float sc_max = max(sc.r, max(sc.g, sc.b));
-    float scaling = max(min(1.0 - sc_max * gltf_sheen_albedo(n_dot_v, u_gltf_pbr_sheen_roughness),
-                            1.0 - sc_max * gltf_sheen_albedo(n_dot_l, u_gltf_pbr_sheen_roughness)), 0.0);
+    float scaling = gltf_sheen_scaling(n_dot_v, n_dot_l);
     float sheen_v_cos = 1.0 / ((1.0 + gltf_sheen_lambda(n_dot_v, alpha_g) + gltf_sheen_lambda(n_dot_l, alpha_g))
                                * (4.0 * n_dot_v));
     float sheen = min(gltf_sheen_distribution(tan2, alpha_g) * sheen_v_cos, FLT_MAX);
@@ -439,7 +458,7 @@ vec3 gltf_pbr_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
     float alpha_c = u_gltf_pbr_clearcoat_roughness * u_gltf_pbr_clearcoat_roughness;
     float a2_c = alpha_c * alpha_c;
 #if defined(GLTF_PBR_CLEARCOAT_NORMAL)  // clearcoatNormalTexture: the coat's own normal on the unperturbed frame
-    vec3 n_c = surface_normal(f.n, f.t, f.b, u_gltf_pbr_clearcoat_normal, u_gltf_pbr_clearcoat_normal_strength);
+    vec3 n_c = gltf_clearcoat_normal(f);
     float c_n_dot_l = dot(n_c, wi);
     float c_n_dot_v, c_n_dot_h, c_v_dot_h, c_tan2;
     bool c_valid = microfacet_geometry(n_c, wi, wo, c_n_dot_l, c_n_dot_v, c_n_dot_h, c_v_dot_h, c_tan2);

@@ -94,17 +94,9 @@ def test_the_comparison_catches_the_usual_mistakes():
     assert np.max(np.abs(_specification(c, m, 0.0, ior, 0.0, c_dt, e_front, 0.0, 0.0) - front) / front.max()) > 0.05
 
 
-def _lights_behind_scene(textured=False, material=None):
-    """tests/test_transmission.py's scene of point, spot and directional lights behind a quad over a floor, the quad
-    ours."""
-    spec = importlib.util.spec_from_file_location("_transmission_tests_dt", pathlib.Path(__file__).parents[1]
-                                                  / "test_transmission.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    glass = module._lights_behind_scene(0.3)
-    scene = glphong.Scene(glass.camera, list(glass.lights))
-    floor = glass.objects[0]
-    scene.add(floor.mesh, floor.material, pose=floor.pose, name=floor.name)
+def _leaf_scene(lights_behind_scene, textured=False, material=None):
+    """A diffusely transmitting quad (a leaf) in the transmission tests' scene of lights on both sides
+    (`lights_behind_scene`, tests/conftest.py)."""
     dt, color = 0.8, (0.3, 0.9, 0.2)
     if textured:
         image = np.random.default_rng(7).integers(0, 256, (16, 16, 3), dtype=np.uint8)
@@ -112,21 +104,22 @@ def _lights_behind_scene(textured=False, material=None):
         color = glphong.Texture(image[::-1], (1.0, 0.8, 0.6))
     material = material or glphong.GltfPBR((0.9, 0.8, 0.6), 0.2, 0.4, diffuse_transmission=dt,
                                            diffuse_transmission_color=color)
-    scene.add(primitives.plane(1.5, segments=4), material, name="leaf")
-    return scene
+    return lights_behind_scene(primitives.plane(1.5, segments=4), material, name="leaf")
 
 
 @pytest.mark.parametrize("textured", [False, True])
-def test_point_spot_and_directional_lights_behind_verify(textured, glphong_backend, glphong_make_renderer):
-    report = glphong.verify(_lights_behind_scene(textured), glphong_make_renderer(48, 40, glphong_backend))
+def test_point_spot_and_directional_lights_behind_verify(textured, glphong_backend, glphong_make_renderer,
+                                                         lights_behind_scene):
+    renderer = glphong_make_renderer(48, 40, glphong_backend)
+    report = glphong.verify(_leaf_scene(lights_behind_scene, textured), renderer)
     assert report.passed and report.transmission.pixels.sum() > 700, report.summary()
 
 
-def test_with_transmission_both_verify(glphong_backend, glphong_make_renderer):
+def test_with_transmission_both_verify(glphong_backend, glphong_make_renderer, lights_behind_scene):
     """KHR_materials_transmission overrides the diffuse transmission by its weight (1 - t), as the README combines
     them; the glass's background and lights behind are drawn by the same pass."""
-    scene = _lights_behind_scene(material=glphong.GltfPBR((0.9, 0.8, 0.6), 0.1, 0.3, transmission=0.5,
-                                                          diffuse_transmission=0.6))
+    scene = _leaf_scene(lights_behind_scene, material=glphong.GltfPBR((0.9, 0.8, 0.6), 0.1, 0.3, transmission=0.5,
+                                                                       diffuse_transmission=0.6))
     report = glphong.verify(scene, glphong_make_renderer(48, 40, glphong_backend))
     assert report.passed, report.summary()
 
@@ -142,7 +135,7 @@ PLANTED = {"1 - F for F": ("* (1.0 - fresnel) * n_dot_l);", "* fresnel * n_dot_l
 
 
 @pytest.mark.parametrize("planted", sorted(PLANTED))
-def test_planted_errors_fail(planted, monkeypatch, glphong_make_renderer):
+def test_planted_errors_fail(planted, monkeypatch, glphong_make_renderer, lights_behind_scene):
     from glphong.shaders import assembly
 
     old, new = PLANTED[planted]
@@ -151,7 +144,7 @@ def test_planted_errors_fail(planted, monkeypatch, glphong_make_renderer):
     assert source[0].count(old) == 1
     monkeypatch.setattr(assembly, "model_source", lambda cls: (source[0].replace(old, new),) + tuple(source[1:])
                         if cls is glphong.materials.gltf_pbr.GltfPBR else original(cls))
-    report = glphong.verify(_lights_behind_scene(), glphong_make_renderer(48, 40, "egl"))
+    report = glphong.verify(_leaf_scene(lights_behind_scene), glphong_make_renderer(48, 40, "egl"))
     assert not report.passed and report.outside_count > 0, report.summary()
 
 

@@ -285,14 +285,6 @@ def test_coat_normal_planted_errors_fail(planted, monkeypatch, glphong_make_rend
                                glphong_make_renderer)
 
 
-def test_coat_normal_with_a_normal_map_is_refused():
-    """The coat's normal is taken on the unperturbed frame, which a material-level normal map replaces."""
-    normal_map = glphong.NormalMap(np.full((4, 4, 3), 128, np.uint8))
-    with pytest.raises(ValueError, match="clearcoat_normal with a normal_map"):
-        glphong.GltfPBR(0.5, 0.0, 0.5, clearcoat=1.0, clearcoat_normal=(0.6, 0.5, 1.0), normal_map=normal_map)
-    glphong.GltfPBR(0.5, 0.0, 0.5, clearcoat=1.0, normal_map=normal_map)  # the coat on the mapped normal: allowed
-
-
 def test_stability_cases_pass(session_gl):
     """The extensions' stability cases (grazing view, roughness 0 and 1, specular 0 and 1, a clamped f0): the GPU
     within the band of the mpmath oracle (the extensions' formulas, gltf_extensions_oracle), finite."""
@@ -389,8 +381,8 @@ def test_files_load_with_their_textures_and_save_back(tmp_path):
 
 def test_files_disabled_coat_and_coat_normals(tmp_path):
     """clearcoatFactor 0 disables the layer; clearcoatNormalTexture without a base normalTexture is the coat's own
-    normal (with its scale; written back); a coat normal other than a normal-mapped base's is named in a warning;
-    out-of-range factors are refused with their JSON path."""
+    normal (with its scale; written back); over a normalTexture too, the coat's normal on the unperturbed frame
+    (test_gltf_coat_normal.py); out-of-range factors are refused with their JSON path."""
     path = _gltf(tmp_path, {"KHR_materials_clearcoat": {"clearcoatFactor": 0.0, "clearcoatRoughnessFactor": 0.5}})
     assert glphong.load_scene(path, light_units="radiometric", lights=[]).objects[0].material.extensions() == ()
     rgb = np.full((4, 4, 3), 128, np.uint8)
@@ -412,12 +404,6 @@ def test_files_disabled_coat_and_coat_normals(tmp_path):
     out.write_text(json.dumps(document))
     again = glphong.load_scene(out, light_units="radiometric", lights=[]).objects[0].material
     assert again.extensions() == ("clearcoat", "clearcoat_normal") and again.clearcoat_normal_strength == 0.5
-    for coat_normal in (None, 1):  # over a normal-mapped base: the base's normal, named
-        coat = {"clearcoatFactor": 1.0} | ({} if coat_normal is None else {"clearcoatNormalTexture": {"index": 1}})
-        path = _gltf(tmp_path, {"KHR_materials_clearcoat": coat}, normal=0, images=[rgb, rgb[::-1]])
-        with pytest.warns(UserWarning, match="coat takes the material's shading normal.*not drawn exactly"):
-            material = glphong.load_scene(path, light_units="radiometric", lights=[]).objects[0].material
-        assert material.extensions() == ("clearcoat",) and material.normal_map is not None
     path = _gltf(tmp_path, {"KHR_materials_specular": {"specularFactor": 1.5}})
     with pytest.raises(glphong.filesafety.SceneFileError,
                        match=r"materials\[0\]\.extensions\.KHR_materials_specular\.specularFactor"):
