@@ -11,9 +11,10 @@ For each image size, in one process: one render (`Renderer.render`: draw and flo
 of ``--repeats`` runs after a warm-up, and one `glphong.verify` as the median of ``--verify-repeats`` runs after one
 warm-up; printed: both medians and their ratio.
 
-``--save DIR`` writes each verify's arrays (reference, low, high, exact, outside, mask) to ``DIR/<scene>_<size>.npz``;
-``--compare DIR`` checks the arrays against such a directory with ``np.array_equal`` (bit for bit) and prints the
-verdict per scene; ``--profile SCENE`` runs cProfile over one verify of that scene at the first size instead.
+``--save DIR`` writes each verify's arrays (reference, low, high, exact, outside, mask, shadow band, relative
+error) to ``DIR/<scene>_<size>.npz``; ``--compare DIR`` checks the arrays against such a directory with
+``np.array_equal`` (bit for bit, NaN equal to NaN) and prints the verdict per scene; ``--profile SCENE`` runs
+cProfile over one verify of that scene at the first size instead.
 
 ``--against BEFORE`` compares two versions of glphong interleaved: BEFORE (the root of a checkout or an export of
 another commit, e.g. ``git archive <commit> | tar -x -C /tmp/before``) and ``--tree`` (default: this checkout), each
@@ -55,7 +56,7 @@ from glphong.core.timing import median_seconds
 from glphong.shaders.binding import binding
 from glphong.twin.functions import safe_normalize
 
-ARRAYS = ("reference", "low", "high", "exact", "outside", "mask", "shadow_band")
+ARRAYS = ("reference", "low", "high", "exact", "outside", "mask", "shadow_band", "relative_error")
 LIGHTS8 = [(1.5 * np.cos(a), 1.5 * np.sin(a), 1.0 + 0.5 * np.sin(3 * a))
            for a in np.linspace(0, 2 * np.pi, 8, endpoint=False)]
 

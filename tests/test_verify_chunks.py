@@ -7,7 +7,8 @@ import pytest
 
 import glphong
 from glphong import primitives
-from glphong.checks import verify
+from glphong.checks import reference, verify
+from glphong.checks.tolerances import BAND
 
 
 def _scene(light, materials):
@@ -41,3 +42,56 @@ def test_the_twin_in_chunks_is_the_twin_whole(light, materials, monkeypatch, glp
     chunked = verify.twin_and_band(scene, gbuffer, shadows=renderer.shadow_settings)
     for a, b in zip(whole, chunked):
         assert a.dtype == b.dtype and np.array_equal(a, b)
+
+
+def test_each_objects_values_are_read_once_for_all_its_chunks(monkeypatch, glphong_make_renderer):
+    """`twin_and_band` reads each term's parameter values from the uniforms once an object
+    (`glphong.checks.uniform_values`), not once a chunk for the twin and again for the band, and the view directions
+    once a chunk for both; the arrays stay those of reading them every time."""
+    scene = _scene(glphong.SpotLight((0.8, -1.0, 2.0), (-0.8, 1.0, -1.5), 20.0, 0.3, 0.6), MATERIALS[1])
+    renderer = glphong_make_renderer(96, 72, "egl")
+    gbuffer = renderer.gbuffer(scene)
+    monkeypatch.setattr(verify, "TWIN_CHUNK", 1 << 30)
+    whole = verify.twin_and_band(scene, gbuffer)
+    calls = []
+    for kind in {type(term) for obj in scene.objects for term in obj.material.components}:
+        read = kind.values_from_uniforms
+        monkeypatch.setattr(kind, "values_from_uniforms",
+                            lambda term, *a, _read=read, **k: calls.append(term) or _read(term, *a, **k))
+    views, shaded = [], []
+    for name, log in (("view_direction", views), ("shade_point", shaded)):
+        monkeypatch.setattr(reference, name, lambda *a, _f=getattr(reference, name), _log=log, **k: _log.append(1) or
+                            _f(*a, **k))
+    monkeypatch.setattr(verify, "TWIN_CHUNK", 67)  # many chunks for the floor, a few for the sphere
+    chunked = verify.twin_and_band(scene, gbuffer)
+    terms = [term for obj in scene.objects for term in obj.material.components]
+    assert sorted(map(id, calls)) == sorted(map(id, terms))  # once each
+    assert len(shaded) > 10 and len(views) == len(shaded)  # the view once a chunk, for the twin and its band
+    for a, b in zip(whole, chunked):
+        assert a.dtype == b.dtype and np.array_equal(a, b)
+
+
+
+@pytest.mark.parametrize("reach", [None, 2.5], ids=["exact irradiance", "range window"])
+def test_a_lights_band_takes_the_irradiance_already_computed(reach, monkeypatch, glphong_make_renderer):
+    """`reference.incident_light` hands a point light's band the irradiance it has just computed instead of computing
+    it again (`ExactIrradiance`: the twin's value is the band; a range window's generic band: its value at the
+    unmoved point, the moved ones computed); both bands equal the kind's band called on its own."""
+    light = glphong.PointLight((0.8, -1.0, 2.0), 20.0, range=reach)
+    scene = _scene(light, MATERIALS[0])
+    gbuffer = glphong_make_renderer(96, 72, "egl").gbuffer(scene)
+    calls = []
+    incident = glphong.PointLight.incident
+    monkeypatch.setattr(glphong.PointLight, "incident", lambda self, x, p: calls.append(x) or incident(self, x, p))
+    for _, _, key, u, position, _, _ in reference.shade_inputs(scene, gbuffer):
+        p = glphong.PointLight.values_from_uniforms(u, 0, dtype=np.float64, defines=key.lights[0].defines)
+        del calls[:]
+        expected = glphong.PointLight.twin().band(position, p, BAND)
+        alone = len(calls)
+        del calls[:]
+        (valid, wi, irradiance, band), = reference.incident_light(position, key, u, band=BAND)
+        assert np.array_equal(band[0], expected[0]) and np.array_equal(band[1], expected[1])
+        # its own call, and the band's less the one at the unmoved point and values (the whole band of the first)
+        assert len(calls) == alone
+        if reach is None:
+            assert alone == 1 and np.array_equal(band[0], irradiance)

@@ -30,6 +30,7 @@ from glphong.twin.functions import (BLINN_HALF_FLOOR, FLT_MAX, FRAME_PARALLEL_LI
                                     phong_delta, phong_lobe, point_irradiance, range_window, safe_normalize,
                                     shading_frame, surface_normal)
 from glphong.checks.shadows import shadow_visibility
+from glphong.checks.uniform_values import values_from
 from glphong.twin.area import (area_angle, area_clip, area_clipped_cosine, area_clipped_lobe, area_edge_powers,  # noqa: F401
                                area_polygon_cosine, area_polygon_lobe, area_solid_angle, area_triangle_sample)
 from glphong.shaders.generated import closed_form
@@ -83,16 +84,29 @@ def incident_light(position, key, uniforms, band=None):
         kind = light_for_key(light_key.name, light_key.source_hash)
         twin = kind.twin()
         for j in range(light_key.count):
-            p = kind.values_from_uniforms(uniforms, j, dtype=position.dtype, defines=light_key.defines)
+            p = values_from(kind, uniforms, j, dtype=position.dtype, defines=light_key.defines)
             with np.errstate(divide="ignore", invalid="ignore", over="ignore", under="ignore"):
-                valid, wi, irradiance = twin.incident(position, p)
+                computed = valid, wi, irradiance = twin.incident(position, p)
                 wi = np.broadcast_to(wi, position.shape)
                 irradiance = np.broadcast_to(irradiance, position.shape)
                 if band is None:
                     out.append((np.broadcast_to(valid, position.shape[:-1]), wi, irradiance))
                 else:
-                    out.append((np.broadcast_to(valid, position.shape[:-1]), wi, irradiance, twin.band(position, p, band)))
+                    out.append((np.broadcast_to(valid, position.shape[:-1]), wi, irradiance,
+                                _band_reusing(twin, position, p, band, computed)))
     return out
+
+
+def _band_reusing(twin, x, p, band, computed):
+    """``twin.band(x, p, band)`` where the band's own call ``twin.incident(x, p)`` (`ExactIrradiance`'s: the twin's
+    value is the band) takes ``computed``, that call's result already in hand, instead of computing it again; its
+    calls at other points (a generic band's moved inputs) compute.  ``twin`` is `incident_light`'s own bare instance."""
+    kind = type(twin)
+    object.__setattr__(twin, "incident", lambda y, q: computed if y is x and q is p else kind.incident(twin, y, q))
+    try:
+        return twin.band(x, p, band)
+    finally:
+        object.__delattr__(twin, "incident")
 
 
 def _terms(material):
@@ -221,7 +235,7 @@ def view_direction(position, n_valid, eye, key):
     return wo, n_valid & ok_v
 
 
-def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=None, incident=None):
+def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=None, incident=None, view=None):
     """E6 at each point (shade.glsl's ``shade_point``).
 
     Parameters
@@ -246,6 +260,8 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=Non
     incident : list, optional
         `incident_light` of these points, where the caller has it already (`glphong.checks.verify.twin_and_band`
         shares it with the band); its first three entries per light are read.
+    view : (wo, lit), optional
+        `view_direction` of these points, where the caller has it already (`glphong.checks.verify.twin_and_band`).
 
     Returns
     -------
@@ -256,15 +272,15 @@ def shade_point(position, n, n_valid, eye, key, uniforms, material, extended=Non
     radiance = material_emission(key, uniforms, position.shape, position.dtype, material, f.inputs)
     if key.num_lights == 0:
         return radiance
-    wo, lit = view_direction(position, n_valid, eye, key)
+    wo, lit = view_direction(position, n_valid, eye, key) if view is None else view
     lights = incident_light(position, key, uniforms) if incident is None else [light[:3] for light in incident]
     for i, (valid, wi, irradiance) in enumerate(lights):
         if f.visibility is not None and f.visibility[i] is not None:  # the ray-cast shadow (checks.shadows)
             irradiance = irradiance * f.visibility[i][0][:, None]
         n_dot_l = _dot(f.n, wi)
-        gate = lit & valid & (n_dot_l > 0)
+        gate = np.flatnonzero(lit & valid & (n_dot_l > 0))  # by index: one search for the gathers and the scatter
         term = np.zeros_like(radiance)
-        if gate.any():
+        if gate.size:
             g = f.select(gate)
             with np.errstate(invalid="ignore", over="ignore", divide="ignore"):
                 term[gate] = light_term(material_response(g, wi[gate], wo[gate], n_dot_l[gate], key, uniforms, material),
@@ -436,7 +452,7 @@ def terms_response(f, wi, wo, n_dot_l, term_keys, uniforms, terms, occluded=Fals
     out = np.zeros(np.shape(wi), np.result_type(f.n, wi))
     for term_key in term_keys:
         term = terms[term_key.name]
-        p = term.values_from_uniforms(uniforms, dtype=out.dtype, inputs=f.inputs)
+        p = values_from(term, uniforms, dtype=out.dtype, inputs=f.inputs)
         response = term.response(f, wi, wo if "view" in term.needs else np.zeros_like(wi), n_dot_l, p)
         out = out + occlusion_factor(term_key, p, occluded) * response
     return out

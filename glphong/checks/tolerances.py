@@ -23,6 +23,7 @@ import numpy as np
 
 from glphong.checks import reference as ref
 from glphong.checks.reference import input_bounds  # noqa: F401 - re-exported
+from glphong.checks.uniform_values import values_from
 from glphong.twin.band import BAND, EPS, FLT_MAX, FLT_MIN, BandConstants, lobe_band  # noqa: F401 - re-exported
 
 __all__ = ["EPS", "FLT_MIN", "FLT_MAX", "BandConstants", "BAND", "lobe_band", "response_band", "point_band",
@@ -61,7 +62,7 @@ def _textured_band(term, f, wi, wo, n_dot_l, u, band):
     return low, high
 
 
-def point_band(key, u, position, n, n_valid, material, band=BAND, incident=None):
+def point_band(key, u, position, n, n_valid, material, band=BAND, incident=None, view=None):
     """Interval the GPU's ``shade_point()`` must return at given points.
 
     Each lit term contributes its own band (`glphong.materials.MaterialModel.band`: the model's
@@ -84,6 +85,8 @@ def point_band(key, u, position, n, n_valid, material, band=BAND, incident=None)
     incident : list, optional
         ``incident_light(position, key, u, band=band)`` where the caller has it already (`glphong.checks.verify`'s
         twin shares it).
+    view : (wo, lit), optional
+        ``glphong.checks.reference.view_direction(position, n_valid, u.get("u_eye"), key)`` where the caller has it.
 
     Returns
     -------
@@ -95,7 +98,7 @@ def point_band(key, u, position, n, n_valid, material, band=BAND, incident=None)
     hi = ref.material_emission(key, u, position.shape, np.float64, inputs=high_inputs) * (1 + band.A * EPS)
     terms = int(key.has_ka) + sum(1 for t in key.terms if t.ambient) + sum(1 for t in key.terms if t.emission)
     if key.num_lights:
-        wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key)
+        wo, lit = ref.view_direction(position, n_valid, u.get("u_eye"), key) if view is None else view
         tol = band.D * EPS
         lights = ref.incident_light(position, key, u, band=band) if incident is None else incident
         for i, (valid, wi, irradiance, (e_low, e_high)) in enumerate(lights):
@@ -104,20 +107,24 @@ def point_band(key, u, position, n, n_valid, material, band=BAND, incident=None)
                 _, v_low, v_high = f.visibility[i]
                 e_low, e_high = e_low * v_low[:, None], e_high * v_high[:, None]
             n_dot_l = ref._dot(f.n, wi)
-            certain = (lit & valid & (n_dot_l > tol))[..., None]
-            possible = lit & valid & (n_dot_l > -tol)
-            f_lo = np.zeros_like(position)
-            f_hi = np.zeros_like(position)
-            if possible.any():
-                f_lo[possible], f_hi[possible] = response_band(key, u, f.select(possible), wi[possible],
-                                                               wo[possible], n_dot_l[possible], material, band)
-            with np.errstate(over="ignore", invalid="ignore"):
-                # an irradiance below FLT_MIN may be flushed to 0 on the GPU, and the term with it
-                e_lo = np.where(e_low < FLT_MIN, 0.0, e_low)
-                t_lo = np.nan_to_num(ref.light_term(f_lo, e_lo) * (1 - band.A * EPS), nan=0.0)
-                t_hi = np.nan_to_num(ref.light_term(f_hi, e_high) * (1 + band.A * EPS), nan=np.inf, posinf=np.inf)
-            lo = lo + np.where(certain, t_lo, 0.0)
-            hi = hi + np.where(possible[..., None], t_hi, 0.0)
+            reached = lit & valid
+            # the points the term may reach, by index: the term is 0 elsewhere (each point's arithmetic is its own)
+            possible = np.flatnonzero(reached & (n_dot_l > -tol))
+            t_lo, t_hi = np.zeros_like(position), np.zeros_like(position)
+            if possible.size:
+                f_lo, f_hi = response_band(key, u, f.select(possible), wi[possible], wo[possible], n_dot_l[possible],
+                                           material, band)
+                certain = (n_dot_l[possible] > tol)[..., None]
+                with np.errstate(over="ignore", invalid="ignore"):
+                    # an irradiance below FLT_MIN may be flushed to 0 on the GPU, and the term with it
+                    e_lo = e_low[possible]
+                    e_lo = np.where(e_lo < FLT_MIN, 0.0, e_lo)
+                    t_lo[possible] = np.where(certain, np.nan_to_num(ref.light_term(f_lo, e_lo) * (1 - band.A * EPS),
+                                                                     nan=0.0), 0.0)
+                    t_hi[possible] = np.nan_to_num(ref.light_term(f_hi, e_high[possible]) * (1 + band.A * EPS),
+                                                   nan=np.inf, posinf=np.inf)
+            lo = lo + t_lo
+            hi = hi + t_hi
         for e_lo, e_hi in extended_band(key, u, position, f, wo, lit, material, band):
             terms += 1
             lo, hi = lo + e_lo, hi + e_hi
@@ -206,7 +213,7 @@ def response_band(key, u, f, wi, wo, n_dot_l, material, band=BAND, term_keys=Non
             if term.surface_inputs():
                 t_lo, t_hi = _textured_band(term, f, wi, wo, n_dot_l, u, band)
             else:
-                t_lo, t_hi = term.band(f, wi, wo, n_dot_l, term.values_from_uniforms(u), band)
+                t_lo, t_hi = term.band(f, wi, wo, n_dot_l, values_from(term, u), band)
         if occluded and term_key.occlusion:  # an occludable light: the term's times its occlusion (>= 0), both ends
             o_lo, o_hi = (ref.occlusion_factor(term_key, term.values_from_uniforms(u, inputs=i), True) for i in _input_ends(f)) \
                 if f.inputs else (ref.occlusion_factor(term_key, term.values_from_uniforms(u), True),) * 2

@@ -8,6 +8,7 @@ from glphong.checks.blend_twin import blend_twin
 from glphong.checks.method_sample import auto_sample_size, method_figures, sample_mask
 from glphong.checks.tolerances import BAND, point_band
 from glphong.checks.transmission_twin import transmission_check
+from glphong.checks.uniform_values import UniformValues
 from glphong.checks.verify_passes import verify_passes
 from glphong.gpu.passes import requested_passes
 from glphong.gpu.peeling import blended_objects
@@ -16,10 +17,11 @@ from glphong.gpu.renderer import Renderer
 
 __all__ = ["VerifyReport", "verify", "compare", "relative_error", "TWIN_CHUNK"]
 
-#: pixels `twin_and_band` shades at once: their temporaries (a few hundred kB) stay below the C allocator's threshold
-#: for mapping fresh pages, which a whole object's (MBs) cross on every array (docs/speed.md, "Verify against the
-#: render")
-TWIN_CHUNK = 4096
+#: most pixels `twin_and_band` shades at once (an object's pixels in equal chunks): their temporaries (a few hundred
+#: kB) stay clear of the C allocator's fresh pages, which a whole object's (MBs) take on every array, and the chunks'
+#: fixed Python cost stays small (8192 against 4096: 0.87 to 0.98 of the twin's time; docs/speed.md, "Verify against
+#: the render")
+TWIN_CHUNK = 8192
 
 
 @dataclass(frozen=True)
@@ -342,22 +344,24 @@ def twin_and_band(scene, gbuffer, band=BAND, shadows=None):
     shadow_band : (H, W) bool ndarray
         Pixels where a shadowing light's visibility is uncertain (the band holds it between 0 and 1).
     """
-    ref = np.zeros(gbuffer.position.shape)
-    low, high = np.zeros_like(ref), np.zeros_like(ref)
+    ref, low, high = (np.zeros(gbuffer.position.shape) for _ in range(3))  # zeroed pages from the kernel, as needed
     shadow_band = np.zeros(gbuffer.mask.shape, bool)
     ref_rows, low_rows, high_rows = (a.reshape(-1, 3) for a in (ref, low, high))  # rows of pixels, written by index
     for selection, obj, key, u, position, f, n_valid in reference.shade_inputs(scene, gbuffer, band=band, shadows=shadows):
+        u = UniformValues(u)  # each term's and light's values read once for all the chunks
         pixels = np.flatnonzero(selection)  # in the order of the selection's pixels, as shade_inputs takes them
-        for a in range(0, len(pixels), TWIN_CHUNK):  # each pixel's arithmetic is its own: chunks change no bit
-            part = slice(a, a + TWIN_CHUNK)
-            here, frame, valid = (position, f, n_valid) if len(pixels) <= TWIN_CHUNK else \
+        step = -(-len(pixels) // -(-len(pixels) // TWIN_CHUNK))  # equal chunks of at most TWIN_CHUNK pixels
+        for a in range(0, len(pixels), step):  # each pixel's arithmetic is its own: chunks change no bit
+            part = slice(a, a + step)
+            here, frame, valid = (position, f, n_valid) if len(pixels) <= step else \
                 (position[part], f.select(part), n_valid[part])
-            # the lights' directions and irradiance, computed once for the twin and its band
+            # the lights' directions and irradiance, and the view, computed once for the twin and its band
             lights = reference.incident_light(here, key, u, band=band) if key.num_lights else []
+            view = reference.view_direction(here, valid, u.get("u_eye"), key) if key.num_lights else None
             ref_rows[pixels[part]] = reference.shade_point(here, frame, valid, u.get("u_eye"), key, u, obj.material,
-                                                           incident=lights)
+                                                           incident=lights, view=view)
             low_rows[pixels[part]], high_rows[pixels[part]] = point_band(key, u, here, frame, valid, obj.material,
-                                                                         band, incident=lights)
+                                                                         band, incident=lights, view=view)
         for v in f.visibility or ():
             if v is not None:
                 shadow_band.reshape(-1)[pixels[v[1] != v[2]]] = True
