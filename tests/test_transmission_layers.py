@@ -233,6 +233,19 @@ def test_a_textured_film_over_transmission_verifies(glphong_backend, glphong_mak
     assert report.passed and report.transmission.pixels.sum() > 100, report.summary()
 
 
+def _mirrored_ggx(wi, wo, n_dot_l, r):
+    """The specification's GGX ``D`` and ``V`` for the light ``wi`` behind the surface (normal +z) mirrored through it,
+    transcribed in float64: ``(n.v, v.h', D, V)``, each (N,), for roughness ``r``."""
+    mirrored = wi * np.array([1.0, 1.0, -1.0])
+    h = (mirrored + wo) / np.linalg.norm(mirrored + wo, axis=1, keepdims=True)
+    n_dot_v, n_dot_h, v_dot_h = wo[:, 2], h[:, 2], np.sum(wo * h, axis=1)
+    a2 = (r * r) ** 2
+    d = a2 / (np.pi * (n_dot_h ** 2 * (a2 - 1.0) + 1.0) ** 2)
+    vis = 1.0 / (2.0 * (n_dot_v * np.sqrt(a2 + (1 - a2) * n_dot_l ** 2)
+                        + n_dot_l * np.sqrt(a2 + (1 - a2) * n_dot_v ** 2)))
+    return n_dot_v, v_dot_h, d, vis
+
+
 def _views_and_lights_behind(rng, count):
     """``(n, wo, wi)``, each (count, 3): the normal +z, random unit views in front (``wo.z >= 0.05`` before
     normalising) and random unit directions toward lights behind the surface (``wi.z <= -0.05``)."""
@@ -258,13 +271,7 @@ def test_the_twins_film_over_transmission_is_the_specifications_at_random_direct
     film = {"iridescence": 0.6, "iridescence_ior": rng.uniform(1.1, 2.2, count),
             "thickness": rng.uniform(50.0, 1200.0, count)}
     got = gltf_transmission_response(n, wi, wo, n_dot_l, c, m, t, r, ior, (specular, color), film=film)
-    mirrored = wi * np.array([1.0, 1.0, -1.0])
-    h = (mirrored + wo) / np.linalg.norm(mirrored + wo, axis=1, keepdims=True)
-    n_dot_v, n_dot_h, v_dot_h = wo[:, 2], h[:, 2], np.sum(wo * h, axis=1)
-    a2 = (r * r) ** 2
-    d = a2 / (np.pi * (n_dot_h ** 2 * (a2 - 1.0) + 1.0) ** 2)
-    vis = 1.0 / (2.0 * (n_dot_v * np.sqrt(a2 + (1 - a2) * n_dot_l ** 2)
-                        + n_dot_l * np.sqrt(a2 + (1 - a2) * n_dot_v ** 2)))
+    n_dot_v, v_dot_h, d, vis = _mirrored_ggx(wi, wo, n_dot_l, r)
     film_f0 = np.minimum(((ior - 1.0) / (ior + 1.0)) ** 2 * color, 1.0) * specular
 
     def one_minus(cos):
@@ -389,13 +396,7 @@ def test_the_twins_btdf_and_weight_are_the_specifications_at_random_directions()
     got = gltf_transmission_response(n, wi, wo, n_dot_l, c, m, t, r, ior, (specular, color),
                                      {"clearcoat": clearcoat, "sheen_color": sheen_color,
                                       "sheen_roughness": sheen_roughness})
-    mirrored = wi * np.array([1.0, 1.0, -1.0])
-    h = (mirrored + wo) / np.linalg.norm(mirrored + wo, axis=1, keepdims=True)
-    n_dot_v, n_dot_h, v_dot_h = wo[:, 2], h[:, 2], np.sum(wo * h, axis=1)
-    a2 = (r * r) ** 2
-    d = a2 / (np.pi * (n_dot_h ** 2 * (a2 - 1.0) + 1.0) ** 2)
-    vis = 1.0 / (2.0 * (n_dot_v * np.sqrt(a2 + (1 - a2) * n_dot_l ** 2)
-                        + n_dot_l * np.sqrt(a2 + (1 - a2) * n_dot_v ** 2)))
+    n_dot_v, v_dot_h, d, vis = _mirrored_ggx(wi, wo, n_dot_l, r)
     f = np.stack([specular_fresnel(x, ior, specular, color) for x in v_dot_h])
     coat = 1.0 - clearcoat * (0.04 + 0.96 * (1.0 - n_dot_v) ** 5)
     sheen = np.maximum(np.minimum(1.0 - 0.9 * sheen_albedo(n_dot_v, sheen_roughness),
