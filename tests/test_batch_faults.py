@@ -193,7 +193,10 @@ def test_sigint_during_a_batch_exits_cleanly_and_the_rerun_resumes(tmp_path, to)
         """)
     angles = [float(a) for a in range(0, 360, 9)]  # 40 frames, 0.2 s each on 2 workers: about 4 s
     out = tmp_path / "frames"
-    script = (f"import sys; sys.path.insert(0, {str(tmp_path)!r})\nfrom glphong.batch import render_many\n"
+    # the child is a user's script at a terminal, whose SIGINT is Python's default: a SIG_IGN inherited from the test
+    # runner's process would stay ignored in it (Python keeps a SIGINT ignored at its start)
+    script = (f"import signal, sys; signal.signal(signal.SIGINT, signal.default_int_handler)\n"
+              f"sys.path.insert(0, {str(tmp_path)!r})\nfrom glphong.batch import render_many\n"
               f"from slow_scenes import slow_scene\nif __name__ == '__main__':\n"
               f"    render_many(slow_scene, {angles!r}, {W}, {H}, {str(out)!r}, workers=2, progress=False)\n")
     (tmp_path / "run_batch.py").write_text(script)
