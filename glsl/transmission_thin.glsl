@@ -5,7 +5,8 @@
 //
 //   L_t = (1 - m) t (1 - max3(F(n.v))) c B keep(n.v, n.v),   F(c) = fresnel_schlick(f0, c) = f0 + (1 - f0) (1 - c)^5
 //   (library chunk fresnel.glsl: c clamped to [0, 1]),  f0 = ((ior - 1)/(ior + 1))^2
-//   gltf_transmission_fresnel(ior, c) -> F: fresnel_schlick(vec3(f0), c); with KHR_materials_specular
+//   gltf_transmission_fresnel(ior, c) -> F (defined in materials/gltf_pbr.glsl, which KHR_materials_diffuse_transmission
+//     also reads): fresnel_schlick(vec3(f0), c); with KHR_materials_specular
 //     (GLTF_PBR_SPECULAR) specular fresnel_schlick(min(f0 specular_color, 1), c) = mix(min(f0 specular_color, 1)
 //     specular, specular, (1 - c)^5), the specification's fresnel_mix F (gltf_pbr.glsl's gltf_specular_fresnel): the
 //     transmitted light is in fresnel_mix's base, so it is weighted by 1 - max3(F) as the diffuse is.  With
@@ -14,7 +15,7 @@
 //     without KHR_materials_specular), d = mix(thickness_minimum, thickness_maximum, thickness_mix)
 //     (gltf_iridescence.glsl's gltf_iridescence_fresnel, as gltf_pbr.glsl's response mixes it): 1 - max3(F'), as the
 //     specification's rgb_mix weights its base.
-//   gltf_transmission_layers(f, wo, n_dot_v, n_dot_l) -> keep: what the layers over the base leave of the light it
+//   gltf_transmission_layers(f, wo, n_dot_v, n_dot_l) -> keep (defined in materials/gltf_pbr.glsl): what the layers over the base leave of the light it
 //     lets through, as they weight the base: KHR_materials_sheen's albedo scaling gltf_sheen_scaling(n.v, n_dot_l) =
 //     max(min(1 - max3(sheen_color) E(n.v), 1 - max3(sheen_color) E(n_dot_l)), 0) (GLTF_PBR_SHEEN; gltf_pbr.glsl)
 //     times KHR_materials_clearcoat's 1 - clearcoat F_c(n.v) (GLTF_PBR_CLEARCOAT; gltf_clearcoat_fresnel), with a
@@ -61,42 +62,6 @@ uniform float u_transmission_levels;
 uniform mat4 u_model;
 uniform mat4 u_view_projection;
 #endif
-
-vec3 gltf_transmission_fresnel(float ior, float c)
-{
-    float r = (ior - 1.0) / (ior + 1.0);
-#if defined(GLTF_PBR_SPECULAR)
-    vec3 fresnel = u_gltf_pbr_specular * fresnel_schlick(min(r * r * u_gltf_pbr_specular_color, vec3(1.0)), c);
-#else
-    vec3 fresnel = fresnel_schlick(vec3(r * r), c);
-#endif
-#if defined(GLTF_PBR_IRIDESCENCE)  // KHR_materials_iridescence: F' = mix(F, F_iridescence(film_f0), iridescence)
-#if defined(GLTF_PBR_SPECULAR)
-    vec3 film_f0 = min(r * r * u_gltf_pbr_specular_color, vec3(1.0)) * u_gltf_pbr_specular;
-#else
-    vec3 film_f0 = vec3(r * r);
-#endif
-    float thickness = mix(u_gltf_pbr_iridescence_thickness_minimum, u_gltf_pbr_iridescence_thickness_maximum,
-                          u_gltf_pbr_iridescence_thickness_mix);
-    vec3 film = gltf_iridescence_fresnel(1.0, u_gltf_pbr_iridescence_ior, film_f0, thickness, clamp(c, 0.0, 1.0));
-    fresnel = mix(fresnel, film, u_gltf_pbr_iridescence);
-#endif
-    return fresnel;
-}
-
-float gltf_transmission_layers(ShadingFrame f, vec3 wo, float n_dot_v, float n_dot_l)
-{
-    float keep = 1.0;
-#if defined(GLTF_PBR_SHEEN)
-    keep = gltf_sheen_scaling(n_dot_v, n_dot_l);
-#endif
-#if defined(GLTF_PBR_CLEARCOAT_NORMAL)  // the coat's own normal n_c (gltf_pbr.glsl's gltf_clearcoat_normal)
-    keep *= 1.0 - u_gltf_pbr_clearcoat * gltf_clearcoat_fresnel(max(dot(gltf_clearcoat_normal(f), wo), 0.0));
-#elif defined(GLTF_PBR_CLEARCOAT)
-    keep *= 1.0 - u_gltf_pbr_clearcoat * gltf_clearcoat_fresnel(n_dot_v);
-#endif
-    return keep;
-}
 
 vec3 gltf_transmission_weight(vec3 n, vec3 wo, vec3 c, float m, float t, float ior)
 {

@@ -401,15 +401,14 @@ def test_files_without_transmission_and_bad_factors(tmp_path):
             glphong.load_scene(path, light_units="radiometric", lights=[])
 
 
-def test_layers_not_drawn_over_transmission_are_refused_and_left_out_of_files(tmp_path):
-    """Diffuse transmission refuses the coat, sheen, specular and film by name (its lights behind are not layered), and
-    a file's surface loads with its diffuse transmission and without them, named in a warning.  Over
+def test_every_layer_over_either_transmission_is_kept_and_loaded_from_files(tmp_path):
+    """Diffuse transmission takes the coat, sheen, specular and film (tests/materials/
+    test_gltf_diffuse_transmission_layers.py), and a file's surface loads with them, without a warning.  Over
     KHR_materials_transmission every layer is drawn (tests/test_transmission_layers.py): the specular, sheen, coat
     (on its own normal too) and film; a file's glass keeps them, without a warning."""
     for layer, keywords in (("clearcoat", {"clearcoat": 1.0}), ("sheen", {"sheen_color": 0.5}),
                             ("specular", {"specular": 0.5}), ("iridescence", {"iridescence": 1.0})):
-        with pytest.raises(ValueError, match=rf"KHR_materials_diffuse_transmission with KHR_materials_{layer}"):
-            glphong.GltfPBR(0.5, 0.0, 0.2, diffuse_transmission=0.5, **keywords)
+        assert layer in glphong.GltfPBR(0.5, 0.0, 0.2, diffuse_transmission=0.5, **keywords).extensions()
         assert layer in glphong.GltfPBR(0.5, 0.0, 0.2, transmission=0.5, **keywords).extensions()
     assert "clearcoat_normal" in glphong.GltfPBR(0.5, 0.0, 0.2, transmission=0.5, clearcoat=1.0,
                                                  clearcoat_normal=(0.7, 0.4, 0.9)).extensions()  # drawn
@@ -422,10 +421,10 @@ def test_layers_not_drawn_over_transmission_are_refused_and_left_out_of_files(tm
         material = glphong.load_scene(path, light_units="radiometric", lights=[]).objects[0].material
     assert material.extensions() == ("specular", "clearcoat", "transmission", "iridescence")
     path = _gltf_file(tmp_path, {"KHR_materials_diffuse_transmission": {"diffuseTransmissionFactor": 1.0}} | layers)
-    with pytest.warns(UserWarning, match=r"KHR_materials_diffuse_transmission with KHR_materials_specular, "
-                                         r"KHR_materials_clearcoat, KHR_materials_iridescence: .*left out"):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
         material = glphong.load_scene(path, light_units="radiometric", lights=[]).objects[0].material
-    assert material.extensions() == ("diffuse_transmission",)
+    assert material.extensions() == ("specular", "clearcoat", "iridescence", "diffuse_transmission")
 
 
 def test_volume_and_dispersion_load_from_files_and_save_back(tmp_path):

@@ -357,13 +357,18 @@ PLANTED_ON = {"coat on the shading normal": ("gltf_clearcoat_fresnel(max(dot(glt
 
 @pytest.mark.parametrize("planted", sorted(PLANTED) + sorted(PLANTED_ON))
 def test_planted_layer_errors_fail_verify(planted, monkeypatch, glphong_make_renderer, lights_behind_scene):
-    """Each planted error in transmission_thin.glsl fails verify: the layers' on the layered glass, the coat's F_c on
+    """Each planted error in transmission_thin.glsl (or the functions it shares with gltf_pbr.glsl) fails verify: the layers' on the layered glass, the coat's F_c on
     n instead of its own n_c over a normal-mapped glass, the film's over a filmed one."""
     old, new, extra = PLANTED[planted] + ({},) if planted in PLANTED else PLANTED_ON[planted]
-    original = assembly.chunk_source
-    assert original("transmission_thin").count(old) == 1
+    original, model = assembly.chunk_source, assembly.model_source
+    source = model(gltf_pbr.GltfPBR)  # gltf_transmission_fresnel and _layers are in gltf_pbr.glsl (diffuse's too)
+    in_thin = original("transmission_thin").count(old)
+    assert in_thin == 1 or (in_thin == 0 and source[0].count(old) == 1)
     monkeypatch.setattr(assembly, "chunk_source", lambda name: original(name).replace(old, new)
                         if name == "transmission_thin" else original(name))
+    if not in_thin:
+        monkeypatch.setattr(assembly, "model_source", lambda cls: (source[0].replace(old, new),) + tuple(source[1:])
+                            if cls is gltf_pbr.GltfPBR else model(cls))
     roughness = 0.3 if planted in PLANTED else 0.0  # the background's band of a rough lookup would hide the coat's
     scene = lights_behind_scene(SPHERE, glphong.GltfPBR((0.9, 0.8, 0.6), 0.1, roughness, **GLASS, **extra))
     report = glphong.verify(scene, glphong_make_renderer(48, 40, "egl"))
@@ -414,7 +419,10 @@ def test_every_function_of_the_transmission_chunk_has_a_twin_of_its_name_in_the_
     (glphong.materials.gltf_pbr) re-exports transmission_thin.glsl's twins as it does its own chunk's."""
     names = set(functions(assembly.chunk_source("transmission_thin")))
     assert {"gltf_transmission_sample", "gltf_volume_light", "gltf_transmission_background",
-            "gltf_transmission_radiance", "gltf_transmission_layers", "gltf_transmission_fresnel"} <= names
+            "gltf_transmission_radiance"} <= names
+    shared = {"gltf_transmission_layers", "gltf_transmission_fresnel"}  # in gltf_pbr.glsl: diffuse transmission's too
+    assert shared <= set(functions(assembly.model_source(gltf_pbr.GltfPBR)[0])) and not shared & names
+    names |= shared
     assert not [name for name in sorted(names) if not callable(getattr(gltf_pbr, name, None))]
 
 

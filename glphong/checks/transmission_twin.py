@@ -393,23 +393,25 @@ def _lights_behind(key, u, f, position, wo, lit, p, scales, band, used=("transmi
         one_minus = [1.0 - gltf_transmission_fresnel(p.ior[k], c)[:, 0] for c in (half - spread, half + spread)]
         rel = band.A * EPS
         cancel = band.A * EPS  # 1 - F where F -> 1 (ior far above 1): F's own rounding, absolute, as the weight's slack
-        if diffuse is not None:  # KHR_materials_diffuse_transmission (gltf_diffuse_transmission)
-            dt, c_dt = diffuse
-            value += np.where(gate, gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, p.m, p.t, dt, p.ior)
-                              * irradiance, 0.0)
-            d_lo, d_hi = scales[1]
-            cos_lo, cos_hi = np.maximum(n_dot_l[k] - tol, 0.0) / np.pi, (n_dot_l[k] + tol) / np.pi
-            lo = d_lo[k] * (np.maximum(one_minus[0] - cancel, 0.0) * cos_lo)[:, None] * e_low[k] * (1.0 - rel)
-            hi = d_hi[k] * ((one_minus[1] + cancel) * cos_hi)[:, None] * e_high[k] * (1.0 + rel)
-            low[k] += np.where(certain[k][:, None], lo, 0.0)
-            high[k] += hi
-        if "transmission" not in used:
-            continue
         if "specular" in used or "iridescence" in used:  # over the specular's interval too; the film's F'
             sub = SimpleNamespace(n=n[k], inputs={q: v[k] for q, v in (f.inputs or {}).items()},
                                   input_bounds={q: tuple(b[k] for b in v) for q, v in (f.input_bounds or {}).items()})
             one_minus = list(_one_minus_fresnel(u, sub, used, p.ior[k], half - spread, half + spread))
         keep_lo, keep_hi = _layers_bounds(u, f, used, np.maximum(n_dot_v, 0.0), n_dot_l, tol, coat)
+        if diffuse is not None:  # KHR_materials_diffuse_transmission (gltf_diffuse_transmission): the same F, keep
+            dt, c_dt = diffuse
+            value += np.where(gate, gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, p.m, p.t, dt, p.ior,
+                                                                       p.specular, p.layers, p.film) * irradiance,
+                              0.0)
+            d_lo, d_hi = scales[1]
+            cos_lo, cos_hi = np.maximum(n_dot_l[k] - tol, 0.0) / np.pi, (n_dot_l[k] + tol) / np.pi
+            lo = d_lo[k] * (np.maximum(one_minus[0] - cancel, 0.0) * cos_lo * keep_lo[k])[:, None] * e_low[k] \
+                * (1.0 - rel)
+            hi = d_hi[k] * ((one_minus[1] + cancel) * cos_hi * keep_hi[k])[:, None] * e_high[k] * (1.0 + rel)
+            low[k] += np.where(certain[k][:, None], lo, 0.0)
+            high[k] += hi
+        if "transmission" not in used:
+            continue
         with np.errstate(invalid="ignore", over="ignore"):
             lo = scale[0][k] * (np.maximum(one_minus[0] - cancel, 0.0) * lobe_low[:, 0] * keep_lo[k])[:, None] \
                 * e_low[k] * (1.0 - rel)

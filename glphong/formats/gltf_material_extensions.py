@@ -179,8 +179,8 @@ def extension_arguments(entry, texture, warn):
 def _without_layers_over_transmission(out, warn):
     """``out`` less the layers glphong does not draw over the light a surface lets through, refused by `glphong.GltfPBR`
     itself, each left out named in a warning: over KHR_materials_transmission none (`TRANSMISSION_EXCLUDES`: the
-    specular, sheen, coat, on its own normal too, and film are drawn); over KHR_materials_diffuse_transmission the
-    coat, sheen, specular and film (`DIFFUSE_TRANSMISSION_EXCLUDES`).  A file's glass keeps its transmission, drawn without them."""
+    specular, sheen, coat, on its own normal too, and film are drawn); over KHR_materials_diffuse_transmission none
+    either (`DIFFUSE_TRANSMISSION_EXCLUDES`: the specular, sheen, coat and film are drawn).  A file's glass keeps its transmission, drawn without them."""
     def used(n):
         return n in out and (isinstance(out[n], SurfaceInput) or float(out[n]) > 0)
 

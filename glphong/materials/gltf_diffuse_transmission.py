@@ -11,10 +11,14 @@ the surface (``n.wi < 0``) sends, with its irradiance ``E`` and ``n_dot_l = -n.w
     h' = normalize(l' + v),  F = f0 + (1 - f0) (1 - v.h')^5,  f0 = ((ior - 1)/(ior + 1))^2
 
 (``t`` KHR_materials_transmission's weight, which overrides the diffuse transmission: the extension's combined
-formula; the Fresnel at the mirrored half vector is the glTF Sample Viewer's).  It is added by the light loops of
+formula; the Fresnel at the mirrored half vector is the glTF Sample Viewer's).  With KHR_materials_specular the
+diffuse BTDF sits in ``fresnel_mix``'s base under the specular's ``F`` (`gltf_transmission_fresnel`), so ``1 - F``
+becomes ``1 - max3(F_specular(v.h'))``; KHR_materials_sheen and _clearcoat multiply it by
+`gltf_transmission_layers` ``(n.v, n_dot_l)``, as they weight the transmission's lights behind, and
+KHR_materials_iridescence replaces ``F`` by the film's ``F' = mix(F, F_iridescence, iridescence)`` (``1 - max3(F')``,
+as the specification's rgb_mix weights its base; docs/transmission.md, "Layers over transmission").  It is added by the light loops of
 the transmissive programs (`glphong.shaders.generated.lights_chunk`, glphong/gpu/transmission.py) and their twin
-(`glphong.checks.transmission_twin`).  Not with KHR_materials_specular, _iridescence, _clearcoat or _sheen (their
-layers over a light behind the surface are not drawn: refused by name).
+(`glphong.checks.transmission_twin`).
 
 =========================== ====== ======= ======= ==================================================================
 parameter                   kind   range   neutral meaning
@@ -28,7 +32,8 @@ import numpy as np
 from glphong.definitions.material_base import constant_part
 from glphong.definitions.params import Param
 from glphong.definitions.surface import SurfaceInput
-from glphong.twin.functions import fresnel_schlick, microfacet_geometry
+from glphong.materials.gltf_transmission import _coat_cosine, gltf_transmission_fresnel, gltf_transmission_layers
+from glphong.twin.functions import microfacet_geometry
 
 __all__ = ["DIFFUSE_TRANSMISSION_PARAMS", "DIFFUSE_TRANSMISSION_EXCLUDES", "gltf_diffuse_transmission_response",
            "diffuse_transmission_gltf_fields"]
@@ -41,14 +46,17 @@ _DT_COLOR = Param("diffuse_transmission_color", "rgb", low=0.0, high=1.0, defaul
                       "the colour of the diffusely transmitted light")
 #: the extension's parameters, appended to `GltfPBR`'s (`glphong.materials.gltf_extensions`)
 DIFFUSE_TRANSMISSION_PARAMS = (_DT, _DT_COLOR)
-#: the extensions refused beside it (their layers over a light behind the surface are not drawn)
-DIFFUSE_TRANSMISSION_EXCLUDES = ("specular", "iridescence", "clearcoat", "sheen")
+#: the extensions refused beside it (none: the specular, sheen, coat and film are drawn over its lights behind)
+DIFFUSE_TRANSMISSION_EXCLUDES = ()
 
 
-def gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior):
+def gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior, specular=None, layers=None,
+                                       film=None):
     """The diffuse BTDF of a punctual light behind the surface times ``n_dot_l = -n.wi > 0`` (gltf_pbr.glsl's
-    ``gltf_diffuse_transmission_response``): ``(1 - m) (1 - t) dt (c_dt / pi) (1 - F(v.h')) n_dot_l`` (module
-    docstring).
+    ``gltf_diffuse_transmission_response``): ``(1 - m) (1 - t) dt (c_dt / pi) (1 - max3(F(v.h'))) n_dot_l keep``
+    (module docstring), ``F`` `glphong.materials.gltf_transmission.gltf_transmission_fresnel` (with
+    KHR_materials_specular its ``fresnel_mix`` F, with KHR_materials_iridescence the film's F'), ``keep`` `glphong.materials.gltf_transmission.gltf_transmission_layers`
+    ``(n.v, n_dot_l)`` (the sheen's and the coat's).
 
     Parameters
     ----------
@@ -60,6 +68,12 @@ def gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior):
         The diffuse transmission colour.
     m, t, dt, ior : (N,) ndarray or float
         Metallic, transmission, diffuse transmission, index of refraction.
+    specular : tuple, optional
+        ``(specular, specular_color)``, (N,) and (N, 3) or (3,): KHR_materials_specular's; None without it.
+    layers : dict, optional
+        `gltf_transmission_layers`' keywords (the coat's own normal as ``coat_normal`` (N, 3)); None: no layers.
+    film : dict, optional
+        KHR_materials_iridescence's (`gltf_transmission_fresnel`'s ``film``); None without it.
 
     Returns
     -------
@@ -67,12 +81,12 @@ def gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior):
     """
     n_dot_l = np.asarray(n_dot_l, np.float64)
     mirrored = wi + (2.0 * n_dot_l)[:, None] * n
-    valid, _, _, v_dot_h, _ = microfacet_geometry(n, mirrored, wo, n_dot_l)
-    r = (np.asarray(ior, np.float64) - 1.0) / (np.asarray(ior, np.float64) + 1.0)
-    fresnel = fresnel_schlick((r * r)[..., None], v_dot_h)[..., 0]
+    valid, n_dot_v, _, v_dot_h, _ = microfacet_geometry(n, mirrored, wo, n_dot_l)
+    fresnel = np.max(gltf_transmission_fresnel(ior, v_dot_h, *(specular or (None, None)), film), axis=-1)
     scale = (1.0 - np.asarray(m, np.float64)) * (1.0 - np.asarray(t, np.float64)) * np.asarray(dt, np.float64)
     value = np.asarray(c_dt, np.float64) * ((scale * (1.0 / np.pi)) * (1.0 - fresnel) * n_dot_l)[:, None]
-    return np.where(valid[:, None], value, 0.0)
+    keep = gltf_transmission_layers(n_dot_v, n_dot_l, **_coat_cosine(layers, wo))
+    return np.where(valid[:, None], value * keep[:, None], 0.0)
 
 
 def diffuse_transmission_gltf_fields(material, texture_index):

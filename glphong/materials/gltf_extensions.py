@@ -17,7 +17,8 @@ Appendix B's GGX and visibility::
                              under the coat (`glphong.materials.gltf_sheen`)
     KHR_materials_anisotropy D V of the base anisotropic: alpha_t = mix(alpha, 1, strength^2) along the rotated
                              tangent, alpha_b = alpha (`glphong.materials.gltf_anisotropy`; needs the tangent frame)
-    KHR_materials_diffuse_transmission  the diffuse times 1 - dt in front; dt c_dt/pi (1 - F(v.h')) for lights behind
+    KHR_materials_diffuse_transmission  the diffuse times 1 - dt in front; dt c_dt/pi (1 - max3(F(v.h'))) times the
+                             layers' weights (sheen, coat) for lights behind, F the specular's or the film's
                              (`glphong.materials.gltf_diffuse_transmission`)
 
 =================== ====== ========= ======= ==========================================================================

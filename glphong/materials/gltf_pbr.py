@@ -273,7 +273,8 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
         The film's thickness ``mix(minimum, maximum, mix)`` [nm] (defaults 100, 400 and 1: 400 nm).
     diffuse_transmission, diffuse_transmission_color : float or SurfaceInput, float or (3,) array_like or SurfaceInput
         ``KHR_materials_diffuse_transmission`` (default 0 and 1: opaque): the diffuse times ``1 - dt`` for lights in
-        front, and ``dt diffuse_transmission_color / pi (1 - F)`` for point, spot and directional lights behind the
+        front, and ``dt diffuse_transmission_color / pi (1 - max3(F))`` (F the specular's or the film's), times the
+        sheen's and the coat's weights, for point, spot and directional lights behind the
         surface (`glphong.materials.gltf_diffuse_transmission`; drawn as glphong draws transmissive surfaces).
     """
 

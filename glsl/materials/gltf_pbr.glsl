@@ -70,8 +70,12 @@
 //   a light in front sees the diffuse times 1 - dt (dt = u_gltf_pbr_diffuse_transmission); a light behind,
 //   gltf_diffuse_transmission_response(f, wi, wo, n_dot_l), n_dot_l = -n.wi > 0 (called by the generated light loops
 //   where n.wi < 0, glphong/shaders/generated.py):
-//   (1 - m) (1 - t) dt (c_dt / pi) (1 - F(v.h')) n_dot_l, l' = wi + 2 n_dot_l n, h' = normalize(l' + v),
-//   F = f0 + (1 - f0) (1 - v.h')^5, c_dt = u_gltf_pbr_diffuse_transmission_color, t the transmission (0 without it).
+//   (1 - m) (1 - t) dt (c_dt / pi) (1 - max3(F(v.h'))) n_dot_l keep(n.v, n_dot_l), l' = wi + 2 n_dot_l n,
+//   h' = normalize(l' + v), F = gltf_transmission_fresnel (f0 + (1 - f0) (1 - v.h')^5; with KHR_materials_specular
+//   its fresnel_mix F, the diffuse BTDF being in the dielectric's base; with KHR_materials_iridescence the film's
+//   F' = mix(F, F_iridescence, iridescence)), keep = gltf_transmission_layers (the sheen's
+//   albedo scaling times the coat's 1 - clearcoat F_c; both defined below, their formulas in transmission_thin.glsl),
+//   c_dt = u_gltf_pbr_diffuse_transmission_color, t the transmission (0 without it).
 // Key defines read here: HAS_UNPERTURBED, GLTF_PBR_DIFFUSE_TRANSMISSION, GLTF_PBR_IRIDESCENCE, GLTF_PBR_ANISOTROPY, GLTF_PBR_CLEARCOAT_NORMAL, GLTF_PBR_SPECULAR, GLTF_PBR_CLEARCOAT, GLTF_PBR_SHEEN, GLTF_PBR_TRANSMISSION, GLTF_PBR_VOLUME (defined where the material uses the
 // extension: its code is not in the program otherwise).
 
@@ -374,22 +378,61 @@ float gltf_sheen_scaling(float n_dot_v, float n_dot_l)
 }
 #endif
 
+#if defined(GLTF_PBR_TRANSMISSION) || defined(GLTF_PBR_DIFFUSE_TRANSMISSION)  // the dielectric's F and the layers'
+// keep over the light let through (formulas: transmission_thin.glsl's header; read there and below)
+vec3 gltf_transmission_fresnel(float ior, float c)
+{
+    float r = (ior - 1.0) / (ior + 1.0);
+#if defined(GLTF_PBR_SPECULAR)
+    vec3 fresnel = u_gltf_pbr_specular * fresnel_schlick(min(r * r * u_gltf_pbr_specular_color, vec3(1.0)), c);
+#else
+    vec3 fresnel = fresnel_schlick(vec3(r * r), c);
+#endif
+#if defined(GLTF_PBR_IRIDESCENCE)  // KHR_materials_iridescence: F' = mix(F, F_iridescence(film_f0), iridescence)
+#if defined(GLTF_PBR_SPECULAR)
+    vec3 film_f0 = min(r * r * u_gltf_pbr_specular_color, vec3(1.0)) * u_gltf_pbr_specular;
+#else
+    vec3 film_f0 = vec3(r * r);
+#endif
+    float thickness = mix(u_gltf_pbr_iridescence_thickness_minimum, u_gltf_pbr_iridescence_thickness_maximum,
+                          u_gltf_pbr_iridescence_thickness_mix);
+    vec3 film = gltf_iridescence_fresnel(1.0, u_gltf_pbr_iridescence_ior, film_f0, thickness, clamp(c, 0.0, 1.0));
+    fresnel = mix(fresnel, film, u_gltf_pbr_iridescence);
+#endif
+    return fresnel;
+}
+
+float gltf_transmission_layers(ShadingFrame f, vec3 wo, float n_dot_v, float n_dot_l)
+{
+    float keep = 1.0;
+#if defined(GLTF_PBR_SHEEN)
+    keep = gltf_sheen_scaling(n_dot_v, n_dot_l);
+#endif
+#if defined(GLTF_PBR_CLEARCOAT_NORMAL)  // the coat's own normal n_c (gltf_pbr.glsl's gltf_clearcoat_normal)
+    keep *= 1.0 - u_gltf_pbr_clearcoat * gltf_clearcoat_fresnel(max(dot(gltf_clearcoat_normal(f), wo), 0.0));
+#elif defined(GLTF_PBR_CLEARCOAT)
+    keep *= 1.0 - u_gltf_pbr_clearcoat * gltf_clearcoat_fresnel(n_dot_v);
+#endif
+    return keep;
+}
+#endif
+
 #if defined(GLTF_PBR_DIFFUSE_TRANSMISSION)  // KHR_materials_diffuse_transmission: the diffuse BTDF of a light behind
 vec3 gltf_diffuse_transmission_response(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l)
 {
     vec3 mirrored = wi + (2.0 * n_dot_l) * f.n;
     float n_dot_v, n_dot_h, v_dot_h, tan2;
     bool valid = microfacet_geometry(f.n, mirrored, wo, n_dot_l, n_dot_v, n_dot_h, v_dot_h, tan2);
-    float r = (u_gltf_pbr_ior - 1.0) / (u_gltf_pbr_ior + 1.0);
-    float fresnel = fresnel_schlick(vec3(r * r), v_dot_h).x;  // fresnel.glsl (library chunk)
+    vec3 fresnel = gltf_transmission_fresnel(u_gltf_pbr_ior, v_dot_h);  // with KHR_materials_specular: its F
+    float fresnel_max = max(fresnel.r, max(fresnel.g, fresnel.b));
 #if defined(GLTF_PBR_TRANSMISSION)
     float t = u_gltf_pbr_transmission;
 #else
     float t = 0.0;
 #endif
     float scale = (1.0 - u_gltf_pbr_metallic) * (1.0 - t) * u_gltf_pbr_diffuse_transmission;
-    vec3 value = u_gltf_pbr_diffuse_transmission_color * ((scale * GLTF_PBR_INV_PI) * (1.0 - fresnel) * n_dot_l);
-    return valid ? value : vec3(0.0);
+    vec3 value = u_gltf_pbr_diffuse_transmission_color * ((scale * GLTF_PBR_INV_PI) * (1.0 - fresnel_max) * n_dot_l);
+    return valid ? value * gltf_transmission_layers(f, wo, n_dot_v, n_dot_l) : vec3(0.0);
 }
 #endif
 
