@@ -117,6 +117,11 @@ class MaterialModel(Material, Definition):
         The parameter that is the exponent ``q`` of every ``lobe_from_delta(delta, q)`` the GLSL evaluates, for a
         model that calls lobe.glsl: ``Renderer(numerics='auto')`` leaves out the lobes' log branch where it is at
         least 151 (`glphong.shaders.numerics`).  None (default): a model that uses lobe.glsl keeps the branch.
+    behind_responses : tuple of (str, str, str)
+        ``(define, function, variable)`` of each GLSL response the model offers to a punctual light behind the surface
+        (``n.wi < 0``): where its term carries the structural ``define`` (``#define <MODEL>_<define> 1``), the light
+        loops add ``light_term(function(f, wi, wo, -n.wi), E)`` as ``variable`` (`glphong.shaders.generated`).  Empty
+        (default): a light behind the surface sends nothing.
 
     Methods a definition provides
     -----------------------------
@@ -153,6 +158,7 @@ class MaterialModel(Material, Definition):
     ambient_scale = 1.0
     in_uber = False
     lobe_exponent = None
+    behind_responses = ()
 
     registry = MATERIALS
     definition_error = MaterialDefinitionError

@@ -284,6 +284,9 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
     #: what the code under a structural define reads beside `needs` (the definition check accepts it there); a coat
     #: normal reads the frame before a base normal map ('unperturbed', gltf_coat_normal)
     structural_needs = {"GLTF_PBR_ANISOTROPY": ("tangent",), "GLTF_PBR_CLEARCOAT_NORMAL": ("tangent", "unperturbed")}
+    #: a light behind the surface: the transmission's BTDF (transmission_thin.glsl) and the diffuse transmission's
+    behind_responses = (("TRANSMISSION", "gltf_transmission_response", "through"),
+                        ("DIFFUSE_TRANSMISSION", "gltf_diffuse_transmission_response", "diffuse_through"))
     ambient = "base_color"
     ambient_scale = 1.0 / np.pi
     emission = "emissive"

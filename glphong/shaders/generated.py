@@ -160,14 +160,14 @@ def transmits(key):
 
 
 def _behind(key):
-    """``(function, variable)`` of each response to a punctual light behind the surface in ``key``'s program: the
-    transmission's BTDF (glsl/transmission_thin.glsl), the diffuse transmission's (glsl/materials/gltf_pbr.glsl)."""
+    """``(function, variable)`` of each response to a punctual light behind the surface in ``key``'s program: those
+    its terms' models declare (``behind_responses``) under the structural defines the terms carry (`GltfPBR`'s:
+    the transmission's BTDF, glsl/transmission_thin.glsl, and the diffuse transmission's,
+    glsl/materials/gltf_pbr.glsl)."""
     if key.output != "radiance" or key.shade_per_vertex or key.alpha_blend:
         return []
-    defines = {d for t in key.terms if t.name == "gltf_pbr" for d in t.defines}
-    return [(name, through) for define, name, through in (
-        ("TRANSMISSION", "gltf_transmission_response", "through"),
-        ("DIFFUSE_TRANSMISSION", "gltf_diffuse_transmission_response", "diffuse_through")) if (define, "1") in defines]
+    return [(name, through) for t in key.terms for define, name, through in model_named(t.name).behind_responses
+            if (define, "1") in t.defines]
 
 
 def closed_form(term, light):
