@@ -93,20 +93,8 @@ def incident_light(position, key, uniforms, band=None):
                     out.append((np.broadcast_to(valid, position.shape[:-1]), wi, irradiance))
                 else:
                     out.append((np.broadcast_to(valid, position.shape[:-1]), wi, irradiance,
-                                _band_reusing(twin, position, p, band, computed)))
+                                twin.band_given(position, p, band, computed)))
     return out
-
-
-def _band_reusing(twin, x, p, band, computed):
-    """``twin.band(x, p, band)`` where the band's own call ``twin.incident(x, p)`` (`ExactIrradiance`'s: the twin's
-    value is the band) takes ``computed``, that call's result already in hand, instead of computing it again; its
-    calls at other points (a generic band's moved inputs) compute.  ``twin`` is `incident_light`'s own bare instance."""
-    kind = type(twin)
-    object.__setattr__(twin, "incident", lambda y, q: computed if y is x and q is p else kind.incident(twin, y, q))
-    try:
-        return twin.band(x, p, band)
-    finally:
-        object.__delattr__(twin, "incident")
 
 
 def _terms(material):

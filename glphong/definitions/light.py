@@ -365,7 +365,21 @@ class LightModel(Definition):
         add up worst-case.  The built-in kinds whose only error is that of a product or quotient return
         the twin's value (their error is inside the term's ``A eps``).
         """
-        return sensitivity_band(lambda x_, p_: self.incident(x_, p_)[2], x, p, self.perturbed_uniforms(), constants)
+        return self.generic_band(x, p, constants)
+
+    def generic_band(self, x, p, constants, base=None):
+        """`band`'s generic default (`sensitivity_band` of the twin's irradiance); ``base``: the irradiance at ``(x,
+        p)`` where the caller has it."""
+        return sensitivity_band(lambda x_, p_: self.incident(x_, p_)[2], x, p, self.perturbed_uniforms(), constants,
+                                base=None if base is None else np.broadcast_to(base, np.shape(x)))
+
+    def band_given(self, x, p, constants, incident):
+        """`band`, where ``incident`` = ``self.incident(x, p)`` is in hand (`glphong.checks.reference.incident_light`
+        computes it for the twin): the generic band takes its value at ``(x, p)`` from it instead of computing it again;
+        a kind with a `band` of its own computes that (it may override this too)."""
+        if type(self).band is not LightModel.band:
+            return self.band(x, p, constants)
+        return self.generic_band(x, p, constants, incident[2])
 
     @classmethod
     def perturbed_uniforms(cls):
@@ -409,7 +423,7 @@ class LightModel(Definition):
 
 
 def sensitivity_band(evaluate, x, p, params, constants, directions=(), rows=1 << 16, factors=(), offset=None,
-                     one_sided=False):
+                     one_sided=False, base=None):
     """The generic band: ``evaluate(x, p, *directions)`` (N, 3) and its first-order sensitivity to its inputs, each
     perturbed by a few ulps as float32 arithmetic perturbs them, added worst-case (`LightModel.band`).
 
@@ -430,9 +444,10 @@ def sensitivity_band(evaluate, x, p, params, constants, directions=(), rows=1 <<
     that vanishes where the domain is clipped) moves by ``-delta`` to first order where a move the other way moves
     it by ``delta``: each move is made one way only and its ``|delta|`` taken both ways, except on the rows where
     the value may reach 0 within a move (a channel at 0, or one that a move changed by more than 1 % of itself: a
-    light seen edge-on, a polygon on the horizon), where both ways are made.
+    light seen edge-on, a polygon on the horizon), where both ways are made.  ``base``: ``evaluate(x, p,
+    *directions)`` where the caller has it already (not evaluated again).
     """
-    base = np.asarray(evaluate(x, p, *directions), dtype=np.float64)
+    base = np.asarray(evaluate(x, p, *directions) if base is None else base, dtype=np.float64)
     up, down = np.zeros_like(base), np.zeros_like(base)
     d = constants.D * EPS
     reach = None if offset is None else np.abs(np.asarray(getattr(p, offset), dtype=np.float64))
@@ -538,6 +553,10 @@ class ExactIrradiance:
         """The twin's value: exact beyond the term's ``A eps``."""
         e = self.incident(x, p)[2]
         return e, e
+
+    def band_given(self, x, p, constants, incident):
+        """The twin's value ``incident[2]``, in hand (`LightModel.band_given`)."""
+        return incident[2], incident[2]
 
 
 # --------------------------------------------------------------------------- shared by the kinds' oracles

@@ -114,6 +114,12 @@ class PointLight(WithRange, LightModel):
             return LightModel.band(self, x, p, constants)
         return ExactIrradiance.band(self, x, p, constants)
 
+    def band_given(self, x, p, constants, incident):
+        """`band` with ``incident`` = ``self.incident(x, p)`` in hand (`LightModel.band_given`)."""
+        if p.defines.get("RANGE"):
+            return self.generic_band(x, p, constants, incident[2])
+        return ExactIrradiance.band_given(self, x, p, constants, incident)
+
     @classmethod
     def from_gltf(cls, value, entry, pose):
         return cls(tuple(pose[:3, 3]), tuple(power_from_intensity(value)), range=entry.get("range"))
