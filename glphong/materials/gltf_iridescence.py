@@ -240,7 +240,8 @@ def iridescence_gltf_fields(material, texture_index):
     ``iridescenceThicknessTexture`` (read on its green channel, unscaled, as the loader makes it; another thickness
     texture is kept in glphong's extras only, with a warning).  An untextured
     ``iridescence_thickness_mix`` below 1 is written as the maximum it gives, ``mix(minimum, maximum, it)`` (the file
-    has no such factor)."""
+    has no such factor); the minimum is written with the thickness texture only (without it the file's thickness is
+    the maximum, and the Khronos validator notes a minimum as having no effect)."""
     if "iridescence" not in material.extensions():
         return {}
     lo, hi = float(material.iridescence_thickness_minimum), float(material.iridescence_thickness_maximum)
@@ -259,4 +260,6 @@ def iridescence_gltf_fields(material, texture_index):
                       "iridescenceThicknessTexture's green channel unscaled, which does not carry it", stacklevel=7)
     elif not isinstance(weight, SurfaceInput):
         fields["iridescenceThicknessMaximum"] = lo + (hi - lo) * float(weight)
+    if "iridescenceThicknessTexture" not in fields:  # the minimum only acts through the texture (the validator's info)
+        del fields["iridescenceThicknessMinimum"]
     return {"KHR_materials_iridescence": fields}

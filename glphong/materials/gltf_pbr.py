@@ -302,7 +302,8 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
     def gltf_fields(self, texture_index):
         """glTF's fields as the file writes them: the factors as they are, the metallic-roughness texture where
         metallic and roughness read one image's blue and green, the emissive factor (its strength above 1 as
-        ``KHR_materials_emissive_strength``) and texture (`MaterialModel.gltf_fields`)."""
+        ``KHR_materials_emissive_strength``) and texture, the occlusion texture (its red channel at strength 1), an
+        ior other than 1.5 as ``KHR_materials_ior`` (`MaterialModel.gltf_fields`)."""
         pbr = {"baseColorFactor": [float(c) for c in np.broadcast_to(constant_part(self.base_color), 3)] + [1.0],
                "metallicFactor": float(constant_part(self.metallic)), "roughnessFactor": float(constant_part(self.roughness))}
         if isinstance(self.base_color, SurfaceInput) and self.base_color.texture is not None:
@@ -319,7 +320,15 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
                 out["extensions"] = {"KHR_materials_emissive_strength": {"emissiveStrength": float(emissive.max())}}
             if isinstance(self.emissive, SurfaceInput) and self.emissive.texture is not None:
                 out["emissiveTexture"] = {"index": texture_index(self.emissive.texture)}
+        # occlusionTexture.r at strength 1 (a loaded strength is folded into its values), linear data as glTF reads it
+        occlusion = self.occlusion
+        if isinstance(occlusion, SurfaceInput) and occlusion.texture is not None and not occlusion.vertex_colors \
+                and occlusion.channel == "r" and float(occlusion.scale) == 1.0 \
+                and occlusion.texture.encoding == "linear8":
+            out["occlusionTexture"] = {"index": texture_index(occlusion.texture)}
         extensions = extension_gltf_fields(self, texture_index)  # KHR_materials_specular, _clearcoat (gltf_extensions)
+        if float(constant_part(self.ior)) != 1.5:  # KHR_materials_ior (1.5: the core's f0 = 0.04, its default)
+            extensions = {"KHR_materials_ior": {"ior": float(constant_part(self.ior))}} | (extensions or {})
         if extensions:
             out["extensions"] = out.get("extensions", {}) | extensions
         return pbr, out
