@@ -605,12 +605,33 @@ MUTATIONS = [
       also=(("glphong/materials/gltf_diffuse_transmission.py",
              "scale = (1.0 - np.asarray(m, np.float64)) * (1.0 - np.asarray(t, np.float64)) * np.asarray(dt, np.float64)",
              "scale = (1.0 - np.asarray(m, np.float64)) * np.asarray(dt, np.float64)"),)),
+    # transmission with blended surfaces (glphong/gpu/renderer.py, glphong/checks/transmission_blend.py): for
+    # tests/test_transmission_blend.py
+    M("renderer.py:transmission-background-without-layers", "glphong/gpu/renderer.py",
+      "self._fullscreen, peel if blending else None)", "self._fullscreen, None)",
+      "transmission with blended surfaces: the background the opaque image alone, without the blended layers"),
+    M("transmission_blend.py:background-cut-left-out", "glphong/checks/transmission_blend.py",
+      "cut=over.cut | (behind.cut if read else False),", "cut=over.cut,",
+      "transmission with blended surfaces: the twin's cut without the background peel's"),
     # KHR_materials_dispersion (glsl/transmission_thin.glsl, glphong/checks/transmission_twin.py): for
     # tests/test_transmission.py
     M("transmission_thin.glsl:dispersion-spread", "glsl/transmission_thin.glsl",
       "float half_spread = (ior - 1.0) * 0.025 * gltf_pbr_dispersion();",
       "float half_spread = (ior - 1.0) * 0.05 * gltf_pbr_dispersion();",
       "KHR_materials_dispersion: the channels' ior spread twice the specification's"),
+    # KHR_materials_volume, lights behind (glsl/transmission_thin.glsl, glphong/shaders/generated.py): for
+    # tests/test_transmission_volume_lights.py
+    M("transmission_thin.glsl:volume-light-attenuation-half-path", "glsl/transmission_thin.glsl",
+      "return gltf_volume_attenuation(length(gltf_volume_exit(f, wo)), gltf_pbr_attenuation());",
+      "return gltf_volume_attenuation(0.5 * length(gltf_volume_exit(f, wo)), gltf_pbr_attenuation());",
+      "KHR_materials_volume: a light behind a volume attenuated over half the transmission ray"),
+    M("transmission_thin.glsl:volume-light-diffuse-unattenuated", "glsl/transmission_thin.glsl",
+      "return gltf_volume_attenuation(gltf_pbr_thickness() * scale, gltf_pbr_attenuation());",
+      "return vec3(1.0);",
+      "KHR_materials_volume with _diffuse_transmission: the diffusely transmitted light not attenuated"),
+    M("generated.py:volume-light-not-moved", "glphong/shaders/generated.py",
+      "_incident(position + {through}_exit, {j},", "_incident(position, {j},",
+      "KHR_materials_volume: a light behind a volume seen from the surface, not from the exit point"),
     # KHR_materials_transmission, _volume, _dispersion (glsl/transmission_thin.glsl, glphong/materials/
     # gltf_transmission.py): for tests/test_transmission.py (planted in GLSL and twin at once: the closed forms)
     M("gltf_pbr.glsl+gltf_pbr.py:transmission-diffuse", "glsl/materials/gltf_pbr.glsl",
@@ -694,10 +715,19 @@ MUTATIONS = [
       "KHR_materials_iridescence over transmission: the film on 1 - cos (GLSL and twin)",
       also=(("glphong/materials/gltf_transmission.py", "np.clip(c, 0, 1).astype(dtype))",
              "np.clip(1 - c, 0, 1).astype(dtype))"),)),
-    M("transmission_twin.py:coat-normal-texel", "glphong/checks/transmission_twin.py",
+    M("transmission_lights.py:coat-normal-texel", "glphong/checks/transmission_lights.py",
       "SimpleNamespace(clearcoat_normal=texel,",
       "SimpleNamespace(clearcoat_normal=np.broadcast_to((0.5, 0.5, 1.0), texel.shape),",
       "KHR_materials_clearcoat over transmission: the twin's coat normal the unperturbed one, not the material's texel"),
+    # area and environment lights behind a transmissive surface (glphong/shaders/generated.py _extended_loop, its twin
+    # glphong/checks/transmission_extended.py): for tests/test_transmission_extended.py
+    M("generated.py:extended-behind-gate", "glphong/shaders/generated.py",
+      'f"            reflected += ({valid} && {n_dot_l} < 0.0) ? {through} : vec3(0.0);"',
+      'f"            reflected += ({valid} && {n_dot_l} > 0.0) ? {through} : vec3(0.0);"',
+      "extended lights behind a transmissive surface: the samples' gate flipped to n.wi > 0 (GPU only)"),
+    M("transmission_extended.py:last-sample-dropped", "glphong/checks/transmission_extended.py",
+      "            for k in range(count):", "            for k in range(count - 1):",
+      "extended lights behind a transmissive surface: the twin leaves out each light's last weighted direction"),
 ]
 del M
 

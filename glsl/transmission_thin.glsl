@@ -40,6 +40,15 @@
 //     (the specification's infinite distance) and for d <= 0 (no path: GLSL's pow(0, 0) is undefined);
 //   gltf_volume_light(x, n, wo, eta, roughness) -> B = sample(uv of the exit, lod(roughness, eta)) times the
 //     attenuation over |ray|.
+//   a point, spot or directional light behind the surface (the generated light loops, glphong/shaders/generated.py,
+//   as the model's behind_exits declare; the Sample Viewer's punctual loop): the transmission's BTDF
+//   (gltf_transmission_response) takes the light seen from the exit point x + gltf_volume_exit(f, wo), its wi' and
+//   E' there (the kind's incident at x + ray; gated on n.wi' < 0), times gltf_volume_exit_attenuation(f, wo);
+//   the diffuse transmission's (gltf_diffuse_transmission_response, at x) times gltf_volume_diffuse_attenuation:
+//   gltf_volume_exit(f, wo) -> gltf_volume_ray(n, wo, ior, thickness) (the material's ior: no dispersion);
+//   gltf_volume_exit_attenuation(f, wo) -> gltf_volume_attenuation(|gltf_volume_exit(f, wo)|, (color, distance));
+//   gltf_volume_diffuse_attenuation(f, wo) -> gltf_volume_attenuation(thickness (s_x + s_y + s_z)/3, (color,
+//     distance)) (the Sample Viewer's diffuseTransmissionThickness: the path not refracted, the scale's mean).
 // GLTF_PBR_DISPERSION (KHR_materials_dispersion, in a volume): the channels refract with iors ior -+ (ior - 1) 0.025
 //   dispersion (red max(ior - h, 1), green ior, blue ior + h), each its own gltf_volume_light, as the Sample Viewer
 //   does but for the red ior kept at 1 or above (KHR_materials_ior's range: below it a grazing view has no refracted
@@ -110,6 +119,22 @@ vec3 gltf_volume_light(vec3 x, vec3 n, vec3 wo, float eta, float roughness)
     vec3 ray = gltf_volume_ray(n, wo, eta, gltf_pbr_thickness());
     return gltf_transmission_sample(gltf_volume_uv(x + ray), gltf_transmission_lod(roughness, eta))
         * gltf_volume_attenuation(length(ray), gltf_pbr_attenuation());
+}
+
+vec3 gltf_volume_exit(ShadingFrame f, vec3 wo)
+{
+    return gltf_volume_ray(f.n, wo, u_gltf_pbr_ior, gltf_pbr_thickness());
+}
+
+vec3 gltf_volume_exit_attenuation(ShadingFrame f, vec3 wo)
+{
+    return gltf_volume_attenuation(length(gltf_volume_exit(f, wo)), gltf_pbr_attenuation());
+}
+
+vec3 gltf_volume_diffuse_attenuation(ShadingFrame f, vec3 wo)
+{
+    float scale = (length(u_model[0].xyz) + length(u_model[1].xyz) + length(u_model[2].xyz)) / 3.0;
+    return gltf_volume_attenuation(gltf_pbr_thickness() * scale, gltf_pbr_attenuation());
 }
 #endif
 

@@ -26,22 +26,21 @@ level of detail (and the one below where float32 may round it across an integer)
 """
 import dataclasses
 from dataclasses import dataclass
+from functools import partial
 from types import SimpleNamespace
 
 import numpy as np
 
-from glphong.checks.reference import incident_light, safe_normalize, shade_inputs
+from glphong.checks.reference import safe_normalize, shade_inputs
+from glphong.checks.transmission_extended import extended_behind
 from glphong.checks.tolerances import BAND
+from glphong.checks.transmission_lights import (_attenuation_slack, _bounds, _coat_cosines, _coat_normal, _film,
+                                                _layers_bounds, _lights_behind, _one_minus_fresnel, _parameter)
 from glphong.definitions.surface import _bilinear
 from glphong.gpu.transmission import transmissive_objects
-from glphong.materials.gltf_coat_normal import gltf_clearcoat_normal
-from glphong.materials.gltf_diffuse_transmission import gltf_diffuse_transmission_response
-from glphong.materials.gltf_pbr import gltf_pbr_band
-from glphong.materials.gltf_transmission import (background_levels, gltf_transmission_fresnel,
-                                                 gltf_transmission_layers, gltf_transmission_lod,
-                                                 gltf_transmission_radiance, gltf_transmission_response,
-                                                 gltf_transmission_sample, gltf_volume_attenuation, gltf_volume_ray,
-                                                 gltf_volume_uv)
+from glphong.materials.gltf_transmission import (background_levels, gltf_transmission_lod,
+                                                 gltf_transmission_radiance, gltf_transmission_sample,
+                                                 gltf_volume_attenuation, gltf_volume_ray, gltf_volume_uv)
 from glphong.scene.scene import Scene
 from glphong.twin.band import EPS
 
@@ -63,6 +62,9 @@ class TransmissionTwin:
         method, whose error against the lobe's integral is docs/transmission.md's, not this report's.
     background : (H, W, 3) float64 ndarray
         The twin of the background (the scene without its transmissive objects).
+    background_blend : glphong.checks.blend_twin.BlendTwin or None
+        Where that scene has blended surfaces: the twin of their composite over it, which is the background
+        (`glphong.checks.transmission_blend`).
     """
 
     transmitted: np.ndarray
@@ -71,6 +73,7 @@ class TransmissionTwin:
     pixels: np.ndarray
     rough: np.ndarray
     background: np.ndarray
+    background_blend: object = None
 
 
 def opaque_scene(scene):
@@ -109,25 +112,6 @@ def background_lookup(levels, uv, lod):
         stack = np.concatenate(spread, axis=0)
         low[at], high[at] = stack.min(axis=0), stack.max(axis=0)
     return value, low, high
-
-
-def _parameter(name, u, f, count):
-    """A material parameter at the object's fragments: its surface input's value where textured, else the uniform;
-    (N, 3) for an rgb one (``count`` 3), (N,) for a scalar."""
-    value = (f.inputs or {}).get(name)
-    value = np.asarray(u[name] if value is None else value, np.float64)
-    n = len(f.n)
-    return np.broadcast_to(value, (n, 3) if count == 3 else (n,))
-
-
-def _bounds(name, u, f, count):
-    """``(low, high)`` of a parameter (its surface input's interval where textured, else the float32 uniform)."""
-    bounds = (f.input_bounds or {}).get(name)
-    if bounds is None:
-        value = _parameter(name, u, f, count)
-        return value, value
-    n = len(f.n)
-    return tuple(np.broadcast_to(np.asarray(b, np.float64), (n, 3) if count == 3 else (n,)) for b in bounds)
 
 
 def transmission_twin(scene, gbuffer, background, band=BAND):
@@ -204,7 +188,8 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
             diffuse = (dt, c_dt)
             scales.append((cd_lo * ((1.0 - m_hi) * (1.0 - t_hi) * dt_lo)[:, None],
                            cd_hi * ((1.0 - m_lo) * (1.0 - t_lo) * dt_hi)[:, None]))
-        lights, lights_low, lights_high = _lights_behind(key, u, f, position, wo, valid, p, scales, band, used, diffuse)
+        behind = partial(_lights_behind, key, u, f, position, wo, valid, p, scales, band, used, diffuse, volume)
+        lights, lights_low, lights_high = (a + b for a, b in zip(behind(), extended_behind(behind, key, u, f, band)))
         out[rows, columns] = value + lights
         out_low[rows, columns] = np.where(valid[:, None], ends.min(axis=0), np.minimum(value, 0.0)) + lights_low
         out_high[rows, columns] = np.where(valid[:, None], ends.max(axis=0), np.maximum(value, 0.0)) + lights_high
@@ -236,24 +221,6 @@ def _material(u, f, used):
                            specular=specular, layers=layers, film=film)
 
 
-def _coat_normal(u, f, texel):
-    """``n_c`` (N, 3) of the texel ``texel`` (N, 3) (`gltf_clearcoat_normal`, in float64)."""
-    scale = _parameter("u_gltf_pbr_clearcoat_normal_strength", u, f, 1)
-    return gltf_clearcoat_normal(f, SimpleNamespace(clearcoat_normal=texel, clearcoat_normal_strength=scale[0]),
-                                 np.dtype(np.float64))
-
-
-def _coat_cosines(u, f, used, wo):
-    """``(low, high)`` of the coat's cosine ``max(n_c.v, 0)`` (N,) each, over the corners of the coat normal's texel
-    interval where textured; None without a coat normal."""
-    if "clearcoat_normal" not in used:
-        return None
-    lo, hi = _bounds("u_gltf_pbr_clearcoat_normal", u, f, 3)
-    texels = [np.stack([(lo, hi)[i][:, k] for k, i in enumerate(index)], axis=1) for index in np.ndindex(2, 2, 2)]
-    cosines = [np.maximum(np.einsum("ij,ij->i", _coat_normal(u, f, texel), wo), 0.0) for texel in texels]
-    return np.min(cosines, axis=0), np.max(cosines, axis=0)
-
-
 def _volume(obj, u, f):
     """KHR_materials_volume's (and _dispersion's) inputs of `gltf_transmission_radiance` for ``obj``'s fragments."""
     return {"thickness": _parameter("u_gltf_pbr_thickness", u, f, 1),
@@ -262,164 +229,6 @@ def _volume(obj, u, f):
             "color": np.asarray(u["u_gltf_pbr_attenuation_color"], np.float64),
             "distance": float(u["u_gltf_pbr_attenuation_distance"]),
             "dispersion": float(u["u_gltf_pbr_dispersion"]) if "dispersion" in obj.material.extensions() else 0.0}
-
-
-def _one_minus_fresnel(u, f, used, ior, cos_low, cos_high, spread=0.0):
-    """``(low, high)`` of ``1 - max3(F)`` (`gltf_transmission_fresnel`), (N,) each: at ``cos_low`` with the greatest
-    specular and specular colour (F grows with both, falls with the cosine), at ``cos_high`` with the least; with the
-    film, `_one_minus_film` (``spread``: its cosine's own tolerance)."""
-    if "iridescence" in used:
-        return _one_minus_film(u, f, used, ior, cos_low, cos_high, spread)
-    if "specular" not in used:
-        return tuple(1.0 - gltf_transmission_fresnel(ior, c)[:, 0] for c in (cos_low, cos_high))
-    (s_lo, s_hi), (k_lo, k_hi) = (_bounds(name, u, f, k) for name, k in (("u_gltf_pbr_specular", 1),
-                                                                         ("u_gltf_pbr_specular_color", 3)))
-    return (1.0 - np.max(gltf_transmission_fresnel(ior, cos_low, s_hi, k_hi), axis=-1),
-            1.0 - np.max(gltf_transmission_fresnel(ior, cos_high, s_lo, k_lo), axis=-1))
-
-
-#: the float32 film's error, absolute in ``1 - max3(F')`` per unit ``iridescence`` (KHR_materials_iridescence over
-#: transmission): gltf_iridescence_fresnel's float32 chain (phases to 40 rad, the sensitivity's sums cancelling) moves
-#: max3(F_iridescence) by at most 3.2e-6 (the twin in float32 against float64, 10^5 random cosines, thicknesses to
-#: 1200 nm, film iors 1 to 2.3, base f0s), taken about 4 times (docs/transmission.md, "Layers over transmission")
-FILM_SLACK = 1.2e-5
-
-
-def _film(u, f, iridescence, thickness_mix):
-    """`gltf_transmission_fresnel`'s ``film`` mapping at the weight ``iridescence`` and ``thickness_mix`` (N,):
-    ``thickness = mix(minimum, maximum, thickness_mix)`` [nm] as gltf_transmission_fresnel forms it."""
-    low, high = (float(u[f"u_gltf_pbr_iridescence_thickness_{end}"]) for end in ("minimum", "maximum"))
-    return {"iridescence": iridescence, "iridescence_ior": _parameter("u_gltf_pbr_iridescence_ior", u, f, 1),
-            "thickness": low * (1.0 - thickness_mix) + high * thickness_mix}
-
-
-def _one_minus_film(u, f, used, ior, cos_low, cos_high, spread):
-    """``(low, high)`` of ``1 - max3(F')`` with KHR_materials_iridescence's film (`gltf_transmission_fresnel`), (N,)
-    each.  F' is not monotone in the cosine, the thickness or the film's base (the specular's, per channel), so the
-    band is first-order, as `glphong.definitions.material.MaterialModel.band`'s: the value at the parameters and the
-    cosine's middle, plus and minus twice the sum of its largest moves when each input alone goes to either end of its
-    interval (the cosine's moved ``spread`` each way; a textured parameter's interval, each channel of an rgb one
-    apart), widened by `FILM_SLACK` times the greatest weight."""
-    names = [("u_gltf_pbr_iridescence", 1), ("u_gltf_pbr_iridescence_thickness_mix", 1)]
-    if "specular" in used:
-        names += [("u_gltf_pbr_specular", 1), ("u_gltf_pbr_specular_color", 3)]
-    values = [np.array(_parameter(name, u, f, k)) for name, k in names]
-    boxes = [_bounds(name, u, f, k) for name, k in names]
-
-    def one_minus(c, inputs):
-        specular = inputs[2:] if "specular" in used else (None, None)
-        return 1.0 - np.max(gltf_transmission_fresnel(ior, c, *specular, _film(u, f, inputs[0], inputs[1])), axis=-1)
-
-    middle = 0.5 * (cos_low + cos_high)
-    value = one_minus(middle, values)
-    move = np.maximum(np.abs(one_minus(cos_low - spread, values) - value),
-                      np.abs(one_minus(cos_high + spread, values) - value))
-    for i, (low, high) in enumerate(boxes):
-        for channel in range(values[i].shape[1]) if values[i].ndim == 2 else (None,):
-            ends = []
-            for end in (low, high):
-                moved = list(values)
-                moved[i] = values[i].copy()
-                if channel is None:
-                    moved[i] = np.asarray(end, np.float64).copy()
-                else:
-                    moved[i][:, channel] = np.asarray(end, np.float64)[:, channel]
-                ends.append(np.abs(one_minus(middle, moved) - value))
-            move = move + np.maximum(*ends)
-    margin = 2.0 * move + FILM_SLACK * boxes[0][1]
-    return value - margin, value + margin
-
-
-def _layers_bounds(u, f, used, n_dot_v, n_dot_l, tol, coat=None):
-    """``(low, high)`` of `gltf_transmission_layers` (N,): the least and greatest over the corners of the sheen's and
-    the coat's parameter intervals and of the cosines moved ``tol`` each way (the coat's own cosine's interval
-    ``coat``, `_coat_cosines`, moved ``16 tol``: n_c's rounding), to ``8 eps`` relative (the table's lookup and the
-    products' rounding)."""
-    if "sheen" not in used and "clearcoat" not in used:
-        return np.ones(len(n_dot_v)), np.ones(len(n_dot_v))
-    boxes = [[{}]]
-    if "sheen" in used:
-        colors, roughs = _bounds("u_gltf_pbr_sheen_color", u, f, 3), _bounds("u_gltf_pbr_sheen_roughness", u, f, 1)
-        boxes.append([{"sheen_color": c, "sheen_roughness": r} for c in colors for r in roughs])
-    if "clearcoat" in used:
-        cosines = [{}] if coat is None else [{"coat_n_dot_v": np.clip(coat[0] - 16.0 * tol, 0.0, 1.0)},
-                                             {"coat_n_dot_v": np.clip(coat[1] + 16.0 * tol, 0.0, 1.0)}]
-        boxes.append([{"clearcoat": c} | k for c in _bounds("u_gltf_pbr_clearcoat", u, f, 1) for k in cosines])
-    corners = [{}]
-    for box in boxes:
-        corners = [a | b for a in corners for b in box]
-    values = [gltf_transmission_layers(np.clip(n_dot_v + dv, 0.0, 1.0), np.clip(n_dot_l + dl, 0.0, 1.0), **corner)
-              for corner in corners for dv in (-tol, tol) for dl in (-tol, tol)]
-    return np.min(values, axis=0) * (1.0 - 8.0 * EPS), np.max(values, axis=0) * (1.0 + 8.0 * EPS)
-
-
-def _lights_behind(key, u, f, position, wo, lit, p, scales, band, used=("transmission",), diffuse=None):
-    """``(value, low, high)``, each (N, 3): what the punctual lights behind the surface send through it
-    (`gltf_transmission_response` where ``used`` holds 'transmission', `gltf_diffuse_transmission_response` with
-    ``diffuse = (dt, c_dt)`` where it holds 'diffuse_transmission', times E, where ``n.wi < 0``, the generated loops'
-    gate); ``p`` the material (`_material`).  ``scales``: ``(low, high)`` of ``(1 - m) t c``, then of ``(1 - m) (1 -
-    t) dt c_dt``.  The diffuse's band: ``1 - F`` over ``v.h'``'s interval times ``n_dot_l`` to ``D eps``, the scale's
-    and the irradiance's intervals, to ``A eps``.  The band: the lobe ``D V (n.l')`` by
-    `glphong.materials.gltf_pbr.gltf_pbr_band` at the mirrored direction (a metal of base colour 1 is that lobe alone;
-    its directions to ``D + 4`` eps: the mirror's own rounding), times ``1 - max3(F)`` over ``v.h``'s interval (and
-    the specular's, `_one_minus_fresnel`), times the layers' interval (`_layers_bounds` at ``n.v`` and ``n_dot_l``),
-    and ``scale = (low, high)`` of ``(1 - m) t c``, times the light's irradiance interval, to ``A eps``; low 0 where
-    ``|n.wi| <= D eps`` (the gate may go either way)."""
-    n = f.n
-    value, low, high = (np.zeros((len(position), 3)) for _ in range(3))
-    scale = scales[0]
-    tol = band.D * EPS
-    wide = dataclasses.replace(band, D=band.D + 4.0)
-    n_dot_v = np.einsum("ij,ij->i", n, wo)
-    coat = _coat_cosines(u, f, used, wo)
-    for valid, wi, irradiance, (e_low, e_high) in incident_light(position, key, u, band=band):
-        n_dot_wi = np.einsum("ij,ij->i", n, wi)
-        possible = lit & valid & (n_dot_wi < tol)
-        if not possible.any():
-            continue
-        certain = lit & valid & (n_dot_wi < -tol)
-        n_dot_l = -n_dot_wi
-        gate = (lit & valid & (n_dot_wi < 0.0))[:, None]
-        response = gltf_transmission_response(n, wi, wo, n_dot_l, p.c, p.m, p.t, p.r, p.ior, p.specular, p.layers,
-                                              p.film) \
-            if "transmission" in used else np.zeros_like(value)
-        value += np.where(gate, response * irradiance, 0.0)
-        k = np.flatnonzero(possible)
-        mirrored = wi[k] + (2.0 * n_dot_l[k])[:, None] * n[k]
-        lobe = SimpleNamespace(base_color=np.ones(3), metallic=np.ones(len(k)), roughness=p.r[k], ior=p.ior[k])
-        lobe_low, lobe_high = gltf_pbr_band(n[k], mirrored, wo[k], n_dot_l[k], lobe, wide)
-        half = np.sqrt(np.einsum("ij,ij->i", mirrored + wo[k], mirrored + wo[k])) / 2.0
-        spread = wide.D * EPS + 3.0 * EPS
-        one_minus = [1.0 - gltf_transmission_fresnel(p.ior[k], c)[:, 0] for c in (half - spread, half + spread)]
-        rel = band.A * EPS
-        cancel = band.A * EPS  # 1 - F where F -> 1 (ior far above 1): F's own rounding, absolute, as the weight's slack
-        if "specular" in used or "iridescence" in used:  # over the specular's interval too; the film's F'
-            sub = SimpleNamespace(n=n[k], inputs={q: v[k] for q, v in (f.inputs or {}).items()},
-                                  input_bounds={q: tuple(b[k] for b in v) for q, v in (f.input_bounds or {}).items()})
-            one_minus = list(_one_minus_fresnel(u, sub, used, p.ior[k], half - spread, half + spread))
-        keep_lo, keep_hi = _layers_bounds(u, f, used, np.maximum(n_dot_v, 0.0), n_dot_l, tol, coat)
-        if diffuse is not None:  # KHR_materials_diffuse_transmission (gltf_diffuse_transmission): the same F, keep
-            dt, c_dt = diffuse
-            value += np.where(gate, gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, p.m, p.t, dt, p.ior,
-                                                                       p.specular, p.layers, p.film) * irradiance,
-                              0.0)
-            d_lo, d_hi = scales[1]
-            cos_lo, cos_hi = np.maximum(n_dot_l[k] - tol, 0.0) / np.pi, (n_dot_l[k] + tol) / np.pi
-            lo = d_lo[k] * (np.maximum(one_minus[0] - cancel, 0.0) * cos_lo * keep_lo[k])[:, None] * e_low[k] \
-                * (1.0 - rel)
-            hi = d_hi[k] * ((one_minus[1] + cancel) * cos_hi * keep_hi[k])[:, None] * e_high[k] * (1.0 + rel)
-            low[k] += np.where(certain[k][:, None], lo, 0.0)
-            high[k] += hi
-        if "transmission" not in used:
-            continue
-        with np.errstate(invalid="ignore", over="ignore"):
-            lo = scale[0][k] * (np.maximum(one_minus[0] - cancel, 0.0) * lobe_low[:, 0] * keep_lo[k])[:, None] \
-                * e_low[k] * (1.0 - rel)
-            hi = scale[1][k] * ((one_minus[1] + cancel) * lobe_high[:, 0] * keep_hi[k])[:, None] * e_high[k] \
-                * (1.0 + rel)
-        low[k] += np.where(certain[k][:, None], np.nan_to_num(lo, nan=0.0), 0.0)
-        high[k] += np.nan_to_num(hi, nan=np.inf, posinf=np.inf)
-    return value, low, high
 
 
 def _through_volume(obj, u, f, position, wo, roughness, ior, pyramids, width):
@@ -446,9 +255,7 @@ def _through_volume(obj, u, f, position, wo, roughness, ior, pyramids, width):
                                     np.log2(width)).astype(np.float64)
         filtered |= lod > 0
         attenuation = gltf_volume_attenuation(np.sqrt(np.einsum("ij,ij->i", ray, ray)), color, distance)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            y = np.sqrt(np.einsum("ij,ij->i", ray, ray)) / distance
-            slack = np.nan_to_num((16.0 + 8.0 * np.abs(y[:, None] * np.log(color))) * EPS, nan=0.0, posinf=0.0)
+        slack = _attenuation_slack(np.sqrt(np.einsum("ij,ij->i", ray, ray)), color, distance)
         ends = []
         for dx, dy in ((0.0, 0.0), (-0.01, -0.01), (0.01, -0.01), (-0.01, 0.01), (0.01, 0.01)):
             moved = uv + np.array([dx, dy]) / size
@@ -458,9 +265,11 @@ def _through_volume(obj, u, f, position, wo, roughness, ior, pyramids, width):
     return low, high, filtered
 
 
-def transmission_check(scene, renderer, gbuffer, shade, band=BAND, exact=None):
+def transmission_check(scene, renderer, gbuffer, shade, band=BAND, exact=None, blend=None):
     """`transmission_twin` of a frame of ``renderer``: the background's twin from `opaque_scene`'s G-buffer drawn by
-    ``renderer`` and shaded by ``shade(scene, gbuffer)`` -> ``(reference, low, high, ...)``.
+    ``renderer`` and shaded by ``shade(scene, gbuffer)`` -> ``(reference, low, high, ...)``; where the scene has
+    blended surfaces, ``blend(opaque, (reference, low, high, covered))`` -> the `glphong.checks.blend_twin.BlendTwin`
+    of their composite over it, which is then the background (`glphong.checks.transmission_blend`).
 
     Raises
     ------
@@ -469,14 +278,21 @@ def transmission_check(scene, renderer, gbuffer, shade, band=BAND, exact=None):
         light with ``shadows=True`` (the background's twin is drawn without the transmissive objects, which the GPU's
         shadow maps hold).
     """
-    name = scene.objects[transmissive_objects(scene)[0]].name
+    obj = scene.objects[transmissive_objects(scene)[0]]
+    name, used = obj.name, obj.material.extensions()
+    named = " and ".join(f"KHR_materials_{e}" for e in ("transmission", "diffuse_transmission") if e in used)
     if exact:
-        raise ValueError(f"object {name!r} is transmissive (KHR_materials_transmission): verify does not compute the "
-                         "exact integrals of extended lights through it (exact=True); the GPU is checked against the "
-                         "twin of the lights' methods (exact=False)")
+        raise ValueError(f"object {name!r} is transmissive ({named}): verify does not compute the exact integrals of "
+                         "extended lights with it (exact=True); the GPU is checked against the twin of the lights' "
+                         "methods, behind the surface too (exact=False; their error: docs/transmission.md, Lights)")
     if any(getattr(light, "shadows", False) for light in scene.lights):
-        raise ValueError(f"object {name!r} is transmissive (KHR_materials_transmission) and a light has shadows=True: "
+        raise ValueError(f"object {name!r} is transmissive ({named}) and a light has shadows=True: "
                          "verify does not twin shadows with transmissive objects yet")
     opaque = opaque_scene(scene)
-    background = shade(opaque, renderer.gbuffer(opaque))[:3]
-    return transmission_twin(scene, gbuffer, background, band)
+    opaque_gbuffer = renderer.gbuffer(opaque)
+    background = shade(opaque, opaque_gbuffer)[:3]
+    if blend is None:
+        return transmission_twin(scene, gbuffer, background, band)
+    behind = blend(opaque, (*background, opaque_gbuffer.mask))
+    twin = transmission_twin(scene, gbuffer, (behind.reference, behind.low, behind.high), band)
+    return dataclasses.replace(twin, background_blend=behind)

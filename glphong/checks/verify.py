@@ -4,9 +4,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from glphong.checks import reference
-from glphong.checks.blend_twin import blend_twin
 from glphong.checks.method_sample import auto_sample_size, method_figures, sample_mask
 from glphong.checks.tolerances import BAND, point_band
+from glphong.checks.transmission_blend import frame_blend_twin, layers_behind
 from glphong.checks.transmission_twin import transmission_check
 from glphong.checks.uniform_values import UniformValues
 from glphong.checks.verify_passes import verify_passes
@@ -273,25 +273,26 @@ def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None,
     ref, low, high, shadow_band = twin_and_band(scene, gbuffer, band, renderer.shadow_settings)
     mask = frame.mask & gbuffer.mask
     mismatch = int((frame.mask != gbuffer.mask).sum())
+    shade = lambda s, g: twin_and_band(s, g, band, renderer.shadow_settings)  # noqa: E731
+    transmission = None
+    if transmissive_objects(scene):  # what the thin walls transmit (glphong.checks.transmission_twin)
+        transmission = transmission_check(scene, renderer, gbuffer, shade, band, exact, layers_behind(
+            renderer, shade, band) if blended_objects(scene) else None)  # (the layers over the background)
+        exact = False
+        ref, low, high = ref + transmission.transmitted, low + transmission.low, high + transmission.high
     blend, cut_mismatch = None, 0
-    if blended_objects(scene):  # the layers over the opaque twin (glphong.checks.blend_twin)
+    if blended_objects(scene):  # the layers over the opaque (and transmissive) twin (glphong.checks.blend_twin)
         if exact:
             raise ValueError("exact integrals of extended lights are not computed for scenes with blended materials")
         exact = False
-        blend = blend_twin(scene, renderer._size, renderer.blend_layers, (ref, low, high, gbuffer.mask),
-                           lambda g: twin_and_band(scene, g, band, renderer.shadow_settings), band)
+        blend = frame_blend_twin(scene, renderer, (ref, low, high, gbuffer.mask), lambda g: shade(scene, g), band,
+                                 transmission)
         ref, low, high, shadow_band = blend.reference, blend.low, blend.high, shadow_band | blend.shadow_band
         covered = blend.coverage > 0.0
         mask = frame.mask & covered
         mismatch = int(((frame.mask != covered) & ~blend.unchecked).sum())
         gpu_cut = np.zeros_like(blend.cut) if frame.blend_cut is None else frame.blend_cut
         cut_mismatch = int(((gpu_cut != blend.cut) & ~blend.unchecked).sum())
-    transmission = None
-    if transmissive_objects(scene):  # what the thin walls transmit (glphong.checks.transmission_twin)
-        transmission = transmission_check(scene, renderer, gbuffer, lambda s, g: twin_and_band(
-            s, g, band, renderer.shadow_settings), band, exact)
-        exact = False
-        ref, low, high = ref + transmission.transmitted, low + transmission.low, high + transmission.high
     rel, outside = compare(frame.radiance, ref, low, high, mask)
     if exact is None:
         exact = any(light.extent == "extended" for light in scene.lights)

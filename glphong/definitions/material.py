@@ -122,6 +122,11 @@ class MaterialModel(Material, Definition):
         (``n.wi < 0``): where its term carries the structural ``define`` (``#define <MODEL>_<define> 1``), the light
         loops add ``light_term(function(f, wi, wo, -n.wi), E)`` as ``variable`` (`glphong.shaders.generated`).  Empty
         (default): a light behind the surface sends nothing.
+    behind_exits : tuple of (str, str, str or None, str)
+        ``(define, variable, exit, attenuation)``: where the term carries ``define``, the behind response stored as
+        ``variable`` takes the light seen from ``position + exit(f, wo)`` (the kind's incident there, gated on its own
+        ``n.wi' < 0``; ``exit`` None: at ``position``), times ``attenuation(f, wo)`` (GLSL functions of the model's,
+        each evaluated once per fragment; `GltfPBR`'s: KHR_materials_volume).  Empty (default): none.
 
     Methods a definition provides
     -----------------------------
@@ -159,6 +164,7 @@ class MaterialModel(Material, Definition):
     in_uber = False
     lobe_exponent = None
     behind_responses = ()
+    behind_exits = ()
 
     registry = MATERIALS
     definition_error = MaterialDefinitionError

@@ -22,6 +22,9 @@ blended objects ``2 n + 1`` times, plus ``n + 1`` depth blits and one composite 
 ``max_layers`` layers keeps its nearest ``max_layers``: the peel past the cap finds where fragments are left, the
 frame's ``blend_cut`` map, and a warning says how many pixels.
 
+With transmissive objects (`glphong.gpu.transmission`) a frame peels twice: against the opaque depth into the
+transmission's background, then against the opaque and transmissive depth over the frame (`merged_peels`).
+
 Not exact: two blended fragments at the same float32 window depth in one pixel (coincident surfaces) are one layer,
 the last drawn; a blended fragment in the opaque surface's 24-bit depth quantum is kept (as the opaque surfaces' own
 ties are decided either way).
@@ -36,7 +39,7 @@ from glphong.gpu.shadows import ShadowMap
 from glphong.shaders.keys import EncodeKey
 
 __all__ = ["BLEND_LAYERS", "MAX_BLEND_LAYERS", "blended", "blended_objects", "blend_key", "CompositeKey", "Peeling",
-           "check_blend_options", "per_pixel_option", "blend_fields", "BlendCapWarning"]
+           "check_blend_options", "per_pixel_option", "blend_fields", "BlendCapWarning", "merged_peels"]
 
 
 class BlendCapWarning(UserWarning):
@@ -104,6 +107,15 @@ def blend_fields(blend, supersample=1):
     return {"blend_layers": layers, "blend_cut": cut}
 
 
+def merged_peels(first, second):
+    """The ``(layers, cut)`` of a frame that peeled twice (None: a peel that did not run): the most layers, and the
+    pixels either cut (`blend_fields` reads it)."""
+    if first is None or second is None:
+        return second if first is None else first
+    cuts = [cut for cut in (first[1], second[1]) if cut is not None]
+    return max(first[0], second[0]), (np.logical_or.reduce(cuts) if cuts else None)
+
+
 def blend_key(key, kind, textured=False):
     """The program key of a blended object's layer (``kind`` 1: shaded at the layer's depth, premultiplied; 3 where
     ``textured``, its alpha from a texture) or peel (2: its window depth alone, so everything the shading needs is
@@ -164,8 +176,9 @@ class Peeling:
             fbo.depth_mask = write
         return fbo
 
-    def draw(self, target, size, draw, max_layers, composite, fullscreen):
-        """Peel and composite the blended layers over ``target``'s first attachment (the opaque image, drawn).
+    def draw(self, target, size, draw, max_layers, composite, fullscreen, into=None):
+        """Peel and composite the blended layers over ``target``'s first attachment (the opaque image, drawn), or over
+        the texture ``into``.
 
         Parameters
         ----------
@@ -180,6 +193,10 @@ class Peeling:
             The cap.
         composite : glphong.gpu.programs.Program
             The `CompositeKey` program; ``fullscreen(composite)`` its vertex array.
+        into : moderngl.Texture, optional
+            An RGBA32F texture of ``size`` to composite over instead of ``target``'s first attachment (the
+            transmission's background, `glphong.gpu.transmission.Transmission.draw`); ``target``'s depth still
+            decides what is peeled.
 
         Returns
         -------
@@ -244,7 +261,7 @@ class Peeling:
                 previous, current = current, previous
             mgl.disable(moderngl.DEPTH_TEST)
             mgl.depth_func = "<"
-            self._framebuffer(target.color_attachments[0], None).use()
+            self._framebuffer(target.color_attachments[0] if into is None else into, None).use()
             mgl.blend_equation = moderngl.FUNC_ADD
             mgl.blend_func = moderngl.ONE, moderngl.ONE_MINUS_SRC_ALPHA  # the layers over the opaque image
             accumulator.use(location=0)

@@ -29,7 +29,7 @@ from glphong.gpu.matte import MATTE_K, MATTE_SAMPLES, MAX_MATTE_K, MAX_MATTE_SAM
 from glphong.gpu.programs import ProgramCache
 from glphong.gpu.drawing import draw_objects
 from glphong.gpu.peeling import (BLEND_LAYERS, MAX_BLEND_LAYERS, CompositeKey, Peeling, blend_fields, blended_objects,
-                                 check_blend_options)
+                                 check_blend_options, merged_peels)
 from glphong.gpu.program_keys import renderer_program_key
 from glphong.gpu.transmission import (TARGET_KEY, TRANSMIT, Transmission, background_need, check_transmission_options,
                                     transmissive_objects)
@@ -485,7 +485,10 @@ class Renderer:
 
     def _draw(self, scene, output, fbo, frame_values=None, planes=frozenset()):
         """Draw ``scene``'s objects into ``fbo`` (`glphong.gpu.drawing`); its radiance with blended objects then peels
-        and composites their layers (`glphong.gpu.peeling`): returns ``(layers, cut)`` then, else None."""
+        and composites their layers (`glphong.gpu.peeling`): returns ``(layers, cut)`` then, else None.  With
+        transmissive objects too (docs/transmission.md), the glTF Sample Viewer's order: the blended layers over the
+        opaque image make the background, the transmissive objects are drawn, and the layers in front of the opaque
+        and transmissive depth go over the frame (`merged_peels` of the two)."""
         self._purge_dead_meshes()
         shadow_values = self._shadow_values(scene, output)
         fbo.use()
@@ -493,17 +496,21 @@ class Renderer:
         self._mgl.enable(moderngl.DEPTH_TEST)
         self._mgl.disable(moderngl.CULL_FACE)
         draw_objects(self, scene, output, frame_values, shadow_values, planes)
+        blending = output == "radiance" and bool(blended_objects(scene))
+
+        def peel(target, into=None):  # the blended layers over target's image (or into), against its depth
+            peeling = self._targets.get(("peeling",)) or self._targets.setdefault(("peeling",), Peeling(self._mgl))
+            return peeling.draw(target, target.size, lambda kind, depth: draw_objects(
+                self, scene, output, {"u_blend_depth": depth}, shadow_values, blend=kind), self.blend_layers,
+                self.programs.get(CompositeKey()), self._fullscreen, into)
+        behind = None
         if output == "radiance" and transmissive_objects(scene):  # over the opaque scene (glphong.gpu.transmission)
             transmission = self._targets.get(TARGET_KEY) or self._targets.setdefault(TARGET_KEY, Transmission(self._mgl))
             transmission.draw(fbo, fbo.size, lambda values: draw_objects(
                 self, scene, output, (frame_values or {}) | values, shadow_values, planes, blend=TRANSMIT),
-                background_need(scene, fbo.size[0]), self.programs, self._fullscreen)
-        if output != "radiance" or not blended_objects(scene):
-            return None
-        peeling = self._targets.get(("peeling",)) or self._targets.setdefault(("peeling",), Peeling(self._mgl))
-        return peeling.draw(fbo, fbo.size, lambda kind, depth: draw_objects(
-            self, scene, output, {"u_blend_depth": depth}, shadow_values, blend=kind), self.blend_layers,
-            self.programs.get(CompositeKey()), self._fullscreen)
+                background_need(scene, fbo.size[0]), self.programs, self._fullscreen, peel if blending else None)
+            behind = transmission.blend
+        return merged_peels(behind, peel(fbo)) if blending else None
 
     def _fullscreen(self, program):
         vao = self._targets.get(("fullscreen", program.key))

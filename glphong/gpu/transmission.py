@@ -10,7 +10,11 @@ A frame of a scene with transmissive objects draws, into the radiance target:
    each level drawn from the one above by glsl/transmission_pyramid.glsl, the same float32 bits as the host's
    `glphong.materials.gltf_transmission.background_levels` (tested); a frame whose every transmissive surface reads
    the texel at its own pixel (roughness 0 or ior 1, thin walls) makes level 0 alone, one whose surfaces read no
-   background (``KHR_materials_diffuse_transmission`` alone) makes nothing;
+   background (``KHR_materials_diffuse_transmission`` alone) makes nothing; where the scene has blended objects too,
+   they are peeled against the opaque depth and composited over level 0 before its pyramid
+   (`glphong.gpu.peeling.Peeling.draw` with ``into``): the glTF Sample Viewer's background, which holds the opaque and
+   the blended surfaces (docs/transmission.md, "With blended surfaces"; the renderer then peels them again over the
+   frame, against the opaque and transmissive depth);
 3. the transmissive objects, depth-tested against the opaque depth and writing it, their radiance programs (the
    define ``GLTF_PBR_TRANSMISSION``) reading the background at their own pixel (transmission_thin.glsl): the nearest
    transmissive surface of a pixel is drawn, and it sees the opaque scene alone (a transmissive surface behind another
@@ -19,8 +23,8 @@ A frame of a scene with transmissive objects draws, into the radiance target:
 ``Transmission.method = "host"`` keeps the path before (the image read back, its pyramid made on the host in float32
 and every level uploaded, every frame): the reference the GPU path is tested against, bit for bit, and benchmarked
 against (benchmarks/transmission_cost.py).  A scene without transmissive objects draws as before, bit for bit (its
-programs contain none of this).  Not with blended materials in the same scene, multisampling, per-vertex shading or
-the uber-shader (a clear error names the option).
+programs contain none of this).  Not on a surface that is blended too, nor with multisampling,
+per-vertex shading or the uber-shader (a clear error names the option).
 """
 import math
 from dataclasses import dataclass
@@ -58,23 +62,20 @@ def drawn_in(obj, blend, output):
 
 
 def check_transmission_options(renderer, scene, radiance=True):
-    """ValueError naming the option where ``renderer`` cannot draw the transmissive objects of ``scene`` (``radiance``:
-    the frame draws the radiance, whose lights must be punctual ones)."""
+    """ValueError naming the option where ``renderer`` cannot draw the transmissive objects of ``scene`` (``radiance``,
+    whether the frame draws the radiance, limits nothing any more: every kind of light is transmitted, an extended one
+    through its weighted directions behind the surface, `glphong.shaders.generated`)."""
     chosen = transmissive_objects(scene)
     if not chosen:
         return
     name = scene.objects[chosen[0]].name
     used = scene.objects[chosen[0]].material.extensions()
     named = " and ".join(f"KHR_materials_{e}" for e in ("transmission", "diffuse_transmission") if e in used)
-    if any(blended(obj) for obj in scene.objects):
-        raise ValueError(f"object {name!r} is transmissive ({named}) and the scene has blended "
-                         "materials (alpha_blend, glTF alphaMode BLEND): glphong does not draw both in one frame yet")
-    extended = [light for light in scene.lights if light.extent == "extended"]
-    if radiance and extended:
-        raise ValueError(f"object {name!r} is transmissive ({named}) and the scene has a "
-                         f"{type(extended[0]).__name__}: glphong transmits point, spot and directional lights through "
-                         "a surface, not area or environment lights yet (their light behind the surface would be "
-                         "left out); light the scene with punctual lights, or give the material transmission=0")
+    both = [scene.objects[i] for i in chosen if blended(scene.objects[i])]
+    if both:  # blended objects beside them are drawn (Transmission.draw's peel); one surface cannot be both
+        raise ValueError(f"object {both[0].name!r} is transmissive and blended (alpha_blend, glTF alphaMode BLEND): "
+                         "glphong draws a surface either through the transmission pass or as a blended layer, not "
+                         "both; give it alpha_blend=None (the glTF Sample Viewer draws it as transmissive)")
     wrong = per_pixel_option(renderer)
     if wrong:
         raise ValueError(f"object {name!r} is transmissive ({named}), which is drawn over the "
@@ -134,6 +135,9 @@ class Transmission:
         level uploaded, every frame; the reference of the tests and benchmarks).
     made : str or None
         What the last frame made: 'none', 'texel' (level 0), 'pyramid' (every level); None before the first.
+    blend : tuple or None
+        The last frame's peel of the blended surfaces into the background (`glphong.gpu.peeling.Peeling.draw`'s
+        ``(layers, cut)``); None where it had none.
     """
 
     def __init__(self, mgl):
@@ -143,6 +147,7 @@ class Transmission:
         self._scratch = None
         self.method = "gpu"
         self.made = None
+        self.blend = None
 
     def _background(self, size, mipmaps):
         """The mipmapped RGBA32F texture of ``size`` (made again where the size changed), filtered through its
@@ -158,21 +163,27 @@ class Transmission:
             self._texture.filter = flt
         return self._texture
 
-    def _host_levels(self, target, size):
-        """The path before: the opaque image read back, its float32 pyramid uploaded level by level."""
+    def _host_levels(self, target, size, composited=False):
+        """The path before: the opaque image (``composited``: level 0, the blended surfaces over it) read back, its
+        float32 pyramid uploaded level by level."""
         opaque = np.empty((size[1], size[0], 4), np.float32)
-        target.read_into(opaque, components=4, attachment=0, dtype="f4")
         texture = self._background(size, True)
+        if composited:
+            texture.read_into(opaque, level=0)
+        else:
+            target.read_into(opaque, components=4, attachment=0, dtype="f4")
         for k, level in enumerate(background_levels(opaque, np.float32)):
             texture.write(np.ascontiguousarray(level, np.float32), level=k)
         return texture
 
-    def _gpu_levels(self, target, size, pyramid, program, fullscreen):
-        """The opaque image copied into level 0 through the pixel buffer (GL to GL) and, with ``pyramid``, each level
-        ``k + 1`` drawn from level ``k`` (glsl/transmission_pyramid.glsl) into a scratch target and copied in."""
+    def _gpu_levels(self, target, size, pyramid, program, fullscreen, composited=False):
+        """The opaque image copied into level 0 through the pixel buffer (GL to GL; ``composited``: level 0 holds the
+        blended surfaces over it already) and, with ``pyramid``, each level ``k + 1`` drawn from level ``k``
+        (glsl/transmission_pyramid.glsl) into a scratch target and copied in."""
         texture = self._background(size, pyramid)
-        target.read_into(self._buffer, components=4, attachment=0, dtype="f4")
-        texture.write(self._buffer, level=0)
+        if not composited:
+            target.read_into(self._buffer, components=4, attachment=0, dtype="f4")
+            texture.write(self._buffer, level=0)
         if not pyramid:
             return texture
         first = (max(size[0] // 2, 1), max(size[1] // 2, 1))
@@ -199,7 +210,17 @@ class Transmission:
             target.use()
         return texture
 
-    def draw(self, target, size, draw, need="pyramid", programs=None, fullscreen=None):
+    def _composite(self, target, size, mipmaps, peel):
+        """Level 0 of the background: ``target``'s opaque image copied in, and the blended surfaces peeled against
+        its opaque depth and composited over it there (``peel(target, into)``, `glphong.gpu.peeling.Peeling.draw`):
+        the glTF Sample Viewer's transmission framebuffer, which holds the opaque and the blended drawables."""
+        texture = self._background(size, mipmaps)
+        target.read_into(self._buffer, components=4, attachment=0, dtype="f4")
+        texture.write(self._buffer, level=0)
+        self.blend = peel(target, texture)
+        target.use()
+
+    def draw(self, target, size, draw, need="pyramid", programs=None, fullscreen=None, peel=None):
         """Make the background of ``target``'s opaque image (its first attachment, drawn) as far as ``need`` asks, and
         draw the transmissive objects over it.
 
@@ -217,20 +238,29 @@ class Transmission:
         programs : glphong.gpu.programs.ProgramCache
             The renderer's programs, of which 'pyramid' takes the `PyramidKey` program; ``fullscreen(program)`` its
             vertex array.
+        peel : callable, optional
+            Where the scene has blended objects: ``peel(target, into)`` peels them against ``target``'s depth (the
+            opaque one) and composites them over the texture ``into`` (`glphong.gpu.peeling.Peeling.draw`), returning
+            its ``(layers, cut)`` (kept in `blend`); the background is then that composite (not made where ``need``
+            is 'none' and the method 'gpu': nothing reads it).
 
         Returns
         -------
         str
             What was made (`made`).
         """
+        self.blend = None
+        composited = peel is not None and (self.method == "host" or need != "none")
+        if composited:
+            self._composite(target, size, self.method == "host" or need == "pyramid", peel)
         if self.method == "host":
-            texture, self.made = self._host_levels(target, size), "pyramid"
+            texture, self.made = self._host_levels(target, size, composited), "pyramid"
         elif need == "none":
             texture, self.made = None, "none"
         else:
             pyramid = need == "pyramid"
             program = programs.get(PyramidKey()) if pyramid else None
-            texture, self.made = self._gpu_levels(target, size, pyramid, program, fullscreen), need
+            texture, self.made = self._gpu_levels(target, size, pyramid, program, fullscreen, composited), need
         target.use()
         draw({} if texture is None else {"u_transmission_background": ShadowMap(texture, None),
                                          "u_transmission_levels": float(math.log2(size[0]))})

@@ -63,8 +63,10 @@ from glphong.materials.gltf_transmission import (gltf_transmission_background,  
                                                  gltf_transmission_fresnel, gltf_transmission_layers,
                                                  gltf_transmission_lod, gltf_transmission_radiance,
                                                  gltf_transmission_response, gltf_transmission_sample,
-                                                 gltf_transmission_weight, gltf_volume_attenuation, gltf_volume_light,
-                                                 gltf_volume_ray, gltf_volume_uv)  # transmission_thin.glsl's twins
+                                                 gltf_transmission_weight, gltf_volume_attenuation,
+                                                 gltf_volume_diffuse_attenuation, gltf_volume_exit,
+                                                 gltf_volume_exit_attenuation, gltf_volume_light, gltf_volume_ray,
+                                                 gltf_volume_uv)  # transmission_thin.glsl's twins
 from glphong.materials.gltf_transmission_cases import transmission_stability_cases  # docs/transmission.md
 from glphong.materials.gltf_diffuse_transmission import gltf_diffuse_transmission_response  # noqa: F401,E402
 from glphong.definitions.material import MaterialModel, Param, Properties, constant_part
@@ -287,6 +289,10 @@ class GltfPBR(GltfExtensionFeatures, MaterialModel):
     #: a light behind the surface: the transmission's BTDF (transmission_thin.glsl) and the diffuse transmission's
     behind_responses = (("TRANSMISSION", "gltf_transmission_response", "through"),
                         ("DIFFUSE_TRANSMISSION", "gltf_diffuse_transmission_response", "diffuse_through"))
+    #: a light behind a volume (transmission_thin.glsl, the Sample Viewer's): the BTDF's seen from the exit point and
+    #: attenuated along the ray, the diffuse transmission's attenuated over the thickness
+    behind_exits = (("VOLUME", "through", "gltf_volume_exit", "gltf_volume_exit_attenuation"),
+                    ("VOLUME", "diffuse_through", None, "gltf_volume_diffuse_attenuation"))
     ambient = "base_color"
     ambient_scale = 1.0 / np.pi
     emission = "emissive"

@@ -48,7 +48,8 @@ from glphong.twin.functions import fresnel_schlick, microfacet_geometry
 __all__ = ["TRANSMISSION_PARAMS", "TRANSMISSION_EXCLUDES", "VOLUME_EXTENSIONS", "volume_extensions",
            "gltf_transmission_fresnel", "gltf_transmission_layers", "gltf_transmission_weight", "gltf_transmission_lod",
            "gltf_transmission_sample", "gltf_transmission_background", "gltf_volume_ray", "gltf_volume_uv",
-           "gltf_volume_attenuation", "gltf_volume_light", "gltf_transmission_response", "gltf_transmission_radiance",
+           "gltf_volume_attenuation", "gltf_volume_light", "gltf_volume_exit", "gltf_volume_exit_attenuation",
+           "gltf_volume_diffuse_attenuation", "gltf_transmission_response", "gltf_transmission_radiance",
            "background_levels", "transmissive"]
 
 _TRANSMISSION = Param("transmission", "scalar", low=0.0, high=1.0, default=0.0, unit="", textureable=True,
@@ -387,6 +388,30 @@ def gltf_volume_light(levels, x, n, wo, eta, roughness, thickness, scale, view_p
     lod = np.broadcast_to(lod, (len(uv),))
     length = np.sqrt(np.einsum("ij,ij->i", ray, ray))
     return gltf_transmission_sample(levels, uv, lod) * gltf_volume_attenuation(length, color, distance)
+
+
+def gltf_volume_exit(n, wo, ior, thickness, scale):
+    """Where a point, spot or directional light behind a volume is seen from: ``x + gltf_volume_exit(...)``,
+    `gltf_volume_ray` at the material's ``ior`` (no dispersion; transmission_thin.glsl's ``gltf_volume_exit``, the
+    Sample Viewer's ``transmissionRay``).  n, wo (N, 3); ior, thickness (N,) or floats; scale (3,) -> (N, 3) [m]."""
+    return gltf_volume_ray(n, wo, ior, thickness, scale)
+
+
+def gltf_volume_exit_attenuation(n, wo, ior, thickness, scale, color, distance):
+    """What the volume leaves of a light behind it along `gltf_volume_exit`: `gltf_volume_attenuation` over its
+    length (transmission_thin.glsl's ``gltf_volume_exit_attenuation``); arguments as `gltf_volume_exit`'s, color
+    (3,), distance float -> (N, 3)."""
+    ray = gltf_volume_exit(n, wo, ior, thickness, scale)
+    return gltf_volume_attenuation(np.sqrt(np.einsum("ij,ij->i", ray, ray)), color, distance)
+
+
+def gltf_volume_diffuse_attenuation(thickness, scale, color, distance):
+    """What the volume leaves of the diffusely transmitted light (transmission_thin.glsl's
+    ``gltf_volume_diffuse_attenuation``, the Sample Viewer's ``diffuseTransmissionThickness``):
+    `gltf_volume_attenuation` over ``thickness (s_x + s_y + s_z) / 3``, the path not refracted.  thickness (N,),
+    scale (3,), color (3,), distance float -> (N, 3)."""
+    return gltf_volume_attenuation(np.asarray(thickness, np.float64) * np.mean(np.asarray(scale, np.float64)), color,
+                                   distance)
 
 
 def gltf_transmission_response(n, wi, wo, n_dot_l, c, m, t, roughness, ior, specular=None, layers=None, film=None):

@@ -104,7 +104,11 @@ def lights_chunk(key):
     ``(lit && valid && n.wi < 0) ? light_term(gltf_transmission_response(f, wi, wo, -n.wi), E) : 0``
     (glsl/transmission_thin.glsl), and one with KHR_materials_diffuse_transmission
     ``(lit && valid && n.wi < 0) ? light_term(gltf_diffuse_transmission_response(f, wi, wo, -n.wi), E) : 0``
-    (glsl/materials/gltf_pbr.glsl).
+    (glsl/materials/gltf_pbr.glsl).  Where a response has an exit (`_behind_exits`: KHR_materials_volume, the glTF
+    Sample Viewer's punctual loop), the light is seen from ``position + exit(f, wo)``: ``valid' =
+    k_incident(position + exit, j, wi', E')`` (times the shadow's visibility at ``position``), ``(lit && valid' &&
+    n.wi' < 0) ? light_term(response(f, wi', wo, -n.wi'), E') attenuation(f, wo) : 0``; one with an attenuation only
+    (the diffuse transmission's) is multiplied by it.
     """
     lines = ["// light loops (generated from the program key): for each light j of each kind k present",
              "//   valid = k_incident(x, j, wi, E);  L += (lit && valid && n.wi > 0) ? material_response(f, wi, wo, n.wi) E : 0",
@@ -120,33 +124,60 @@ def lights_chunk(key):
         if light.shadow_map == "ortho":
             lines += [f"uniform vec3 u_shadow_axis{slot};", f"uniform vec3 u_shadow_e1{slot};", f"uniform vec3 u_shadow_e2{slot};"]
     behind = _behind(key)  # KHR_materials_transmission, _diffuse_transmission: a punctual light behind the surface
+    exits = _behind_exits(key)  # KHR_materials_volume: seen from the exit point, attenuated
     lines += [f"vec3 {name}(ShadingFrame f, vec3 wi, vec3 wo, float n_dot_l);" for name, _ in behind]
+    lines += [f"vec3 {name}(ShadingFrame f, vec3 wo);" for name in
+              dict.fromkeys(name for ends in exits.values() for name in ends if name)]
     lines += ["", "void add_lights(inout vec3 radiance, vec3 position, ShadingFrame f, vec3 wo, bool lit)", "{",
               "    vec3 wi;", "    vec3 irradiance;", "    float n_dot_l;", "    bool valid;"]
-    term = ["        n_dot_l = dot(f.n, wi);",
-            "        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), irradiance);",
-            "        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);"]
-    for name, through in behind:
-        term += [f"        vec3 {through} = light_term({name}(f, wi, wo, -n_dot_l), irradiance);",
-                 f"        radiance += (lit && valid && n_dot_l < 0.0) ? {through} : vec3(0.0);"]
+    for through, (exit, attenuation) in exits.items():
+        lines += [f"    vec3 {through}_exit = {exit}(f, wo);"] if exit else []
+        lines += [f"    vec3 {through}_attenuation = {attenuation}(f, wo);"]
+        lines += [f"    vec3 {through}_wi;", f"    vec3 {through}_irradiance;", f"    float {through}_n_dot_l;",
+                  f"    bool {through}_valid;"] if exit else []
+
+    def term(kind, j, shadow=None):
+        """The body after the light's own incident call (and its shadow ``shadow``, an expression)."""
+        body = ["        n_dot_l = dot(f.n, wi);",
+                "        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), irradiance);",
+                "        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);"]
+        for name, through in behind:
+            exit, attenuation = exits.get(through, (None, None))
+            if exit:
+                body.append(f"        {through}_valid = {kind}_incident(position + {through}_exit, {j}, {through}_wi, "
+                            f"{through}_irradiance);")
+                body += [f"        {through}_irradiance *= visibility;"] if shadow else []
+                body.append(f"        {through}_n_dot_l = dot(f.n, {through}_wi);")
+            wi, e, n_dot_l, valid = (f"{through}_{v}" if exit else v for v in ("wi", "irradiance", "n_dot_l", "valid"))
+            scaled = f" * {through}_attenuation" if attenuation else ""
+            body += [f"        vec3 {through} = light_term({name}(f, {wi}, wo, -{n_dot_l}), {e}){scaled};",
+                     f"        radiance += (lit && {valid} && {n_dot_l} < 0.0) ? {through} : vec3(0.0);"]
+        return body
+
     for light in key.lights:
         if light.extended:
             lines += _extended_loop(key, light)
             continue
         if not light.shadowed:
             lines += [f"    for (int j = 0; j < {light.name.upper()}_LIGHT_COUNT; ++j) {{",
-                      f"        valid = {light.name}_incident(position, j, wi, irradiance);", *term, "    }"]
+                      f"        valid = {light.name}_incident(position, j, wi, irradiance);", *term(light.name, "j"),
+                      "    }"]
             continue
         for j in range(light.count):
             lines += ["    {", f"        valid = {light.name}_incident(position, {j}, wi, irradiance);"]
             slot = slots.get((light.name, j))
+            shadow = None
             if slot is not None and light.shadow_map == "cube":
-                lines.append(f"        irradiance *= shadow_cube(u_shadow_map{slot}, u_shadow_origin{slot}, "
-                             f"u_shadow_texel{slot}, position, shadow_face_normal);")
+                shadow = (f"shadow_cube(u_shadow_map{slot}, u_shadow_origin{slot}, u_shadow_texel{slot}, position, "
+                          "shadow_face_normal)")
             elif slot is not None:
-                lines.append(f"        irradiance *= shadow_ortho(u_shadow_map{slot}, u_shadow_origin{slot}, u_shadow_axis{slot}, "
-                             f"u_shadow_e1{slot}, u_shadow_e2{slot}, u_shadow_texel{slot}, position, shadow_face_normal);")
-            lines += [*term, "    }"]
+                shadow = (f"shadow_ortho(u_shadow_map{slot}, u_shadow_origin{slot}, u_shadow_axis{slot}, "
+                          f"u_shadow_e1{slot}, u_shadow_e2{slot}, u_shadow_texel{slot}, position, shadow_face_normal)")
+            if shadow and exits:  # the exit's light takes the visibility at the surface (docs/transmission.md)
+                lines += [f"        float visibility = {shadow};", "        irradiance *= visibility;"]
+            elif shadow:
+                lines.append(f"        irradiance *= {shadow};")
+            lines += [*term(light.name, j, shadow if exits else None), "    }"]
     lines += ["}"]
     sampled = [_sampled_response(key, light) for light in key.lights if light.extended]
     return "\n".join([line for chunk in sampled for line in chunk] + lines) + "\n"
@@ -168,6 +199,16 @@ def _behind(key):
         return []
     return [(name, through) for t in key.terms for define, name, through in model_named(t.name).behind_responses
             if (define, "1") in t.defines]
+
+
+def _behind_exits(key):
+    """``{variable: (exit, attenuation)}`` of the behind responses that ``key``'s terms' models see from an exit point
+    or attenuate (``behind_exits`` under the defines the terms carry: `GltfPBR`'s KHR_materials_volume,
+    glsl/transmission_thin.glsl), for the responses `_behind` gives; empty for every other program."""
+    throughs = {through for _, through in _behind(key)}
+    return {through: (exit, attenuation) for t in key.terms
+            for define, through, exit, attenuation in model_named(t.name).behind_exits
+            if (define, "1") in t.defines and through in throughs}
 
 
 def closed_form(term, light):
@@ -196,7 +237,13 @@ def _extended_loop(key, light):
     """The loop over an extended kind's lights (docs/design.md section 13): each closed-form term reflects the
     kind's integral (``k E(n)``, ``k_s`` times the lobe integral about ``r_v``), the others its weighted
     directions; the sum is gated by ``lit`` once.  An occludable kind (the environment): each term's part times its
-    occlusion."""
+    occlusion.  A program with responses to a light behind the surface (`_behind`: KHR_materials_transmission,
+    _diffuse_transmission) runs the weighted directions whatever its terms and adds, for each response, ``(valid &&
+    n.wi < 0) ? light_term(<response>(f, wi, wo, -n.wi), E) : 0``: the kinds' samples do not depend on ``n`` (points
+    on the light, the environment's fixed directions over the whole sphere), so those behind are the back
+    hemisphere's; not darkened by the occlusion (the surroundings in front, as the background seen through it).  A
+    volume (`_behind_exits`): a response with an exit point samples the kind again from ``position + exit``, gated on
+    its own ``n.wi' < 0``, and each is times its attenuation, as the punctual loops' (`lights_chunk`)."""
     upper = light.name.upper()
     lines = [f"    for (int j = 0; j < {upper}_LIGHT_COUNT; ++j) {{", "        vec3 reflected = vec3(0.0);"]
     closed = [t for t in key.lit_terms if closed_form(t, light)]
@@ -211,12 +258,28 @@ def _extended_loop(key, light):
         else:
             lines.append(f"        reflected += {k} * {light.name}_lobe(position, f.n, reflect(-wo, f.n), "
                          f"u_{t.name}_{t.integral.exponent}, j);")
-    if len(closed) < len(key.lit_terms):
+    sampled = len(closed) < len(key.lit_terms)
+    behind = _behind(key)
+    if sampled or behind:
         lines += [f"        for (int k = 0; k < {upper}_MAX_SAMPLES; ++k) {{",
                   f"            valid = {light.name}_sample(position, f.n, j, k, wi, irradiance);",
-                  "            n_dot_l = dot(f.n, wi);",
-                  f"            vec3 term = light_term(material_response_{light.name}(f, wi, wo, n_dot_l), irradiance);",
-                  "            reflected += (valid && n_dot_l > 0.0) ? term : vec3(0.0);", "        }"]
+                  "            n_dot_l = dot(f.n, wi);"]
+        if sampled:
+            lines += [f"            vec3 term = light_term(material_response_{light.name}(f, wi, wo, n_dot_l), irradiance);",
+                      "            reflected += (valid && n_dot_l > 0.0) ? term : vec3(0.0);"]
+        if behind:
+            lines.append("            // behind the surface (n.wi < 0): what each response transmits of the direction")
+        exits = _behind_exits(key)  # a volume: the direction seen from the exit point, attenuated (lights_chunk's)
+        for name, through in behind:
+            exit, attenuation = exits.get(through, (None, None))
+            wi, e, n_dot_l, valid = (f"{through}_{v}" if exit else v for v in ("wi", "irradiance", "n_dot_l", "valid"))
+            if exit:
+                lines += [f"            {valid} = {light.name}_sample(position + {through}_exit, f.n, j, k, {wi}, "
+                          f"{e});", f"            {n_dot_l} = dot(f.n, {wi});"]
+            scaled = f" * {through}_attenuation" if attenuation else ""
+            lines += [f"            vec3 {through} = light_term({name}(f, {wi}, wo, -{n_dot_l}), {e}){scaled};",
+                      f"            reflected += ({valid} && {n_dot_l} < 0.0) ? {through} : vec3(0.0);"]
+        lines.append("        }")
     return lines + ["        radiance += lit ? reflected : vec3(0.0);", "    }"]
 
 
