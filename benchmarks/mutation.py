@@ -613,6 +613,17 @@ MUTATIONS = [
     M("transmission_blend.py:background-cut-left-out", "glphong/checks/transmission_blend.py",
       "cut=over.cut | (behind.cut if read else False),", "cut=over.cut,",
       "transmission with blended surfaces: the twin's cut without the background peel's"),
+    M("renderer.py:transmission-background-peel-from-front", "glphong/gpu/renderer.py",
+      "self._fullscreen, into, into and (lambda depth: layers(TRANSMIT_DEPTH, depth)))", "self._fullscreen, into, None)",
+      "transmission with blended surfaces: the background's peel starts at the front again (not behind the glass): "
+      "a layer in front of the glass transmitted through it a second time"),
+    M("transmission_blend.py:background-twin-from-front", "glphong/checks/transmission_blend.py",
+      "lambda gbuffer: shade(opaque, gbuffer), band, start)", "lambda gbuffer: shade(opaque, gbuffer), band, None)",
+      "transmission with blended surfaces: the background's twin holds the layers in front of the glass too"),
+    M("peeling.py:framebuffer-key-glo-alone", "glphong/gpu/peeling.py",
+      "key = tuple(None if a is None else (type(a).__name__, a.glo) for a in (color, depth)) + (write,)",
+      "key = tuple(None if a is None else a.glo for a in (color, depth)) + (write,)",
+      "depth peeling: the framebuffer cache keyed by glo alone (a texture and a renderbuffer of one glo share one)"),
     # KHR_materials_dispersion (glsl/transmission_thin.glsl, glphong/checks/transmission_twin.py): for
     # tests/test_transmission.py
     M("transmission_thin.glsl:dispersion-spread", "glsl/transmission_thin.glsl",
@@ -728,6 +739,15 @@ MUTATIONS = [
     M("transmission_extended.py:last-sample-dropped", "glphong/checks/transmission_extended.py",
       "            for k in range(count):", "            for k in range(count - 1):",
       "extended lights behind a transmissive surface: the twin leaves out each light's last weighted direction"),
+    # transmissive surfaces under shadowing lights (glphong/checks/transmission_twin.py): for
+    # tests/test_transmission_shadows.py
+    M("transmission_twin.py:background-opaque-casters", "glphong/checks/transmission_twin.py",
+      "shaded = shade(scene, in_scene(scene, opaque_gbuffer))", "shaded = shade(opaque, opaque_gbuffer)",
+      "shadows through glass: the background twinned in the scene without its transmissive objects (their shadows "
+      "and the maps' frusta left out), not in the GPU's whole-scene maps"),
+    M("transmission_twin.py:behind-unshadowed", "glphong/checks/transmission_twin.py",
+      "for i, v in enumerate(visibility or ()):", "for i, v in enumerate(()):",
+      "shadows through glass: the lights behind the surface without their visibility at it"),
 ]
 del M
 

@@ -30,7 +30,8 @@
 // ALPHA_BLEND (defined only in a blended surface's layer programs, glphong/gpu/peeling.py, docs/design.md section 16;
 //   per-pixel shading only): with z = gl_FragCoord.z (the window depth, float32) and
 //   z_k = texelFetch(u_blend_depth, pixel).r:
-//   2 (the peel): discard where z <= z_k (the previous layer's depth; -1 before the first); out = vec4(z), which the
+//   2 (the peel): discard where z <= z_k (the previous layer's depth; -1 before the first, or before the background's
+//     first the transmissive surfaces' nearest depth, which their own kind 2 programs draw); out = vec4(z), which the
 //     renderer MIN-blends, so the target keeps the nearest depth behind the previous layer exactly;
 //   1 (the layer): out = vec4(a L, a), a = u_alpha_blend: premultiplied, composited front to back by the blend unit
 //     (C += (1 - A) c, A += (1 - A) a); discarded at the end where z != z_k (this layer's depth), so textures are

@@ -346,9 +346,9 @@ def test_options_that_cannot_draw_it_are_refused_by_name(glphong_make_renderer):
     with pytest.raises(ValueError, match="exact=True"):
         glphong.verify(scene, renderer, exact=True)
     shadowed = _scene(glass, glphong.DirectionalLight((0.0, 0.0, -1.0), E, shadows=True))
-    renderer.render(shadowed)  # drawn; verify says what it does not twin
-    with pytest.raises(ValueError, match="shadows=True"):
-        glphong.verify(shadowed, renderer)
+    report = glphong.verify(shadowed, renderer)  # twinned (tests/test_transmission_shadows.py): the floor behind the
+    inner = slice(SIZE // 2 - 6, SIZE // 2 + 6)  # glass lies in the glass's own full shadow, as the GPU's maps hold it
+    assert report.passed and not report.transmission.transmitted[inner, inner].any(), report.summary()
 
 
 def _no_light(glass):

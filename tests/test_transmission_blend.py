@@ -11,9 +11,9 @@ the glass.  Every quad's edge lies on a pixel boundary.  ``n.v = 1`` everywhere,
 
 (a) the blended quad between the floor and the glass: ``(1 - f0) c (A L_q + (1 - A) L_floor)``: the glass sees it in
     its background;
-(b) the blended quad in front of the glass: ``A L_q + (1 - A) (1 - f0) c (A L_q + (1 - A) L_floor)``: composited
-    over the glass, whose background holds it too (the glTF Sample Viewer's: its transmission framebuffer draws every
-    blended surface over the opaque scene, those in front of the glass included).
+(b) the blended quad in front of the glass: ``A L_q + (1 - A) (1 - f0) c L_floor``: composited over the glass frame
+    without it, whose background holds the floor alone (the decal seen once; the glTF Sample Viewer's transmission
+    framebuffer would hold it too, and the glass transmit it a second time).
 """
 import numpy as np
 import pytest
@@ -21,7 +21,7 @@ import pytest
 import glphong
 from glphong import primitives
 from glphong.checks.blend_twin import blend_hits
-from glphong.gpu.peeling import BlendCapWarning
+from glphong.gpu.peeling import BlendCapWarning, Peeling
 from glphong.gpu.transmission import TARGET_KEY, Transmission
 
 WIDTH, HEIGHT = 48, 40
@@ -80,8 +80,7 @@ def _closed_form(quad_z):
     if quad_z < 0.5:  # (a): the decal in the glass's background
         background = np.where(decal, over(ALPHA, quad, floor), floor)
         return np.where(glass, weight * background, background)
-    background = np.where(decal, over(ALPHA, quad, floor), floor)  # (b): the decal in the background too
-    frame = np.where(glass, weight * background, floor)
+    frame = np.where(glass, weight * floor, floor)  # (b): the glass frame without the decal, the decal over it
     return np.where(decal, over(ALPHA, quad, frame), frame)
 
 
@@ -202,3 +201,24 @@ def test_a_surface_both_transmissive_and_blended_is_refused(glphong_make_rendere
     glass = glphong.GltfPBR(GLASS_COLOR, 0.0, 0.0, transmission=1.0, alpha_blend=glphong.AlphaBlend(0.5))
     with pytest.raises(ValueError, match="'glass' is transmissive and blended"):
         glphong_make_renderer(WIDTH, HEIGHT, "egl").render(_scene(0.25, glass=glass))
+
+
+def test_a_texture_and_a_renderbuffer_of_one_glo_get_their_own_framebuffers():
+    """GL names textures and renderbuffers apart, so a peel texture and the blit's scratch renderbuffer may share a
+    glo; one framebuffer for both made the blit copy the scratch colour over the cleared peel target, which then peeled
+    the first layer twice (seen after other renderers had come and gone: the background's blend_layers 2 for one
+    decal)."""
+    made = []
+
+    class Context:
+        def framebuffer(self, colors, depth):
+            made.append((tuple(colors), depth))
+            return type("Framebuffer", (), {})()
+
+    texture = type("Texture", (), {"glo": 9})()
+    renderbuffer = type("Renderbuffer", (), {"glo": 9})()
+    depth = type("Renderbuffer", (), {"glo": 3})()
+    peeling = Peeling(Context())
+    assert peeling._framebuffer(texture, depth, write=True) is not peeling._framebuffer(renderbuffer, depth, write=True)
+    assert peeling._framebuffer(texture, depth, write=True) is peeling._framebuffer(texture, depth, write=True)
+    assert [colors[0] for colors, _ in made] == [texture, renderbuffer]

@@ -6,10 +6,11 @@ may snap it to) the ray is cast against every opaque and blended triangle (`glph
 faces); the hits of a blended object nearer than the nearest opaque hit are its layers, in increasing ``t``; a back
 face (not `front`) of a one-sided blended material is not a layer (culled, as glTF's ``doubleSided: false``); a hit
 of the same object at the same point as the previous one (``t2 - t1 <= SAME_POINT t1``: a shared edge) is that layer
-again.  Layer ``k`` of every sample becomes a G-buffer of its own (the hit point, the interpolated normal flipped on
-back faces of two-sided materials, the uv and vertex colour, the triangle's own normal) shaded by
-`glphong.checks.verify.twin_and_band`, the same twin and band as an opaque surface's.  Composite, front to back with
-``a_k`` the material's alpha as float32 holds it:
+again; with a start surface (``start``: the background of a transmissive one, `glphong.checks.transmission_blend`),
+the hits at or before it are no layers either.  Layer ``k`` of every sample becomes a G-buffer of its own (the hit
+point, the interpolated normal flipped on back faces of two-sided materials, the uv and vertex colour, the triangle's
+own normal) shaded by `glphong.checks.verify.twin_and_band`, the same twin and band as an opaque surface's.  Composite,
+front to back with ``a_k`` the material's alpha as float32 holds it:
 
     C = sum_k (prod_{j<k} (1 - a_j)) a_k L_k + prod_k (1 - a_k) L_opaque,
 
@@ -65,8 +66,13 @@ class BlendHits:
     ambiguous: np.ndarray
 
 
-def blend_hits(scene, width, height, offsets=SAMPLE_OFFSETS):
-    """Cast every sample ray of every pixel against the opaque and blended objects (module): `BlendHits`."""
+def blend_hits(scene, width, height, offsets=SAMPLE_OFFSETS, start=None):
+    """Cast every sample ray of every pixel against the opaque and blended objects (module): `BlendHits`.
+
+    ``start``, optional: ``(t, depth)``, each (S, H, W) float64 (inf where none), the ray parameter and view depth [m]
+    of a surface not in ``scene`` (a transmissive one, `glphong.checks.transmission_blend`) that the layers of a ray
+    start behind where it lies in front of the opaque hit: a blended hit at or before it is no layer, and a ray is
+    tied where a blended hit, or the opaque one, lies within the depth buffer's resolution of it."""
     camera = scene.camera
     opaque = drawn_objects(scene, lambda obj: f"object {obj.name!r} has a textured alpha mask: verify of blended "
                                               "materials does not follow textured alpha masks yet")
@@ -92,13 +98,15 @@ def blend_hits(scene, width, height, offsets=SAMPLE_OFFSETS):
     np.minimum.at(opaque_t, ray[hit_opaque], t[hit_opaque])
     np.minimum.at(opaque_depth, ray[hit_opaque], depth[hit_opaque])
     layer = is_blend[obj] & (t < opaque_t[ray])
+    tied = np.zeros(rays, bool)
+    if start is not None:
+        layer &= _behind_start(camera, start, ray, t, depth, layer, opaque_t, opaque_depth, tied)
     ray, t, tri, u, v, det, depth, obj = (a[layer] for a in (ray, t, tri, u, v, det, depth, obj))
     start = np.r_[True, ray[1:] != ray[:-1]] if len(ray) else np.zeros(0, bool)
     first = np.maximum.accumulate(np.where(start, np.arange(len(ray)), 0)) if len(ray) else np.zeros(0, np.int64)
     rank = np.arange(len(ray)) - first
     count = np.bincount(ray, minlength=rays)
     # order undetermined in float32: consecutive layers, or the last layer and the opaque surface, tie in depth
-    tied = np.zeros(rays, bool)
     pair = ~start
     np.logical_or.at(tied, ray[pair], depth_tie(camera, depth[np.flatnonzero(pair) - 1], depth[pair]))  # any pair
     last = np.r_[ray[1:] != ray[:-1], True] if len(ray) else np.zeros(0, bool)
@@ -123,6 +131,22 @@ def blend_hits(scene, width, height, offsets=SAMPLE_OFFSETS):
         face[ray[at]] = safe_normalize(np.cross(c[:, 1] - c[:, 0], c[:, 2] - c[:, 0]))[1]
         faces.append(face.reshape(shape + (3,)))
     return BlendHits(layers, count.reshape(shape), faces, ambiguous.reshape(height, width))
+
+
+def _behind_start(camera, start, ray, t, depth, layer, opaque_t, opaque_depth, tied):
+    """`blend_hits`'s ``start``: (M,) bool, whether each hit lies behind the start surface of its ray (or the ray's
+    start surface is none, or not in front of the opaque hit); marks ``tied`` (rays,) where a layer, or the opaque
+    surface under a layer, ties with the start surface in depth."""
+    start_t, start_depth = (np.reshape(a, -1) for a in start)
+    ahead = start_t < opaque_t  # (the GPU's depth-only pass of the start surface is tested against the opaque depth)
+    near = np.flatnonzero(layer & ahead[ray])
+    z = start_depth[ray[near]]
+    tied[ray[near[depth_tie(camera, np.minimum(depth[near], z), np.maximum(depth[near], z))]]] = True
+    both = np.flatnonzero(np.isfinite(start_depth) & np.isfinite(opaque_depth) & (np.bincount(
+        ray[layer], minlength=len(tied)) > 0))
+    a, b = start_depth[both], opaque_depth[both]
+    tied[both[depth_tie(camera, np.minimum(a, b), np.maximum(a, b))]] = True
+    return ~ahead[ray] | (t > start_t[ray])
 
 
 def front_of(det, mirrored):
@@ -238,7 +262,7 @@ def _alphas(scene, layer, band):
     return alpha, spread
 
 
-def blend_twin(scene, size, cap, opaque, shade, band=BAND):
+def blend_twin(scene, size, cap, opaque, shade, band=BAND, start=None):
     """The twin of a frame of ``scene`` with blended surfaces (module).
 
     Parameters
@@ -254,13 +278,15 @@ def blend_twin(scene, size, cap, opaque, shade, band=BAND):
         ``shade(gbuffer)`` -> ``(reference, low, high, shadow_band)`` (`glphong.checks.verify.twin_and_band`).
     band : glphong.checks.tolerances.BandConstants
         For a textured alpha's filter error.
+    start : tuple, optional
+        `blend_hits`'s: the layers behind a transmissive surface alone.
 
     Returns
     -------
     BlendTwin
     """
     width, height = size
-    hits = blend_hits(scene, width, height)
+    hits = blend_hits(scene, width, height, start=start)
     samples = len(hits.count)
     values = {"reference": [], "low": [], "high": []}
     alphas, spreads = [], []

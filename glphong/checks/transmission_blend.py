@@ -1,13 +1,16 @@
 """The twin of a frame with transmissive and blended surfaces (docs/transmission.md, "With blended surfaces"), in the
-order the GPU draws it (`glphong.gpu.renderer.Renderer._draw`, the glTF Sample Viewer's):
+order the GPU draws it (`glphong.gpu.renderer.Renderer._draw`):
 
 1. the background: the blended layers composited over the scene without its transmissive objects
-   (`glphong.checks.blend_twin.blend_twin` of `glphong.checks.transmission_twin.opaque_scene`), what the thin walls
-   see (`layers_behind`, given to `glphong.checks.transmission_twin.transmission_check`);
+   (`glphong.checks.blend_twin.blend_twin` of `glphong.checks.transmission_twin.opaque_scene`), on each sample ray
+   only those behind the nearest hit of a transmissive object where it lies in front of the opaque hit (`glass_start`,
+   the GPU's depth-only pass), all of them elsewhere: what the thin walls see (`layers_behind`, given to
+   `glphong.checks.transmission_twin.transmission_check`);
 2. the frame twin of the whole scene's G-buffer (its nearest opaque or transmissive surface) plus what the
    transmissive surfaces transmit of that background, and its band (the shading band plus the transmission's);
 3. the blended layers nearer than that surface (a transmissive one occludes those behind it, which the background
-   holds) composited over it (`frame_blend_twin`): the blend twin's composite and band.
+   holds) composited over it (`frame_blend_twin`): the blend twin's composite and band.  Each layer is so counted
+   once, behind the glass or in front of it.
 
 A pixel is unchecked where the final blend twin leaves it so, or where a transmissive surface reads a background
 pixel left unchecked (the low end of its band is not finite there).  The cap: the GPU peels twice, and its
@@ -19,17 +22,33 @@ import dataclasses
 import numpy as np
 
 from glphong.checks.blend_twin import blend_twin
-from glphong.gpu.transmission import background_need
+from glphong.checks.frame_twin import SAMPLE_OFFSETS, _hits, _world_triangles
+from glphong.gpu.transmission import background_need, transmissive_objects
 
-__all__ = ["layers_behind", "frame_blend_twin"]
+__all__ = ["glass_start", "layers_behind", "frame_blend_twin"]
 
 
-def layers_behind(renderer, shade, band):
+def glass_start(scene, width, height):
+    """The nearest hit of the transmissive objects of ``scene`` on every sample ray of a ``width`` x ``height`` frame
+    (`glphong.checks.frame_twin.SAMPLE_OFFSETS`, both faces): ``(t, depth)``, each (S, H, W) float64, the ray
+    parameter and the view depth [m], inf where none (`glphong.checks.blend_twin.blend_hits`'s ``start``)."""
+    corners = _world_triangles(scene, transmissive_objects(scene))[0]
+    (ray, t, _, _, _, _, depth), _ = _hits(scene.camera, width, height, SAMPLE_OFFSETS, corners)
+    shape = (len(SAMPLE_OFFSETS), height, width)
+    nearest_t, nearest_depth = np.full(shape, np.inf), np.full(shape, np.inf)
+    np.minimum.at(nearest_t.reshape(-1), ray, t)
+    np.minimum.at(nearest_depth.reshape(-1), ray, depth)
+    return nearest_t, nearest_depth
+
+
+def layers_behind(scene, renderer, shade, band):
     """``transmission_check``'s ``blend``: ``blend(opaque, (reference, low, high, covered))`` -> the `BlendTwin` of
-    the blended layers of the scene ``opaque`` over that twin (``shade(scene, gbuffer)`` ->
+    the blended layers of the scene ``opaque`` (``scene`` without its transmissive objects) behind the transmissive
+    surfaces of ``scene`` (`glass_start`) over that twin (``shade(scene, gbuffer)`` ->
     `glphong.checks.verify.twin_and_band`'s four arrays)."""
+    start = glass_start(scene, *renderer._size)
     return lambda opaque, under: blend_twin(opaque, renderer._size, renderer.blend_layers, under,
-                                            lambda gbuffer: shade(opaque, gbuffer), band)
+                                            lambda gbuffer: shade(opaque, gbuffer), band, start)
 
 
 def frame_blend_twin(scene, renderer, frame, shade, band, transmission=None):

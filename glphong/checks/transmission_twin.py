@@ -11,12 +11,13 @@ function:
 (`glphong.materials.gltf_transmission`'s twins compute the value, this module the band).
 
 ``B`` from the twin of the background: the scene without its transmissive objects, its G-buffer drawn by the GPU and
-shaded by the twin (``shade``: `glphong.checks.verify.twin_and_band`), which is the opaque surface the pixel's ray
-meets next behind the thin wall (it goes straight through).  Roughness 0 (or ior 1): ``B`` is that surface's radiance
-at the pixel, exactly.  Roughness ``r > 0``: ``B`` is the trilinear lookup of the background's pyramid of 2x2 box
-means (`glphong.materials.gltf_transmission.background_levels`, in float64) at the pixel's centre, level of detail
-``log2(W) r clamp(2 ior - 2, 0, 1)`` (`gltf_transmission_lod`): the GPU's method, whose own error against the integral
-of the lobe is measured apart (benchmarks/transmission_rough.py, docs/transmission.md).
+shaded by the twin in the whole scene (``shade``: `glphong.checks.verify.twin_and_band`; `in_scene`: the GPU's opaque
+pass draws with the whole scene's shadow maps, whose casters include the transmissive objects), which is the opaque
+surface the pixel's ray meets next behind the thin wall (it goes straight through).  Roughness 0 (or ior 1): ``B`` is
+that surface's radiance at the pixel, exactly.  Roughness ``r > 0``: ``B`` is the trilinear lookup of the background's
+pyramid of 2x2 box means (`glphong.materials.gltf_transmission.background_levels`, in float64) at the pixel's centre,
+level of detail ``log2(W) r clamp(2 ior - 2, 0, 1)`` (`gltf_transmission_lod`): the GPU's method, whose own error
+against the integral of the lobe is measured apart (benchmarks/transmission_rough.py, docs/transmission.md).
 
 The band: ``w`` to ``(5 D + A) eps`` of ``(1 - m) t c`` (the Fresnel's slope in ``n.v`` is at most 5, ``n.v`` to ``D
 eps``; the chain's rounding ``A eps``; the specular's interval where textured), times ``keep``'s interval
@@ -31,7 +32,7 @@ from types import SimpleNamespace
 
 import numpy as np
 
-from glphong.checks.reference import safe_normalize, shade_inputs
+from glphong.checks.reference import incident_light, safe_normalize, shade_inputs
 from glphong.checks.transmission_extended import extended_behind
 from glphong.checks.tolerances import BAND
 from glphong.checks.transmission_lights import (_attenuation_slack, _bounds, _coat_cosines, _coat_normal, _film,
@@ -44,7 +45,8 @@ from glphong.materials.gltf_transmission import (background_levels, gltf_transmi
 from glphong.scene.scene import Scene
 from glphong.twin.band import EPS
 
-__all__ = ["TransmissionTwin", "opaque_scene", "transmission_twin", "transmission_check", "background_lookup"]
+__all__ = ["TransmissionTwin", "opaque_scene", "in_scene", "transmission_twin", "transmission_check",
+           "background_lookup"]
 
 
 @dataclass(frozen=True)
@@ -65,6 +67,10 @@ class TransmissionTwin:
     background_blend : glphong.checks.blend_twin.BlendTwin or None
         Where that scene has blended surfaces: the twin of their composite over it, which is the background
         (`glphong.checks.transmission_blend`).
+    shadow_band : (H, W) bool ndarray or None
+        Where a light has ``shadows=True``: the transmissive pixels whose background pixel (the same pixel) has a
+        shadowing light's visibility uncertain (`glphong.checks.verify.twin_and_band`'s shadow band; the background's
+        band holds it between 0 and 1, and the lookups of rough surfaces and volumes read that band too).
     """
 
     transmitted: np.ndarray
@@ -74,6 +80,7 @@ class TransmissionTwin:
     rough: np.ndarray
     background: np.ndarray
     background_blend: object = None
+    shadow_band: np.ndarray = None
 
 
 def opaque_scene(scene):
@@ -114,7 +121,7 @@ def background_lookup(levels, uv, lod):
     return value, low, high
 
 
-def transmission_twin(scene, gbuffer, background, band=BAND):
+def transmission_twin(scene, gbuffer, background, band=BAND, shadows=None):
     """The transmitted radiance of a frame's transmissive surfaces (module).
 
     Parameters
@@ -123,8 +130,11 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
     gbuffer : glphong.GBuffer
         The GPU's G-buffer of the whole scene (its transmissive surfaces included).
     background : tuple of (H, W, 3) float64 ndarray
-        ``(reference, low, high)``: the twin of `opaque_scene` on its own G-buffer.
+        ``(reference, low, high)``: the twin of `opaque_scene`'s G-buffer, shaded in ``scene`` (`in_scene`).
     band : glphong.checks.tolerances.BandConstants
+    shadows : (int, int), optional
+        The renderer's shadow settings (`glphong.Renderer.shadow_settings`), where a light has ``shadows=True``: the
+        lights behind the surface take each shadowed light's ray-cast visibility at the surface (`_visible`).
 
     Returns
     -------
@@ -139,7 +149,7 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
     chosen = set(transmissive_objects(scene))
     pyramids = None
     tol = band.D * EPS
-    for selection, obj, key, u, position, f, n_valid in shade_inputs(scene, gbuffer, band=band):
+    for selection, obj, key, u, position, f, n_valid in shade_inputs(scene, gbuffer, band=band, shadows=shadows):
         if int(gbuffer.object_index[selection][0]) not in chosen:
             continue
         rows, columns = np.nonzero(selection)
@@ -189,13 +199,29 @@ def transmission_twin(scene, gbuffer, background, band=BAND):
             scales.append((cd_lo * ((1.0 - m_hi) * (1.0 - t_hi) * dt_lo)[:, None],
                            cd_hi * ((1.0 - m_lo) * (1.0 - t_lo) * dt_hi)[:, None]))
         behind = partial(_lights_behind, key, u, f, position, wo, valid, p, scales, band, used, diffuse, volume)
-        lights, lights_low, lights_high = (a + b for a, b in zip(behind(), extended_behind(behind, key, u, f, band)))
+        lights, lights_low, lights_high = (a + b for a, b in zip(behind(_visible(key, u, band, f.visibility)),
+                                                                 extended_behind(behind, key, u, f, band)))
         out[rows, columns] = value + lights
         out_low[rows, columns] = np.where(valid[:, None], ends.min(axis=0), np.minimum(value, 0.0)) + lights_low
         out_high[rows, columns] = np.where(valid[:, None], ends.max(axis=0), np.maximum(value, 0.0)) + lights_high
         pixels[rows, columns] = True
         rough[rows, columns] = is_rough
     return TransmissionTwin(out, out_low, out_high, pixels, rough, reference)
+
+
+def _visible(key, u, band, visibility):
+    """The punctual lights at points ``x`` (N, 3), `incident_light`'s ``(valid, wi, E, (E_low, E_high))`` each, every
+    shadowed light's ``E`` and interval times its visibility at the fragments (``f.visibility``: the exact value, its
+    low and high): the generated loops' ``irradiance *= V(position)``, which the responses behind the surface and a
+    volume's exit point (``x`` moved) take as they are (`glphong.shaders.generated.lights_chunk`)."""
+    def incident(x):
+        lights = incident_light(x, key, u, band=band)
+        for i, v in enumerate(visibility or ()):
+            if v is not None:
+                valid, wi, e, (e_low, e_high) = lights[i]
+                lights[i] = (valid, wi, e * v[0][:, None], (e_low * v[1][:, None], e_high * v[2][:, None]))
+        return lights
+    return incident
 
 
 def _material(u, f, used):
@@ -265,18 +291,32 @@ def _through_volume(obj, u, f, position, wo, roughness, ior, pyramids, width):
     return low, high, filtered
 
 
+def in_scene(scene, gbuffer):
+    """`opaque_scene`'s G-buffer ``gbuffer`` with its object indices those of the same objects in ``scene`` (-1 where
+    not covered): shaded in ``scene``, its surfaces take the programs, uniforms and shadow maps (every caster of
+    ``scene``, its transmissive objects included, and their frusta from its bounds) that the GPU's opaque pass draws
+    them with."""
+    chosen = set(transmissive_objects(scene))
+    kept = np.array([i for i in range(len(scene.objects)) if i not in chosen] + [-1])
+    return dataclasses.replace(gbuffer, object_index=kept[gbuffer.object_index])
+
+
 def transmission_check(scene, renderer, gbuffer, shade, band=BAND, exact=None, blend=None):
     """`transmission_twin` of a frame of ``renderer``: the background's twin from `opaque_scene`'s G-buffer drawn by
-    ``renderer`` and shaded by ``shade(scene, gbuffer)`` -> ``(reference, low, high, ...)``; where the scene has
-    blended surfaces, ``blend(opaque, (reference, low, high, covered))`` -> the `glphong.checks.blend_twin.BlendTwin`
-    of their composite over it, which is then the background (`glphong.checks.transmission_blend`).
+    ``renderer`` and shaded in ``scene`` (`in_scene`) by ``shade(scene, gbuffer)`` -> ``(reference, low, high,
+    shadow_band)``; where the scene has blended surfaces, ``blend(opaque, (reference, low, high, covered))`` -> the
+    `glphong.checks.blend_twin.BlendTwin` of their composite over it, which is then the background
+    (`glphong.checks.transmission_blend`).  Where a light has ``shadows=True``, the GPU's maps hold every caster, the
+    transmissive objects included (`glphong.gpu.renderer.Renderer._shadow_values`): the background's visibility is
+    theirs (`in_scene`), and the lights behind the surface take the visibility at it (``renderer.shadow_settings``
+    to `transmission_twin`).
 
     Raises
     ------
     ValueError
         ``exact=True`` (the extended lights' exact integrals are not computed through a transmissive surface), or a
-        light with ``shadows=True`` (the background's twin is drawn without the transmissive objects, which the GPU's
-        shadow maps hold).
+        light with ``shadows=True`` in a scene with blended surfaces too (their layers in the background are twinned
+        in `opaque_scene`, without the transmissive casters).
     """
     obj = scene.objects[transmissive_objects(scene)[0]]
     name, used = obj.name, obj.material.extensions()
@@ -285,14 +325,19 @@ def transmission_check(scene, renderer, gbuffer, shade, band=BAND, exact=None, b
         raise ValueError(f"object {name!r} is transmissive ({named}): verify does not compute the exact integrals of "
                          "extended lights with it (exact=True); the GPU is checked against the twin of the lights' "
                          "methods, behind the surface too (exact=False; their error: docs/transmission.md, Lights)")
-    if any(getattr(light, "shadows", False) for light in scene.lights):
-        raise ValueError(f"object {name!r} is transmissive ({named}) and a light has shadows=True: "
-                         "verify does not twin shadows with transmissive objects yet")
+    shadowed = any(getattr(light, "shadows", False) for light in scene.lights)
+    if shadowed and blend is not None:
+        raise ValueError(f"object {name!r} is transmissive ({named}), the scene has blended surfaces and a light has "
+                         "shadows=True: verify does not twin the blended layers of the background in the shadow maps "
+                         "of the whole scene yet (the render draws them)")
     opaque = opaque_scene(scene)
     opaque_gbuffer = renderer.gbuffer(opaque)
-    background = shade(opaque, opaque_gbuffer)[:3]
+    shaded = shade(scene, in_scene(scene, opaque_gbuffer))  # the GPU's opaque pass: the whole scene's maps
+    shadows = renderer.shadow_settings if shadowed else None
     if blend is None:
-        return transmission_twin(scene, gbuffer, background, band)
-    behind = blend(opaque, (*background, opaque_gbuffer.mask))
-    twin = transmission_twin(scene, gbuffer, (behind.reference, behind.low, behind.high), band)
-    return dataclasses.replace(twin, background_blend=behind)
+        twin = transmission_twin(scene, gbuffer, shaded[:3], band, shadows)
+    else:
+        behind = blend(opaque, (*shaded[:3], opaque_gbuffer.mask))
+        twin = dataclasses.replace(transmission_twin(scene, gbuffer, (behind.reference, behind.low, behind.high), band,
+                                                     shadows), background_blend=behind)
+    return dataclasses.replace(twin, shadow_band=twin.pixels & shaded[3]) if shadowed else twin

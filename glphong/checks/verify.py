@@ -277,9 +277,11 @@ def verify(scene, renderer, band=BAND, exact=None, passes=None, next_scene=None,
     transmission = None
     if transmissive_objects(scene):  # what the thin walls transmit (glphong.checks.transmission_twin)
         transmission = transmission_check(scene, renderer, gbuffer, shade, band, exact, layers_behind(
-            renderer, shade, band) if blended_objects(scene) else None)  # (the layers over the background)
+            scene, renderer, shade, band) if blended_objects(scene) else None)  # (the layers over the background)
         exact = False
         ref, low, high = ref + transmission.transmitted, low + transmission.low, high + transmission.high
+        if transmission.shadow_band is not None:  # the background's uncertain visibility seen through the glass
+            shadow_band = shadow_band | transmission.shadow_band
     blend, cut_mismatch = None, 0
     if blended_objects(scene):  # the layers over the opaque (and transmissive) twin (glphong.checks.blend_twin)
         if exact:

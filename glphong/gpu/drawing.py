@@ -11,7 +11,7 @@ import numpy as np
 
 from glphong.gpu.peeling import blend_key
 from glphong.gpu.resources import ObjectEntry
-from glphong.gpu.transmission import TRANSMIT, drawn_in
+from glphong.gpu.transmission import drawn_in
 from glphong.gpu.view_cull import MIN_TRIANGLES, box_inside, visible_triangles
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
@@ -118,7 +118,8 @@ def draw_list(renderer, scene, output, aspect, frame_values=None, shadow_values=
             entry = None
         if shared is not None or entry is None or entry.state != state or entry.index != index:
             key = shared or renderer.program_key(scene, obj, output, planes)
-            key = blend_key(key, blend, obj.material.alpha_blend.textured) if blend and blend != TRANSMIT else key
+            kind = blend & 3  # a blended layer's (1) or peel's (2) program; TRANSMIT_DEPTH: the peel's of a glass
+            key = blend_key(key, kind, kind == 1 and obj.material.alpha_blend.textured) if kind else key
             program = renderer.programs.get(key)
             values = bound.uniform_values(index, key, aspect) if shared is not None else \
                 bound.object_uniform_values(index, key)

@@ -22,8 +22,13 @@ blended objects ``2 n + 1`` times, plus ``n + 1`` depth blits and one composite 
 ``max_layers`` layers keeps its nearest ``max_layers``: the peel past the cap finds where fragments are left, the
 frame's ``blend_cut`` map, and a warning says how many pixels.
 
-With transmissive objects (`glphong.gpu.transmission`) a frame peels twice: against the opaque depth into the
-transmission's background, then against the opaque and transmissive depth over the frame (`merged_peels`).
+With transmissive objects (`glphong.gpu.transmission`) a frame peels twice: into the transmission's background the
+layers behind the nearest transmissive surface of each pixel and in front of the opaque depth (all of them where no
+transmissive surface covers the pixel), then, over the frame, those in front of the opaque and transmissive depth
+(`merged_peels`).  The background's first peel starts from the transmissive surfaces' nearest window depth instead of
+-1 (``start``): drawn by their peel programs into a float32 target cleared to -1, depth-tested LESS against a copy of
+the opaque depth and writing it (the nearest depth quantum's first fragment), then again EQUAL and MIN-blended (every
+fragment of that quantum: the nearest exactly, as the peel's own target holds it).
 
 Not exact: two blended fragments at the same float32 window depth in one pixel (coincident surfaces) are one layer,
 the last drawn; a blended fragment in the opaque surface's 24-bit depth quantum is kept (as the opaque surfaces' own
@@ -169,14 +174,15 @@ class Peeling:
     def _framebuffer(self, color, depth, write=False):
         """The framebuffer of ``color`` (a texture or renderbuffer, or None) and ``depth`` (or None), writing depth
         with ``write``."""
-        key = (None if color is None else color.glo, None if depth is None else depth.glo, write)
+        # textures and renderbuffers name their GL objects apart: a texture and a renderbuffer may share a glo
+        key = tuple(None if a is None else (type(a).__name__, a.glo) for a in (color, depth)) + (write,)
         fbo = self._framebuffers.get(key)
         if fbo is None:
             fbo = self._framebuffers[key] = self._mgl.framebuffer([] if color is None else [color], depth)
             fbo.depth_mask = write
         return fbo
 
-    def draw(self, target, size, draw, max_layers, composite, fullscreen, into=None):
+    def draw(self, target, size, draw, max_layers, composite, fullscreen, into=None, start=None):
         """Peel and composite the blended layers over ``target``'s first attachment (the opaque image, drawn), or over
         the texture ``into``.
 
@@ -197,6 +203,11 @@ class Peeling:
             An RGBA32F texture of ``size`` to composite over instead of ``target``'s first attachment (the
             transmission's background, `glphong.gpu.transmission.Transmission.draw`); ``target``'s depth still
             decides what is peeled.
+        start : callable, optional
+            ``start(depth)``: draw the transmissive objects with their peel programs
+            (`glphong.gpu.transmission.TRANSMIT_DEPTH`), binding ``depth`` to ``u_blend_depth``; the first peel then
+            keeps only the fragments strictly behind their nearest window depth in front of ``target``'s
+            (`_start_depth`), every fragment where none covers the pixel.
 
         Returns
         -------
@@ -232,6 +243,8 @@ class Peeling:
         layers, cut = 0, None
         mgl.enable(moderngl.DEPTH_TEST | moderngl.BLEND)
         try:
+            bound = z[previous] if start is None else self._start_depth(size, start, z[previous], opaque_depth,
+                                                                          depth_copy, layer_depth)
             while True:
                 peel[current].use()
                 peel[current].clear(_FAR, _FAR, _FAR, _FAR)  # (and its depth: the blit comes after)
@@ -242,7 +255,7 @@ class Peeling:
                 mgl.blend_equation = moderngl.MIN
                 mgl.depth_func = "<="
                 with self._query:
-                    draw(2, ShadowMap(z[previous], None))
+                    draw(2, ShadowMap(bound, None))
                 if self._query.samples == 0:
                     break
                 if layers == max_layers:
@@ -259,6 +272,7 @@ class Peeling:
                 draw(1, ShadowMap(z[current], None))
                 layers += 1
                 previous, current = current, previous
+                bound = z[previous]
             mgl.disable(moderngl.DEPTH_TEST)
             mgl.depth_func = "<"
             self._framebuffer(target.color_attachments[0] if into is None else into, None).use()
@@ -274,6 +288,29 @@ class Peeling:
             mgl.disable(moderngl.BLEND)
             mgl.enable(moderngl.DEPTH_TEST)
         return layers, cut
+
+    def _start_depth(self, size, start, empty, opaque_depth, depth_copy, layer_depth):
+        """The window depth the background's first peel starts from (module): the nearest fragment ``start`` draws in
+        front of the opaque depth, as float32 holds it, -1 where there is none; ``empty`` a depth texture cleared to
+        -1 (no fragment discarded), ``opaque_depth`` and ``depth_copy`` the blit's framebuffers onto ``layer_depth``.
+        Called with the depth test and blending on (`draw`'s state); returns the float32 texture of ``size``."""
+        mgl = self._mgl
+        texture = self._texture("start", size, 1)
+        fbo = self._framebuffer(texture, layer_depth, write=True)
+        fbo.use()
+        fbo.clear(-1.0, -1.0, -1.0, -1.0)  # (and its depth: the blit comes after)
+        depth_copy.use()
+        mgl.copy_framebuffer(depth_copy, opaque_depth)
+        fbo.use()
+        mgl.disable(moderngl.BLEND)
+        mgl.depth_func = "<"  # as the transmissive objects' own draw: the nearest quantum's first fragment written
+        start(ShadowMap(empty, None))
+        mgl.enable(moderngl.BLEND)
+        mgl.blend_func = moderngl.ONE, moderngl.ONE
+        mgl.blend_equation = moderngl.MIN
+        mgl.depth_func = "=="  # every fragment of that quantum: the least depth exactly
+        start(ShadowMap(empty, None))
+        return texture
 
     def gl_object_count(self):
         """GL objects held: textures, framebuffers and the query."""

@@ -31,8 +31,8 @@ from glphong.gpu.drawing import draw_objects
 from glphong.gpu.peeling import (BLEND_LAYERS, MAX_BLEND_LAYERS, CompositeKey, Peeling, blend_fields, blended_objects,
                                  check_blend_options, merged_peels)
 from glphong.gpu.program_keys import renderer_program_key
-from glphong.gpu.transmission import (TARGET_KEY, TRANSMIT, Transmission, background_need, check_transmission_options,
-                                    transmissive_objects)
+from glphong.gpu.transmission import (TARGET_KEY, TRANSMIT, TRANSMIT_DEPTH, Transmission, background_need,
+                                    check_transmission_options, transmissive_objects)
 from glphong.scene.scene import Scene
 
 __all__ = ["Renderer", "Frame", "GBuffer", "RendererReleasedError"]
@@ -486,9 +486,10 @@ class Renderer:
     def _draw(self, scene, output, fbo, frame_values=None, planes=frozenset()):
         """Draw ``scene``'s objects into ``fbo`` (`glphong.gpu.drawing`); its radiance with blended objects then peels
         and composites their layers (`glphong.gpu.peeling`): returns ``(layers, cut)`` then, else None.  With
-        transmissive objects too (docs/transmission.md), the glTF Sample Viewer's order: the blended layers over the
-        opaque image make the background, the transmissive objects are drawn, and the layers in front of the opaque
-        and transmissive depth go over the frame (`merged_peels` of the two)."""
+        transmissive objects too (docs/transmission.md): the blended layers behind the transmissive surfaces' depth
+        (``start``, `glphong.gpu.peeling.Peeling.draw`) over the opaque image make the background, the transmissive
+        objects are drawn, and the layers in front of the opaque and transmissive depth go over the frame
+        (`merged_peels` of the two)."""
         self._purge_dead_meshes()
         shadow_values = self._shadow_values(scene, output)
         fbo.use()
@@ -500,9 +501,10 @@ class Renderer:
 
         def peel(target, into=None):  # the blended layers over target's image (or into), against its depth
             peeling = self._targets.get(("peeling",)) or self._targets.setdefault(("peeling",), Peeling(self._mgl))
-            return peeling.draw(target, target.size, lambda kind, depth: draw_objects(
-                self, scene, output, {"u_blend_depth": depth}, shadow_values, blend=kind), self.blend_layers,
-                self.programs.get(CompositeKey()), self._fullscreen, into)
+            layers = lambda kind, depth: draw_objects(  # noqa: E731 - (into: those behind the glass alone, start)
+                self, scene, output, {"u_blend_depth": depth}, shadow_values, blend=kind)
+            return peeling.draw(target, target.size, layers, self.blend_layers, self.programs.get(CompositeKey()),
+                                self._fullscreen, into, into and (lambda depth: layers(TRANSMIT_DEPTH, depth)))
         behind = None
         if output == "radiance" and transmissive_objects(scene):  # over the opaque scene (glphong.gpu.transmission)
             transmission = self._targets.get(TARGET_KEY) or self._targets.setdefault(TARGET_KEY, Transmission(self._mgl))

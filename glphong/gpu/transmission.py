@@ -11,10 +11,11 @@ A frame of a scene with transmissive objects draws, into the radiance target:
    `glphong.materials.gltf_transmission.background_levels` (tested); a frame whose every transmissive surface reads
    the texel at its own pixel (roughness 0 or ior 1, thin walls) makes level 0 alone, one whose surfaces read no
    background (``KHR_materials_diffuse_transmission`` alone) makes nothing; where the scene has blended objects too,
-   they are peeled against the opaque depth and composited over level 0 before its pyramid
-   (`glphong.gpu.peeling.Peeling.draw` with ``into``): the glTF Sample Viewer's background, which holds the opaque and
-   the blended surfaces (docs/transmission.md, "With blended surfaces"; the renderer then peels them again over the
-   frame, against the opaque and transmissive depth);
+   their layers behind the nearest transmissive surface of each pixel (all of them where none covers it) and in front
+   of the opaque depth are peeled and composited over level 0 before its pyramid (`glphong.gpu.peeling.Peeling.draw`
+   with ``into`` and ``start``, a depth-only pass of the transmissive objects): what lies behind the glass, each layer
+   seen once (docs/transmission.md, "With blended surfaces"; the renderer then peels those in front over the frame,
+   against the opaque and transmissive depth);
 3. the transmissive objects, depth-tested against the opaque depth and writing it, their radiance programs (the
    define ``GLTF_PBR_TRANSMISSION``) reading the background at their own pixel (transmission_thin.glsl): the nearest
    transmissive surface of a pixel is drawn, and it sees the opaque scene alone (a transmissive surface behind another
@@ -37,11 +38,14 @@ from glphong.gpu.shadows import ShadowMap
 from glphong.materials.gltf_transmission import background_levels, gltf_transmission_lod, transmissive
 from glphong.shaders.keys import EncodeKey
 
-__all__ = ["TRANSMIT", "transmissive_objects", "drawn_in", "check_transmission_options", "background_need",
-           "PyramidKey", "Transmission", "TARGET_KEY"]
+__all__ = ["TRANSMIT", "TRANSMIT_DEPTH", "transmissive_objects", "drawn_in", "check_transmission_options",
+           "background_need", "PyramidKey", "Transmission", "TARGET_KEY"]
 
 #: `glphong.gpu.drawing.draw_list`'s selector of the transmissive objects (0 the others, 1 and 2 blended layers)
 TRANSMIT = 4
+#: the transmissive objects drawn by their peel programs (`glphong.gpu.peeling.blend_key` kind 2): their window depth
+#: alone, where the background's peel of the blended layers starts (`glphong.gpu.peeling.Peeling.draw`'s ``start``)
+TRANSMIT_DEPTH = TRANSMIT | 2
 #: the renderer's target key of its `Transmission` (released and counted with the peel's, `glphong.gpu.resources`)
 TARGET_KEY = ("peeling", "transmission")
 
@@ -53,8 +57,9 @@ def transmissive_objects(scene):
 
 def drawn_in(obj, blend, output):
     """Whether ``draw_list`` draws ``obj`` with selector ``blend`` for ``output``: a transmissive object only with
-    `TRANSMIT` in a radiance draw (and as an opaque one in every other output: the G-buffer, the matte)."""
-    if blend == TRANSMIT:
+    `TRANSMIT` (or `TRANSMIT_DEPTH`) in a radiance draw (and as an opaque one in every other output: the G-buffer, the
+    matte)."""
+    if blend & TRANSMIT:
         return transmissive(obj.material)
     if blended(obj) != bool(blend):
         return False
@@ -211,9 +216,9 @@ class Transmission:
         return texture
 
     def _composite(self, target, size, mipmaps, peel):
-        """Level 0 of the background: ``target``'s opaque image copied in, and the blended surfaces peeled against
-        its opaque depth and composited over it there (``peel(target, into)``, `glphong.gpu.peeling.Peeling.draw`):
-        the glTF Sample Viewer's transmission framebuffer, which holds the opaque and the blended drawables."""
+        """Level 0 of the background: ``target``'s opaque image copied in, and the blended layers behind the nearest
+        transmissive surface (all where none covers the pixel) and in front of its opaque depth composited over it
+        there (``peel(target, into)``, `glphong.gpu.peeling.Peeling.draw` with its ``start``)."""
         texture = self._background(size, mipmaps)
         target.read_into(self._buffer, components=4, attachment=0, dtype="f4")
         texture.write(self._buffer, level=0)
@@ -239,10 +244,11 @@ class Transmission:
             The renderer's programs, of which 'pyramid' takes the `PyramidKey` program; ``fullscreen(program)`` its
             vertex array.
         peel : callable, optional
-            Where the scene has blended objects: ``peel(target, into)`` peels them against ``target``'s depth (the
-            opaque one) and composites them over the texture ``into`` (`glphong.gpu.peeling.Peeling.draw`), returning
-            its ``(layers, cut)`` (kept in `blend`); the background is then that composite (not made where ``need``
-            is 'none' and the method 'gpu': nothing reads it).
+            Where the scene has blended objects: ``peel(target, into)`` peels their layers behind the transmissive
+            surfaces' nearest depth and in front of ``target``'s (the opaque one) and composites them over the
+            texture ``into`` (`glphong.gpu.peeling.Peeling.draw` with ``start``), returning its ``(layers, cut)``
+            (kept in `blend`); the background is then that composite (not made where ``need`` is 'none' and the
+            method 'gpu': nothing reads it).
 
         Returns
         -------
