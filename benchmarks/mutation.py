@@ -618,7 +618,8 @@ MUTATIONS = [
       "transmission with blended surfaces: the background's peel starts at the front again (not behind the glass): "
       "a layer in front of the glass transmitted through it a second time"),
     M("transmission_blend.py:background-twin-from-front", "glphong/checks/transmission_blend.py",
-      "lambda gbuffer: shade(opaque, gbuffer), band, start)", "lambda gbuffer: shade(opaque, gbuffer), band, None)",
+      "lambda gbuffer: shade(scene, in_scene(scene, gbuffer)), band, start)",
+      "lambda gbuffer: shade(scene, in_scene(scene, gbuffer)), band, None)",
       "transmission with blended surfaces: the background's twin holds the layers in front of the glass too"),
     M("peeling.py:framebuffer-key-glo-alone", "glphong/gpu/peeling.py",
       "key = tuple(None if a is None else (type(a).__name__, a.glo) for a in (color, depth)) + (write,)",
@@ -748,6 +749,11 @@ MUTATIONS = [
     M("transmission_twin.py:behind-unshadowed", "glphong/checks/transmission_twin.py",
       "for i, v in enumerate(visibility or ()):", "for i, v in enumerate(()):",
       "shadows through glass: the lights behind the surface without their visibility at it"),
+    M("transmission_blend.py:background-layers-opaque-casters", "glphong/checks/transmission_blend.py",
+      "lambda gbuffer: shade(scene, in_scene(scene, gbuffer)), band, start)",
+      "lambda gbuffer: shade(opaque, gbuffer), band, start)",
+      "shadows through glass with blended surfaces: the background's layers twinned in the scene without its "
+      "transmissive objects (the glass's shadow on a layer behind it left out), not in the GPU's whole-scene maps"),
 ]
 del M
 

@@ -11,8 +11,10 @@ Independent checks, at pixels classified here by float64 segment tests against t
 glphong's): through clear glass (roughness 0, transmission 1, no ambient light) a floor point in the box's shadow
 shows 0 (the glass reflects a point light only along its mirror direction), a lit one the thin wall's closed form
 ``(1 - m) t (1 - F(n.v)) c B``, Schlick's ``F`` with ``f0 = ((ior - 1)/(ior + 1))^2``, ``B = k_d (n.l) P / (4 pi
-d^2)`` the Lambert floor under the point light.  Planted errors (the background unshadowed, the glass casting
-nothing into the background's maps, the lights behind unshadowed) fail `verify`.
+d^2)`` the Lambert floor under the point light; with a blended veil in front of the glass, ``a L_veil + (1 - a)`` times
+that, ``L_veil`` the Lambert veil's own.  A casting veil in front of the glass and one behind it (in its shadow) pass
+`verify`.  Planted errors (the background unshadowed, the glass casting nothing into the background's maps, the lights
+behind unshadowed, the veil behind shaded without the glass's shadow) fail `verify`.
 """
 import numpy as np
 import pytest
@@ -20,7 +22,7 @@ import trimesh
 
 import glphong
 from glphong import primitives
-from glphong.checks import transmission_twin, verify as verify_module
+from glphong.checks import transmission_blend, transmission_twin, verify as verify_module
 from glphong.checks.tolerances import BAND
 
 WIDTH, HEIGHT = 48, 40
@@ -64,11 +66,17 @@ def _segment_meets_box(p, q):
     return near <= far and far > 0.0 and near < 1.0
 
 
+def _square_at(p, q, centre, side):
+    """Where the segment ``p`` -> ``q`` meets the plane y = ``centre[1]`` inside the square (facing y) of ``side``
+    about ``centre`` (3,), None where it does not (float64)."""
+    if (p[1] - centre[1]) * (q[1] - centre[1]) >= 0.0:
+        return None
+    x = p + (centre[1] - p[1]) / (q[1] - p[1]) * (q - p)
+    return x if np.max(np.abs((x - centre)[[0, 2]])) < side / 2 else None
+
+
 def _segment_meets_glass(p, q):
-    t = (GLASS_Y - p[1]) / (q[1] - p[1])
-    x = p + t * (q - p)
-    half = GLASS_SIDE / 2
-    return 0.0 < t < 1.0 and abs(x[0]) < half and abs(x[2] - GLASS_CENTRE_Z) < half
+    return _square_at(p, q, np.array([0.0, GLASS_Y, GLASS_CENTRE_Z]), GLASS_SIDE) is not None
 
 
 def _classes(glass_points):
@@ -178,11 +186,66 @@ def test_the_lights_behind_take_the_visibility_at_the_glass(glphong_backend, glp
     assert not planted.passed and (planted.outside & planted.transmission.pixels).sum() >= 4, planted.summary()
 
 
-def test_shadows_with_blended_surfaces_too_are_refused(glphong_make_renderer):
-    renderer = glphong_make_renderer(WIDTH, HEIGHT, "egl")
+VEIL_SIDE, VEIL_ALPHA, VEIL_K_D = 0.6, 0.5, 0.5
+VEILS = {"in front": np.array([0.2, -1.4, 0.5]),  # between the camera and the glass, facing it (normal -y)
+         "behind": np.array([-0.35, -0.8, 0.55])}  # between the glass and the box, in the glass's shadow
+
+
+def _veil_scene(where):
+    """`_scene` plus a blended Lambert veil (alpha 0.5, casting shadows) in front of the glass or behind it."""
     scene = _scene()
-    scene.add(primitives.plane(0.5), glphong.Lambert(0.5, alpha_blend=glphong.AlphaBlend(0.5)),
-              pose=_pose((-0.8, 0.5, 0.3), FACING), name="veil")
-    renderer.render(scene)  # drawn; verify says what it does not twin
-    with pytest.raises(ValueError, match="shadows=True"):
-        glphong.verify(scene, renderer)
+    scene.add(primitives.plane(VEIL_SIDE), glphong.Lambert(VEIL_K_D, alpha_blend=glphong.AlphaBlend(VEIL_ALPHA)),
+              pose=_pose(VEILS[where], FACING), name="veil")
+    return scene
+
+
+@pytest.mark.parametrize("where", list(VEILS))
+def test_verify_twins_a_casting_veil_with_the_glass(where, glphong_backend, glphong_make_renderer):
+    renderer = glphong_make_renderer(WIDTH, HEIGHT, glphong_backend)
+    scene = _veil_scene(where)
+    report = glphong.verify(scene, renderer)
+    assert report.passed, report.summary()
+    # the veil's layer seen over the glass (in front) or through it (behind), on >= 100 glass pixels
+    gbuffer = renderer.gbuffer(scene)
+    seen = [(i, j) for i, j in zip(*np.nonzero(gbuffer.object_index == 2)) if _square_at(
+        EYE, EYE + 10.0 * (gbuffer.position[i, j] - EYE), VEILS[where], VEIL_SIDE) is not None]
+    assert len(seen) >= 100, len(seen)
+
+
+def test_a_veil_over_the_glass_is_its_closed_form(glphong_backend, glphong_make_renderer):
+    """At glass pixels whose view ray meets the veil in front and then a lit floor point (neither the box, the glass
+    nor the veil between it and the light): ``a L_veil + (1 - a) (1 - m) t (1 - F) c B``, the veil's ``L_veil = k_d
+    (n.l) P / (4 pi d^2)`` (nothing between it and the light)."""
+    renderer = glphong_make_renderer(WIDTH, HEIGHT, glphong_backend)
+    scene = _veil_scene("in front")
+    frame = renderer.render(scene)
+    gbuffer = renderer.gbuffer(scene)
+    glass = gbuffer.object_index == 2
+    classes = _classes({(i, j): gbuffer.position[i, j].astype(np.float64) for i, j in zip(*np.nonzero(glass))})
+    expected, got = [], []
+    for i, j in _inner(classes, "lit"):
+        x = gbuffer.position[i, j].astype(np.float64)
+        veil = _square_at(EYE, EYE + 10.0 * (x - EYE), VEILS["in front"], 0.9 * VEIL_SIDE)  # off its edges
+        floor = classes[i, j][1]
+        if veil is None or _square_at(floor, LIGHT, VEILS["in front"], 1.1 * VEIL_SIDE) is not None:
+            continue
+        to_light = LIGHT - veil
+        d = np.linalg.norm(to_light)
+        lit_veil = VEIL_K_D * (-to_light[1] / d) * POWER / (4.0 * np.pi * d * d)  # its normal -y
+        expected.append(VEIL_ALPHA * lit_veil + (1.0 - VEIL_ALPHA) * _thin_wall(x, floor))
+        got.append(frame.radiance[i, j])
+    assert len(expected) >= 50, len(expected)
+    np.testing.assert_allclose(np.array(got, np.float64), np.array(expected), rtol=1e-5)
+
+
+def test_a_veil_behind_shaded_without_the_glass_s_shadow_fails(monkeypatch, glphong_make_renderer):
+    """The veil behind the glass lies in the glass's shadow: its layer in the background twinned in `opaque_scene`
+    (the maps without the glass, as before) fails `verify` where the glass shows it."""
+    renderer = glphong_make_renderer(WIDTH, HEIGHT, "egl")
+    scene = _veil_scene("behind")
+    behind = verify_module.layers_behind
+    monkeypatch.setattr(transmission_blend, "in_scene", lambda whole, gbuffer: gbuffer)  # opaque_scene's indices
+    monkeypatch.setattr(verify_module, "layers_behind", lambda whole, renderer, shade, band: behind(
+        whole, renderer, lambda s, g: shade(transmission_twin.opaque_scene(s), g), band))
+    report = glphong.verify(scene, renderer)
+    assert not report.passed and (report.outside & report.transmission.pixels).sum() >= 50, report.summary()

@@ -119,15 +119,18 @@ def test_a_volume_sphere_lit_from_behind_verifies(extra, glphong_backend, glphon
 
 def test_shadowed_lights_behind_a_volume_take_the_visibility_at_the_surface(glphong_backend, glphong_make_renderer):
     """Shadowed point and directional lights behind a lone glass quad: nothing occludes them (the quad's own depth
-    in their maps, the visibility 1), so the frame equals the unshadowed one (verify refuses shadows beside a
-    transmissive object; this checks the shadowed loops' exit code compiles and keeps the light)."""
+    in their maps, the visibility 1), so the frame equals the unshadowed one, and verify (which twins the shadowed
+    lights behind a transmissive surface with the visibility at it: tests/test_transmission_shadows.py) passes."""
     camera = glphong.PerspectiveCamera.look_at((0.3, -0.4, 2.5), (0.0, 0.0, 0.0))
     frames = []
     for shadows in (False, True):
         scene = glphong.Scene(camera, [glphong.PointLight((0.2, 0.1, -0.6), 5.0, shadows=shadows),
                                        glphong.DirectionalLight((0.1, 0.2, 1.0), 1.5, shadows=shadows)])
         scene.add(primitives.plane(1.5), _glass(diffuse_transmission=0.3), name="glass")
-        frames.append(glphong_make_renderer(48, 40, glphong_backend).render(scene).radiance)
+        renderer = glphong_make_renderer(48, 40, glphong_backend)
+        frames.append(renderer.render(scene).radiance)
+        report = glphong.verify(scene, renderer)
+        assert report.passed, report.summary()
     lit = frames[0].max(axis=-1) > 0
     assert lit.sum() > 700
     np.testing.assert_allclose(frames[1][lit], frames[0][lit], rtol=1e-6, atol=1e-7 * frames[0].max())

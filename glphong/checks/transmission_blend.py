@@ -4,8 +4,9 @@ order the GPU draws it (`glphong.gpu.renderer.Renderer._draw`):
 1. the background: the blended layers composited over the scene without its transmissive objects
    (`glphong.checks.blend_twin.blend_twin` of `glphong.checks.transmission_twin.opaque_scene`), on each sample ray
    only those behind the nearest hit of a transmissive object where it lies in front of the opaque hit (`glass_start`,
-   the GPU's depth-only pass), all of them elsewhere: what the thin walls see (`layers_behind`, given to
-   `glphong.checks.transmission_twin.transmission_check`);
+   the GPU's depth-only pass), all of them elsewhere, each shaded in the whole scene (its shadow maps' casters, the
+   transmissive objects included: `glphong.checks.transmission_twin.in_scene`): what the thin walls see
+   (`layers_behind`, given to `glphong.checks.transmission_twin.transmission_check`);
 2. the frame twin of the whole scene's G-buffer (its nearest opaque or transmissive surface) plus what the
    transmissive surfaces transmit of that background, and its band (the shading band plus the transmission's);
 3. the blended layers nearer than that surface (a transmissive one occludes those behind it, which the background
@@ -23,6 +24,7 @@ import numpy as np
 
 from glphong.checks.blend_twin import blend_twin
 from glphong.checks.frame_twin import SAMPLE_OFFSETS, _hits, _world_triangles
+from glphong.checks.transmission_twin import in_scene
 from glphong.gpu.transmission import background_need, transmissive_objects
 
 __all__ = ["glass_start", "layers_behind", "frame_blend_twin"]
@@ -44,11 +46,12 @@ def glass_start(scene, width, height):
 def layers_behind(scene, renderer, shade, band):
     """``transmission_check``'s ``blend``: ``blend(opaque, (reference, low, high, covered))`` -> the `BlendTwin` of
     the blended layers of the scene ``opaque`` (``scene`` without its transmissive objects) behind the transmissive
-    surfaces of ``scene`` (`glass_start`) over that twin (``shade(scene, gbuffer)`` ->
-    `glphong.checks.verify.twin_and_band`'s four arrays)."""
+    surfaces of ``scene`` (`glass_start`) over that twin, each layer shaded in ``scene`` (``shade(scene,
+    in_scene(scene, gbuffer))`` -> `glphong.checks.verify.twin_and_band`'s four arrays): the GPU's background peel
+    draws them with the whole scene's shadow maps, whose casters include the transmissive objects."""
     start = glass_start(scene, *renderer._size)
     return lambda opaque, under: blend_twin(opaque, renderer._size, renderer.blend_layers, under,
-                                            lambda gbuffer: shade(opaque, gbuffer), band, start)
+                                            lambda gbuffer: shade(scene, in_scene(scene, gbuffer)), band, start)
 
 
 def frame_blend_twin(scene, renderer, frame, shade, band, transmission=None):

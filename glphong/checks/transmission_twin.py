@@ -309,14 +309,13 @@ def transmission_check(scene, renderer, gbuffer, shade, band=BAND, exact=None, b
     (`glphong.checks.transmission_blend`).  Where a light has ``shadows=True``, the GPU's maps hold every caster, the
     transmissive objects included (`glphong.gpu.renderer.Renderer._shadow_values`): the background's visibility is
     theirs (`in_scene`), and the lights behind the surface take the visibility at it (``renderer.shadow_settings``
-    to `transmission_twin`).
+    to `transmission_twin`); the blended layers of the background are shaded in the whole scene too (``blend``:
+    `glphong.checks.transmission_blend.layers_behind`).
 
     Raises
     ------
     ValueError
-        ``exact=True`` (the extended lights' exact integrals are not computed through a transmissive surface), or a
-        light with ``shadows=True`` in a scene with blended surfaces too (their layers in the background are twinned
-        in `opaque_scene`, without the transmissive casters).
+        ``exact=True`` (the extended lights' exact integrals are not computed through a transmissive surface).
     """
     obj = scene.objects[transmissive_objects(scene)[0]]
     name, used = obj.name, obj.material.extensions()
@@ -326,10 +325,6 @@ def transmission_check(scene, renderer, gbuffer, shade, band=BAND, exact=None, b
                          "extended lights with it (exact=True); the GPU is checked against the twin of the lights' "
                          "methods, behind the surface too (exact=False; their error: docs/transmission.md, Lights)")
     shadowed = any(getattr(light, "shadows", False) for light in scene.lights)
-    if shadowed and blend is not None:
-        raise ValueError(f"object {name!r} is transmissive ({named}), the scene has blended surfaces and a light has "
-                         "shadows=True: verify does not twin the blended layers of the background in the shadow maps "
-                         "of the whole scene yet (the render draws them)")
     opaque = opaque_scene(scene)
     opaque_gbuffer = renderer.gbuffer(opaque)
     shaded = shade(scene, in_scene(scene, opaque_gbuffer))  # the GPU's opaque pass: the whole scene's maps
