@@ -50,8 +50,9 @@ suite grew, so select with ``--only``.  ``--timeout`` (default 900 s) bounds eac
 **Verdicts.**  pytest's exit code decides:
 
 - 1 (tests failed or errored): *caught*; the first ``FAILED``/``ERROR`` node id is reported;
-- 2 (interrupted, usually a collection error such as an import that no longer works): counted
-  as caught, shown as ``caught (collection error)``;
+- 2 (interrupted): *caught* where a test failed first (pytest-xdist ends a ``-x`` run that way
+  after the first ``FAILED``), else a collection error such as an import that no longer works:
+  counted as caught, shown as ``caught (collection error)``;
 - 0 (all passed): *MISSED*;
 - anything else (3 internal error, 4 usage error, 5 no tests collected, a timeout, a signal):
   *error*: the run said nothing about the mutation; the tail of its output is printed.
@@ -614,7 +615,7 @@ MUTATIONS = [
       "cut=over.cut | (behind.cut if read else False),", "cut=over.cut,",
       "transmission with blended surfaces: the twin's cut without the background peel's"),
     M("renderer.py:transmission-background-peel-from-front", "glphong/gpu/renderer.py",
-      "self._fullscreen, into, into and (lambda depth: layers(TRANSMIT_DEPTH, depth)))", "self._fullscreen, into, None)",
+      "None if into is None else (lambda depth: layers(TRANSMIT_DEPTH, depth)))", "None)",
       "transmission with blended surfaces: the background's peel starts at the front again (not behind the glass): "
       "a layer in front of the glass transmitted through it a second time"),
     M("transmission_blend.py:background-twin-from-front", "glphong/checks/transmission_blend.py",
@@ -642,8 +643,12 @@ MUTATIONS = [
       "return vec3(1.0);",
       "KHR_materials_volume with _diffuse_transmission: the diffusely transmitted light not attenuated"),
     M("generated.py:volume-light-not-moved", "glphong/shaders/generated.py",
-      "_incident(position + {through}_exit, {j},", "_incident(position, {j},",
+      "{incident(f'position + {through}_exit', wi, e)}", "{incident('position', wi, e)}",
       "KHR_materials_volume: a light behind a volume seen from the surface, not from the exit point"),
+    M("generated.py:volume-light-unshadowed", "glphong/shaders/generated.py",
+      'lines += [f"{pad}{e} *= visibility;"] if shadowed else []', "",
+      "KHR_materials_volume: a shadowed light behind a volume, seen from the exit point, without the visibility at "
+      "the surface"),
     # KHR_materials_transmission, _volume, _dispersion (glsl/transmission_thin.glsl, glphong/materials/
     # gltf_transmission.py): for tests/test_transmission.py (planted in GLSL and twin at once: the closed forms)
     M("gltf_pbr.glsl+gltf_pbr.py:transmission-diffuse", "glsl/materials/gltf_pbr.glsl",
@@ -734,9 +739,10 @@ MUTATIONS = [
     # area and environment lights behind a transmissive surface (glphong/shaders/generated.py _extended_loop, its twin
     # glphong/checks/transmission_extended.py): for tests/test_transmission_extended.py
     M("generated.py:extended-behind-gate", "glphong/shaders/generated.py",
-      'f"            reflected += ({valid} && {n_dot_l} < 0.0) ? {through} : vec3(0.0);"',
-      'f"            reflected += ({valid} && {n_dot_l} > 0.0) ? {through} : vec3(0.0);"',
-      "extended lights behind a transmissive surface: the samples' gate flipped to n.wi > 0 (GPU only)"),
+      'f"{pad}{total} += ({gate}{valid} && {n_dot_l} < 0.0) ? {through} : vec3(0.0);"',
+      'f"{pad}{total} += ({gate}{valid} && {n_dot_l} > 0.0) ? {through} : vec3(0.0);"',
+      "lights behind a transmissive surface: the gate flipped to n.wi > 0, in the punctual loops and the extended "
+      "kinds' samples (GPU only)"),
     M("transmission_extended.py:last-sample-dropped", "glphong/checks/transmission_extended.py",
       "            for k in range(count):", "            for k in range(count - 1):",
       "extended lights behind a transmissive surface: the twin leaves out each light's last weighted direction"),
@@ -894,12 +900,13 @@ def run_suite(copy, timeout, extra):
     return code, output, time.monotonic() - start
 
 
-def verdict(code):
-    """Result text for a pytest exit code (None: timed out)."""
+def verdict(code, output=""):
+    """Result text for a pytest exit code (None: timed out) and its ``-rfE`` output (a run that xdist stopped after a
+    failed test under ``-x`` exits 2 too, with the test's ``FAILED`` line)."""
     if code == 1:
         return "caught"
     if code == 2:
-        return "caught (collection error)"
+        return "caught" if re.search(r"(?m)^FAILED ", output) else "caught (collection error)"
     if code == 0:
         return "MISSED"
     return "error (timeout)" if code is None else f"error (exit {code})"
@@ -925,8 +932,8 @@ def markdown(rows):
     missed = sum(r == "MISSED" for _, r, _, _ in rows)
     errors = len(rows) - caught - missed
     out += ["", f"caught {caught} of {len(rows)} ({missed} missed, {errors} errors)"]
-    out += ["", "caught: a test failed (pytest exit 1); caught (collection error): pytest exit 2, counted as "
-                "caught; MISSED: every test passed (exit 0); error: timeout or exit 3, 4 or 5, the run said "
+    out += ["", "caught: a test failed (pytest exit 1, or 2 when xdist stopped the run after it); caught (collection "
+                "error): pytest exit 2 with no failed test, counted as caught; MISSED: every test passed (exit 0); error: timeout or exit 3, 4 or 5, the run said "
                 "nothing about the mutation."]
     return "\n".join(out) + "\n"
 
@@ -990,7 +997,7 @@ def main(argv=None):
                 code, output, seconds = run_suite(copy, args.timeout, extra)
             finally:
                 shutil.rmtree(copy, ignore_errors=True)
-            result = verdict(code)
+            result = verdict(code, output)
             test = first_failure(output) if code in (1, 2) else ""
             rows.append((m, result, test, seconds))
             print(f"[{i}/{len(chosen)}] {m.name:<{width}}  {result:<9}  {test or '-'}  ({seconds:.0f} s)", flush=True)

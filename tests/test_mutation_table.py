@@ -25,3 +25,12 @@ def test_a_stale_entry_is_named():
     stale = mutation.Mutation("stale", "glsl/common.glsl", "text that is in no chunk", "other text", "a stale entry")
     (found,) = mutation.problems([stale], ROOT)
     assert "stale" in found and "occurs 0 times" in found
+
+
+def test_a_run_stopped_after_a_failed_test_is_caught_not_a_collection_error():
+    """pytest-xdist ends a ``-x`` run with exit 2 after the first failure: that is a caught mutation; exit 2 without a
+    failed test is a collection error (still counted as caught, and said so)."""
+    verdict = _mutation_module().verdict
+    assert verdict(1) == "caught" and verdict(0) == "MISSED" and verdict(None) == "error (timeout)"
+    assert verdict(2, "FAILED tests/test_x.py::test_y - AssertionError\n!!! xdist.dsession.Interrupted") == "caught"
+    assert verdict(2, "ERROR tests/test_x.py - ImportError: no module\n!!! Interrupted") == "caught (collection error)"

@@ -104,8 +104,9 @@ def test_blended_and_transmissive_quads_are_the_closed_form(quad_z, glphong_back
 
 
 def test_a_scene_with_either_alone_draws_as_before(glphong_make_renderer):
-    """The decal fully transparent or the glass fully opaque changes nothing of the other's path: the frame equals the
-    frame of the scene without the other object, bit for bit."""
+    """Where only one of the two covers a pixel, the frame of both is that one's own frame, bit for bit: outside the
+    glass the scene without the glass (the peel's composite alone), outside the decal the scene without the decal
+    (drawn without a background peel: nothing blended in it)."""
     renderer = glphong_make_renderer(WIDTH, HEIGHT, "egl")
     scene = _scene(0.25)
     without_decal = glphong.Scene(scene.camera, scene.lights)

@@ -162,22 +162,28 @@ def test_a_background_without_the_whole_scene_s_shadows_fails(planted, monkeypat
     assert not report.passed and (report.outside & report.transmission.pixels).sum() >= 4, report.summary()
 
 
-def _behind_scene():
+def _behind_scene(thickness=0.0):
     """A glass quad (roughness 0.3) between the camera and a point light behind it, nearly on the line of sight, a small
-    box between the light and the glass casting its shadow on the glass; a floor below."""
+    box between the light and the glass casting its shadow on the glass; a floor below.  ``thickness`` > 0: a volume
+    (KHR_materials_volume), whose light behind is taken from the exit point, with the visibility at the glass."""
     camera = glphong.PerspectiveCamera.look_at((0.0, -3.0, 0.5), (0.0, 0.0, 0.5), up=(0.0, 0.0, 1.0), yfov=0.8)
     scene = glphong.Scene(camera, [glphong.PointLight((0.0, 1.5, 0.7), 20.0, shadows=True)])
     scene.add(primitives.plane(6.0), glphong.Lambert(K_D), name="floor")
     scene.add(trimesh.creation.box((0.2, 0.2, 0.2)), glphong.Lambert(0.5), pose=_pose((0.05, 0.3, 0.65)),
               smooth=False, name="blocker")
-    scene.add(primitives.plane(GLASS_SIDE), glphong.GltfPBR(C, 0.0, 0.3, ior=IOR, transmission=1.0),
+    volume = dict(thickness=thickness, attenuation_color=(0.9, 0.7, 0.5), attenuation_distance=0.5) if thickness else {}
+    scene.add(primitives.plane(GLASS_SIDE), glphong.GltfPBR(C, 0.0, 0.3, ior=IOR, transmission=1.0, **volume),
               pose=_pose((0.0, GLASS_Y, 0.6), FACING), name="glass")
     return scene
 
 
-def test_the_lights_behind_take_the_visibility_at_the_glass(glphong_backend, glphong_make_renderer, monkeypatch):
+@pytest.mark.parametrize("thickness", [0.0, 0.05], ids=["thin", "volume"])
+def test_the_lights_behind_take_the_visibility_at_the_glass(thickness, glphong_backend, glphong_make_renderer,
+                                                            monkeypatch):
+    """The blocker's shadow on the glass darkens the light behind it (thin, and seen from a volume's exit point): the
+    twin with the visibility passes, the twin without it fails where the shadow falls."""
     renderer = glphong_make_renderer(WIDTH, HEIGHT, glphong_backend)
-    scene = _behind_scene()
+    scene = _behind_scene(thickness)
     report = glphong.verify(scene, renderer)
     assert report.passed, report.summary()
     visible = transmission_twin._visible

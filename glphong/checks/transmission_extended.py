@@ -9,7 +9,7 @@ KHR_materials_diffuse_transmission's)::
 
 The kinds' samples do not depend on the normal (the area kinds' points on the light, the environment's fixed
 directions over the whole sphere), so those behind the surface are the back hemisphere's.  Each direction is twinned
-as a punctual light behind the surface (``transmission_twin._lights_behind``), its irradiance's interval the kind's
+as a punctual light behind the surface (`glphong.checks.transmission_lights._lights_behind`), its irradiance's interval the kind's
 ``sample_band``; a light's sum of ``m`` directions is widened by ``(1 +- m eps)``, as
 `glphong.checks.tolerances.extended_band` widens the reflected part.
 """

@@ -268,7 +268,7 @@ class Renderer:
         names = requested_passes(passes, depth, normals)
         check_passes(scene, names, next_scene, previous_scene)
         check_blend_options(self, scene)
-        check_transmission_options(self, scene, "radiance" in names)
+        check_transmission_options(self, scene)
         geometry = [n for n in names if n not in ("radiance", "matte")]
         extra = self._draw_matte(scene) if "matte" in names else {}
         if geometry and "radiance" in names and self.samples == 1 and self.supersample == 1 \
@@ -504,7 +504,8 @@ class Renderer:
             layers = lambda kind, depth: draw_objects(  # noqa: E731 - (into: those behind the glass alone, start)
                 self, scene, output, {"u_blend_depth": depth}, shadow_values, blend=kind)
             return peeling.draw(target, target.size, layers, self.blend_layers, self.programs.get(CompositeKey()),
-                                self._fullscreen, into, into and (lambda depth: layers(TRANSMIT_DEPTH, depth)))
+                                self._fullscreen, into,
+                                None if into is None else (lambda depth: layers(TRANSMIT_DEPTH, depth)))
         behind = None
         if output == "radiance" and transmissive_objects(scene):  # over the opaque scene (glphong.gpu.transmission)
             transmission = self._targets.get(TARGET_KEY) or self._targets.setdefault(TARGET_KEY, Transmission(self._mgl))

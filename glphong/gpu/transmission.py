@@ -66,10 +66,10 @@ def drawn_in(obj, blend, output):
     return bool(blend) or output != "radiance" or not transmissive(obj.material)
 
 
-def check_transmission_options(renderer, scene, radiance=True):
-    """ValueError naming the option where ``renderer`` cannot draw the transmissive objects of ``scene`` (``radiance``,
-    whether the frame draws the radiance, limits nothing any more: every kind of light is transmitted, an extended one
-    through its weighted directions behind the surface, `glphong.shaders.generated`)."""
+def check_transmission_options(renderer, scene):
+    """ValueError naming the option where ``renderer`` cannot draw the transmissive objects of ``scene`` (every kind of
+    light is transmitted, an extended one through its weighted directions behind the surface,
+    `glphong.shaders.generated`)."""
     chosen = transmissive_objects(scene)
     if not chosen:
         return

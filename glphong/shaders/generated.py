@@ -141,18 +141,8 @@ def lights_chunk(key):
         body = ["        n_dot_l = dot(f.n, wi);",
                 "        vec3 term = light_term(material_response(f, wi, wo, n_dot_l), irradiance);",
                 "        radiance += (lit && valid && n_dot_l > 0.0) ? term : vec3(0.0);"]
-        for name, through in behind:
-            exit, attenuation = exits.get(through, (None, None))
-            if exit:
-                body.append(f"        {through}_valid = {kind}_incident(position + {through}_exit, {j}, {through}_wi, "
-                            f"{through}_irradiance);")
-                body += [f"        {through}_irradiance *= visibility;"] if shadow else []
-                body.append(f"        {through}_n_dot_l = dot(f.n, {through}_wi);")
-            wi, e, n_dot_l, valid = (f"{through}_{v}" if exit else v for v in ("wi", "irradiance", "n_dot_l", "valid"))
-            scaled = f" * {through}_attenuation" if attenuation else ""
-            body += [f"        vec3 {through} = light_term({name}(f, {wi}, wo, -{n_dot_l}), {e}){scaled};",
-                     f"        radiance += (lit && {valid} && {n_dot_l} < 0.0) ? {through} : vec3(0.0);"]
-        return body
+        return body + _behind_lines(behind, exits, lambda at, wi, e: f"{kind}_incident({at}, {j}, {wi}, {e})",
+                                    "        ", "radiance", "lit && ", bool(shadow))
 
     for light in key.lights:
         if light.extended:
@@ -269,18 +259,33 @@ def _extended_loop(key, light):
                       "            reflected += (valid && n_dot_l > 0.0) ? term : vec3(0.0);"]
         if behind:
             lines.append("            // behind the surface (n.wi < 0): what each response transmits of the direction")
-        exits = _behind_exits(key)  # a volume: the direction seen from the exit point, attenuated (lights_chunk's)
-        for name, through in behind:
-            exit, attenuation = exits.get(through, (None, None))
-            wi, e, n_dot_l, valid = (f"{through}_{v}" if exit else v for v in ("wi", "irradiance", "n_dot_l", "valid"))
-            if exit:
-                lines += [f"            {valid} = {light.name}_sample(position + {through}_exit, f.n, j, k, {wi}, "
-                          f"{e});", f"            {n_dot_l} = dot(f.n, {wi});"]
-            scaled = f" * {through}_attenuation" if attenuation else ""
-            lines += [f"            vec3 {through} = light_term({name}(f, {wi}, wo, -{n_dot_l}), {e}){scaled};",
-                      f"            reflected += ({valid} && {n_dot_l} < 0.0) ? {through} : vec3(0.0);"]
+        # a volume: the direction seen from the exit point, attenuated (as lights_chunk's)
+        lines += _behind_lines(behind, _behind_exits(key), lambda at, wi, e: f"{light.name}_sample({at}, f.n, j, k, "
+                               f"{wi}, {e})", "            ", "reflected", "", False)
         lines.append("        }")
     return lines + ["        radiance += lit ? reflected : vec3(0.0);", "    }"]
+
+
+def _behind_lines(behind, exits, incident, pad, total, gate, shadowed):
+    """The GLSL lines that add each response to a light behind the surface (`_behind`) to ``total``, for one light
+    direction ``wi`` (irradiance ``irradiance``, ``n_dot_l``, ``valid``) of a punctual loop or an extended kind's
+    sample loop: ``total += (<gate>valid && n.wi < 0) ? light_term(<response>(f, wi, wo, -n.wi), E) : 0``.  A
+    response with an exit (`_behind_exits`: a volume) takes the light again from ``position + <through>_exit``
+    (``incident(at, wi, e)``: the kind's own call there; ``shadowed``: its irradiance times the ``visibility`` at
+    ``position``), gated on its own ``n.wi' < 0``; one with an attenuation is multiplied by it.  ``pad``: the
+    lines' indentation."""
+    lines = []
+    for name, through in behind:
+        exit, attenuation = exits.get(through, (None, None))
+        wi, e, n_dot_l, valid = (f"{through}_{v}" if exit else v for v in ("wi", "irradiance", "n_dot_l", "valid"))
+        if exit:
+            lines.append(f"{pad}{valid} = {incident(f'position + {through}_exit', wi, e)};")
+            lines += [f"{pad}{e} *= visibility;"] if shadowed else []
+            lines.append(f"{pad}{n_dot_l} = dot(f.n, {wi});")
+        scaled = f" * {through}_attenuation" if attenuation else ""
+        lines += [f"{pad}vec3 {through} = light_term({name}(f, {wi}, wo, -{n_dot_l}), {e}){scaled};",
+                  f"{pad}{total} += ({gate}{valid} && {n_dot_l} < 0.0) ? {through} : vec3(0.0);"]
+    return lines
 
 
 def lod_chunk(key):
