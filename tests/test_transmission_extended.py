@@ -9,13 +9,16 @@ exactly and the diffuse BTDF is ``c_dt / pi``; a RectLight below it shines on it
 16) / d_k^2`` toward each cell's centre (written out here), and the exact integral is ``(c_dt / pi) E_back`` with
 ``E_back`` the irradiance of the rectangle at the normal ``-n`` by Lambert's polygon formula (written out here).
 """
+import dataclasses
+
 import numpy as np
 import pytest
 
 import glphong
 from glphong import primitives
+from glphong.definitions.material import Integral
 from glphong.shaders import keys
-from glphong.shaders.builders import program_key
+from glphong.shaders.builders import _as_light_keys, _with_usage, program_key, term_keys
 from glphong.shaders.generated import lights_chunk
 
 SIZE = 24  # px; the view spans [-1, 1] m
@@ -178,3 +181,16 @@ def test_verify_refuses_the_exact_integrals_naming_the_extension(glphong_make_re
         glphong.verify(scene, renderer, exact=True)
     report = glphong.verify(scene, renderer)
     assert report.passed and report.exact is None, report.summary()
+
+
+def test_a_light_behind_declares_the_kind_s_samples_whatever_the_terms_closed_forms():
+    """The extended loop samples the kind for the light behind the surface even where every lit term reflects it in
+    closed form (a model of the open mechanism may declare ``behind_responses`` and an ``Integral``): the key then
+    asks the kind for its samples' defines too, or the generated ``<kind>_sample`` call would not compile."""
+    glass = glphong.GltfPBR(0.5, 0.0, 0.4, transmission=1.0)
+    (light,) = _as_light_keys([glphong.EnvironmentLight(np.ones((4, 8)))])
+    terms = term_keys(glass, True, False, extended=True, occludable=True)
+    closed = tuple(dataclasses.replace(t, integral=Integral("irradiance", "base_color")) for t in terms)
+    assert all(t.integral.form in light.integrals for t in closed if t.lit)  # every lit term closed, as planted
+    without, with_behind = (dict(_with_usage(light, closed, behind).defines) for behind in (False, True))
+    assert "USES_SAMPLE" not in without and with_behind["USES_SAMPLE"] == "1"

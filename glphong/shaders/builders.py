@@ -5,6 +5,7 @@ from dataclasses import replace
 
 from glphong.definitions.light import light_for_key, registered_lights
 from glphong.definitions.material import registered_models
+from glphong.shaders.generated import terms_behind
 from glphong.shaders.keys import LightKey, ProgramKey, TermKey
 from glphong.shaders.options import MAX_TEXTURED_INPUTS, UBER_MAX_LIGHTS
 
@@ -118,7 +119,8 @@ def program_key(material, lights, ambient_radiance, output="radiance", gbuffer_n
         any(not t.vanishes() for t in material.components)
     terms = term_keys(material, lit, _ambient_present(ambient_radiance), extended=any(k.extended for k in lights),
                       occludable=any(k.occludable for k in lights))
-    lights = tuple(_with_usage(k, terms) if k.extended else k for k in lights)
+    behind = output == "radiance" and bool(terms_behind(terms))  # lights behind the surface: the kinds' samples
+    lights = tuple(_with_usage(k, terms, behind) if k.extended else k for k in lights)
     needs = {n for t in terms if t.lit for n in t.needs}
     modes = [mode for t in terms for _, mode in t.inputs]
     normal_map = lit and material.normal_map is not None
@@ -152,13 +154,15 @@ def _sees_through(material):
     return callable(extensions) and "transmission" in extensions()
 
 
-def _with_usage(light, terms):
+def _with_usage(light, terms, behind=False):
     """An extended kind's `LightKey` with the defines its kind adds for what the program's lit ``terms`` use of it
-    (`glphong.lights.LightModel.usage_defines`: its closed forms 'irradiance' and 'lobe', its samples 'sample')."""
+    (`glphong.lights.LightModel.usage_defines`: its closed forms 'irradiance' and 'lobe', its samples 'sample');
+    ``behind``: the program adds what the kind sends through the surface from behind, over its samples whatever the
+    terms' closed forms (`glphong.shaders.generated`'s extended loop)."""
     lit = [t for t in terms if t.lit]
     closed = {t.integral.form for t in lit if t.integral is not None and t.integral.form in light.integrals}
-    uses = tuple(sorted(closed)) + (("sample",) if any(t.integral is None or t.integral.form not in light.integrals
-                                                       for t in lit) else ())
+    uses = tuple(sorted(closed)) + (("sample",) if behind or any(
+        t.integral is None or t.integral.form not in light.integrals for t in lit) else ())
     extra = tuple(light_for_key(light.name, light.source_hash).usage_defines(light.defines, uses))
     return replace(light, defines=light.defines + extra) if extra else light
 

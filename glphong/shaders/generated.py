@@ -9,7 +9,7 @@ import numpy as np
 from glphong.definitions.registry import model_named, model_source
 
 __all__ = ["MATERIAL_CHUNK", "LIGHTS_CHUNK", "LOD_CHUNK", "material_chunk", "lights_chunk", "lod_chunk", "transmits",
-           "model_chunk_label"]
+           "terms_behind", "model_chunk_label"]
 
 #: the label of the generated material chunk
 MATERIAL_CHUNK = "generated:material"
@@ -187,7 +187,14 @@ def _behind(key):
     glsl/materials/gltf_pbr.glsl)."""
     if key.output != "radiance" or key.shade_per_vertex or key.alpha_blend:
         return []
-    return [(name, through) for t in key.terms for define, name, through in model_named(t.name).behind_responses
+    return terms_behind(key.terms)
+
+
+def terms_behind(terms):
+    """``(function, variable)`` of each response to a light behind the surface that ``terms`` (`TermKey`) declare:
+    their models' ``behind_responses`` under the structural defines the terms carry (`_behind` is a radiance
+    program's; `glphong.shaders.builders` asks it before the key is made, for the extended kinds' samples)."""
+    return [(name, through) for t in terms for define, name, through in model_named(t.name).behind_responses
             if (define, "1") in t.defines]
 
 
