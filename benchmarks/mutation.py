@@ -645,6 +645,13 @@ MUTATIONS = [
     M("generated.py:volume-light-not-moved", "glphong/shaders/generated.py",
       "{incident(f'position + {through}_exit', wi, e)}", "{incident('position', wi, e)}",
       "KHR_materials_volume: a light behind a volume seen from the surface, not from the exit point"),
+    M("frame_twin.py:one-sided-glass-back-faces-kept", "glphong/checks/frame_twin.py",
+      "    return cull[owner] & ((det > 0.0) == mirrored[owner])", "    return cull[owner] & False",
+      "one-sided glass: the twins keep its back faces, which the GPU culls"),
+    M("drawing.py:one-sided-glass-in-the-gbuffer", "glphong/gpu/drawing.py",
+      'if blend or (output == "gbuffer" and one_sided_transmissive(scene.objects[entry.index].material)):',
+      "if blend:",
+      "one-sided glass: its back faces drawn in the G-buffer, which the transmission pass culls"),
     M("generated.py:volume-light-unshadowed", "glphong/shaders/generated.py",
       'lines += [f"{pad}{e} *= visibility;"] if shadowed else []', "",
       "KHR_materials_volume: a shadowed light behind a volume, seen from the exit point, without the visibility at "

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from glphong.checks.frame_twin import (SAME_POINT, SAMPLE_OFFSETS, PixelHits, _fill, _hits, _normal, _per_vertex,
-                                       _world_triangles, depth_tie)
+                                       _world_triangles, culled_back_faces, depth_tie)
 from glphong.checks.tolerances import BAND
 from glphong.definitions.surface import surface_texture_band
 from glphong.gpu.frame import GBuffer
@@ -88,6 +88,7 @@ def blend_hits(scene, width, height, offsets=SAMPLE_OFFSETS, start=None):
     obj = owner[tri]
     front = (det > 0.0) != mirrored[obj]
     keep = ~is_blend[obj] | front | two_sided[obj]  # a one-sided blended material's back faces are culled
+    keep &= ~culled_back_faces(scene, obj, det)  # and a one-sided transmissive one's
     same = np.r_[False, (ray[1:] == ray[:-1]) & (obj[1:] == obj[:-1]) & (t[1:] - t[:-1] <= SAME_POINT * t[:-1])]
     keep &= ~same
     ray, t, tri, u, v, det, depth, obj = (a[keep] for a in (ray, t, tri, u, v, det, depth, obj))

@@ -65,6 +65,7 @@ import numpy as np
 from glphong.core import validate as _validate
 from glphong.gpu.matte import drawn_objects
 from glphong.gpu.passes import check_corresponds
+from glphong.gpu.transmission import one_sided_transmissive
 from glphong.twin.band import EPS
 from glphong.twin.functions import dot, safe_normalize
 from glphong.checks.raycast import T_MIN
@@ -201,6 +202,17 @@ def _world_triangles(scene, drawn):
     return np.concatenate(corners), np.concatenate(owner), np.concatenate(local)
 
 
+def culled_back_faces(scene, owner, det):
+    """Whether each hit is a back face the GPU culls, (M,) bool: a one-sided transmissive object's
+    (`glphong.gpu.transmission.one_sided_transmissive`: its transmission pass and its G-buffer cull them, as a
+    blended one's).  ``owner`` (M,) the hits' object indices, ``det`` (M,) their Moller-Trumbore determinants (> 0:
+    the counter-clockwise side, reversed by a mirroring pose)."""
+    objects = scene.objects
+    cull = np.array([one_sided_transmissive(obj.material) for obj in objects] + [False])
+    mirrored = np.array([obj.mirrored for obj in objects] + [False])
+    return cull[owner] & ((det > 0.0) == mirrored[owner])
+
+
 def _pixel_boxes(camera, width, height, corners):
     """Inclusive pixel ranges ``(i0, i1, j0, j1)``, each (F,) int64, that may hold a triangle's samples (see the
     module); ``i1 < i0`` or ``j1 < j0`` where none."""
@@ -335,8 +347,9 @@ def cast_pixels(scene, width, height, offsets=SAMPLE_OFFSETS):
     camera = scene.camera
     corners, owner, local = _world_triangles(scene, _drawn_objects(scene))
     (ray, t, tri, u, v, det, depth), (o, d) = _hits(camera, width, height, offsets, corners)
-    order = np.lexsort((t, ray))
-    ray, t, tri, u, v, det, depth = (a[order] for a in (ray, t, tri, u, v, det, depth))
+    drawn = ~culled_back_faces(scene, owner[tri], det)
+    order = np.lexsort((t[drawn], ray[drawn]))
+    ray, t, tri, u, v, det, depth = (a[drawn][order] for a in (ray, t, tri, u, v, det, depth))
     first, second = _nearest_and_tie(camera, ray, t, owner[tri], depth)
     mirrored = np.array([obj.mirrored for obj in scene.objects] + [False])
     shape = (len(offsets), height, width)

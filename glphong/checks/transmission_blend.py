@@ -23,7 +23,7 @@ import dataclasses
 import numpy as np
 
 from glphong.checks.blend_twin import blend_twin
-from glphong.checks.frame_twin import SAMPLE_OFFSETS, _hits, _world_triangles
+from glphong.checks.frame_twin import SAMPLE_OFFSETS, _hits, _world_triangles, culled_back_faces
 from glphong.checks.transmission_twin import in_scene
 from glphong.gpu.transmission import background_need, transmissive_objects
 
@@ -32,10 +32,13 @@ __all__ = ["glass_start", "layers_behind", "frame_blend_twin"]
 
 def glass_start(scene, width, height):
     """The nearest hit of the transmissive objects of ``scene`` on every sample ray of a ``width`` x ``height`` frame
-    (`glphong.checks.frame_twin.SAMPLE_OFFSETS`, both faces): ``(t, depth)``, each (S, H, W) float64, the ray
-    parameter and the view depth [m], inf where none (`glphong.checks.blend_twin.blend_hits`'s ``start``)."""
-    corners = _world_triangles(scene, transmissive_objects(scene))[0]
-    (ray, t, _, _, _, _, depth), _ = _hits(scene.camera, width, height, SAMPLE_OFFSETS, corners)
+    (`glphong.checks.frame_twin.SAMPLE_OFFSETS`; a one-sided material's front faces only, as its transmissive draw
+    culls the back ones, `glphong.gpu.drawing`): ``(t, depth)``, each (S, H, W) float64, the ray parameter and the
+    view depth [m], inf where none (`glphong.checks.blend_twin.blend_hits`'s ``start``)."""
+    corners, owner, _ = _world_triangles(scene, transmissive_objects(scene))
+    (ray, t, tri, _, _, det, depth), _ = _hits(scene.camera, width, height, SAMPLE_OFFSETS, corners)
+    keep = ~culled_back_faces(scene, owner[tri], det)
+    ray, t, depth = ray[keep], t[keep], depth[keep]
     shape = (len(SAMPLE_OFFSETS), height, width)
     nearest_t, nearest_depth = np.full(shape, np.inf), np.full(shape, np.inf)
     np.minimum.at(nearest_t.reshape(-1), ray, t)

@@ -11,7 +11,7 @@ import numpy as np
 
 from glphong.gpu.peeling import blend_key
 from glphong.gpu.resources import ObjectEntry
-from glphong.gpu.transmission import drawn_in
+from glphong.gpu.transmission import drawn_in, one_sided_transmissive
 from glphong.gpu.view_cull import MIN_TRIANGLES, box_inside, visible_triangles
 from glphong.scene.culling import closed_outward, view_allows_culling, world_sphere
 from glphong.shaders.binding import binding
@@ -25,7 +25,9 @@ def draw_objects(renderer, scene, output, frame_values=None, shadow_values=None,
 
     Opaque objects (``blend=0``): back faces culled where they cannot be seen (`glphong.scene.culling`).  Blended
     ones: back faces culled where the material is one-sided (glTF's ``doubleSided: false``), drawn where it is
-    two-sided (a transparent closed mesh shows its far side through its near one)."""
+    two-sided (a transparent closed mesh shows its far side through its near one).  Transmissive ones are drawn so
+    in the radiance's transmission pass, and in the G-buffer too (what the radiance shaded: a one-sided glass seen
+    from behind is not there, and the surface behind it is)."""
     mgl = renderer._mgl
     camera = scene.camera
     eye = tuple(camera.pose[:3, 3])
@@ -40,7 +42,7 @@ def draw_objects(renderer, scene, output, frame_values=None, shadow_values=None,
         if entry.mirrored != mirrored:  # a mirroring pose (det < 0) reverses the winding
             mirrored = entry.mirrored
             mgl.front_face = "cw" if mirrored else "ccw"
-        if blend:
+        if blend or (output == "gbuffer" and one_sided_transmissive(scene.objects[entry.index].material)):
             cull = not scene.objects[entry.index].material.two_sided
         else:
             cull = entry.sphere is not None and view_allows_culling(*entry.sphere, eye, forward, near, far)

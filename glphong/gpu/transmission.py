@@ -38,8 +38,8 @@ from glphong.gpu.shadows import ShadowMap
 from glphong.materials.gltf_transmission import background_levels, gltf_transmission_lod, transmissive
 from glphong.shaders.keys import EncodeKey
 
-__all__ = ["TRANSMIT", "TRANSMIT_DEPTH", "transmissive_objects", "drawn_in", "check_transmission_options",
-           "background_need", "PyramidKey", "Transmission", "TARGET_KEY"]
+__all__ = ["TRANSMIT", "TRANSMIT_DEPTH", "transmissive_objects", "drawn_in", "one_sided_transmissive",
+           "check_transmission_options", "background_need", "PyramidKey", "Transmission", "TARGET_KEY"]
 
 #: `glphong.gpu.drawing.draw_list`'s selector of the transmissive objects (0 the others, 1 and 2 blended layers)
 TRANSMIT = 4
@@ -64,6 +64,13 @@ def drawn_in(obj, blend, output):
     if blended(obj) != bool(blend):
         return False
     return bool(blend) or output != "radiance" or not transmissive(obj.material)
+
+
+def one_sided_transmissive(material):
+    """Whether ``material`` is transmissive and one-sided (glTF's ``doubleSided: false``): its back faces are culled in
+    the transmission pass, as a blended one's (`glphong.gpu.drawing`), and so in the G-buffer the radiance's twin
+    reads."""
+    return transmissive(material) and not material.two_sided
 
 
 def check_transmission_options(renderer, scene):
