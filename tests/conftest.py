@@ -144,6 +144,7 @@ def pyrender_check():
 #: alone at the end of the run (longest first is the classic schedule for parallel workers); the rest keep their order
 LONG_FIRST = (
     "tests/test_docs.py::test_the_site_builds",
+    "tests/test_soak.py::test_frames_with_a_new_scene_each_grow_nothing",
     "tests/test_docs.py::test_docs_python_block_runs[measured_brdfs.md",
     "tests/test_custom_material_example.py::test_its_stability_cases_run_from_the_command_line",
     "tests/lights/test_light_mechanism.py::test_cli_stability_imports_a_light_kind",
