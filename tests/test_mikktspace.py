@@ -32,6 +32,8 @@ import PIL.Image
 import pytest
 
 import glphong
+from glphong.filesafety import Limits, SceneFileError
+from glphong.formats.gltf_data import MIKKTSPACE_BYTES_PER_TRIANGLE
 from glphong.scene.geometry import tangents_from_uvs
 from glphong.scene.mikktspace import mikktspace_corners, mikktspace_vertices
 
@@ -194,3 +196,20 @@ def test_non_finite_tangents_or_uvs_in_a_file_are_refused_by_path(tmp_path, name
     with pytest.raises(glphong.filesafety.SceneFileError,
                        match=rf"meshes\[0\]\.primitives\[0\]\.attributes\.{name}: {name} holds NaN or infinite"):
         _load(path)
+
+
+def test_the_tangents_working_memory_counts_against_the_decoded_bytes_limit(tmp_path):
+    """MikkTSpace's arrays (about 1 KiB a triangle at their peak, `MIKKTSPACE_BYTES_PER_TRIANGLE`) are charged to
+    ``Limits.decoded_bytes`` before they are made: a file whose accessors fit a limit but whose tangents would not is
+    refused by name, and loads under a limit with room for them."""
+    positions, normals, uvs, indices, _ = _mesh("uv_sphere")
+    path = _gltf(tmp_path / "mesh.gltf", positions, normals, uvs, indices, {"normalTexture": {"index": 0}})
+    triangles = len(np.asarray(indices).reshape(-1, 3))
+    accessors = sum(np.asarray(a).nbytes for a in (positions, normals, uvs)) + 4 * triangles * 3
+    tight = Limits(decoded_bytes=accessors + MIKKTSPACE_BYTES_PER_TRIANGLE * triangles // 2)
+    with pytest.raises(SceneFileError, match="MikkTSpace") as caught:
+        glphong.load_scene(path, lights=[], camera=glphong.PerspectiveCamera(0.8), limits=tight)
+    assert "decoded_bytes" in str(caught.value)
+    room = Limits(decoded_bytes=8 * accessors + MIKKTSPACE_BYTES_PER_TRIANGLE * triangles)
+    mesh = glphong.load_scene(path, lights=[], camera=glphong.PerspectiveCamera(0.8), limits=room).objects[0].mesh
+    assert mesh.given_tangents is not None

@@ -343,6 +343,11 @@ def _primitive_mesh(gltf, primitive, where, key, uv_set, mikktspace):
     return gltf._meshes[key]
 
 
+#: what `glphong.scene.mikktspace.mikktspace_vertices` holds at its peak per triangle [bytes] (tracemalloc: 970 on an
+#: icosphere of 81,920 triangles), charged to ``Limits.decoded_bytes`` before a primitive's tangents are made
+MIKKTSPACE_BYTES_PER_TRIANGLE = 1024
+
+
 def _reads_tangents(entry):
     """Whether a glTF material entry reads the tangent frame: a ``normalTexture``, ``KHR_materials_anisotropy`` or
     ``KHR_materials_clearcoat``'s ``clearcoatNormalTexture``."""
@@ -407,6 +412,8 @@ def _new_primitive_mesh(gltf, primitive, where, uv_set, mikktspace):
     colors = None if colors is None else np.clip(colors[:, :3], 0.0, 1.0)
     tangents = attributes["TANGENT"]
     if mikktspace and tangents is None and uvs is not None:
+        # MikkTSpace's working arrays, counted against the decoded-bytes limit before they are made
+        gltf.charge(MIKKTSPACE_BYTES_PER_TRIANGLE * len(triangles), f"{where}.attributes (MikkTSpace tangents)")
         positions, normals, triangles, uvs, colors, tangents = _with_mikktspace(positions, normals, triangles, uvs,
                                                                                 colors)
     return MeshData(positions, normals, triangles, uvs=uvs, tangents=tangents, colors=colors)

@@ -96,6 +96,7 @@ class Scene:
         self.ambient = ambient
         self._lights = []
         self._objects = []
+        self._ids = {}  # instance id -> the object's name: `add` checks an id in constant time
         for light in light_list:
             self.add_light(light)
 
@@ -164,6 +165,7 @@ class Scene:
         _check_mesh_serves(data, material, label)
         obj = SceneObject(data, material, pose, label, bool(casts_shadow), instance_id, category)
         self._objects.append(obj)
+        self._ids[instance_id] = obj.name
         return obj
 
     def _instance_id(self, label, value):
@@ -174,10 +176,9 @@ class Scene:
         else:
             value = _validate.positive_int(f"object {label!r}: instance_id", value, 1, MAX_ID)
             default = ""
-        for other in self._objects:
-            if other.instance_id == value:
-                raise ValueError(f"object {label!r}: instance_id {value}{default} is already object {other.name!r}'s; "
-                                 "ids are unique in a scene")
+        if value in self._ids:  # constant time: a file of many nodes adds its objects in linear time
+            raise ValueError(f"object {label!r}: instance_id {value}{default} is already object "
+                             f"{self._ids[value]!r}'s; ids are unique in a scene")
         return value
 
     @classmethod
