@@ -55,7 +55,8 @@ def lights(samples=None):
 
 
 def measure(light, response, grid=GRID):
-    """``(rms, worst)``: the method's relative RMS error over the grid and its largest per-point relative error."""
+    """``(rms, worst, own)``: the method's relative RMS error over the grid, its largest per-point relative error, and
+    the quadrature's own error estimate (relative, its largest)."""
     s = np.linspace(-0.55, 0.55, grid)
     x = np.stack([*np.meshgrid(s, s, indexing="ij"), np.zeros((grid, grid))], axis=-1).reshape(-1, 3)
     n = np.tile([0.0, 0.0, 1.0], (len(x), 1))

@@ -103,12 +103,12 @@ def blend_hits(scene, width, height, offsets=SAMPLE_OFFSETS, start=None):
     if start is not None:
         layer &= _behind_start(camera, start, ray, t, depth, layer, opaque_t, opaque_depth, tied)
     ray, t, tri, u, v, det, depth, obj = (a[layer] for a in (ray, t, tri, u, v, det, depth, obj))
-    start = np.r_[True, ray[1:] != ray[:-1]] if len(ray) else np.zeros(0, bool)
-    first = np.maximum.accumulate(np.where(start, np.arange(len(ray)), 0)) if len(ray) else np.zeros(0, np.int64)
+    run_start = np.r_[True, ray[1:] != ray[:-1]] if len(ray) else np.zeros(0, bool)  # each ray's first layer
+    first = np.maximum.accumulate(np.where(run_start, np.arange(len(ray)), 0)) if len(ray) else np.zeros(0, np.int64)
     rank = np.arange(len(ray)) - first
     count = np.bincount(ray, minlength=rays)
     # order undetermined in float32: consecutive layers, or the last layer and the opaque surface, tie in depth
-    pair = ~start
+    pair = ~run_start
     np.logical_or.at(tied, ray[pair], depth_tie(camera, depth[np.flatnonzero(pair) - 1], depth[pair]))  # any pair
     last = np.r_[ray[1:] != ray[:-1], True] if len(ray) else np.zeros(0, bool)
     finite = last & np.isfinite(opaque_depth[ray])

@@ -71,14 +71,8 @@ def _one_minus_fresnel(u, f, used, ior, cos_low, cos_high, spread=0.0):
 
 
 #: the float32 film's error, absolute in ``1 - max3(F')`` per unit ``iridescence`` (KHR_materials_iridescence over
-
-
 #: transmission): gltf_iridescence_fresnel's float32 chain (phases to 40 rad, the sensitivity's sums cancelling) moves
-
-
 #: max3(F_iridescence) by at most 3.2e-6 (the twin in float32 against float64, 10^5 random cosines, thicknesses to
-
-
 #: 1200 nm, film iors 1 to 2.3, base f0s), taken about 4 times (docs/transmission.md, "Layers over transmission")
 FILM_SLACK = 1.2e-5
 
@@ -233,13 +227,14 @@ def _behind_part(u, f, used, wo, n_dot_v, coat, light, lit, p, band, turn, atten
     mirrored = wi[k] + (2.0 * n_dot_l[k])[:, None] * n[k]
     half = np.sqrt(np.einsum("ij,ij->i", mirrored + wo[k], mirrored + wo[k])) / 2.0
     spread = wide.D * EPS + 3.0 * EPS
-    one_minus = [1.0 - gltf_transmission_fresnel(p.ior[k], c)[:, 0] for c in (half - spread, half + spread)]
     rel = band.A * EPS
     cancel = band.A * EPS  # 1 - F where F -> 1 (ior far above 1): F's own rounding, absolute, as the weight's slack
     if "specular" in used or "iridescence" in used:  # over the specular's interval too; the film's F'
         sub = SimpleNamespace(n=n[k], inputs={q: v[k] for q, v in (f.inputs or {}).items()},
                               input_bounds={q: tuple(b[k] for b in v) for q, v in (f.input_bounds or {}).items()})
         one_minus = list(_one_minus_fresnel(u, sub, used, p.ior[k], half - spread, half + spread))
+    else:
+        one_minus = [1.0 - gltf_transmission_fresnel(p.ior[k], c)[:, 0] for c in (half - spread, half + spread)]
     keep_lo, keep_hi = _layers_bounds(u, f, used, np.maximum(n_dot_v, 0.0), n_dot_l, tol, coat)
     if diffuse is None:
         lobe = SimpleNamespace(base_color=np.ones(3), metallic=np.ones(len(k)), roughness=p.r[k], ior=p.ior[k])

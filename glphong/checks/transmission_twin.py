@@ -41,12 +41,13 @@ from glphong.definitions.surface import _bilinear
 from glphong.gpu.transmission import transmissive_objects
 from glphong.materials.gltf_transmission import (background_levels, gltf_transmission_lod,
                                                  gltf_transmission_radiance, gltf_transmission_sample,
-                                                 gltf_volume_attenuation, gltf_volume_ray, gltf_volume_uv)
+                                                 gltf_dispersion_iors, gltf_volume_attenuation, gltf_volume_ray,
+                                                 gltf_volume_uv)
 from glphong.scene.scene import Scene
 from glphong.twin.band import EPS
 
 __all__ = ["TransmissionTwin", "opaque_scene", "in_scene", "transmission_twin", "transmission_check",
-           "background_lookup"]
+           "background_lookup", "background_texel_bounds"]
 
 
 @dataclass(frozen=True)
@@ -98,16 +99,22 @@ def opaque_scene(scene):
 def background_lookup(levels, uv, lod):
     """``textureLod`` of a pyramid ``levels`` (GL row order, clamped to the edge, GL_LINEAR_MIPMAP_LINEAR) at ``uv``
     (N, 2) and level of detail ``lod`` (N,) > 0: ``(value, low_texel, high_texel)``, each (N, C), the value the
-    trilinear mix of the two levels about ``lod`` (the coarsest for ``lod`` beyond it) and the least and greatest texel
-    it weights on the levels ``floor(lod) - 1`` (where float32 may round ``lod`` across an integer) to ``floor(lod) +
-    1`` (``floor(lod)`` alone where ``lod`` is an integer: 0, the bilinear lookup of level 0)."""
+    trilinear mix of the two levels about ``lod`` (the coarsest for ``lod`` beyond it, `gltf_transmission_sample`) and
+    `background_texel_bounds`."""
+    return (gltf_transmission_sample(levels, uv, lod), *background_texel_bounds(levels, uv, lod))
+
+
+def background_texel_bounds(levels, uv, lod):
+    """The least and greatest texel a lookup of `background_lookup` weights, each (N, C): on the levels ``floor(lod)
+    - 1`` (where float32 may round ``lod`` across an integer) to ``floor(lod) + 1`` (``floor(lod)`` alone where
+    ``lod`` is an integer: 0, the bilinear lookup of level 0); the band's ends need these alone."""
     top = len(levels) - 1
     lod = np.minimum(np.asarray(lod, np.float64), top)
     d1 = np.floor(lod).astype(np.int64)
     frac = lod - d1
-    value = gltf_transmission_sample(levels, uv, lod)  # the GPU's lookup (gltf_transmission)
-    low = np.full(value.shape, np.inf)
-    high = np.full(value.shape, -np.inf)
+    shape = (len(uv), levels[0].shape[2])
+    low = np.full(shape, np.inf)
+    high = np.full(shape, -np.inf)
     for k in np.unique(d1):
         at = d1 == k
         texels_a = _bilinear(levels[k], uv[at], "clamp")[1]
@@ -118,7 +125,7 @@ def background_lookup(levels, uv, lod):
             spread.append(np.where(near[None, :, None], _bilinear(levels[k - 1], uv[at], "clamp")[1], texels_a))
         stack = np.concatenate(spread, axis=0)
         low[at], high[at] = stack.min(axis=0), stack.max(axis=0)
-    return value, low, high
+    return low, high
 
 
 def transmission_twin(scene, gbuffer, background, band=BAND, shadows=None):
@@ -182,12 +189,12 @@ def transmission_twin(scene, gbuffer, background, band=BAND, shadows=None):
         if (is_rough.any() or volume) and len(pyramids) == 1:
             pyramids += [background_levels(a[::-1]) for a in (b_low, b_high)]
         if volume:  # KHR_materials_volume (and _dispersion): the lookup where the exit point projects
-            lo, hi, is_rough = _through_volume(obj, u, f, position, wo, p.r, p.ior, pyramids, width)
+            lo, hi, is_rough = _through_volume(volume, f, position, wo, p.r, p.ior, pyramids, width)
         elif is_rough.any():
             uv = fragcoord[is_rough] / np.array([width, height])
             level = lod[is_rough].astype(np.float64)
-            lo[is_rough] = background_lookup(pyramids[1], uv, level)[1]
-            hi[is_rough] = background_lookup(pyramids[2], uv, level)[2]
+            lo[is_rough] = background_texel_bounds(pyramids[1], uv, level)[0]
+            hi[is_rough] = background_texel_bounds(pyramids[2], uv, level)[1]
         ends = np.stack([w_lo * lo, w_lo * hi, w_hi * lo, w_hi * hi])
         scales = [(c_lo * ((1.0 - m_hi) * t_lo)[:, None], c_hi * ((1.0 - m_lo) * t_hi)[:, None])]
         diffuse = None
@@ -257,19 +264,15 @@ def _volume(obj, u, f):
             "dispersion": float(u["u_gltf_pbr_dispersion"]) if "dispersion" in obj.material.extensions() else 0.0}
 
 
-def _through_volume(obj, u, f, position, wo, roughness, ior, pyramids, width):
-    """``(low, high, filtered)`` of a volume's fragments' ``B`` (transmission_thin.glsl's ``gltf_volume_light``,
-    `glphong.materials.gltf_transmission.gltf_volume_light`, per channel its own ior where the material disperses):
+def _through_volume(volume, f, position, wo, roughness, ior, pyramids, width):
+    """``(low, high, filtered)`` of a volume's fragments' ``B`` (``volume``: `_volume`'s; transmission_thin.glsl's
+    ``gltf_volume_light``, `glphong.materials.gltf_transmission.gltf_volume_light`, per channel its own ior where the material disperses):
     the least and greatest texel the lookup may weight (the footprints at the exit's uv moved a hundredth of a texel
     each way: float32 places it within that) times the attenuation to ``(A + 8 |y ln c|) eps`` relative (``y = d /
     distance``).  ``filtered``: where the level of detail is above 0."""
     n = len(position)
-    volume = _volume(obj, u, f)
     color, distance = volume["color"], volume["distance"]
-    etas = [ior]
-    if volume["dispersion"]:
-        half = (ior - 1.0) * 0.025 * volume["dispersion"]
-        etas = [np.maximum(ior - half, 1.0), ior, ior + half]  # the red kept at 1 or above (transmission_thin.glsl)
+    etas = gltf_dispersion_iors(ior, volume["dispersion"]) if volume["dispersion"] else [ior]
     low, high = np.zeros((n, 3)), np.zeros((n, 3))
     filtered = np.zeros(n, bool)
     size = np.array([pyramids[0][0].shape[1], pyramids[0][0].shape[0]], np.float64)
@@ -285,7 +288,8 @@ def _through_volume(obj, u, f, position, wo, roughness, ior, pyramids, width):
         ends = []
         for dx, dy in ((0.0, 0.0), (-0.01, -0.01), (0.01, -0.01), (-0.01, 0.01), (0.01, 0.01)):
             moved = uv + np.array([dx, dy]) / size
-            ends += [background_lookup(pyramids[1], moved, lod)[1], background_lookup(pyramids[2], moved, lod)[2]]
+            ends += [background_texel_bounds(pyramids[1], moved, lod)[0],
+                     background_texel_bounds(pyramids[2], moved, lod)[1]]
         low[:, channels] = (np.min(ends, axis=0) * attenuation * (1.0 - slack))[:, channels]
         high[:, channels] = (np.max(ends, axis=0) * attenuation * (1.0 + slack))[:, channels]
     return low, high, filtered

@@ -24,12 +24,9 @@ import numpy as np
 
 from glphong.formats.gltf_transmission import TRANSMISSION_FACTORS, TRANSMISSION_TEXTURES, transmission_arguments
 from glphong.core.filesafety import SceneFileError
-from glphong.definitions.surface import SurfaceInput
 from glphong.materials import Texture
 from glphong.materials.gltf_coat_normal import COAT_NORMAL_PARAMS
-from glphong.materials.gltf_extensions import EXTENSION_PARAMS, EXTENSIONS
-from glphong.materials.gltf_diffuse_transmission import DIFFUSE_TRANSMISSION_EXCLUDES
-from glphong.materials.gltf_transmission import TRANSMISSION_EXCLUDES
+from glphong.materials.gltf_extensions import EXTENSIONS
 
 __all__ = ["MATERIAL_EXTENSIONS", "extension_arguments", "check_material_extensions", "extension_texture_infos",
            "tangent_frame_error"]
@@ -173,33 +170,5 @@ def extension_arguments(entry, texture, warn):
         out |= {"iridescence_ior": float(film.get("iridescenceIor", 1.3)),
                 "iridescence_thickness_minimum": float(film.get("iridescenceThicknessMinimum", 100.0)),
                 "iridescence_thickness_maximum": float(film.get("iridescenceThicknessMaximum", 400.0))}
-    return _without_layers_over_transmission(out | transmission_arguments(extensions, texture), warn)
+    return out | transmission_arguments(extensions, texture)  # every layer is drawn over transmission too
 
-
-def _without_layers_over_transmission(out, warn):
-    """``out`` less the layers glphong does not draw over the light a surface lets through, refused by `glphong.GltfPBR`
-    itself, each left out named in a warning: over KHR_materials_transmission none (`TRANSMISSION_EXCLUDES`: the
-    specular, sheen, coat, on its own normal too, and film are drawn); over KHR_materials_diffuse_transmission none
-    either (`DIFFUSE_TRANSMISSION_EXCLUDES`: the specular, sheen, coat and film are drawn).  A file's glass keeps its transmission, drawn without them."""
-    def used(n):
-        return n in out and (isinstance(out[n], SurfaceInput) or float(out[n]) > 0)
-
-    through = [n for n in ("transmission", "diffuse_transmission") if used(n)]
-    if not through:
-        return out
-    excludes = set(TRANSMISSION_EXCLUDES) | (set(DIFFUSE_TRANSMISSION_EXCLUDES) if "diffuse_transmission" in through
-                                             else set())
-    defaults = {p.name: p.default for p in EXTENSION_PARAMS}
-    dropped = []
-    for name in sorted(excludes, key=list(EXTENSIONS).index):
-        keys = [k for k in EXTENSIONS[name][1] if k in out]
-        differs = any(isinstance(out[k], SurfaceInput) or np.any(np.asarray(out[k], np.float64) != defaults[k])
-                      for k in keys)
-        if differs:
-            dropped.append(EXTENSIONS[name][0])
-        for key in keys + (["clearcoat_normal", "clearcoat_normal_strength"] if name == "clearcoat" else []):
-            out.pop(key, None)
-    if dropped:
-        warn(f"{' and '.join(EXTENSIONS[n][0] for n in through)} with {', '.join(dropped)}: glphong does not draw "
-             "that layer over the light the surface lets through, so it is left out (docs/gltf_extensions.md)")
-    return out

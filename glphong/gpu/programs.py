@@ -11,7 +11,7 @@ import moderngl
 import numpy as np
 
 from glphong.shaders.assembly import assemble, name_chunks
-from glphong.shaders.generated import transmits
+from glphong.shaders.generated import terms_behind, transmits
 from glphong.gpu.shadows import ShadowMap
 from glphong.gpu.textures import TextureStore
 from glphong.lights import light_for_key
@@ -70,8 +70,7 @@ class Program:
         self.optional |= {"u_eye"} if "view" in getattr(key, "numerics", ()) else set()
         # the transmission pass's background (glphong.gpu.transmission), given to every program that pass draws: only
         # one that `transmits` declares it (glsl/transmission_thin.glsl), not KHR_materials_diffuse_transmission's alone
-        if ("DIFFUSE_TRANSMISSION", "1") in {d for t in getattr(key, "terms", ()) for d in t.defines} \
-                and not transmits(key):
+        if terms_behind(getattr(key, "terms", ())) and not transmits(key):  # what the terms' models declare
             self.optional |= {"u_transmission_background", "u_transmission_levels"}
         #: the bytes last written to each uniform (`write` skips unchanged ones)
         self._written = {}

@@ -33,6 +33,7 @@ from dataclasses import dataclass
 import moderngl
 import numpy as np
 
+from glphong.definitions.material_base import constant_part
 from glphong.gpu.peeling import blended, per_pixel_option
 from glphong.gpu.shadows import ShadowMap
 from glphong.materials.gltf_transmission import background_levels, gltf_transmission_lod, transmissive
@@ -108,7 +109,7 @@ def background_need(scene, width):
         used = material.extensions()
         if "transmission" not in used:
             continue
-        roughness = np.float32(getattr(material.roughness, "scale", material.roughness))
+        roughness = np.float32(constant_part(material.roughness))
         if "volume" in used or gltf_transmission_lod(roughness, np.float32(material.ior), levels) > 0:
             return "pyramid"
         need = "texel"

@@ -35,7 +35,7 @@ from glphong.definitions.surface import SurfaceInput
 from glphong.materials.gltf_transmission import _coat_cosine, gltf_transmission_fresnel, gltf_transmission_layers
 from glphong.twin.functions import microfacet_geometry
 
-__all__ = ["DIFFUSE_TRANSMISSION_PARAMS", "DIFFUSE_TRANSMISSION_EXCLUDES", "gltf_diffuse_transmission_response",
+__all__ = ["DIFFUSE_TRANSMISSION_PARAMS", "gltf_diffuse_transmission_response",
            "diffuse_transmission_gltf_fields"]
 
 _DT = Param("diffuse_transmission", "scalar", low=0.0, high=1.0, default=0.0, unit="", textureable=True,
@@ -46,8 +46,6 @@ _DT_COLOR = Param("diffuse_transmission_color", "rgb", low=0.0, high=1.0, defaul
                       "the colour of the diffusely transmitted light")
 #: the extension's parameters, appended to `GltfPBR`'s (`glphong.materials.gltf_extensions`)
 DIFFUSE_TRANSMISSION_PARAMS = (_DT, _DT_COLOR)
-#: the extensions refused beside it (none: the specular, sheen, coat and film are drawn over its lights behind)
-DIFFUSE_TRANSMISSION_EXCLUDES = ()
 
 
 def gltf_diffuse_transmission_response(n, wi, wo, n_dot_l, c_dt, m, t, dt, ior, specular=None, layers=None,

@@ -54,15 +54,14 @@ from glphong.definitions.material_base import constant_part
 from glphong.definitions.params import Param
 from glphong.definitions.surface import SurfaceInput
 from glphong.materials.gltf_anisotropy import ANISOTROPY_PARAMS, anisotropy_cases
-from glphong.materials.gltf_diffuse_transmission import (DIFFUSE_TRANSMISSION_EXCLUDES, DIFFUSE_TRANSMISSION_PARAMS,
-                                                         diffuse_transmission_gltf_fields)
+from glphong.materials.gltf_diffuse_transmission import DIFFUSE_TRANSMISSION_PARAMS, diffuse_transmission_gltf_fields
 from glphong.materials.gltf_iridescence import (IRIDESCENCE_PARAMS, gltf_iridescence_oracle, iridescence_cases,
                                                 iridescence_gltf_fields)
 from glphong.materials.gltf_coat_normal import COAT_NORMAL_PARAMS, gltf_clearcoat_geometry, uses_coat_normal
 from glphong.materials.gltf_lobe import gltf_clearcoat_fresnel, gltf_pbr_specular
 from glphong.materials.gltf_sheen import SHEEN_PARAMS, gltf_sheen_oracle, sheen_cases
-from glphong.materials.gltf_transmission import (TRANSMISSION_EXCLUDES, TRANSMISSION_PARAMS, VOLUME_EXTENSIONS,
-                                                 transmission_gltf_fields, volume_extensions)
+from glphong.materials.gltf_transmission import (TRANSMISSION_PARAMS, VOLUME_EXTENSIONS, transmission_gltf_fields,
+                                                 volume_extensions)
 from glphong.twin.functions import microfacet_geometry
 
 # GltfExtensionFeatures and ExtensionProperties are GltfPBR's own (a class named here would become glphong.materials')
@@ -173,15 +172,6 @@ class GltfExtensionFeatures:
             warnings.warn("KHR_materials_clearcoat with an emission: glphong does not darken the emission by the "
                           "coat's 1 - clearcoat F_c(n.v) (F_c = 0.04 at normal view, 1 at grazing): the emission is "
                           "drawn as it is (docs/gltf_extensions.md)", stacklevel=3)
-        used = self.extensions()
-        for through, excludes in (("transmission", TRANSMISSION_EXCLUDES),  # the layers not drawn over the light
-                                  ("diffuse_transmission", DIFFUSE_TRANSMISSION_EXCLUDES)):  # let through
-            both = [EXTENSIONS[name][0] for name in excludes if name in used]
-            if through in used and both:
-                raise ValueError(f"{EXTENSIONS[through][0]} with {', '.join(both)}: glphong does not draw that "
-                                 "extension's layer over the light the surface lets through (from behind it, or the "
-                                 f"scene seen through it); give {through}=0 or leave the other out "
-                                 "(docs/gltf_extensions.md)")
 
     def extensions(self):
         """The extensions this material uses, by short name (`EXTENSIONS`): specular where ``specular`` or

@@ -45,10 +45,10 @@ from glphong.materials.gltf_sheen import gltf_sheen_scaling
 from glphong.twin.band import FLT_MAX
 from glphong.twin.functions import fresnel_schlick, microfacet_geometry
 
-__all__ = ["TRANSMISSION_PARAMS", "TRANSMISSION_EXCLUDES", "VOLUME_EXTENSIONS", "volume_extensions",
+__all__ = ["TRANSMISSION_PARAMS", "VOLUME_EXTENSIONS", "volume_extensions",
            "gltf_transmission_fresnel", "gltf_transmission_layers", "gltf_transmission_weight", "gltf_transmission_lod",
            "gltf_transmission_sample", "gltf_transmission_background", "gltf_volume_ray", "gltf_volume_uv",
-           "gltf_volume_attenuation", "gltf_volume_light", "gltf_volume_exit", "gltf_volume_exit_attenuation",
+           "gltf_volume_attenuation", "gltf_dispersion_iors", "gltf_volume_light", "gltf_volume_exit", "gltf_volume_exit_attenuation",
            "gltf_volume_diffuse_attenuation", "gltf_transmission_response", "gltf_transmission_radiance",
            "background_levels", "transmissive"]
 
@@ -74,9 +74,6 @@ TRANSMISSION_PARAMS = (_TRANSMISSION, _THICKNESS, _ATTENUATION_DISTANCE, _ATTENU
 #: KHR_materials_volume's parameters and KHR_materials_dispersion's, by glphong's short names of the extensions
 VOLUME_EXTENSIONS = {"volume": ("KHR_materials_volume", ("thickness", "attenuation_distance", "attenuation_color")),
                      "dispersion": ("KHR_materials_dispersion", ("dispersion",))}
-#: the layers (by `glphong.materials.gltf_extensions.EXTENSIONS`' short names) refused over KHR_materials_transmission:
-#: none (specular, sheen, the coat, on its own normal too, and the film are drawn over the light let through)
-TRANSMISSION_EXCLUDES = ()
 
 
 def transmissive(material):
@@ -375,6 +372,15 @@ def gltf_volume_attenuation(d, color, distance):
         return np.where((d <= 0.0)[..., None], 1.0, np.asarray(color, np.float64) ** (d / float(distance))[..., None])
 
 
+def gltf_dispersion_iors(ior, dispersion):
+    """KHR_materials_dispersion's iors of the red, green and blue channels (transmission_thin.glsl's
+    ``gltf_transmission_radiance`` forms them inline): ``max(ior - h, 1)``, ``ior``, ``ior + h`` with ``h = (ior - 1)
+    0.025 dispersion`` (half of ``n_F - n_C = (n_d - 1)/V_d``, ``dispersion = 20/V_d``), the red kept at 1 or above
+    (below it a grazing view has no refracted ray).  ior (N,) or float; dispersion float -> a tuple of three."""
+    half = (np.asarray(ior, np.float64) - 1.0) * 0.025 * float(dispersion)
+    return np.maximum(ior - half, 1.0), ior, ior + half
+
+
 def gltf_volume_light(levels, x, n, wo, eta, roughness, thickness, scale, view_projection, color, distance):
     """``B`` through a volume (transmission_thin.glsl's ``gltf_volume_light``): `gltf_transmission_sample` where the
     exit point ``x + gltf_volume_ray(n, wo, eta, thickness, scale)`` projects (`gltf_volume_uv`), at
@@ -475,10 +481,9 @@ def gltf_transmission_radiance(levels, fragcoord, x, n, wo, valid, p, volume=Non
             return gltf_volume_light(levels, x, n, wo, eta, p.r, volume["thickness"], volume["scale"],
                                      volume["view_projection"], volume["color"], volume["distance"])
 
-        if volume.get("dispersion"):  # KHR_materials_dispersion: red max(ior - h, 1), green ior, blue ior + h
-            spread = (p.ior - 1.0) * 0.025 * float(volume["dispersion"])
+        if volume.get("dispersion"):  # KHR_materials_dispersion: each channel its own ior
             behind = np.stack([light(eta)[:, k] for k, eta in
-                               enumerate((np.maximum(p.ior - spread, 1.0), p.ior, p.ior + spread))], 1)
+                               enumerate(gltf_dispersion_iors(p.ior, float(volume["dispersion"])))], 1)
         else:
             behind = light(p.ior)
     weight = gltf_transmission_weight(n_dot_v, p.c, p.m, p.t, p.ior, *(p.specular or (None, None)),
