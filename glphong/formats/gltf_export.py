@@ -26,8 +26,10 @@ What is written:
   without ``to_gltf``) is skipped, with a warning.
 
 A scene without objects has no accessors, buffer views nor buffer (glTF refuses empty arrays and 0-byte buffers).
-The files pass the Khronos glTF validator without an error or a warning (``benchmarks/gltf_validate.py``; the rules
-in Python: tests/test_gltf_conformance.py).
+The 72 files of ``benchmarks/gltf_validate.py`` pass the Khronos glTF validator without an error or a warning (the
+rules in Python: tests/test_gltf_conformance.py); a mesh whose normals hold a zero vector is written as it is, which
+the validator reports (``ACCESSOR_VECTOR3_NON_UNIT``): glphong draws such a vertex with its emission terms only, and
+no unit vector would keep that.
 
 Nothing is written compressed: a scene loaded from a Draco- or meshopt-compressed file, or with KTX2 or WebP textures,
 is written with plain buffers and PNG images (its decoded arrays and pixels, so it reads back equal).
